@@ -1,0 +1,70 @@
+#include "cli.hpp"
+
+#include "bodypoint/scene_file.hpp"
+
+#include <cmath>
+#include <iostream>
+
+namespace bodypoint::cli {
+
+void add_scene_options(po::options_description& desc, SceneOptions& o) {
+  SceneParams& p = o.params;
+  desc.add_options()
+      ("A", po::value(&p.A)->default_value(p.A), "Coulomb constant of the centre at the origin (A < 0 repels)")
+      ("m", po::value(&p.m)->default_value(p.m), "mass")
+      ("B", po::value(&p.B)->default_value(p.B), "coupling inertia (B = 0: material point)")
+      ("J", po::value(&p.J)->default_value(p.J), "rotational inertia")
+      ("K1", po::value(&p.start.K1)->default_value(p.start.K1), "initial linear momentum K1(0) = K1 i")
+      ("Kx", po::value(&p.start.Kx)->default_value(p.start.Kx), "K2(0) = Kx i - Kz k")
+      ("Kz", po::value(&p.start.Kz)->default_value(p.start.Kz), "K2(0) = Kx i - Kz k")
+      ("d", po::value(&p.start.d)->default_value(p.start.d), "impact parameter")
+      ("L", po::value(&p.start.L)->default_value(p.start.L), "initial distance along -x")
+      ("scene", po::value(&o.scene_file), "TOML scene file with several centres and bodies (see scenes/)");
+}
+
+Scene make_scene(const po::variables_map& vm, const SceneOptions& o) {
+  if (vm.count("scene")) {
+    for (const char* k : {"A", "m", "B", "J", "K1", "Kx", "Kz", "d", "L"})
+      if (vm.count(k) && !vm[k].defaulted())
+        throw Error(std::string("--") + k + " cannot be combined with --scene (set it in the scene file)");
+    return read_scene_file(o.scene_file);
+  }
+  return thesis_scene(o.params);
+}
+
+void add_step_options(po::options_description& desc, StepOptions& o) {
+  desc.add_options()
+      ("h", po::value(&o.h)->default_value(o.h), "step size")
+      ("steps", po::value(&o.steps)->default_value(o.steps), "number of steps n")
+      ("t-end", po::value(&o.t_end), "end time T (steps = ceil(T/h), h adjusted to T/steps)");
+}
+
+void apply_step_options(const po::variables_map& vm, const StepOptions& o, RunSpec& spec) {
+  if (!std::isfinite(o.h) || o.h <= 0.0) throw Error("--h must be a finite number > 0");
+  spec.h = o.h;
+  spec.steps = o.steps;
+  if (vm.count("t-end")) {
+    if (!vm["steps"].defaulted()) throw Error("give --steps or --t-end, not both");
+    if (!std::isfinite(o.t_end) || o.t_end <= 0.0) throw Error("--t-end must be a finite number > 0");
+    const double n = std::ceil(o.t_end / o.h * (1.0 - 1e-12));
+    if (n > 1e13) throw Error("--t-end / --h asks for more than 1e13 steps");
+    spec.steps = static_cast<long>(n);
+    spec.h = o.t_end / static_cast<double>(spec.steps);
+  }
+  if (spec.steps < 1) throw Error("--steps must be >= 1");
+}
+
+bool parse(int argc, char** argv, const po::options_description& desc, po::variables_map& vm,
+           const std::string& usage) {
+  po::options_description all(desc);
+  all.add_options()("help", "show this help");
+  po::store(po::command_line_parser(argc, argv).options(all).positional({}).run(), vm);
+  if (vm.count("help")) {
+    std::cout << usage << "\n\n" << all << "\n";
+    return false;
+  }
+  po::notify(vm);
+  return true;
+}
+
+}  // namespace bodypoint::cli

@@ -1,0 +1,43 @@
+// bodypoint command line: options shared by the subcommands.
+#pragma once
+
+#include "bodypoint/model.hpp"
+#include "bodypoint/run.hpp"
+
+#include <boost/program_options.hpp>
+
+#include <string>
+#include <vector>
+
+namespace bodypoint::cli {
+
+namespace po = boost::program_options;
+
+/// Scene options named as in the thesis, defaulting to table 3.1.
+struct SceneOptions {
+  SceneParams params;
+  std::string scene_file;
+};
+void add_scene_options(po::options_description& desc, SceneOptions& o);
+/// The scene from --scene or from the thesis's parameters (never both).
+Scene make_scene(const po::variables_map& vm, const SceneOptions& o);
+
+/// Step options: --h and --steps or --t-end.
+struct StepOptions {
+  double h = 1e-4;
+  long steps = 500000;
+  double t_end = 0.0;
+};
+void add_step_options(po::options_description& desc, StepOptions& o);
+/// Fills spec.h and spec.steps. With --t-end T: steps = ceil(T/h), h = T/steps (hits T exactly).
+void apply_step_options(const po::variables_map& vm, const StepOptions& o, RunSpec& spec);
+
+/// Parses argv into vm, rejecting unknown options and positional words; returns false after
+/// printing help when --help is given.
+bool parse(int argc, char** argv, const po::options_description& desc, po::variables_map& vm,
+           const std::string& usage);
+
+int cmd_simulate(int argc, char** argv);
+int cmd_methods(int argc, char** argv);
+
+}  // namespace bodypoint::cli

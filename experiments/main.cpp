@@ -1,0 +1,40 @@
+// bodypoint: command-line entry point. Every failure ends in one line on stderr and exit code 2.
+#include "bodypoint/model.hpp"
+#include "cli.hpp"
+
+#include <cstring>
+#include <exception>
+#include <iostream>
+#include <string>
+
+namespace {
+
+constexpr const char* usage =
+    "usage: bodypoint <command> [options]\n"
+    "commands:\n"
+    "  simulate   integrate a scene with one method (default: thesis table 3.1)\n"
+    "  methods    list the integration methods\n"
+    "Run 'bodypoint <command> --help' for the options of a command.";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2 || std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0) {
+    std::cout << usage << "\n";
+    return argc < 2 ? 2 : 0;
+  }
+  const std::string cmd = argv[1];
+  try {
+    if (cmd == "simulate") return bodypoint::cli::cmd_simulate(argc - 1, argv + 1);
+    if (cmd == "methods") return bodypoint::cli::cmd_methods(argc - 1, argv + 1);
+    std::cerr << "bodypoint: error: unknown command '" << cmd << "' (simulate, methods)\n";
+    return 2;
+  } catch (const bodypoint::Error& e) {
+    std::cerr << "bodypoint: error: " << e.what() << "\n";
+  } catch (const boost::program_options::error& e) {
+    std::cerr << "bodypoint: error: " << e.what() << "\n";
+  } catch (const std::exception& e) {
+    std::cerr << "bodypoint: error: " << e.what() << "\n";
+  }
+  return 2;
+}

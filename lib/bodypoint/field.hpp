@@ -1,0 +1,68 @@
+// bodypoint: Coulomb fields.
+//
+// F(R) = -A (R - c)/|R - c|^3,  Pi(R) = -A/|R - c|  (shared/PHYSICS.md "Model"; thesis eq. 1.2).
+// Forces and potentials of several centres add. Two field types let a step loop pay only for
+// what the scene holds: `OriginCentre` (one centre at the origin, no centre loop, the total
+// angular momentum K2Q about it is conserved) and `CentreList` (any number, anywhere).
+// The choice is made once, outside the step loop, by `visit_field`.
+#pragma once
+
+#include "bodypoint/model.hpp"
+
+#include <cmath>
+#include <vector>
+
+namespace bodypoint {
+
+struct OriginCentre {
+  double A = 0.0;
+  /// K2Q = R x K1 + K2 is a first integral only for a single centre (taken as the origin).
+  static constexpr bool has_angular_momentum = true;
+
+  [[nodiscard]] Vec3 force(const Vec3& R) const {
+    const double r2 = R.squaredNorm();
+    const double inv_r = 1.0 / std::sqrt(r2);
+    return (-A * inv_r * inv_r * inv_r) * R;
+  }
+  [[nodiscard]] double potential(const Vec3& R) const { return -A / R.norm(); }
+  [[nodiscard]] Vec3 reference_point() const { return Vec3::Zero(); }
+};
+
+struct CentreList {
+  std::vector<Centre> centres;
+  /// With one centre at c, K2Q = (R - c) x K1 + K2 is still conserved.
+  static constexpr bool has_angular_momentum = false;
+
+  [[nodiscard]] Vec3 force(const Vec3& R) const {
+    Vec3 F = Vec3::Zero();
+    for (const Centre& k : centres) {
+      const Vec3 d = R - k.c;
+      const double inv_r = 1.0 / std::sqrt(d.squaredNorm());
+      F -= (k.A * inv_r * inv_r * inv_r) * d;
+    }
+    return F;
+  }
+  [[nodiscard]] double potential(const Vec3& R) const {
+    double P = 0.0;
+    for (const Centre& k : centres) P -= k.A / (R - k.c).norm();
+    return P;
+  }
+  [[nodiscard]] bool single() const { return centres.size() == 1; }
+  [[nodiscard]] Vec3 reference_point() const { return centres.front().c; }
+};
+
+/// True when every centre repels (A < 0), so that Pi > 0 everywhere.
+inline bool all_repulsive(const std::vector<Centre>& centres) {
+  for (const Centre& k : centres)
+    if (!(k.A < 0.0)) return false;
+  return true;
+}
+
+/// Calls f(OriginCentre) for one centre at the origin, f(CentreList) otherwise.
+template <class F>
+decltype(auto) visit_field(const std::vector<Centre>& centres, F&& f) {
+  if (centres.size() == 1 && centres.front().c.isZero(0.0)) return f(OriginCentre{centres.front().A});
+  return f(CentreList{centres});
+}
+
+}  // namespace bodypoint

@@ -1,0 +1,97 @@
+// bodypoint: first integrals and their deviation along a run (shared/PHYSICS.md "First integrals").
+//
+//   E    = 1/2 m v.v + B v.w + 1/2 J w.w + Pi(R)   (thesis eq. 4.1 with Erratum 2: B v.w, not B/2 v.w)
+//   K2Q  = (R - c) x K1 + K2                       (eq. 1.6; a vector, only for a single centre c)
+//   |K2|^2                                         (eq. 4.2)
+#pragma once
+
+#include "bodypoint/field.hpp"
+#include "bodypoint/model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+namespace bodypoint {
+
+inline double kinetic_energy(const BodyPoint& p, const State& s) {
+  return 0.5 * p.m * s.v.squaredNorm() + p.B * s.v.dot(s.w) + 0.5 * p.J * s.w.squaredNorm();
+}
+
+template <class Field>
+double energy(const BodyPoint& p, const Field& f, const State& s) {
+  return kinetic_energy(p, s) + f.potential(s.R);
+}
+
+/// Reference point about which K2Q is conserved, or nothing when the field has several centres.
+inline std::optional<Vec3> angular_momentum_point(const OriginCentre&) { return Vec3::Zero(); }
+inline std::optional<Vec3> angular_momentum_point(const CentreList& f) {
+  if (f.single()) return f.reference_point();
+  return std::nullopt;
+}
+
+inline Vec3 total_angular_momentum(const BodyPoint& p, const State& s, const Vec3& c) {
+  const Momenta q = to_momenta(p, s);
+  return (s.R - c).cross(q.K1) + q.K2;
+}
+
+inline double proper_momentum_sq(const BodyPoint& p, const State& s) {
+  return (p.B * s.v + p.J * s.w).squaredNorm();
+}
+
+/// Maxima over a run of the thesis's metric |X_i - X_0|/|X_0| (absolute where X_0 = 0) and of
+/// |K2Q_i - K2Q_0|. `has_K2Q` is false in fields where K2Q is not an integral.
+struct InvariantStats {
+  double max_rel_dE = 0.0;
+  double max_rel_dK2sq = 0.0;
+  double max_abs_dK2Q = 0.0;
+  bool has_K2Q = false;
+};
+
+inline double relative_deviation(double x, double x0) {
+  const double scale = std::abs(x0);
+  return scale > 0.0 ? std::abs(x - x0) / scale : std::abs(x - x0);
+}
+
+/// Tracks the deviations of every integral the field has; one call per observed state.
+template <class Field>
+class InvariantMonitor {
+ public:
+  InvariantMonitor(const BodyPoint& p, const Field& f, const State& s0)
+      : p_(p), f_(f), c_(angular_momentum_point(f)) {
+    E0_ = energy(p_, f_, s0);
+    K2sq0_ = proper_momentum_sq(p_, s0);
+    if (c_) K2Q0_ = total_angular_momentum(p_, s0, *c_);
+    stats_.has_K2Q = c_.has_value();
+  }
+
+  void update(const State& s) {
+    last_rel_dE_ = relative_deviation(energy(p_, f_, s), E0_);
+    stats_.max_rel_dE = std::max(stats_.max_rel_dE, last_rel_dE_);
+    last_rel_dK2sq_ = relative_deviation(proper_momentum_sq(p_, s), K2sq0_);
+    stats_.max_rel_dK2sq = std::max(stats_.max_rel_dK2sq, last_rel_dK2sq_);
+    if (c_) {
+      last_abs_dK2Q_ = (total_angular_momentum(p_, s, *c_) - K2Q0_).norm();
+      stats_.max_abs_dK2Q = std::max(stats_.max_abs_dK2Q, last_abs_dK2Q_);
+    }
+    // A NaN anywhere poisons every later comparison; remember it instead of losing it in max().
+    if (!std::isfinite(last_rel_dE_)) stats_.max_rel_dE = last_rel_dE_;
+  }
+
+  [[nodiscard]] const InvariantStats& stats() const { return stats_; }
+  [[nodiscard]] double last_rel_dE() const { return last_rel_dE_; }
+  [[nodiscard]] double last_rel_dK2sq() const { return last_rel_dK2sq_; }
+  [[nodiscard]] double last_abs_dK2Q() const { return last_abs_dK2Q_; }
+  [[nodiscard]] double E0() const { return E0_; }
+
+ private:
+  BodyPoint p_;
+  const Field& f_;
+  std::optional<Vec3> c_;
+  double E0_ = 0.0, K2sq0_ = 0.0;
+  Vec3 K2Q0_ = Vec3::Zero();
+  InvariantStats stats_;
+  double last_rel_dE_ = 0.0, last_rel_dK2sq_ = 0.0, last_abs_dK2Q_ = 0.0;
+};
+
+}  // namespace bodypoint

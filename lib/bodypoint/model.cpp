@@ -1,0 +1,78 @@
+#include "bodypoint/model.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace bodypoint {
+namespace {
+
+std::string num(double x) {
+  std::ostringstream os;
+  os.precision(17);
+  os << x;
+  return os.str();
+}
+
+void require_finite(double x, const std::string& what) {
+  if (!std::isfinite(x)) throw Error(what + " must be a finite number, got " + num(x));
+}
+
+void require_finite(const Vec3& x, const std::string& what) {
+  for (int i = 0; i < 3; ++i) require_finite(x[i], what);
+}
+
+}  // namespace
+
+void validate(const BodyPoint& p, const std::string& who) {
+  require_finite(p.m, who + ": m");
+  require_finite(p.B, who + ": B");
+  require_finite(p.J, who + ": J");
+  if (p.m <= 0.0) throw Error(who + ": mass m must be > 0, got " + num(p.m));
+  if (p.J <= 0.0) throw Error(who + ": inertia J must be > 0, got " + num(p.J));
+  if (!(p.D() > 0.0))
+    throw Error(who + ": D = m J - B^2 must be > 0 (kinetic energy positive definite), got " +
+                num(p.D()));
+}
+
+void validate(const Scene& scene) {
+  if (scene.centres.empty()) throw Error("the scene has no Coulomb centre");
+  if (scene.bodies.empty()) throw Error("the scene has no body-point");
+  for (std::size_t k = 0; k < scene.centres.size(); ++k) {
+    const std::string who = "centre " + std::to_string(k + 1);
+    require_finite(scene.centres[k].c, who + ": position");
+    require_finite(scene.centres[k].A, who + ": A");
+  }
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+    const Body& b = scene.bodies[i];
+    const std::string who = b.name.empty() ? "body " + std::to_string(i + 1) : "body '" + b.name + "'";
+    validate(b.p, who);
+    require_finite(b.s0.R, who + ": R");
+    require_finite(b.s0.v, who + ": v");
+    require_finite(b.s0.w, who + ": w");
+    for (std::size_t k = 0; k < scene.centres.size(); ++k) {
+      // A body on a centre has infinite potential energy and an undefined force.
+      if ((b.s0.R - scene.centres[k].c).norm() == 0.0)
+        throw Error(who + " starts on centre " + std::to_string(k + 1) + " (R = c); move it off the centre");
+    }
+  }
+}
+
+Scene thesis_scene(const SceneParams& sp) {
+  require_finite(sp.A, "A");
+  require_finite(sp.start.d, "d");
+  require_finite(sp.start.L, "L");
+  require_finite(sp.start.K1, "K1");
+  require_finite(sp.start.Kx, "Kx");
+  require_finite(sp.start.Kz, "Kz");
+  if (sp.start.K1 == 0.0) throw Error("K1 must be non-zero (R(0) contains Kz/K1)");
+  BodyPoint p{sp.m, sp.B, sp.J};
+  validate(p, "body");
+  Body body{p, to_state(p, thesis_momenta(sp.start)), "body"};
+  Scene s;
+  s.centres.push_back(Centre{Vec3::Zero(), sp.A});
+  s.bodies.push_back(body);
+  validate(s);
+  return s;
+}
+
+}  // namespace bodypoint

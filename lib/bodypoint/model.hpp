@@ -1,0 +1,116 @@
+// bodypoint: the body-point model.
+//
+// A body-point is a particle with translational and rotational degrees of freedom and spherical
+// inertia tensors, kinetic energy T = 1/2 m v.v + B v.w + 1/2 J w.w (thesis eq. 1.3,
+// shared/PHYSICS.md "Model"). Symbols follow the physics:
+//   m  mass, B  coupling, J  rotational inertia, D = m J - B^2 (> 0 for positive-definite T),
+//   R  position, v  translational velocity, w  angular velocity,
+//   K1 = m v + B w  linear momentum (eq. 1.4), K2 = B v + J w  proper angular momentum (eq. 1.5),
+//   A  Coulomb constant of a centre at c: F = -A (R - c)/|R - c|^3, Pi = -A/|R - c|.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace bodypoint {
+
+using Vec3 = Eigen::Vector3d;
+
+/// Every invalid input is reported by throwing this; drivers print what() on one line.
+struct Error : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Inertial parameters of one body-point.
+struct BodyPoint {
+  double m = 1.0;
+  double B = 0.0;
+  double J = 1.0;
+  [[nodiscard]] double D() const { return m * J - B * B; }
+};
+
+/// A fixed Coulomb centre at c with constant A (A < 0 repels, A > 0 attracts).
+struct Centre {
+  Vec3 c = Vec3::Zero();
+  double A = 0.0;
+};
+
+/// Physical variables (R, v, w).
+struct State {
+  Vec3 R = Vec3::Zero();
+  Vec3 v = Vec3::Zero();
+  Vec3 w = Vec3::Zero();
+};
+
+/// Canonical variables (R, K1, K2) used by the splitting methods.
+struct Momenta {
+  Vec3 R = Vec3::Zero();
+  Vec3 K1 = Vec3::Zero();
+  Vec3 K2 = Vec3::Zero();
+};
+
+/// (R, v, w) -> (R, K1, K2), eq. 1.4-1.5.
+inline Momenta to_momenta(const BodyPoint& p, const State& s) {
+  return {s.R, p.m * s.v + p.B * s.w, p.B * s.v + p.J * s.w};
+}
+
+/// (R, K1, K2) -> (R, v, w): v = (J K1 - B K2)/D, w = (m K2 - B K1)/D (PHYSICS.md "Model").
+inline State to_state(const BodyPoint& p, const Momenta& q) {
+  const double inv_D = 1.0 / p.D();
+  return {q.R, (p.J * q.K1 - p.B * q.K2) * inv_D, (p.m * q.K2 - p.B * q.K1) * inv_D};
+}
+
+/// The thesis's initial-condition parameters (eq. 1.11-1.13).
+struct ThesisStart {
+  double d = 10.0;   ///< impact parameter
+  double L = 200.0;  ///< initial distance along -x
+  double K1 = 5.0;   ///< |K1(0)|, K1(0) = K1 i
+  double Kx = 2.0;   ///< K2(0) = Kx i - Kz k
+  double Kz = 5.0;
+};
+
+/// K1(0) = K1 i, K2(0) = Kx i - Kz k, R(0) = -L i + (d - Kz/K1) j (eq. 1.11-1.13), so that the
+/// z-component of K2Q = R x K1 + K2 is -d K1.
+inline Momenta thesis_momenta(const ThesisStart& t) {
+  Momenta q;
+  q.K1 = Vec3(t.K1, 0.0, 0.0);
+  q.K2 = Vec3(t.Kx, 0.0, -t.Kz);
+  q.R = Vec3(-t.L, t.d - t.Kz / t.K1, 0.0);
+  return q;
+}
+
+/// One body of a scene: parameters, initial state and a label for output.
+struct Body {
+  BodyPoint p;
+  State s0;
+  std::string name;
+};
+
+/// Centres and independent body-points (body-points do not act on each other).
+struct Scene {
+  std::vector<Centre> centres;
+  std::vector<Body> bodies;
+};
+
+/// Table 3.1 of the thesis: A=-2, m=1, J=1, B=0.7, K1=5, Kx=2, Kz=5, d=10, L=200.
+struct SceneParams {
+  double A = -2.0;
+  double m = 1.0;
+  double B = 0.7;
+  double J = 1.0;
+  ThesisStart start;
+};
+
+/// Scene of one body and one centre at the origin from the thesis's parameters.
+Scene thesis_scene(const SceneParams& sp);
+
+/// Throws Error with a one-line message on the first violated rule: finite numbers, m > 0,
+/// J > 0, D = mJ - B^2 > 0, at least one centre and one body, no body starting on a centre.
+void validate(const Scene& scene);
+void validate(const BodyPoint& p, const std::string& who);
+
+}  // namespace bodypoint

@@ -1,0 +1,216 @@
+// bodypoint: method registry and the typed run loops behind `run`.
+//
+// The field type (one centre at the origin or a list), the spin (B = 0 or not) and the observer
+// (none, or invariants and samples) are chosen here, once, before the step loop starts; each
+// combination is its own instantiation of the generic loop.
+#include "bodypoint/run.hpp"
+
+#include "bodypoint/field.hpp"
+#include "bodypoint/rhs.hpp"
+#include "bodypoint/rk/odeint.hpp"
+#include "bodypoint/splitting/blanes_moan.hpp"
+#include "bodypoint/splitting/classic.hpp"
+#include "bodypoint/splitting/composition.hpp"
+#include "bodypoint/splitting/kahan_li.hpp"
+#include "bodypoint/splitting/lie_poisson.hpp"
+#include "bodypoint/splitting/mclachlan.hpp"
+#include "bodypoint/splitting/sofroniou_spaletta.hpp"
+#include "bodypoint/splitting/thesis.hpp"
+#include "bodypoint/splitting/yoshida.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <type_traits>
+
+namespace bodypoint {
+namespace {
+
+namespace sp = splitting;
+using Clock = std::chrono::steady_clock;
+
+/// Observer that tracks the invariants at every step and hands every `every`-th state to a sink.
+template <class Field, class ToPhysical>
+class Monitor {
+ public:
+  static constexpr bool active = true;
+
+  Monitor(const BodyPoint& p, const Field& f, const State& s0, const RunSpec& spec,
+          const SampleSink* sink, ToPhysical to_physical)
+      : inv_(p, f, s0), spec_(spec), sink_(sink), to_physical_(std::move(to_physical)) {
+    if (sink_) (*sink_)(Sample{0, 0.0, s0, 0.0, 0.0, 0.0});
+  }
+
+  template <class X>
+  void operator()(long i, const X& x) {
+    const State s = to_physical_(x);
+    inv_.update(s);
+    if (sink_ && (i % spec_.every == 0 || i == spec_.steps))
+      (*sink_)(Sample{i, static_cast<double>(i) * spec_.h, s, inv_.last_rel_dE(),
+                      inv_.last_rel_dK2sq(), inv_.last_abs_dK2Q()});
+  }
+
+  [[nodiscard]] const InvariantStats& stats() const { return inv_.stats(); }
+
+ private:
+  InvariantMonitor<Field> inv_;
+  const RunSpec& spec_;
+  const SampleSink* sink_;
+  ToPhysical to_physical_;
+};
+
+/// Runs `loop(observer)` with a null observer or a monitor, timing the loop only.
+template <class Field, class ToPhysical, class Loop>
+RunResult observe(const BodyPoint& p, const Field& field, const State& s0, const RunSpec& spec,
+                  const SampleSink* sink, ToPhysical to_physical, Loop&& loop) {
+  RunResult r;
+  r.steps = spec.steps;
+  r.t_end = static_cast<double>(spec.steps) * spec.h;
+  if (spec.track_invariants || sink) {
+    Monitor<Field, ToPhysical> mon(p, field, s0, spec, sink, to_physical);
+    const auto t0 = Clock::now();
+    r.final = loop(mon);
+    r.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
+    r.invariants = mon.stats();
+  } else {
+    sp::NullObserver none;
+    const auto t0 = Clock::now();
+    r.final = loop(none);
+    r.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  }
+  return r;
+}
+
+/// Calls f(field, std::bool_constant<Spin>) with the field and spin decided once.
+template <class F>
+RunResult dispatch(const Body& body, const std::vector<Centre>& centres, F&& f) {
+  return visit_field(centres, [&](const auto& field) {
+    if (body.p.B == 0.0) return f(field, std::false_type{});
+    return f(field, std::true_type{});
+  });
+}
+
+template <template <class, bool> class Kernel, const auto& Seq>
+RunResult run_splitting(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
+                        const SampleSink* sink) {
+  return dispatch(body, centres, [&](const auto& field, auto spin) {
+    using Field = std::decay_t<decltype(field)>;
+    using K = Kernel<Field, decltype(spin)::value>;
+    K kernel(body.p, field);
+    auto to_physical = [&kernel](const typename K::state_type& x) { return kernel.to_physical(x); };
+    RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
+      typename K::state_type x = kernel.initial_state(body.s0);
+      sp::integrate<Seq>(kernel, x, spec.h, spec.steps, obs);
+      return kernel.to_physical(x);
+    });
+    r.force_evals = kernel.evals;
+    return r;
+  });
+}
+
+template <class Stepper>
+RunResult run_odeint(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
+                     const SampleSink* sink) {
+  return dispatch(body, centres, [&](const auto& field, auto spin) {
+    using Field = std::decay_t<decltype(field)>;
+    long evals = 0;
+    EquationsOfMotion<Field, decltype(spin)::value> sys{body.p, field, &evals};
+    auto to_physical = [](const OdeState<double>& x) { return from_ode(x); };
+    RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
+      OdeState<double> x = to_ode(body.s0);
+      Stepper stepper;
+      for (long i = 0; i < spec.steps; ++i) {
+        stepper.do_step(std::ref(sys), x, static_cast<double>(i) * spec.h, spec.h);
+        if constexpr (std::decay_t<decltype(obs)>::active) obs(i + 1, x);
+      }
+      return from_ode(x);
+    });
+    r.force_evals = evals;
+    return r;
+  });
+}
+
+// Flattened op sequences (static storage, so they can be template arguments).
+constexpr auto euler_ops = sp::flatten(sp::euler);
+constexpr auto verlet_ops = sp::flatten(sp::verlet_kdk);
+constexpr auto strang_ops = sp::flatten(sp::strang_dkd_table);
+constexpr auto ruth3_ops = sp::flatten(sp::ruth3);
+constexpr auto y4_ops = sp::flatten(sp::yoshida4);
+constexpr auto bm4_ops = sp::flatten(sp::blanes_moan4);
+constexpr auto y6_ops = sp::flatten(sp::yoshida6);
+constexpr auto kl6_ops = sp::flatten(sp::kahan_li6);
+constexpr auto y8_ops = sp::flatten(sp::yoshida8);
+constexpr auto y8d_ops = sp::flatten(sp::yoshida8d);
+constexpr auto mcl8_ops = sp::flatten(sp::mclachlan8);
+constexpr auto kl8_ops = sp::flatten(sp::kahan_li8);
+constexpr auto ss10_ops = sp::flatten(sp::sofroniou_spaletta10);
+
+template <const auto& Seq>
+MethodInfo thesis_method(std::string_view name, int order, std::string_view what) {
+  return {name, Family::Thesis, order, static_cast<int>(Seq.kicks()), static_cast<int>(Seq.kicks()),
+          what, &run_splitting<sp::ThesisKernel, Seq>};
+}
+
+template <const auto& Seq>
+MethodInfo lie_method(std::string_view name, int order, std::string_view what) {
+  return {name, Family::LiePoisson, order, static_cast<int>(Seq.kicks()),
+          static_cast<int>(Seq.kicks_merged()), what, &run_splitting<sp::LiePoissonKernel, Seq>};
+}
+
+std::vector<MethodInfo> make_registry() {
+  return {
+      {"rk4", Family::Odeint, 4, 4, 4, "classical Runge-Kutta (thesis 2.1; odeint runge_kutta4)",
+       &run_odeint<rk::Rk4>},
+      {"ab4", Family::Odeint, 4, 1, 1,
+       "Adams-Bashforth 4 started by RK4 (thesis 2.2; odeint adams_bashforth<4>)",
+       &run_odeint<rk::Ab4>},
+      thesis_method<euler_ops>("thesis-euler", 1, "thesis symplectic Euler, frozen gyroscopic term"),
+      thesis_method<verlet_ops>("thesis-verlet", 2, "thesis Verlet (KDK), frozen gyroscopic term"),
+      thesis_method<ruth3_ops>("thesis-ruth3", 3, "thesis Ruth 3, frozen gyroscopic term"),
+      thesis_method<y4_ops>("thesis-fr4", 4, "thesis Forest-Ruth 4 (eq. 2.9-2.10), frozen gyroscopic term"),
+      thesis_method<y6_ops>("thesis-y6", 6, "thesis Yoshida 6 (table 2.1), frozen gyroscopic term"),
+      lie_method<euler_ops>("lp-euler", 1, "exact Lie-Poisson splitting, Lie-Trotter D K"),
+      lie_method<verlet_ops>("lp-verlet", 2, "exact Lie-Poisson Strang, kick-drift-kick"),
+      lie_method<strang_ops>("lp-verlet-dkd", 2, "exact Lie-Poisson Strang, drift-kick-drift"),
+      lie_method<ruth3_ops>("lp-ruth3", 3, "exact Lie-Poisson, Ruth 1983 third order"),
+      lie_method<y4_ops>("lp-y4", 4, "exact Lie-Poisson, Yoshida/Forest-Ruth 4 (3 stages)"),
+      lie_method<bm4_ops>("lp-bm4", 4, "exact Lie-Poisson, Blanes-Moan 2002 S6 (6 stages)"),
+      lie_method<y6_ops>("lp-y6", 6, "exact Lie-Poisson, Yoshida 6 triple jump (thesis table 2.1)"),
+      lie_method<kl6_ops>("lp-kl6", 6, "exact Lie-Poisson, Kahan-Li 1997 p6 s9"),
+      lie_method<y8_ops>("lp-y8", 8, "exact Lie-Poisson, Yoshida 8 triple jump (27 stages)"),
+      lie_method<y8d_ops>("lp-y8d", 8, "exact Lie-Poisson, Yoshida 1990 solution D (15 stages)"),
+      lie_method<mcl8_ops>("lp-mcl8", 8, "exact Lie-Poisson, McLachlan 1995 p8 s15"),
+      lie_method<kl8_ops>("lp-kl8", 8, "exact Lie-Poisson, Kahan-Li 1997 p8 s17"),
+      lie_method<ss10_ops>("lp-ss10", 10, "exact Lie-Poisson, Sofroniou-Spaletta 2005 p10 s35"),
+  };
+}
+
+}  // namespace
+
+const std::vector<MethodInfo>& methods() {
+  static const std::vector<MethodInfo> registry = make_registry();
+  return registry;
+}
+
+const MethodInfo* find_method(std::string_view name) {
+  for (const MethodInfo& m : methods())
+    if (m.name == name) return &m;
+  return nullptr;
+}
+
+const MethodInfo& method_or_throw(std::string_view name) {
+  if (const MethodInfo* m = find_method(name)) return *m;
+  throw Error("unknown method '" + std::string(name) + "' (see 'bodypoint methods')");
+}
+
+RunResult run(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
+              const RunSpec& spec, const SampleSink* sink) {
+  validate(Scene{centres, {body}});
+  if (!std::isfinite(spec.h) || spec.h <= 0.0)
+    throw Error("step size h must be a finite number > 0, got " + std::to_string(spec.h));
+  if (spec.steps < 1) throw Error("number of steps must be >= 1");
+  if (spec.every < 1) throw Error("--every must be >= 1");
+  return method.run(body, centres, spec, sink);
+}
+
+}  // namespace bodypoint

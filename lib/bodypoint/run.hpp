@@ -1,0 +1,70 @@
+// bodypoint: running one method on one body of a scene.
+//
+// `run` integrates a body for `steps` fixed steps of size h from t0 = 0 (time is t0 + i h, never a
+// running sum) and returns the final state, the force-evaluation count and the wall time of the
+// step loop. Invariants are tracked only when asked for, and states are handed to a sink only
+// when one is given: with neither, the step loop runs with a null observer and stores nothing.
+#pragma once
+
+#include "bodypoint/invariants.hpp"
+#include "bodypoint/model.hpp"
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace bodypoint {
+
+struct RunSpec {
+  double h = 1e-4;
+  long steps = 500000;
+  bool track_invariants = false;
+  long every = 1;  ///< hand every `every`-th state (and the last) to the sink
+};
+
+/// One observed state with the deviations of the integrals the field has.
+struct Sample {
+  long step;
+  double t;
+  const State& s;
+  double rel_dE, rel_dK2sq, abs_dK2Q;
+};
+using SampleSink = std::function<void(const Sample&)>;
+
+struct RunResult {
+  State final;
+  long steps = 0;
+  double t_end = 0.0;
+  long force_evals = 0;
+  double wall_s = 0.0;
+  std::optional<InvariantStats> invariants;
+};
+
+enum class Family { Thesis, LiePoisson, Odeint };
+
+struct MethodInfo {
+  std::string_view name;
+  Family family;
+  int order;            ///< nominal order (for the thesis family: of the underlying table)
+  int stages;           ///< sub-steps (kicks) per step as written
+  int evals_per_step;   ///< force evaluations per step in a long run without per-step output
+  std::string_view description;
+  RunResult (*run)(const Body&, const std::vector<Centre>&, const RunSpec&, const SampleSink*);
+};
+
+/// Every fixed-step method, in the order `bodypoint methods` lists them.
+const std::vector<MethodInfo>& methods();
+
+/// The method called `name`, or nullptr.
+const MethodInfo* find_method(std::string_view name);
+
+/// Throws Error("unknown method ...") for a name not in methods().
+const MethodInfo& method_or_throw(std::string_view name);
+
+/// Validates the inputs (scene, h > 0 and finite, steps >= 1, every >= 1) and runs.
+RunResult run(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
+              const RunSpec& spec, const SampleSink* sink = nullptr);
+
+}  // namespace bodypoint

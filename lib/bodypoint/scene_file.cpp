@@ -1,0 +1,125 @@
+#include "bodypoint/scene_file.hpp"
+
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <toml++/toml.h>
+
+namespace bodypoint {
+namespace {
+
+[[noreturn]] void fail(const std::string& origin, const std::string& what) {
+  throw Error(origin + ": " + what);
+}
+
+double number(const toml::table& t, std::string_view key, const std::string& where, const std::string& origin) {
+  const toml::node* n = t.get(key);
+  if (!n) fail(origin, where + ": missing '" + std::string(key) + "'");
+  if (auto v = n->value<double>()) return *v;  // accepts integers too
+  fail(origin, where + ": '" + std::string(key) + "' must be a number");
+}
+
+Vec3 vector3(const toml::table& t, std::string_view key, const std::string& where, const std::string& origin) {
+  const toml::node* n = t.get(key);
+  if (!n) fail(origin, where + ": missing '" + std::string(key) + "'");
+  const toml::array* a = n->as_array();
+  if (!a || a->size() != 3) fail(origin, where + ": '" + std::string(key) + "' must be an array of 3 numbers");
+  Vec3 v;
+  for (std::size_t i = 0; i < 3; ++i) {
+    auto x = (*a)[i].value<double>();
+    if (!x) fail(origin, where + ": '" + std::string(key) + "' must be an array of 3 numbers");
+    v[static_cast<Eigen::Index>(i)] = *x;
+  }
+  return v;
+}
+
+void only_keys(const toml::table& t, const std::set<std::string>& allowed, const std::string& where,
+               const std::string& origin) {
+  for (const auto& [k, _] : t)
+    if (!allowed.count(std::string(k.str())))
+      fail(origin, where + ": unknown key '" + std::string(k.str()) + "'");
+}
+
+const toml::array* array_of_tables(const toml::table& root, std::string_view key, const std::string& origin) {
+  const toml::node* n = root.get(key);
+  if (!n) return nullptr;
+  const toml::array* a = n->as_array();
+  if (!a || !a->is_array_of_tables())
+    fail(origin, "'" + std::string(key) + "' must be written as [[" + std::string(key) + "]] tables");
+  return a;
+}
+
+}  // namespace
+
+Scene parse_scene(const std::string& text, const std::string& origin) {
+  toml::table root;
+  try {
+    root = toml::parse(text, origin);
+  } catch (const toml::parse_error& e) {
+    const auto& src = e.source();
+    fail(origin, "line " + std::to_string(src.begin.line) + ": " + std::string(e.description()));
+  }
+  only_keys(root, {"centre", "body"}, "top level", origin);
+
+  Scene scene;
+  if (const toml::array* cs = array_of_tables(root, "centre", origin)) {
+    for (std::size_t k = 0; k < cs->size(); ++k) {
+      const toml::table& t = *(*cs)[k].as_table();
+      const std::string where = "centre " + std::to_string(k + 1);
+      only_keys(t, {"position", "A"}, where, origin);
+      Centre c;
+      c.A = number(t, "A", where, origin);
+      if (t.contains("position")) c.c = vector3(t, "position", where, origin);
+      scene.centres.push_back(c);
+    }
+  }
+  if (const toml::array* bs = array_of_tables(root, "body", origin)) {
+    for (std::size_t i = 0; i < bs->size(); ++i) {
+      const toml::table& t = *(*bs)[i].as_table();
+      std::string where = "body " + std::to_string(i + 1);
+      only_keys(t, {"name", "m", "B", "J", "R", "v", "w", "d", "L", "K1", "Kx", "Kz"}, where, origin);
+      Body b;
+      if (const toml::node* n = t.get("name")) {
+        auto s = n->value<std::string>();
+        if (!s) fail(origin, where + ": 'name' must be a string");
+        b.name = *s;
+      }
+      b.p = BodyPoint{number(t, "m", where, origin), number(t, "B", where, origin), number(t, "J", where, origin)};
+      const bool physical = t.contains("R") || t.contains("v") || t.contains("w");
+      const bool thesis = t.contains("d") || t.contains("L") || t.contains("K1") || t.contains("Kx") || t.contains("Kz");
+      if (physical == thesis)
+        fail(origin, where + ": give either R, v, w or the thesis's d, L, K1, Kx, Kz (exactly one form)");
+      try {
+        validate(b.p, where);
+      } catch (const Error& e) {
+        fail(origin, e.what());
+      }
+      if (physical) {
+        b.s0 = State{vector3(t, "R", where, origin), vector3(t, "v", where, origin), vector3(t, "w", where, origin)};
+      } else {
+        ThesisStart ts{number(t, "d", where, origin), number(t, "L", where, origin), number(t, "K1", where, origin),
+                       number(t, "Kx", where, origin), number(t, "Kz", where, origin)};
+        if (ts.K1 == 0.0) fail(origin, where + ": K1 must be non-zero");
+        b.s0 = to_state(b.p, thesis_momenta(ts));
+      }
+      if (b.name.empty()) b.name = "body" + std::to_string(i + 1);
+      scene.bodies.push_back(b);
+    }
+  }
+  try {
+    validate(scene);
+  } catch (const Error& e) {
+    fail(origin, e.what());
+  }
+  return scene;
+}
+
+Scene read_scene_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(path + ": cannot open scene file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parse_scene(ss.str(), path);
+}
+
+}  // namespace bodypoint

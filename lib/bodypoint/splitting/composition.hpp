@@ -1,0 +1,196 @@
+// bodypoint: one generic composition engine for every drift/kick splitting method.
+//
+// A splitting table is a sequence of pairs  D(a_0 h) K(b_0 h) D(a_1 h) K(b_1 h) ... D(a_{N-1} h) K(b_{N-1} h),
+// the form of the thesis's eq. 2.12 (C_i = a_i, D_i = b_i), where D is the drift (flow of the kinetic
+// part) and K the kick (flow of the potential part). Zero coefficients are skipped.
+//
+// Symmetric compositions of a second-order basic method S2 with weights g_1..g_s,
+//   S(h) = S2(g_s h) ... S2(g_2 h) S2(g_1 h),
+// are built at compile time by `strang_dkd` (S2 = D(h/2) K(h) D(h/2)) or `strang_kdk`
+// (S2 = K(h/2) D(h) K(h/2)); `triple_jump` raises the order of a symmetric method by two
+// (Yoshida 1990, eq. 5.2-5.4; thesis appendix 2, eq. P2.1-P2.3).
+//
+// The engine (`integrate`) runs n steps. When no observer needs the state at every step and the
+// kernel allows it, the last sub-flow of one step and the first of the next (same type) are merged
+// ("first same as last"), so a symmetric s-stage composition costs s force evaluations per step.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <type_traits>
+
+namespace bodypoint::splitting {
+
+/// D(a_i) K(b_i) pairs, i = 0..N-1.
+template <std::size_t N>
+struct Table {
+  std::array<double, N> a{};
+  std::array<double, N> b{};
+};
+
+/// The n-th root of x > 0 by Newton's method, usable in constant expressions.
+constexpr double nth_root(double x, int n) {
+  double y = x > 1.0 ? x : 1.0;
+  for (int it = 0; it < 200; ++it) {
+    double p = 1.0;
+    for (int k = 0; k < n - 1; ++k) p *= y;
+    const double next = y - (p * y - x) / (n * p);
+    if (next == y) break;
+    y = next;
+  }
+  return y;
+}
+
+/// Triple jump of a symmetric method of order 2k with weights g (Yoshida 1990, eq. 5.4):
+/// S_{2k+2}(h) = S_{2k}(x1 h) S_{2k}(x0 h) S_{2k}(x1 h), x1 = 1/(2 - 2^{1/(2k+1)}), x0 = 1 - 2 x1.
+template <std::size_t S>
+constexpr std::array<double, 3 * S> triple_jump(const std::array<double, S>& g, int order_of_g) {
+  const double r = nth_root(2.0, order_of_g + 1);
+  const double x1 = 1.0 / (2.0 - r);
+  const double x0 = -r / (2.0 - r);
+  std::array<double, 3 * S> out{};
+  for (std::size_t i = 0; i < S; ++i) {
+    out[i] = x1 * g[i];
+    out[S + i] = x0 * g[i];
+    out[2 * S + i] = x1 * g[i];
+  }
+  return out;
+}
+
+/// Full palindromic weight list g_1..g_s from its first half (s = 2 H - 1): the middle weight
+/// g_H is derived from the consistency condition sum g = 1 (the tables list only g_1..g_{H-1}).
+template <std::size_t H>
+constexpr std::array<double, 2 * H + 1> palindrome(const std::array<double, H>& half) {
+  std::array<double, 2 * H + 1> g{};
+  double sum = 0.0;
+  for (std::size_t i = 0; i < H; ++i) {
+    g[i] = half[i];
+    g[2 * H - i] = half[i];
+    sum += half[i];
+  }
+  g[H] = 1.0 - 2.0 * sum;
+  return g;
+}
+
+/// S(h) = prod S2(g_i h) with S2 = D(h/2) K(h) D(h/2), adjacent half drifts merged:
+/// a = (g1/2, (g1+g2)/2, ..., gs/2), b = (g1, ..., gs, 0).
+template <std::size_t S>
+constexpr Table<S + 1> strang_dkd(const std::array<double, S>& g) {
+  Table<S + 1> t{};
+  t.a[0] = 0.5 * g[0];
+  for (std::size_t i = 1; i < S; ++i) t.a[i] = 0.5 * (g[i - 1] + g[i]);
+  t.a[S] = 0.5 * g[S - 1];
+  for (std::size_t i = 0; i < S; ++i) t.b[i] = g[i];
+  t.b[S] = 0.0;
+  return t;
+}
+
+/// S(h) = prod S2(g_i h) with S2 = K(h/2) D(h) K(h/2): a = (0, g1, ..., gs),
+/// b = (g1/2, (g1+g2)/2, ..., gs/2).
+template <std::size_t S>
+constexpr Table<S + 1> strang_kdk(const std::array<double, S>& g) {
+  Table<S + 1> t{};
+  t.a[0] = 0.0;
+  for (std::size_t i = 0; i < S; ++i) t.a[i + 1] = g[i];
+  t.b[0] = 0.5 * g[0];
+  for (std::size_t i = 1; i < S; ++i) t.b[i] = 0.5 * (g[i - 1] + g[i]);
+  t.b[S] = 0.5 * g[S - 1];
+  return t;
+}
+
+/// One sub-flow of a step: a drift or a kick for c*h.
+struct Op {
+  bool kick = false;
+  double c = 0.0;
+};
+
+/// A table flattened to its non-zero sub-flows, adjacent flows of one type merged.
+template <std::size_t M>
+struct OpSequence {
+  std::array<Op, M> ops{};
+  std::size_t size = 0;
+  [[nodiscard]] constexpr std::size_t kicks() const {
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < size; ++i) k += ops[i].kick ? 1 : 0;
+    return k;
+  }
+  /// First and last sub-flows are of one type, so consecutive steps can share them.
+  [[nodiscard]] constexpr bool fsal() const { return size >= 2 && ops[0].kick == ops[size - 1].kick; }
+  /// Force evaluations per step when consecutive steps are merged.
+  [[nodiscard]] constexpr std::size_t kicks_merged() const {
+    return fsal() && ops[0].kick ? kicks() - 1 : kicks();
+  }
+};
+
+template <std::size_t N>
+constexpr OpSequence<2 * N> flatten(const Table<N>& t) {
+  OpSequence<2 * N> s{};
+  auto push = [&s](bool kick, double c) {
+    if (c == 0.0) return;
+    if (s.size > 0 && s.ops[s.size - 1].kick == kick) {
+      s.ops[s.size - 1].c += c;
+    } else {
+      s.ops[s.size++] = Op{kick, c};
+    }
+  };
+  for (std::size_t i = 0; i < N; ++i) {
+    push(false, t.a[i]);
+    push(true, t.b[i]);
+  }
+  return s;
+}
+
+/// Sums of the drift and kick coefficients (each must be 1 for a consistent method).
+template <std::size_t N>
+constexpr double drift_sum(const Table<N>& t) {
+  double s = 0.0;
+  for (double x : t.a) s += x;
+  return s;
+}
+template <std::size_t N>
+constexpr double kick_sum(const Table<N>& t) {
+  double s = 0.0;
+  for (double x : t.b) s += x;
+  return s;
+}
+
+/// An observer that observes nothing; the engine compiles it away.
+struct NullObserver {
+  static constexpr bool active = false;
+  template <class X>
+  void operator()(long, const X&) const {}
+};
+
+/// Kernel concept: `state_type`, `drift(x, tau)`, `kick(x, tau)`, `begin_step(x)`,
+/// `static constexpr bool mergeable` (false when a step depends on the state at its start).
+template <const auto& Seq, class Kernel, class Observer>
+void integrate(Kernel& k, typename Kernel::state_type& x, double h, long n, Observer& obs) {
+  constexpr std::size_t M = Seq.size;
+  static_assert(M >= 1, "empty splitting");
+  auto apply = [&k, &x](const Op& op, double hh) {
+    if (op.kick) {
+      k.kick(x, op.c * hh);
+    } else {
+      k.drift(x, op.c * hh);
+    }
+  };
+  constexpr bool merge = Seq.fsal() && Kernel::mergeable && !Observer::active;
+  if constexpr (merge) {
+    if (n <= 0) return;
+    apply(Seq.ops[0], h);
+    for (long i = 0; i < n; ++i) {
+      for (std::size_t j = 1; j + 1 < M; ++j) apply(Seq.ops[j], h);
+      Op last = Seq.ops[M - 1];
+      if (i + 1 < n) last.c += Seq.ops[0].c;
+      apply(last, h);
+    }
+  } else {
+    for (long i = 0; i < n; ++i) {
+      k.begin_step(x);
+      for (std::size_t j = 0; j < M; ++j) apply(Seq.ops[j], h);
+      if constexpr (Observer::active) obs(i + 1, x);
+    }
+  }
+}
+
+}  // namespace bodypoint::splitting

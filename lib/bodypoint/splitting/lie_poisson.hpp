@@ -1,0 +1,127 @@
+// bodypoint: the exact Lie-Poisson sub-flows of H = T(K1, K2) + Pi(R).
+//
+// shared/PHYSICS.md "Exact Lie-Poisson splitting". With Omega = -(B/D) K1 (constant during a drift):
+//
+//   kinetic drift for tau:  K1 const,  dK2/dt = Omega x K2  (K2 precesses about K1),
+//     K2(tau) = K2 + tau S1(phi) u + tau^2 C1(phi) W,                u = Omega x K2, W = Omega x u,
+//     R(tau)  = R + tau (J K1 - B K2)/D - (B/D) [tau^2 C1(phi) u + tau^3 S3(phi) W],
+//   with phi = |Omega| tau, S1 = sin(phi)/phi, C1 = (1 - cos phi)/phi^2, S3 = (phi - sin phi)/phi^3
+//   (the R line is the integral of dR/dt = (J K1 - B K2(t))/D). All three are even, entire
+//   functions of phi, evaluated from phi^2 by their Taylor series for phi < 1 and in closed form
+//   otherwise, so |K1| -> 0 and B -> 0 are smooth and no division by |K1| occurs.
+//
+//   potential kick for tau:  R, K2 const,  K1 += tau F(R).
+//
+// Both flows conserve K2Q = R x K1 + K2 and |K2|^2 exactly. A material point (Spin = false,
+// B = 0) skips the rotation: the drift is R += tau K1/m.
+// R and K1 are accumulated with Kahan's compensated summation so that long runs of
+// high-order methods reach a round-off floor near 1e-15 relative instead of growing with sqrt(n) eps.
+#pragma once
+
+#include "bodypoint/model.hpp"
+
+#include <array>
+#include <cmath>
+
+namespace bodypoint::splitting {
+
+/// (R, K1, K2) with compensation terms for R and K1.
+struct LieState {
+  Vec3 R = Vec3::Zero();
+  Vec3 K1 = Vec3::Zero();
+  Vec3 K2 = Vec3::Zero();
+  Vec3 R_err = Vec3::Zero();
+  Vec3 K1_err = Vec3::Zero();
+};
+
+inline LieState to_lie(const Momenta& q) { return {q.R, q.K1, q.K2, Vec3::Zero(), Vec3::Zero()}; }
+inline Momenta from_lie(const LieState& x) { return {x.R + x.R_err, x.K1 + x.K1_err, x.K2}; }
+
+/// x += dx with Kahan compensation; err holds minus the low-order part not yet in x.
+inline void compensated_add(Vec3& x, Vec3& err, const Vec3& dx) {
+  const Vec3 y = dx - err;
+  const Vec3 t = x + y;
+  err = (t - x) - y;
+  x = t;
+}
+
+/// S1 = sin(phi)/phi, C1 = (1 - cos phi)/phi^2, S3 = (phi - sin phi)/phi^3 from x = phi^2.
+struct DriftFunctions {
+  double S1, C1, S3;
+};
+
+inline DriftFunctions drift_functions(double x) {
+  if (x < 1.0) {
+    // Taylor series in x: S1 = sum (-x)^k/(2k+1)!, C1 = sum (-x)^k/(2k+2)!, S3 = sum (-x)^k/(2k+3)!.
+    // Nine terms: the first omitted term of S3 is below 1/21! ~ 2e-20 of its value 1/6.
+    constexpr int terms = 9;
+    constexpr auto inv_factorials = [] {
+      std::array<double, 2 * terms + 4> f{};
+      double v = 1.0;
+      f[0] = 1.0;
+      for (int n = 1; n < 2 * terms + 4; ++n) {
+        v /= n;
+        f[n] = v;
+      }
+      return f;
+    }();
+    double s1 = 0.0, c1 = 0.0, s3 = 0.0;
+    for (int k = terms - 1; k >= 0; --k) {
+      const double sign = (k % 2 == 0) ? 1.0 : -1.0;
+      s1 = s1 * x + sign * inv_factorials[2 * k + 1];
+      c1 = c1 * x + sign * inv_factorials[2 * k + 2];
+      s3 = s3 * x + sign * inv_factorials[2 * k + 3];
+    }
+    return {s1, c1, s3};
+  }
+  const double phi = std::sqrt(x);
+  const double s = std::sin(phi);
+  const double c = std::cos(phi);
+  return {s / phi, (1.0 - c) / x, (phi - s) / (x * phi)};
+}
+
+/// Exact drift and kick for one body-point in `Field`. `Spin = false` requires B = 0.
+template <class Field, bool Spin>
+struct LiePoissonKernel {
+  using state_type = LieState;
+  static constexpr bool mergeable = true;
+
+  BodyPoint p;
+  Field field;
+  long evals = 0;
+
+  LiePoissonKernel(const BodyPoint& bp, Field f)
+      : p(bp), field(std::move(f)), inv_D_(1.0 / bp.D()), inv_m_(1.0 / bp.m) {}
+
+  [[nodiscard]] LieState initial_state(const State& s0) const { return to_lie(to_momenta(p, s0)); }
+  void begin_step(LieState&) const {}
+
+  void drift(LieState& x, double tau) const {
+    if constexpr (!Spin) {
+      compensated_add(x.R, x.R_err, (tau * inv_m_) * x.K1);  // B = 0: v = K1/m
+    } else {
+      const double BD = p.B * inv_D_;
+      const Vec3 Omega = -BD * x.K1;
+      const Vec3 u = Omega.cross(x.K2);
+      const Vec3 W = Omega.cross(u);
+      const DriftFunctions f = drift_functions(Omega.squaredNorm() * tau * tau);
+      const double t2 = tau * tau;
+      const Vec3 dR = (tau * inv_D_) * (p.J * x.K1 - p.B * x.K2) - BD * ((t2 * f.C1) * u + (t2 * tau * f.S3) * W);
+      x.K2 += (tau * f.S1) * u + (t2 * f.C1) * W;
+      compensated_add(x.R, x.R_err, dR);
+    }
+  }
+
+  void kick(LieState& x, double tau) {
+    ++evals;
+    compensated_add(x.K1, x.K1_err, tau * field.force(x.R));
+  }
+
+  [[nodiscard]] State to_physical(const LieState& x) const { return to_state(p, from_lie(x)); }
+
+ private:
+  double inv_D_;
+  double inv_m_;
+};
+
+}  // namespace bodypoint::splitting
