@@ -1,0 +1,160 @@
+// bodypoint: independent references a run is checked against (shared/PHYSICS.md "What to check a
+// run against").
+//
+// - `reference_state`: Boost.Odeint's runge_kutta_fehlberg78 with step-size control, in long
+//   double, on PreciseEquations (rhs.hpp), which shares no code with the production kernels.
+// - `kepler_state`: the analytic two-body (Rutherford/Kepler) motion of a material point (B = 0)
+//   in one centre's field, by the universal-variable form of Kepler's equation
+//   (J. M. A. Danby, Fundamentals of Celestial Mechanics, 2nd ed. 1988, sec. 6.9; Stumpff
+//   functions), valid for attraction and repulsion alike (mu = A/m of either sign).
+// - `helix_state`: the exact free motion (A = 0): K1 constant, K2 rotating about K1 at rate
+//   -(B/D)|K1|, R from the conservation of R x K1 + K2 (PHYSICS.md, kinetic drift).
+#pragma once
+
+#include "bodypoint/model.hpp"
+#include "bodypoint/rhs.hpp"
+
+#include <boost/numeric/odeint/integrate/integrate_adaptive.hpp>
+#include <boost/numeric/odeint/stepper/controlled_runge_kutta.hpp>
+#include <boost/numeric/odeint/stepper/runge_kutta_fehlberg78.hpp>
+
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+namespace bodypoint {
+
+/// State at t_end from s0 at t = 0, integrated in long double with relative and absolute
+/// tolerance `tol`.
+inline State reference_state(const Body& body, const std::vector<Centre>& centres, double t_end,
+                             long double tol = 1e-16L) {
+  namespace odeint = boost::numeric::odeint;
+  using S = OdeState<long double>;
+  PreciseEquations<long double> sys(body.p, centres);
+  S x;
+  const OdeState<double> x0 = to_ode(body.s0);
+  for (int i = 0; i < 9; ++i) x[i] = x0[i];
+  using Stepper = odeint::runge_kutta_fehlberg78<S, long double>;
+  using Checker = odeint::default_error_checker<long double, typename Stepper::algebra_type,
+                                                typename Stepper::operations_type>;
+#pragma GCC diagnostic push
+  // GCC 12 reports odeint's default-constructed stepper members as maybe-uninitialized when the
+  // controller copies them (a false positive inside Boost; the members are arrays it fills first).
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+  odeint::controlled_runge_kutta<Stepper> stepper{Checker(tol, tol)};
+  odeint::integrate_adaptive(stepper, std::cref(sys), x, 0.0L, static_cast<long double>(t_end), 1e-3L);
+#pragma GCC diagnostic pop
+  OdeState<double> out;
+  for (int i = 0; i < 9; ++i) out[i] = static_cast<double>(x[i]);
+  return from_ode(out);
+}
+
+namespace detail {
+/// Stumpff functions c0..c3 of z (Danby eq. 6.9.x), in long double.
+inline void stumpff(long double z, long double c[4]) {
+  if (std::abs(z) < 0.1L) {
+    // Series c_n(z) = sum (-z)^k/(2k+n)!, enough terms for |z| < 0.1 to reach long double.
+    for (int n = 0; n < 4; ++n) {
+      long double term = 1.0L, sum = 0.0L;
+      for (int j = 1; j <= n; ++j) term /= j;
+      for (int k = 0; k < 20; ++k) {
+        sum += term;
+        term *= -z / ((2 * k + n + 1) * (2 * k + n + 2));
+      }
+      c[n] = sum;
+    }
+    return;
+  }
+  if (z > 0) {
+    const long double s = std::sqrt(z);
+    c[0] = std::cos(s);
+    c[1] = std::sin(s) / s;
+  } else {
+    const long double s = std::sqrt(-z);
+    c[0] = std::cosh(s);
+    c[1] = std::sinh(s) / s;
+  }
+  c[2] = (1.0L - c[0]) / z;
+  c[3] = (1.0L - c[1]) / z;
+}
+}  // namespace detail
+
+/// Position and velocity at time t of d^2R/dt^2 = -mu R/|R|^3 from (R0, v0); mu = A/m.
+inline void kepler_state(double mu_d, const Vec3& R0, const Vec3& v0, double t_d, Vec3& R, Vec3& v) {
+  using ld = long double;
+  const ld mu = mu_d, t = t_d;
+  const ld r0 = std::sqrt(static_cast<ld>(R0.squaredNorm()));
+  const ld sigma0 = static_cast<ld>(R0.dot(v0));
+  const ld beta = 2.0L * mu / r0 - static_cast<ld>(v0.squaredNorm());  // -2 x energy per mass
+  auto G = [&](ld s, ld g[4]) {
+    ld c[4];
+    detail::stumpff(beta * s * s, c);
+    g[0] = c[0];
+    g[1] = s * c[1];
+    g[2] = s * s * c[2];
+    g[3] = s * s * s * c[3];
+  };
+  // Solve t = r0 G1 + sigma0 G2 + mu G3 for s; dt/ds = r(s) > 0, so bracket and Newton-bisect.
+  ld lo = 0.0L, hi = t / r0;
+  ld g[4];
+  auto tof = [&](ld s) {
+    G(s, g);
+    return r0 * g[1] + sigma0 * g[2] + mu * g[3];
+  };
+  while (tof(hi) < t) {
+    lo = hi;
+    hi *= 2.0L;
+    if (hi > 1e6L) throw std::runtime_error("kepler_state: no bracket");
+  }
+  ld s = 0.5L * (lo + hi);
+  for (int it = 0; it < 200; ++it) {
+    const ld f = tof(s) - t;
+    const ld r = r0 * g[0] + sigma0 * g[1] + mu * g[2];
+    if (f > 0) hi = s; else lo = s;
+    ld next = s - f / r;
+    if (!(next > lo && next < hi)) next = 0.5L * (lo + hi);
+    if (std::abs(next - s) <= 1e-19L * std::abs(s)) {
+      s = next;
+      break;
+    }
+    s = next;
+  }
+  G(s, g);
+  const ld r = r0 * g[0] + sigma0 * g[1] + mu * g[2];
+  const ld f = 1.0L - mu * g[2] / r0, gg = t - mu * g[3];
+  const ld fd = -mu * g[1] / (r0 * r), gd = 1.0L - mu * g[2] / r;
+  for (int i = 0; i < 3; ++i) {
+    R[i] = static_cast<double>(f * R0[i] + gg * v0[i]);
+    v[i] = static_cast<double>(fd * R0[i] + gd * v0[i]);
+  }
+}
+
+/// The exact material-point state at t in one centre's field (B must be 0; w is constant).
+inline State kepler_body_state(const Body& body, const Centre& centre, double t) {
+  State s;
+  Vec3 R, v;
+  kepler_state(centre.A / body.p.m, body.s0.R - centre.c, body.s0.v, t, R, v);
+  s.R = R + centre.c;
+  s.v = v;
+  s.w = body.s0.w;
+  return s;
+}
+
+/// The exact free motion (A = 0) at time t, written independently of the splitting kernel:
+/// Rodrigues rotation of K2 about k = K1/|K1| by theta = -(B/D)|K1| t, and
+/// R = R0 + t (J|K1| - B K2.k)/D k + K1 x (K2_0 - K2_t)/|K1|^2 (PHYSICS.md, kinetic drift).
+inline State helix_state(const BodyPoint& p, const State& s0, double t) {
+  const Momenta q0 = to_momenta(p, s0);
+  const double k1 = q0.K1.norm();
+  const Vec3 k = q0.K1 / k1;
+  const double theta = -(p.B / p.D()) * k1 * t;
+  const Vec3& K2 = q0.K2;
+  const Vec3 K2t = K2 * std::cos(theta) + k.cross(K2) * std::sin(theta) + k * k.dot(K2) * (1.0 - std::cos(theta));
+  Momenta q;
+  q.K1 = q0.K1;
+  q.K2 = K2t;
+  q.R = q0.R + (t * (p.J * k1 - p.B * K2.dot(k)) / p.D()) * k + q0.K1.cross(K2 - K2t) / (k1 * k1);
+  return to_state(p, q);
+}
+
+}  // namespace bodypoint

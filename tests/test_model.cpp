@@ -1,0 +1,214 @@
+// Model, initial conditions, equations of motion and input validation.
+#include "bodypoint/field.hpp"
+#include "bodypoint/invariants.hpp"
+#include "bodypoint/rhs.hpp"
+#include "bodypoint/run.hpp"
+#include "bodypoint/scene_file.hpp"
+#include "common.hpp"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <random>
+
+namespace bodypoint {
+namespace {
+
+// Conversions and the thesis's start involve a handful of roundings of O(10) numbers.
+constexpr double kConversionTol = 1e-13;
+// dK1/dt and dK2Q/dt are sums of terms of size |F| ~ 1e-2..1 and B^2|w x v|/D ~ 10^2 for the random
+// states below; their exact cancellation leaves only rounding of that size.
+constexpr double kIdentityTol = 1e-11;
+
+TEST(InitialConditions, ReproduceThesisEquations) {
+  SceneParams sp;  // table 3.1
+  const Scene s = thesis_scene(sp);
+  const Body& b = s.bodies.front();
+  const Momenta q = to_momenta(b.p, b.s0);
+  EXPECT_NEAR((q.K1 - Vec3(5, 0, 0)).norm(), 0.0, kConversionTol);
+  EXPECT_NEAR((q.K2 - Vec3(2, 0, -5)).norm(), 0.0, kConversionTol);
+  EXPECT_NEAR((q.R - Vec3(-200, 9, 0)).norm(), 0.0, kConversionTol);  // table 3.1: R(0) = 9 j - 200 i
+  const Vec3 K2Q = total_angular_momentum(b.p, b.s0, Vec3::Zero());
+  EXPECT_NEAR(K2Q.z(), -sp.start.d * sp.start.K1, kConversionTol);
+  // Eq. 1.14-1.15 written out by the thesis.
+  const double m = 1, B = 0.7, J = 1, K1 = 5, Kx = 2, Kz = 5, den = B * B - m * J;
+  EXPECT_NEAR((b.s0.v - Vec3((B * Kx - J * K1) / den, 0, -B * Kz / den)).norm(), 0.0, kConversionTol);
+  EXPECT_NEAR((b.s0.w - Vec3((B * K1 - m * Kx) / den, 0, m * Kz / den)).norm(), 0.0, kConversionTol);
+}
+
+TEST(InitialConditions, MomentaRoundTrip) {
+  const BodyPoint p{1.3, -0.4, 0.8};
+  const State s{Vec3(1, 2, 3), Vec3(-0.5, 0.25, 2), Vec3(3, -1, 0.5)};
+  const State back = to_state(p, to_momenta(p, s));
+  EXPECT_NEAR((back.v - s.v).norm(), 0.0, kConversionTol);
+  EXPECT_NEAR((back.w - s.w).norm(), 0.0, kConversionTol);
+}
+
+/// The thesis's printed eq. 1.10 (both signs flipped), to show the identity test catches it.
+OdeState<double> thesis_printed_rhs(const BodyPoint& p, double A, const OdeState<double>& x) {
+  const State s = from_ode(x);
+  const double r3 = std::pow(s.R.norm(), 3);
+  const Vec3 wxv = s.w.cross(s.v);
+  const Vec3 dv = (-A * p.J / r3 * s.R - p.B * p.B * wxv) / p.D();
+  const Vec3 dw = (-A * p.B / r3 * s.R - p.m * p.B * wxv) / p.D();  // eq. 1.10 as printed
+  return to_ode(State{s.v, dv, dw});
+}
+
+TEST(EquationsOfMotion, LinearMomentumObeysForceAndAngularMomentumIsConstant) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-10, 10);
+  const BodyPoint p{1.0, 0.7, 1.0};
+  const double A = -2.0;
+  EquationsOfMotion<OriginCentre, true> eom{p, OriginCentre{A}};
+  for (int trial = 0; trial < 100; ++trial) {
+    const State s{Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng))};
+    OdeState<double> dx;
+    eom(to_ode(s), dx, 0.0);
+    const State d = from_ode(dx);  // (dR, dv, dw)
+    const Vec3 F = OriginCentre{A}.force(s.R);
+    const Vec3 dK1 = p.m * d.v + p.B * d.w;
+    EXPECT_LT((dK1 - F).norm(), kIdentityTol) << "dK1/dt = F violated";
+    const Vec3 K1 = p.m * s.v + p.B * s.w;
+    const Vec3 dK2Q = d.R.cross(K1) + s.R.cross(dK1) + p.B * d.v + p.J * d.w;
+    EXPECT_LT(dK2Q.norm(), kIdentityTol) << "d(R x K1 + K2)/dt = 0 violated";
+
+    const State dp = from_ode(thesis_printed_rhs(p, A, to_ode(s)));
+    const Vec3 dK1_printed = p.m * dp.v + p.B * dp.w;
+    EXPECT_GT((dK1_printed - F).norm(), 1e3 * kIdentityTol) << "the identity must reject eq. 1.10 as printed";
+  }
+}
+
+TEST(Invariants, EnergyUsesFullCouplingTerm) {
+  // Erratum 2: the coupling term is B v.w, not B/2 v.w.
+  const BodyPoint p{2.0, 0.5, 3.0};
+  const State s{Vec3(1, 0, 0), Vec3(1, 2, 3), Vec3(-1, 0.5, 2)};
+  const double T = 0.5 * 2.0 * 14.0 + 0.5 * (-1 + 1 + 6) + 0.5 * 3.0 * 5.25;
+  EXPECT_DOUBLE_EQ(kinetic_energy(p, s), T);
+  EXPECT_DOUBLE_EQ(energy(p, OriginCentre{-2.0}, s), T + 2.0);
+}
+
+// ---- validation: every rule has a test -------------------------------------------------------
+
+Scene scene_with(const BodyPoint& p, const Vec3& R = Vec3(-10, 1, 0)) {
+  Scene s;
+  s.centres.push_back({Vec3::Zero(), -2.0});
+  s.bodies.push_back({p, State{R, Vec3(1, 0, 0), Vec3::Zero()}, "b"});
+  return s;
+}
+
+void expect_error(const std::function<void()>& f, const std::string& fragment) {
+  try {
+    f();
+    ADD_FAILURE() << "no error, expected one mentioning '" << fragment << "'";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+  }
+}
+
+TEST(Validation, RejectsNonPositiveMassInertiaAndD) {
+  expect_error([] { validate(scene_with({0.0, 0.0, 1.0})); }, "mass m must be > 0");
+  expect_error([] { validate(scene_with({-1.0, 0.0, 1.0})); }, "mass m must be > 0");
+  expect_error([] { validate(scene_with({1.0, 0.0, 0.0})); }, "inertia J must be > 0");
+  expect_error([] { validate(scene_with({1.0, 1.0, 1.0})); }, "D = m J - B^2 must be > 0");
+  expect_error([] { validate(scene_with({1.0, 2.0, 1.0})); }, "D = m J - B^2 must be > 0");
+}
+
+TEST(Validation, RejectsNonFiniteNumbers) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  expect_error([&] { validate(scene_with({nan, 0.0, 1.0})); }, "finite");
+  expect_error([&] { validate(scene_with({1.0, inf, 1.0})); }, "finite");
+  expect_error([&] { validate(scene_with({1.0, 0.0, 1.0}, Vec3(nan, 0, 0))); }, "finite");
+  Scene s = scene_with({1.0, 0.0, 1.0});
+  s.centres[0].A = inf;
+  expect_error([&] { validate(s); }, "finite");
+  SceneParams sp;
+  sp.start.d = nan;
+  expect_error([&] { thesis_scene(sp); }, "finite");
+}
+
+TEST(Validation, RejectsBodyOnCentreAndEmptyScenes) {
+  expect_error([] { validate(scene_with({1.0, 0.0, 1.0}, Vec3::Zero())); }, "starts on centre");
+  Scene s = scene_with({1.0, 0.0, 1.0});
+  s.centres.clear();
+  expect_error([&] { validate(s); }, "no Coulomb centre");
+}
+
+TEST(Validation, RejectsBadRunSpecAndUnknownMethod) {
+  const Scene s = test::table31();
+  RunSpec spec;
+  spec.steps = 10;
+  spec.h = 0.0;
+  expect_error([&] { run(method_or_throw("rk4"), s.bodies[0], s.centres, spec); }, "step size h");
+  spec.h = -1e-3;
+  expect_error([&] { run(method_or_throw("rk4"), s.bodies[0], s.centres, spec); }, "step size h");
+  spec.h = std::numeric_limits<double>::quiet_NaN();
+  expect_error([&] { run(method_or_throw("rk4"), s.bodies[0], s.centres, spec); }, "step size h");
+  spec.h = 1e-3;
+  spec.steps = 0;
+  expect_error([&] { run(method_or_throw("rk4"), s.bodies[0], s.centres, spec); }, "steps");
+  expect_error([] { method_or_throw("rk5"); }, "unknown method 'rk5'");
+}
+
+// ---- scene files -------------------------------------------------------------------------------
+
+TEST(SceneFile, ParsesBothBodyForms) {
+  const Scene s = parse_scene(R"(
+[[centre]]
+position = [1.0, 2.0, 0.0]
+A = -2
+[[centre]]
+A = 0.5
+[[body]]
+name = "thesis"
+m = 1
+B = 0.7
+J = 1
+d = 10
+L = 200
+K1 = 5
+Kx = 2
+Kz = 5
+[[body]]
+m = 2
+B = 0
+J = 1
+R = [-50, 3, 0]
+v = [1, 0, 0]
+w = [0, 0, 1]
+)", "inline");
+  ASSERT_EQ(s.centres.size(), 2u);
+  ASSERT_EQ(s.bodies.size(), 2u);
+  EXPECT_EQ(s.centres[0].c, Vec3(1, 2, 0));
+  EXPECT_EQ(s.centres[1].c, Vec3::Zero());
+  EXPECT_EQ(s.bodies[0].name, "thesis");
+  EXPECT_EQ(s.bodies[1].name, "body2");
+  EXPECT_NEAR((to_momenta(s.bodies[0].p, s.bodies[0].s0).K1 - Vec3(5, 0, 0)).norm(), 0.0, kConversionTol);
+  EXPECT_EQ(s.bodies[1].s0.R, Vec3(-50, 3, 0));
+}
+
+TEST(SceneFile, ExampleSceneInRepositoryIsValid) {
+  const Scene s = read_scene_file(std::string(BODYPOINT_SOURCE_DIR) + "/scenes/two-centres.toml");
+  EXPECT_GE(s.centres.size(), 2u);
+  EXPECT_GE(s.bodies.size(), 2u);
+}
+
+TEST(SceneFile, RejectsMalformedFiles) {
+  const std::string body = "[[body]]\nm = 1\nB = 0\nJ = 1\nR = [1, 0, 0]\nv = [0, 1, 0]\nw = [0, 0, 0]\n";
+  expect_error([] { parse_scene("this is = = not toml", "f"); }, "f: line 1");
+  expect_error([&] { parse_scene("[[centre]]\nA = -1\ncolour = 3\n" + body, "f"); }, "unknown key 'colour'");
+  expect_error([&] { parse_scene("[[centre]]\nposition = [0, 0, 0]\n" + body, "f"); }, "missing 'A'");
+  expect_error([&] { parse_scene("[[centre]]\nA = \"big\"\n" + body, "f"); }, "'A' must be a number");
+  expect_error([&] { parse_scene("[[centre]]\nA = -1\nposition = [0, 0]\n" + body, "f"); }, "array of 3 numbers");
+  expect_error([] { parse_scene("[[centre]]\nA = -1\n[[body]]\nm = 1\nB = 0\nJ = 1\nR = [1, 0, 0]\nv = [0, 1, 0]\nw = [0, 0, 0]\nd = 3\n", "f"); },
+               "exactly one form");
+  expect_error([] { parse_scene("[[centre]]\nA = -1\n[[body]]\nm = 1\nB = 1\nJ = 1\nR = [1, 0, 0]\nv = [0, 1, 0]\nw = [0, 0, 0]\n", "f"); },
+               "D = m J - B^2");
+  expect_error([] { parse_scene("[[centre]]\nA = -1\n[[body]]\nm = 1\nB = 0\nJ = 1\nR = [0, 0, 0]\nv = [0, 1, 0]\nw = [0, 0, 0]\n", "f"); },
+               "starts on centre");
+  expect_error([] { parse_scene("", "f"); }, "no Coulomb centre");
+  expect_error([] { read_scene_file("/nonexistent/scene.toml"); }, "cannot open");
+}
+
+}  // namespace
+}  // namespace bodypoint
