@@ -1,5 +1,6 @@
 // `bodypoint simulate`: one method on one scene; readable summary, --json, or a trajectory CSV.
 #include "bodypoint/io.hpp"
+#include "bodypoint/reference.hpp"
 #include "bodypoint/run.hpp"
 #include "cli.hpp"
 
@@ -7,6 +8,7 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 namespace bodypoint::cli {
@@ -24,7 +26,7 @@ std::string scene_header(const po::variables_map& vm, const SceneOptions& o) {
   return os.str();
 }
 
-std::string json_body(const RunResult& r) {
+std::string json_body(const RunResult& r, const std::optional<double>& err_R) {
   std::ostringstream os;
   os << "\"R\": " << json_vec(r.final.R) << ", \"v\": " << json_vec(r.final.v)
      << ", \"w\": " << json_vec(r.final.w);
@@ -33,6 +35,7 @@ std::string json_body(const RunResult& r) {
        << ", \"max_rel_dK2sq\": " << json_number(r.invariants->max_rel_dK2sq);
     if (r.invariants->has_K2Q) os << ", \"max_abs_dK2Q\": " << json_number(r.invariants->max_abs_dK2Q);
   }
+  if (err_R) os << ", \"err_R\": " << json_number(*err_R);
   os << ", \"force_evals\": " << r.force_evals << ", \"wall_s\": " << json_number(r.wall_s);
   return os.str();
 }
@@ -45,7 +48,7 @@ int cmd_simulate(int argc, char** argv) {
   std::string method_name = "lp-y4";
   std::string out;
   long every = 1;
-  bool json = false, no_invariants = false;
+  bool json = false, no_invariants = false, with_reference = false;
   po::options_description desc("bodypoint simulate");
   add_scene_options(desc, so);
   add_step_options(desc, st);
@@ -54,7 +57,9 @@ int cmd_simulate(int argc, char** argv) {
       ("out", po::value(&out), "write the trajectory to this CSV file (atomically)")
       ("every", po::value(&every)->default_value(every), "with --out: write every k-th step (and the last)")
       ("json", po::bool_switch(&json), "print one JSON object instead of the summary")
-      ("no-invariants", po::bool_switch(&no_invariants), "do not track the invariants (fastest; final state only)");
+      ("no-invariants", po::bool_switch(&no_invariants), "do not track the invariants (fastest; final state only)")
+      ("reference", po::bool_switch(&with_reference),
+       "also report err_R = |R - R_ref| against Boost.Odeint rkf78 in long double at tolerance 1e-16");
   po::variables_map vm;
   if (!parse(argc, argv, desc, vm,
              "usage: bodypoint simulate [options]\n"
@@ -84,6 +89,7 @@ int cmd_simulate(int argc, char** argv) {
   }
 
   std::vector<RunResult> results;
+  std::vector<std::optional<double>> errors;
   for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
     const Body& body = scene.bodies[b];
     if (file) {
@@ -104,6 +110,9 @@ int cmd_simulate(int argc, char** argv) {
       throw Error("body '" + body.name + "': the integration produced a non-finite state (NaN/inf); "
                   "the step is too large for a close approach, or the body fell onto an attracting centre");
     results.push_back(r);
+    std::optional<double> err;
+    if (with_reference) err = (r.final.R - reference_state(body, scene.centres, r.t_end).R).norm();
+    errors.push_back(err);
   }
   if (file) file->commit();
 
@@ -111,12 +120,12 @@ int cmd_simulate(int argc, char** argv) {
     const RunResult& r0 = results.front();
     std::cout << "{\"method\": \"" << method.name << "\", \"h\": " << json_number(spec.h)
               << ", \"steps\": " << spec.steps << ", \"t_end\": " << json_number(r0.t_end) << ", "
-              << json_body(r0);
+              << json_body(r0, errors.front());
     if (results.size() > 1) {
       std::cout << ", \"bodies\": [";
       for (std::size_t b = 0; b < results.size(); ++b)
         std::cout << (b ? ", " : "") << "{\"name\": \"" << scene.bodies[b].name << "\", "
-                  << json_body(results[b]) << "}";
+                  << json_body(results[b], errors[b]) << "}";
       std::cout << "]";
     }
     std::cout << "}\n";
@@ -141,6 +150,9 @@ int cmd_simulate(int argc, char** argv) {
         std::cout << "  max |K2Q - K2Q_0|          = " << r.invariants->max_abs_dK2Q << "\n";
       std::cout << std::defaultfloat;
     }
+    if (errors[b])
+      std::cout << std::setprecision(3) << std::scientific << "  |R - R_ref| (odeint rkf78, long double) = "
+                << *errors[b] << "\n" << std::defaultfloat;
     std::cout << "  force evaluations = " << r.force_evals << ", wall time = " << std::setprecision(3)
               << r.wall_s << " s\n";
   }

@@ -1,1 +1,176 @@
+// The bodypoint command line: the issue's acceptance run, the JSON and CSV outputs, and one clear
+// line plus a non-zero exit (and no output file) for every kind of bad input.
+#include "bodypoint/reference.hpp"
+#include "common.hpp"
+
 #include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <sys/wait.h>
+
+namespace bodypoint {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Issue #2: rk4 at h = 1e-3 to t = 50 ends within 1e-5 of an independent solution ...
+constexpr double kRk4FinalTol = 1e-5;
+// ... and reports max_rel_dE below 1e-8.
+constexpr double kRk4EnergyTol = 1e-8;
+
+struct Result {
+  int code;
+  std::string out, err;
+};
+
+Result run_cli(const std::string& args) {
+  const fs::path err = fs::temp_directory_path() / ("bp_err_" + std::to_string(::getpid()));
+  const std::string cmd = std::string(BODYPOINT_BIN) + " " + args + " 2>" + err.string() + " </dev/null";
+  Result r;
+  FILE* p = ::popen(cmd.c_str(), "r");
+  std::array<char, 4096> buf{};
+  while (std::fgets(buf.data(), buf.size(), p)) r.out += buf.data();
+  const int status = ::pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream e(err);
+  std::stringstream ss;
+  ss << e.rdbuf();
+  r.err = ss.str();
+  fs::remove(err);
+  return r;
+}
+
+Vec3 json_vec(const std::string& json, const std::string& key) {
+  const std::regex re("\"" + key + "\": \\[([^,]+), ([^,]+), ([^\\]]+)\\]");
+  std::smatch m;
+  EXPECT_TRUE(std::regex_search(json, m, re)) << key << " in " << json;
+  return Vec3(std::stod(m[1]), std::stod(m[2]), std::stod(m[3]));
+}
+
+double json_num(const std::string& json, const std::string& key) {
+  const std::regex re("\"" + key + "\": ([^,}]+)");
+  std::smatch m;
+  EXPECT_TRUE(std::regex_search(json, m, re)) << key << " in " << json;
+  return std::stod(m[1]);
+}
+
+TEST(Cli, Rk4OnTheDefaultSceneMeetsTheFoundationTarget) {
+  const Result r = run_cli("simulate --method rk4 --h 1e-3 --t-end 50 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Scene s = test::table31();
+  const State ref = reference_state(s.bodies.front(), s.centres, 50.0);
+  EXPECT_LT((json_vec(r.out, "R") - ref.R).norm(), kRk4FinalTol);
+  EXPECT_LT(json_num(r.out, "max_rel_dE"), kRk4EnergyTol);
+  EXPECT_EQ(json_num(r.out, "steps"), 50000);
+  EXPECT_EQ(json_num(r.out, "force_evals"), 200000);
+}
+
+TEST(Cli, EveryMethodRunsAndReportsItsInvariants) {
+  const Result list = run_cli("methods");
+  ASSERT_EQ(list.code, 0);
+  for (const MethodInfo& m : methods()) {
+    EXPECT_NE(list.out.find(std::string(m.name)), std::string::npos) << m.name;
+    const Result r = run_cli("simulate --json --h 0.01 --t-end 50 --method " + std::string(m.name));
+    ASSERT_EQ(r.code, 0) << m.name << ": " << r.err;
+    for (const char* key : {"max_rel_dE", "max_rel_dK2sq", "max_abs_dK2Q", "force_evals", "wall_s"})
+      EXPECT_NE(r.out.find(key), std::string::npos) << m.name << " lacks " << key;
+  }
+}
+
+TEST(Cli, TrajectoryCsvHasHeaderAndEveryKthRow) {
+  const fs::path out = fs::temp_directory_path() / "bp_traj.csv";
+  fs::remove(out);
+  const Result r = run_cli("simulate --method lp-y4 --h 0.01 --steps 1000 --every 100 --out " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(out);
+  std::string line;
+  int comments = 0, rows = 0;
+  std::string header;
+  while (std::getline(in, line)) {
+    if (line.rfind("#", 0) == 0) {
+      ++comments;
+    } else if (header.empty()) {
+      header = line;
+    } else {
+      ++rows;
+    }
+  }
+  EXPECT_GE(comments, 2);
+  EXPECT_EQ(header, "body,t,Rx,Ry,Rz,vx,vy,vz,wx,wy,wz,rel_dE,rel_dK2sq,abs_dK2Q");
+  EXPECT_EQ(rows, 11);  // steps 0, 100, ..., 1000
+  fs::remove(out);
+}
+
+TEST(Cli, SceneFileWithSeveralCentresAndBodies) {
+  const Result r = run_cli("simulate --json --method lp-y6 --h 0.01 --t-end 20 --scene " +
+                           std::string(BODYPOINT_SOURCE_DIR) + "/scenes/two-centres.toml");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"bodies\": ["), std::string::npos);
+  EXPECT_EQ(r.out.find("max_abs_dK2Q"), std::string::npos) << "K2Q is not an integral with two centres";
+}
+
+struct BadInput {
+  std::string args, fragment;
+};
+
+TEST(Cli, BadInputGivesOneLineErrorNonZeroExitAndNoOutputFile) {
+  const fs::path dir = fs::temp_directory_path() / "bp_bad";
+  fs::create_directories(dir);
+  const fs::path bad_scene = dir / "bad.toml";
+  std::ofstream(bad_scene) << "[[centre]]\nA = -1\n[[body]\nm = 1\n";
+  const std::vector<BadInput> cases = {
+      {"--m 0", "mass m must be > 0"},
+      {"--m -1", "mass m must be > 0"},
+      {"--J 0", "inertia J must be > 0"},
+      {"--B 1", "D = m J - B^2 must be > 0"},
+      {"--h 0", "--h must be a finite number > 0"},
+      {"--h -1e-3", "--h must be a finite number > 0"},
+      {"--h nan", "--h must be a finite number > 0"},
+      {"--A inf", "must be a finite number"},
+      {"--d nan", "must be a finite number"},
+      {"--L 0 --d 1", "starts on centre"},
+      {"--method rk5", "unknown method 'rk5'"},
+      {"--bogus 3", "unrecognised option"},
+      {"--steps 10 --t-end 5", "not both"},
+      {"--steps 0", "--steps must be >= 1"},
+      {"--scene " + bad_scene.string(), "bad.toml: line"},
+      {"--scene /nonexistent.toml", "cannot open scene file"},
+      {"--scene " + bad_scene.string() + " --d 3", "cannot be combined with --scene"},
+      {"--h abc", "invalid"},
+  };
+  const fs::path out = dir / "out.csv";
+  for (const BadInput& c : cases) {
+    fs::remove(out);
+    const bool sets_steps = c.args.find("--steps") != std::string::npos;
+    const Result r = run_cli(std::string("simulate ") + (sets_steps ? "" : "--steps 100 ") + c.args + " --out " + out.string());
+    EXPECT_NE(r.code, 0) << c.args;
+    EXPECT_NE(r.err.find(c.fragment), std::string::npos) << c.args << " -> " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.args << " -> " << r.err;
+    EXPECT_FALSE(fs::exists(out)) << c.args << " left an output file";
+    for (const auto& e : fs::directory_iterator(dir))
+      EXPECT_EQ(e.path().string().find(".tmp."), std::string::npos) << "temporary left behind";
+  }
+  const Result unwritable = run_cli("simulate --steps 10 --out /nonexistent-dir/x.csv");
+  EXPECT_NE(unwritable.code, 0);
+  EXPECT_NE(unwritable.err.find("cannot write output file"), std::string::npos) << unwritable.err;
+  const Result unknown = run_cli("frobnicate");
+  EXPECT_NE(unknown.code, 0);
+  EXPECT_NE(unknown.err.find("unknown command"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST(Cli, DivergedRunIsAnErrorNotANumber) {
+  // A material point aimed at an attracting centre whose first drift lands exactly on it
+  // (R0 = -1 i, v0 = 2 i, h = 0.5): the force there is undefined and the state turns into NaN.
+  const Result r = run_cli("simulate --method thesis-euler --A 5 --B 0 --K1 2 --L 1 --d 0 --Kz 0 --Kx 0 --h 0.5 --steps 10");
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("non-finite"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace bodypoint
