@@ -36,6 +36,9 @@ std::string json_body(const RunResult& r, const std::optional<double>& err_R) {
     if (r.invariants->has_K2Q) os << ", \"max_abs_dK2Q\": " << json_number(r.invariants->max_abs_dK2Q);
   }
   if (err_R) os << ", \"err_R\": " << json_number(*err_R);
+  if (r.max_step > 0.0)
+    os << ", \"accepted_steps\": " << r.steps << ", \"min_step\": " << json_number(r.min_step)
+       << ", \"max_step\": " << json_number(r.max_step);
   os << ", \"force_evals\": " << r.force_evals << ", \"wall_s\": " << json_number(r.wall_s);
   return os.str();
 }
@@ -48,6 +51,7 @@ int cmd_simulate(int argc, char** argv) {
   std::string method_name = "lp-y4";
   std::string out;
   long every = 1;
+  double tol = 1e-10;
   bool json = false, no_invariants = false, with_reference = false;
   po::options_description desc("bodypoint simulate");
   add_scene_options(desc, so);
@@ -55,6 +59,7 @@ int cmd_simulate(int argc, char** argv) {
   desc.add_options()
       ("method", po::value(&method_name)->default_value(method_name), "integration method (see 'bodypoint methods')")
       ("out", po::value(&out), "write the trajectory to this CSV file (atomically)")
+      ("tol", po::value(&tol)->default_value(tol), "adaptive methods (odeint-*): error tolerance per step")
       ("every", po::value(&every)->default_value(every), "with --out: write every k-th step (and the last)")
       ("json", po::bool_switch(&json), "print one JSON object instead of the summary")
       ("no-invariants", po::bool_switch(&no_invariants), "do not track the invariants (fastest; final state only)")
@@ -71,6 +76,8 @@ int cmd_simulate(int argc, char** argv) {
   RunSpec spec;
   apply_step_options(vm, st, spec);
   spec.every = every;
+  spec.tol = tol;
+  spec.t_end = spec.h * static_cast<double>(spec.steps);
   if (every < 1) throw Error("--every must be >= 1");
   spec.track_invariants = !no_invariants;
 
@@ -119,6 +126,7 @@ int cmd_simulate(int argc, char** argv) {
   if (json) {
     const RunResult& r0 = results.front();
     std::cout << "{\"method\": \"" << method.name << "\", \"h\": " << json_number(spec.h)
+              << (is_adaptive(method) ? ", \"tol\": " + json_number(spec.tol) : std::string())
               << ", \"steps\": " << spec.steps << ", \"t_end\": " << json_number(r0.t_end) << ", "
               << json_body(r0, errors.front());
     if (results.size() > 1) {

@@ -1,5 +1,6 @@
 #include "bodypoint/io.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -37,10 +38,10 @@ void AtomicFile::commit() {
 }
 
 std::string fmt(double x) {
-  std::ostringstream os;
-  os.precision(std::numeric_limits<double>::max_digits10);
-  os << x;
-  return os.str();
+  // Shortest representation that reads back to the same double (0.7, not 0.69999999999999996).
+  char buf[32];
+  const auto res = std::to_chars(buf, buf + sizeof buf, x);
+  return std::string(buf, res.ptr);
 }
 
 std::string json_number(double x) { return std::isfinite(x) ? fmt(x) : "null"; }

@@ -2,7 +2,7 @@
 //
 // `AtomicFile` writes to a temporary file beside the target and renames it over the target on
 // commit(), so a failed or interrupted run never leaves a half-written result. Numbers are written
-// with max_digits10 significant digits so that a value read back is the value computed.
+// so that a value read back is exactly the value computed.
 #pragma once
 
 #include "bodypoint/model.hpp"
@@ -32,7 +32,7 @@ class AtomicFile {
   bool committed_ = false;
 };
 
-/// x with 17 significant digits ("nan"/"inf" spelled as such).
+/// x in the shortest form that reads back exactly ("nan"/"inf" spelled as such).
 std::string fmt(double x);
 /// JSON number, or null for a non-finite value.
 std::string json_number(double x);

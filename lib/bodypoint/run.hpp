@@ -18,8 +18,10 @@
 namespace bodypoint {
 
 struct RunSpec {
-  double h = 1e-4;
-  long steps = 500000;
+  double h = 1e-4;       ///< fixed step; for adaptive methods the first trial step
+  long steps = 500000;   ///< fixed-step methods: number of steps (t_end = steps h)
+  double t_end = 0.0;    ///< adaptive methods: end time (0: steps h)
+  double tol = 1e-10;    ///< adaptive methods: relative and absolute error tolerance per step
   bool track_invariants = false;
   long every = 1;  ///< hand every `every`-th state (and the last) to the sink
 };
@@ -40,9 +42,12 @@ struct RunResult {
   long force_evals = 0;
   double wall_s = 0.0;
   std::optional<InvariantStats> invariants;
+  double min_step = 0.0, max_step = 0.0;  ///< smallest and largest accepted physical step
 };
 
-enum class Family { Thesis, LiePoisson, Odeint };
+/// Thesis: the thesis's drift/kick schemes; LiePoisson: exact splittings; Odeint: fixed-step
+/// odeint steppers (rk4, ab4); OdeintAdaptive: step-size-controlled odeint steppers (--tol).
+enum class Family { Thesis, LiePoisson, Odeint, OdeintAdaptive };
 
 struct MethodInfo {
   std::string_view name;
@@ -63,7 +68,10 @@ const MethodInfo* find_method(std::string_view name);
 /// Throws Error("unknown method ...") for a name not in methods().
 const MethodInfo& method_or_throw(std::string_view name);
 
-/// Validates the inputs (scene, h > 0 and finite, steps >= 1, every >= 1) and runs.
+/// True for methods that choose their own steps (spec.tol, spec.t_end apply).
+inline bool is_adaptive(const MethodInfo& m) { return m.family == Family::OdeintAdaptive; }
+
+/// Validates the inputs (scene, h > 0 and finite, steps >= 1, every >= 1, tol > 0) and runs.
 RunResult run(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
               const RunSpec& spec, const SampleSink* sink = nullptr);
 
