@@ -175,8 +175,10 @@ int cmd_methods(int argc, char** argv) {
   std::cout << std::left << std::setw(16) << "method" << std::setw(8) << "order" << std::setw(8)
             << "stages" << std::setw(14) << "evals/step" << "description\n";
   for (const MethodInfo& m : methods())
-    std::cout << std::left << std::setw(16) << m.name << std::setw(8) << m.order << std::setw(8)
-              << m.stages << std::setw(14) << m.evals_per_step << m.description << "\n";
+    std::cout << std::left << std::setw(16) << m.name << std::setw(8)
+              << (m.order ? std::to_string(m.order) : "var") << std::setw(8)
+              << (is_adaptive(m) ? "-" : std::to_string(m.stages)) << std::setw(14)
+              << (is_adaptive(m) ? "adaptive" : std::to_string(m.evals_per_step)) << m.description << "\n";
   return 0;
 }
 

@@ -52,7 +52,7 @@ enum class Family { Thesis, LiePoisson, Odeint, OdeintAdaptive };
 struct MethodInfo {
   std::string_view name;
   Family family;
-  int order;            ///< nominal order (for the thesis family: of the underlying table)
+  int order;            ///< nominal order (thesis family: of the underlying table; 0: variable)
   int stages;           ///< sub-steps (kicks) per step as written
   int evals_per_step;   ///< force evaluations per step in a long run without per-step output
   std::string_view description;
