@@ -39,5 +39,6 @@ bool parse(int argc, char** argv, const po::options_description& desc, po::varia
 
 int cmd_simulate(int argc, char** argv);
 int cmd_methods(int argc, char** argv);
+int cmd_work_precision(int argc, char** argv);
 
 }  // namespace bodypoint::cli

@@ -14,6 +14,7 @@ constexpr const char* usage =
     "commands:\n"
     "  simulate   integrate a scene with one method (default: thesis table 3.1)\n"
     "  methods    list the integration methods\n"
+    "  work-precision  final-position error against run time, every method and Boost.Odeint\n"
     "Run 'bodypoint <command> --help' for the options of a command.";
 
 }  // namespace
@@ -27,7 +28,8 @@ int main(int argc, char** argv) {
   try {
     if (cmd == "simulate") return bodypoint::cli::cmd_simulate(argc - 1, argv + 1);
     if (cmd == "methods") return bodypoint::cli::cmd_methods(argc - 1, argv + 1);
-    std::cerr << "bodypoint: error: unknown command '" << cmd << "' (simulate, methods)\n";
+    if (cmd == "work-precision") return bodypoint::cli::cmd_work_precision(argc - 1, argv + 1);
+    std::cerr << "bodypoint: error: unknown command '" << cmd << "' (simulate, methods, work-precision)\n";
     return 2;
   } catch (const bodypoint::Error& e) {
     std::cerr << "bodypoint: error: " << e.what() << "\n";

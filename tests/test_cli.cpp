@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <regex>
 #include <sstream>
 #include <sys/wait.h>
@@ -162,6 +163,32 @@ TEST(Cli, BadInputGivesOneLineErrorNonZeroExitAndNoOutputFile) {
   EXPECT_NE(unknown.code, 0);
   EXPECT_NE(unknown.err.find("unknown command"), std::string::npos);
   fs::remove_all(dir);
+}
+
+TEST(Cli, WorkPrecisionQuickWritesRowsForEveryMethodAndASummary) {
+  const fs::path out = fs::temp_directory_path() / "bp_wp.csv";
+  fs::remove(out);
+  const Result r = run_cli("work-precision --quick --out " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(out);
+  std::string line, header;
+  std::map<std::string, int> rows;
+  while (std::getline(in, line)) {
+    if (line.rfind("#", 0) == 0) continue;
+    if (header.empty()) {
+      header = line;
+      continue;
+    }
+    rows[line.substr(0, line.find(',', line.find(',') + 1))]++;  // "scene,method"
+  }
+  EXPECT_EQ(header, "scene,method,h,tol,err_R,err_rel,max_rel_dE,force_evals,wall_s");
+  for (const char* scene : {"thesis", "material"})
+    for (const MethodInfo& m : methods())
+      EXPECT_GT(rows[std::string(scene) + "," + std::string(m.name)], 0) << scene << " " << m.name;
+  for (const char* target : {"| thesis | 1e-04 |", "| thesis | 1e-07 |", "| material | 1e-10 |"})
+    EXPECT_NE(r.out.find(target), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("reference thesis: odeint rkf78 long double"), std::string::npos) << r.err;
+  fs::remove(out);
 }
 
 TEST(Cli, DivergedRunIsAnErrorNotANumber) {

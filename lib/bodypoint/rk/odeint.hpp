@@ -32,6 +32,11 @@ using Dopri5 = odeint::controlled_runge_kutta<odeint::runge_kutta_dopri5<OdeStat
 using Rkf78 = odeint::controlled_runge_kutta<odeint::runge_kutta_fehlberg78<OdeState<double>>>;
 using BulirschStoer = odeint::bulirsch_stoer<OdeState<double>>;
 
+#pragma GCC diagnostic push
+// GCC 12 reports the default-constructed stepper that odeint's controller copies as (maybe-)
+// uninitialised: a false positive inside Boost (its members are work arrays written before use).
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#pragma GCC diagnostic ignored "-Wuninitialized"
 template <class Controlled>
 Controlled make_controlled(double tol) {
   if constexpr (std::is_same_v<Controlled, BulirschStoer>) {
@@ -41,5 +46,6 @@ Controlled make_controlled(double tol) {
     return Controlled(Checker(tol, tol));
   }
 }
+#pragma GCC diagnostic pop
 
 }  // namespace bodypoint::rk

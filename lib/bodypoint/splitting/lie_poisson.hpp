@@ -58,30 +58,47 @@ struct DriftFunctions {
   double S1, C1, S3;
 };
 
-inline DriftFunctions drift_functions(double x) {
-  if (x < 1.0) {
-    // Taylor series in x: S1 = sum (-x)^k/(2k+1)!, C1 = sum (-x)^k/(2k+2)!, S3 = sum (-x)^k/(2k+3)!.
-    // Nine terms: the first omitted term of S3 is below 1/21! ~ 2e-20 of its value 1/6.
-    constexpr int terms = 9;
-    constexpr auto inv_factorials = [] {
-      std::array<double, 2 * terms + 4> f{};
-      double v = 1.0;
-      f[0] = 1.0;
-      for (int n = 1; n < 2 * terms + 4; ++n) {
-        v /= n;
-        f[n] = v;
-      }
-      return f;
-    }();
-    double s1 = 0.0, c1 = 0.0, s3 = 0.0;
-    for (int k = terms - 1; k >= 0; --k) {
-      const double sign = (k % 2 == 0) ? 1.0 : -1.0;
-      s1 = s1 * x + sign * inv_factorials[2 * k + 1];
-      c1 = c1 * x + sign * inv_factorials[2 * k + 2];
-      s3 = s3 * x + sign * inv_factorials[2 * k + 3];
-    }
-    return {s1, c1, s3};
+namespace detail {
+/// (-1)^k/(2k+n)! for n = 1, 2, 3 and k = 0..8.
+struct SeriesCoefficients {
+  double s1[9], c1[9], s3[9];
+};
+constexpr SeriesCoefficients series_coefficients() {
+  SeriesCoefficients c{};
+  double inv_fact[22]{};
+  inv_fact[0] = 1.0;
+  for (int n = 1; n < 22; ++n) inv_fact[n] = inv_fact[n - 1] / n;
+  for (int k = 0; k < 9; ++k) {
+    const double sign = (k % 2 == 0) ? 1.0 : -1.0;
+    c.s1[k] = sign * inv_fact[2 * k + 1];
+    c.c1[k] = sign * inv_fact[2 * k + 2];
+    c.s3[k] = sign * inv_fact[2 * k + 3];
   }
+  return c;
+}
+inline constexpr SeriesCoefficients kSeries = series_coefficients();
+
+/// Horner evaluation of the first Terms terms of the three series at x.
+template <int Terms>
+inline DriftFunctions drift_series(double x) {
+  double s1 = kSeries.s1[Terms - 1], c1 = kSeries.c1[Terms - 1], s3 = kSeries.s3[Terms - 1];
+  for (int k = Terms - 2; k >= 0; --k) {
+    s1 = s1 * x + kSeries.s1[k];
+    c1 = c1 * x + kSeries.c1[k];
+    s3 = s3 * x + kSeries.s3[k];
+  }
+  return {s1, c1, s3};
+}
+}  // namespace detail
+
+inline DriftFunctions drift_functions(double x) {
+  // Taylor series S1 = sum (-x)^k/(2k+1)!, C1 = sum (-x)^k/(2k+2)!, S3 = sum (-x)^k/(2k+3)!, cut where
+  // the first omitted term of S3 (the slowest) is below 1e-19 of its value 1/6:
+  //   x < 1e-3: 4 terms (x^4/11! < 3e-20),  x < 0.1: 6 terms (x^6/15! < 8e-19),  x < 1: 9 terms
+  //   (x^9/21! < 2e-20). Typical steps (phi = |Omega| tau ~ 1e-2) take the 4-term branch.
+  if (x < 1e-3) return detail::drift_series<4>(x);
+  if (x < 0.1) return detail::drift_series<6>(x);
+  if (x < 1.0) return detail::drift_series<9>(x);
   const double phi = std::sqrt(x);
   const double s = std::sin(phi);
   const double c = std::cos(phi);

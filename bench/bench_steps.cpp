@@ -1,0 +1,111 @@
+// Micro-benchmarks: the floor (one force evaluation, one exact drift), one step of every method on
+// table 3.1 and on a material point, and Boost.Odeint's steppers on the same system.
+// Counters: time_per_step (seconds, SI-prefixed) and force evaluations per second.
+//
+//   build/bin/bench_steps --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+#include "bodypoint/field.hpp"
+#include "bodypoint/rhs.hpp"
+#include "bodypoint/rk/odeint.hpp"
+#include "bodypoint/run.hpp"
+#include "bodypoint/scenes.hpp"
+#include "bodypoint/splitting/lie_poisson.hpp"
+
+#include <benchmark/benchmark.h>
+
+namespace bodypoint {
+namespace {
+
+namespace sp = splitting;
+constexpr long kSteps = 10000;  // steps per benchmark iteration (amortises the run set-up)
+
+void set_counters(benchmark::State& st, long steps, long evals) {
+  st.counters["time_per_step"] = benchmark::Counter(static_cast<double>(steps),
+                                                    benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  st.counters["evals_per_s"] = benchmark::Counter(static_cast<double>(evals), benchmark::Counter::kIsRate);
+}
+
+void BM_ForceEvaluation(benchmark::State& st) {
+  const OriginCentre f{-2.0};
+  Vec3 R(-200, 9, 0), acc = Vec3::Zero();
+  for (auto _ : st) {
+    acc += f.force(R);
+    R.x() += 1e-3;
+    benchmark::DoNotOptimize(acc);
+  }
+  set_counters(st, static_cast<long>(st.iterations()), static_cast<long>(st.iterations()));
+}
+BENCHMARK(BM_ForceEvaluation);
+
+template <bool Spin>
+void BM_ExactDrift(benchmark::State& st) {
+  const NamedScene ns = named_scene("thesis");
+  BodyPoint p = ns.scene.bodies.front().p;
+  if (!Spin) p.B = 0.0;
+  const sp::LiePoissonKernel<OriginCentre, Spin> k(p, OriginCentre{-2.0});
+  sp::LieState x = k.initial_state(ns.scene.bodies.front().s0);
+  for (auto _ : st) {
+    k.drift(x, 1e-3);
+    benchmark::DoNotOptimize(x);
+  }
+  set_counters(st, static_cast<long>(st.iterations()), 0);
+}
+BENCHMARK(BM_ExactDrift<true>)->Name("BM_ExactDrift/body-point");
+BENCHMARK(BM_ExactDrift<false>)->Name("BM_ExactDrift/material-point");
+
+/// Whole steps of a registered method (no invariants, no output): the production loop.
+void BM_MethodStep(benchmark::State& st, const std::string& method, const std::string& scene) {
+  const NamedScene ns = named_scene(scene);
+  const MethodInfo& m = method_or_throw(method);
+  RunSpec spec;
+  spec.h = 1e-3;
+  spec.steps = kSteps;
+  spec.t_end = 1e-3 * kSteps;
+  spec.tol = 1e-10;
+  long steps = 0, evals = 0;
+  for (auto _ : st) {
+    const RunResult r = run(m, ns.scene.bodies.front(), ns.scene.centres, spec);
+    benchmark::DoNotOptimize(r.final.R);
+    steps += r.steps;
+    evals += r.force_evals;
+  }
+  set_counters(st, steps, evals);
+  st.counters["evals_per_step"] = static_cast<double>(evals) / static_cast<double>(steps);
+}
+
+void register_method_benchmarks() {
+  for (const MethodInfo& m : methods()) {
+    for (const char* scene : {"thesis", "material"}) {
+      benchmark::RegisterBenchmark(("BM_Step/" + std::string(m.name) + "/" + scene).c_str(),
+                                   [name = std::string(m.name), scene](benchmark::State& st) {
+                                     BM_MethodStep(st, name, scene);
+                                   });
+    }
+  }
+}
+
+/// Boost.Odeint steppers called directly on the system (no bodypoint loop around them).
+template <class Stepper>
+void BM_OdeintDirect(benchmark::State& st) {
+  const NamedScene ns = named_scene("thesis");
+  const Body& b = ns.scene.bodies.front();
+  EquationsOfMotion<OriginCentre, true> sys{b.p, OriginCentre{-2.0}};
+  Stepper stepper;
+  OdeState<double> x = to_ode(b.s0);
+  double t = 0;
+  for (auto _ : st) {
+    stepper.do_step(std::ref(sys), x, t, 1e-3);
+    t += 1e-3;
+    benchmark::DoNotOptimize(x);
+  }
+  set_counters(st, static_cast<long>(st.iterations()), 0);
+}
+BENCHMARK(BM_OdeintDirect<rk::Rk4>)->Name("BM_OdeintDirect/runge_kutta4");
+BENCHMARK(BM_OdeintDirect<boost::numeric::odeint::runge_kutta_dopri5<OdeState<double>>>)
+    ->Name("BM_OdeintDirect/runge_kutta_dopri5");
+BENCHMARK(BM_OdeintDirect<boost::numeric::odeint::runge_kutta_fehlberg78<OdeState<double>>>)
+    ->Name("BM_OdeintDirect/runge_kutta_fehlberg78");
+
+const int registered = (register_method_benchmarks(), 0);
+
+}  // namespace
+}  // namespace bodypoint

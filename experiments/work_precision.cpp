@@ -1,0 +1,230 @@
+// `bodypoint work-precision`: final-position error against run time for every method, side by side
+// with Boost.Odeint, on named scenes (lib/bodypoint/scenes.hpp).
+//
+// For each scene the reference is Boost.Odeint rkf78 in long double at tolerance 1e-18; its own error
+// is estimated as the larger of its distance to the same integration at tolerance 1e-15 and to the
+// 10th-order Lie-Poisson method at a small step (two independent cross-checks). For each method a
+// ladder of steps (halving h) or tolerances (dividing by 10) is run; each configuration is timed as
+// the median of several repeats with no invariant tracking and no output inside the timed region, and
+// run once more, untimed, to measure max_rel_dE.
+#include "bodypoint/io.hpp"
+#include "bodypoint/reference.hpp"
+#include "bodypoint/run.hpp"
+#include "bodypoint/scenes.hpp"
+#include "cli.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <memory>
+#include <sstream>
+
+namespace bodypoint::cli {
+namespace {
+
+struct Row {
+  std::string scene, method;
+  double h = 0, tol = 0;  // one of them set
+  double err_R = 0, err_rel = 0, max_rel_dE = 0, wall_s = 0;
+  long force_evals = 0;
+};
+
+std::vector<std::string> split_list(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+/// Small-step run of the highest-order splitting, as a cross-check of the reference.
+double splitting_check_step(const std::string& scene) { return scene == "close" ? 5e-4 : 5e-3; }
+
+struct Options {
+  long repeats = 3;
+  double min_timed_s = 0.02;  ///< repeat a configuration until this much time has been measured
+  double max_evals = 2e7;     ///< stop a ladder when a run would exceed this many force evaluations
+  double floor = 1e-13;       ///< stop a ladder once the relative error is below this
+};
+
+Row measure(const NamedScene& ns, const MethodInfo& m, const Body& body, const State& ref, double h,
+            double tol, const Options& o) {
+  RunSpec spec;
+  spec.t_end = ns.t_end;
+  if (is_adaptive(m)) {
+    spec.tol = tol;
+    spec.h = 1e-3;
+    spec.steps = 1;
+  } else {
+    spec.steps = std::max(1L, std::lround(ns.t_end / h));
+    spec.h = ns.t_end / static_cast<double>(spec.steps);
+  }
+  std::vector<double> times;
+  RunResult r;
+  double total = 0;
+  while ((long)times.size() < o.repeats || (total < o.min_timed_s && times.size() < 50)) {
+    r = run(m, body, ns.scene.centres, spec);
+    times.push_back(r.wall_s);
+    total += r.wall_s;
+  }
+  RunSpec inv = spec;
+  inv.track_invariants = true;
+  const RunResult ri = run(m, body, ns.scene.centres, inv);
+  Row row;
+  row.scene = ns.name;
+  row.method = std::string(m.name);
+  row.h = is_adaptive(m) ? 0.0 : spec.h;
+  row.tol = is_adaptive(m) ? tol : 0.0;
+  row.err_R = (r.final.R - ref.R).norm();
+  if (!std::isfinite(row.err_R)) row.err_R = std::numeric_limits<double>::infinity();
+  row.err_rel = row.err_R / ref.R.norm();
+  row.max_rel_dE = ri.invariants ? ri.invariants->max_rel_dE : 0.0;
+  row.force_evals = r.force_evals;
+  row.wall_s = median(times);
+  return row;
+}
+
+}  // namespace
+
+int cmd_work_precision(int argc, char** argv) {
+  std::string scenes_arg = "all", methods_arg = "all", out, summary;
+  Options o;
+  bool quick = false;
+  po::options_description desc("bodypoint work-precision");
+  desc.add_options()
+      ("scenes", po::value(&scenes_arg)->default_value(scenes_arg), "comma-separated: thesis,close,material,long,two-centres or all")
+      ("methods", po::value(&methods_arg)->default_value(methods_arg), "comma-separated method names or all")
+      ("repeats", po::value(&o.repeats)->default_value(o.repeats), "timed repeats per configuration (median reported)")
+      ("max-evals", po::value(&o.max_evals)->default_value(o.max_evals), "largest run of a ladder, in force evaluations")
+      ("quick", po::bool_switch(&quick), "coarse: scenes thesis and material, 1 repeat, runs up to 1e6 force evaluations")
+      ("out", po::value(&out), "CSV: scene, method, h, tol, err_R, err_rel, max_rel_dE, force_evals, wall_s")
+      ("summary", po::value(&summary), "also write the summary table (Markdown) to this file");
+  po::variables_map vm;
+  if (!parse(argc, argv, desc, vm,
+             "usage: bodypoint work-precision [options]\n"
+             "Final-position error against run time for every method on named scenes."))
+    return 0;
+  if (quick) {
+    if (vm["scenes"].defaulted()) scenes_arg = "thesis,material";
+    o.repeats = 1;
+    o.min_timed_s = 0.0;
+    if (vm["max-evals"].defaulted()) o.max_evals = 1e6;
+  }
+  if (o.repeats < 1) throw Error("--repeats must be >= 1");
+  if (!(o.max_evals >= 1)) throw Error("--max-evals must be >= 1");
+  const std::vector<std::string> scene_names = scenes_arg == "all" ? named_scene_names() : split_list(scenes_arg);
+  std::vector<const MethodInfo*> ms;
+  if (methods_arg == "all") {
+    for (const MethodInfo& m : methods()) ms.push_back(&m);
+  } else {
+    for (const std::string& n : split_list(methods_arg)) ms.push_back(&method_or_throw(n));
+  }
+  if (ms.empty()) throw Error("--methods is empty");
+  std::vector<NamedScene> scenes;
+  for (const std::string& n : scene_names) scenes.push_back(named_scene(n));
+
+  std::unique_ptr<AtomicFile> csv, md;
+  if (!out.empty()) csv = std::make_unique<AtomicFile>(out);
+  if (!summary.empty()) md = std::make_unique<AtomicFile>(summary);
+
+  std::vector<Row> rows;
+  std::ostringstream refs;
+  for (const NamedScene& ns : scenes) {
+    const Body& body = ns.scene.bodies.front();
+    const State ref = reference_state(body, ns.scene.centres, ns.t_end, 1e-18L);
+    const State loose = reference_state(body, ns.scene.centres, ns.t_end, 1e-15L);
+    RunSpec cs;
+    cs.steps = std::lround(ns.t_end / splitting_check_step(ns.name));
+    cs.h = ns.t_end / static_cast<double>(cs.steps);
+    const State split = run(method_or_throw("lp-ss10"), body, ns.scene.centres, cs).final;
+    const double ref_err = std::max((ref.R - loose.R).norm(), (ref.R - split.R).norm());
+    refs << "reference " << ns.name << ": odeint rkf78 long double tol 1e-18, t_end " << fmt(ns.t_end)
+         << ", |R_ref| = " << fmt(ref.R.norm()) << ", estimated error " << std::setprecision(2)
+         << std::scientific << ref_err << " (relative " << ref_err / ref.R.norm() << ")" << std::defaultfloat
+         << "\n";
+    std::cerr << refs.str().substr(refs.str().rfind("reference " + ns.name));
+    for (const MethodInfo* m : ms) {
+      if (is_adaptive(*m)) {
+        for (double tol = 1e-3; tol >= 1e-14; tol /= 10) {
+          const Row r = measure(ns, *m, body, ref, 0, tol, o);
+          rows.push_back(r);
+          if (r.err_rel < o.floor || static_cast<double>(r.force_evals) > o.max_evals) break;
+        }
+      } else {
+        for (double h = 0.5;; h /= 2) {
+          const double evals = ns.t_end / h * std::max(1, m->evals_per_step);
+          if (evals > o.max_evals) break;
+          const Row r = measure(ns, *m, body, ref, h, 0, o);
+          rows.push_back(r);
+          if (r.err_rel < o.floor) break;
+        }
+      }
+    }
+  }
+
+  if (csv) {
+    std::ostream& os = csv->stream();
+    os << "# bodypoint work-precision, revision " << git_revision() << "\n"
+       << "# err_R = |R(t_end) - R_ref| against odeint rkf78 in long double at tol 1e-18; err_rel = err_R/|R_ref|\n"
+       << "# wall_s = median over repeats of the step loop alone (no invariants, no output)\n";
+    std::istringstream ref_lines(refs.str());
+    for (std::string line; std::getline(ref_lines, line);) os << "# " << line << "\n";
+    os << "scene,method,h,tol,err_R,err_rel,max_rel_dE,force_evals,wall_s\n";
+    for (const Row& r : rows)
+      os << r.scene << ',' << r.method << ',' << (r.h > 0 ? fmt(r.h) : "") << ',' << (r.tol > 0 ? fmt(r.tol) : "")
+         << ',' << fmt(r.err_R) << ',' << fmt(r.err_rel) << ',' << fmt(r.max_rel_dE) << ',' << r.force_evals
+         << ',' << fmt(r.wall_s) << '\n';
+  }
+
+  // Summary: cheapest configuration of each method reaching each target relative error.
+  std::ostringstream sum;
+  sum << "| scene | target err_rel | best bodypoint method | config | time [ms] | best odeint method | config | time [ms] | speed-up |\n"
+      << "|---|---|---|---|---|---|---|---|---|\n";
+  auto is_odeint = [](const std::string& name) {
+    const MethodInfo& m = method_or_throw(name);
+    return m.family == Family::Odeint || m.family == Family::OdeintAdaptive;
+  };
+  auto config = [](const Row& r) {
+    std::ostringstream c;
+    c << std::setprecision(3);
+    if (r.h > 0) c << "h=" << r.h; else c << "tol=" << r.tol;
+    return c.str();
+  };
+  for (const NamedScene& ns : scenes) {
+    for (double target : {1e-4, 1e-7, 1e-10}) {
+      const Row* best_bp = nullptr;
+      const Row* best_od = nullptr;
+      for (const Row& r : rows) {
+        if (r.scene != ns.name || !(r.err_rel <= target)) continue;
+        const Row*& slot = is_odeint(r.method) ? best_od : best_bp;
+        if (!slot || r.wall_s < slot->wall_s) slot = &r;
+      }
+      sum << "| " << ns.name << " | " << std::setprecision(0) << std::scientific << target << std::defaultfloat
+          << std::setprecision(3) << " | ";
+      if (best_bp) sum << best_bp->method << " | " << config(*best_bp) << " | " << best_bp->wall_s * 1e3 << " | ";
+      else sum << "- | - | - | ";
+      if (best_od) sum << best_od->method << " | " << config(*best_od) << " | " << best_od->wall_s * 1e3 << " | ";
+      else sum << "- | - | - | ";
+      if (best_bp && best_od) sum << std::setprecision(3) << best_od->wall_s / best_bp->wall_s << "x |\n";
+      else sum << "- |\n";
+    }
+  }
+  std::cout << sum.str();
+  if (md) {
+    md->stream() << "<!-- bodypoint work-precision, revision " << git_revision() << " -->\n" << sum.str();
+    md->commit();
+  }
+  if (csv) csv->commit();
+  return 0;
+}
+
+}  // namespace bodypoint::cli
