@@ -1,6 +1,7 @@
 #include "cli.hpp"
 
 #include "bodypoint/scene_file.hpp"
+#include "sweep.hpp"
 
 #include <cmath>
 #include <iostream>
@@ -40,18 +41,16 @@ void add_step_options(po::options_description& desc, StepOptions& o) {
 }
 
 void apply_step_options(const po::variables_map& vm, const StepOptions& o, RunSpec& spec) {
-  if (!std::isfinite(o.h) || o.h <= 0.0) throw Error("--h must be a finite number > 0");
-  spec.h = o.h;
-  spec.steps = o.steps;
+  double t_end = 0.0;
   if (vm.count("t-end")) {
     if (!vm["steps"].defaulted()) throw Error("give --steps or --t-end, not both");
     if (!std::isfinite(o.t_end) || o.t_end <= 0.0) throw Error("--t-end must be a finite number > 0");
-    const double n = std::ceil(o.t_end / o.h * (1.0 - 1e-12));
-    if (n > 1e13) throw Error("--t-end / --h asks for more than 1e13 steps");
-    spec.steps = static_cast<long>(n);
-    spec.h = o.t_end / static_cast<double>(spec.steps);
+    t_end = o.t_end;
   }
-  if (spec.steps < 1) throw Error("--steps must be >= 1");
+  const RunSpec r = resolve_steps(o.h, o.steps, t_end, spec.tol);
+  spec.h = r.h;
+  spec.steps = r.steps;
+  spec.t_end = r.t_end;
 }
 
 bool parse(int argc, char** argv, const po::options_description& desc, po::variables_map& vm,

@@ -40,5 +40,11 @@ bool parse(int argc, char** argv, const po::options_description& desc, po::varia
 int cmd_simulate(int argc, char** argv);
 int cmd_methods(int argc, char** argv);
 int cmd_work_precision(int argc, char** argv);
+int cmd_sweep(int argc, char** argv);
+int cmd_timing(int argc, char** argv);
+int cmd_study(int argc, char** argv);
+
+/// Method list from 'all', 'fixed' (every fixed-step method) or comma-separated names.
+std::vector<const MethodInfo*> parse_methods(const std::string& list);
 
 }  // namespace bodypoint::cli

@@ -15,6 +15,9 @@ constexpr const char* usage =
     "  simulate   integrate a scene with one method (default: thesis table 3.1)\n"
     "  methods    list the integration methods\n"
     "  work-precision  final-position error against run time, every method and Boost.Odeint\n"
+    "  sweep      vary one parameter over a range for a list of methods (CSV)\n"
+    "  timing     run time against the number of steps (median of repeats)\n"
+    "  study      regenerate the thesis's studies (d, L, h, Kx sweeps, timing, table 4.1, appendix 1)\n"
     "Run 'bodypoint <command> --help' for the options of a command.";
 
 }  // namespace
@@ -29,7 +32,10 @@ int main(int argc, char** argv) {
     if (cmd == "simulate") return bodypoint::cli::cmd_simulate(argc - 1, argv + 1);
     if (cmd == "methods") return bodypoint::cli::cmd_methods(argc - 1, argv + 1);
     if (cmd == "work-precision") return bodypoint::cli::cmd_work_precision(argc - 1, argv + 1);
-    std::cerr << "bodypoint: error: unknown command '" << cmd << "' (simulate, methods, work-precision)\n";
+    if (cmd == "sweep") return bodypoint::cli::cmd_sweep(argc - 1, argv + 1);
+    if (cmd == "timing") return bodypoint::cli::cmd_timing(argc - 1, argv + 1);
+    if (cmd == "study") return bodypoint::cli::cmd_study(argc - 1, argv + 1);
+    std::cerr << "bodypoint: error: unknown command '" << cmd << "' (simulate, methods, work-precision, sweep, timing, study)\n";
     return 2;
   } catch (const bodypoint::Error& e) {
     std::cerr << "bodypoint: error: " << e.what() << "\n";

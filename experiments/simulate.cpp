@@ -74,10 +74,10 @@ int cmd_simulate(int argc, char** argv) {
   const MethodInfo& method = method_or_throw(method_name);
   const Scene scene = make_scene(vm, so);
   RunSpec spec;
+  spec.tol = tol;
   apply_step_options(vm, st, spec);
   spec.every = every;
   spec.tol = tol;
-  spec.t_end = spec.h * static_cast<double>(spec.steps);
   if (every < 1) throw Error("--every must be >= 1");
   spec.track_invariants = !no_invariants;
 

@@ -1,0 +1,117 @@
+// `bodypoint timing`: run time against the number of steps n for each method (thesis fig. 4.12-4.13),
+// measured properly: warm-up runs, repeats, median and spread per point, one thread, and nothing
+// but the step loop inside the timed region (no invariants, no output).
+#include "timing.hpp"
+
+#include "bodypoint/io.hpp"
+#include "cli.hpp"
+#include "sweep.hpp"
+
+#include <algorithm>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <unistd.h>
+
+namespace bodypoint::cli {
+
+std::vector<TimingRow> run_timing(const TimingSpec& spec, bool progress) {
+  if (spec.methods.empty()) throw Error("the method list is empty");
+  if (spec.ns.empty()) throw Error("no values of n");
+  if (spec.repeats < 1) throw Error("--repeats must be >= 1");
+  if (spec.warmup < 0) throw Error("--warmup must be >= 0");
+  const Scene scene = thesis_scene(spec.base);
+  std::vector<TimingRow> rows;
+  std::size_t done = 0;
+  const std::size_t total = spec.ns.size() * spec.methods.size();
+  for (long n : spec.ns) {
+    if (n < 1) throw Error("n must be >= 1, got " + std::to_string(n));
+    for (const MethodInfo* m : spec.methods) {
+      RunSpec rs;
+      rs.h = spec.h;
+      rs.steps = n;
+      rs.t_end = spec.h * static_cast<double>(n);
+      rs.tol = spec.tol;
+      for (long w = 0; w < spec.warmup; ++w) run(*m, scene.bodies.front(), scene.centres, rs);
+      std::vector<double> t;
+      long evals = 0;
+      for (long r = 0; r < spec.repeats; ++r) {
+        const RunResult res = run(*m, scene.bodies.front(), scene.centres, rs);
+        t.push_back(res.wall_s);
+        evals = res.force_evals;
+      }
+      std::sort(t.begin(), t.end());
+      rows.push_back({n, m, t[t.size() / 2], t.front(), t.back(), spec.repeats, evals});
+      if (progress) std::cerr << "\r" << ++done << "/" << total << std::flush;
+    }
+  }
+  if (progress) std::cerr << "\n";
+  return rows;
+}
+
+void write_timing_csv(std::ostream& os, const TimingSpec& spec, const std::vector<TimingRow>& rows,
+                      const std::string& command) {
+  const SceneParams& p = spec.base;
+  os << "# bodypoint timing, revision " << git_revision() << "\n"
+     << "# command: " << command << "\n"
+     << "# scene: A=" << fmt(p.A) << " m=" << fmt(p.m) << " B=" << fmt(p.B) << " J=" << fmt(p.J)
+     << " K1=" << fmt(p.start.K1) << " Kx=" << fmt(p.start.Kx) << " Kz=" << fmt(p.start.Kz)
+     << " d=" << fmt(p.start.d) << " L=" << fmt(p.start.L) << " h=" << fmt(spec.h) << "\n"
+     << "# " << spec.warmup << " warm-up run(s), then " << spec.repeats
+     << " timed repeats of the step loop alone (no invariants, no output), one thread\n"
+     << "n,method,median_s,min_s,max_s,repeats,force_evals\n";
+  for (const TimingRow& r : rows)
+    os << r.n << ',' << r.method->name << ',' << fmt(r.median_s) << ',' << fmt(r.min_s) << ',' << fmt(r.max_s)
+       << ',' << r.repeats << ',' << r.force_evals << '\n';
+}
+
+int cmd_timing(int argc, char** argv) {
+  SceneOptions so;
+  TimingSpec spec;
+  std::string methods_arg = "fixed", out, values;
+  double from = 500, to = 250000, step = 500;
+  po::options_description desc("bodypoint timing");
+  add_scene_options(desc, so);
+  desc.add_options()
+      ("h", po::value(&spec.h)->default_value(spec.h), "step size")
+      ("from", po::value(&from)->default_value(from), "smallest n")
+      ("to", po::value(&to)->default_value(to), "largest n")
+      ("step", po::value(&step)->default_value(step), "increment of n")
+      ("values", po::value(&values), "explicit comma-separated values of n instead")
+      ("methods", po::value(&methods_arg)->default_value(methods_arg), "comma-separated names, 'fixed' or 'all'")
+      ("repeats", po::value(&spec.repeats)->default_value(spec.repeats), "timed repeats per point (median, min, max)")
+      ("warmup", po::value(&spec.warmup)->default_value(spec.warmup), "untimed runs before the repeats")
+      ("out", po::value(&out), "CSV file (default: standard output)");
+  po::variables_map vm;
+  if (!parse(argc, argv, desc, vm,
+             "usage: bodypoint timing [options]\nRun time of the step loop against the number of steps n."))
+    return 0;
+  if (vm.count("scene")) throw Error("timing uses the thesis's scene parameters; --scene is not supported");
+  spec.base = so.params;
+  spec.methods = parse_methods(methods_arg);
+  std::vector<double> ns;
+  if (vm.count("values")) {
+    std::stringstream ss(values);
+    for (std::string s; std::getline(ss, s, ',');) ns.push_back(std::stod(s));
+  } else {
+    ns = linear_range(from, to, step);
+  }
+  for (double n : ns) {
+    if (!(n >= 1) || n != std::floor(n)) throw Error("n must be a whole number >= 1, got " + fmt(n));
+    spec.ns.push_back(static_cast<long>(n));
+  }
+  std::unique_ptr<AtomicFile> file;
+  if (!out.empty()) file = std::make_unique<AtomicFile>(out);
+  const auto rows = run_timing(spec, ::isatty(2) == 1);
+  std::string command = "bodypoint";
+  for (int i = 0; i < argc; ++i) command += std::string(" ") + argv[i];
+  if (file) {
+    write_timing_csv(file->stream(), spec, rows, command);
+    file->commit();
+  } else {
+    write_timing_csv(std::cout, spec, rows, command);
+  }
+  return 0;
+}
+
+}  // namespace bodypoint::cli

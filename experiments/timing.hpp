@@ -1,0 +1,35 @@
+// bodypoint: timing runs (run time against the number of steps), shared by `timing` and `study`.
+#pragma once
+
+#include "bodypoint/model.hpp"
+#include "bodypoint/run.hpp"
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace bodypoint::cli {
+
+struct TimingSpec {
+  std::vector<long> ns;
+  std::vector<const MethodInfo*> methods;
+  SceneParams base;
+  double h = 1e-4;
+  double tol = 1e-10;
+  long repeats = 5;
+  long warmup = 1;
+};
+
+struct TimingRow {
+  long n;
+  const MethodInfo* method;
+  double median_s, min_s, max_s;
+  long repeats;
+  long force_evals;
+};
+
+std::vector<TimingRow> run_timing(const TimingSpec& spec, bool progress);
+void write_timing_csv(std::ostream& os, const TimingSpec& spec, const std::vector<TimingRow>& rows,
+                      const std::string& command);
+
+}  // namespace bodypoint::cli

@@ -1,0 +1,158 @@
+// Experiment drivers: sweep rows equal single simulate runs bit for bit, the thread count does not
+// change the output, bad ranges are rejected, and the --quick study recipes run and write their CSVs.
+#include "common.hpp"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <sys/wait.h>
+
+namespace bodypoint {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+  int code;
+  std::string out, err;
+};
+
+Result run_cli(const std::string& args) {
+  const fs::path err = fs::temp_directory_path() / ("bp_exp_err_" + std::to_string(::getpid()));
+  const std::string cmd = std::string(BODYPOINT_BIN) + " " + args + " 2>" + err.string() + " </dev/null";
+  Result r;
+  FILE* p = ::popen(cmd.c_str(), "r");
+  std::array<char, 4096> buf{};
+  while (std::fgets(buf.data(), buf.size(), p)) r.out += buf.data();
+  const int status = ::pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream e(err);
+  std::stringstream ss;
+  ss << e.rdbuf();
+  r.err = ss.str();
+  fs::remove(err);
+  return r;
+}
+
+std::vector<std::vector<std::string>> csv_rows(const std::string& text) {
+  std::vector<std::vector<std::string>> rows;
+  std::stringstream ss(text);
+  bool header = true;
+  for (std::string line; std::getline(ss, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    if (header) {
+      header = false;
+      continue;
+    }
+    std::vector<std::string> cells;
+    std::stringstream ls(line);
+    for (std::string c; std::getline(ls, c, ',');) cells.push_back(c);
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+std::string json_field(const std::string& json, const std::string& key) {
+  const std::regex re("\"" + key + "\": ([^,}\\]]+)");
+  std::smatch m;
+  EXPECT_TRUE(std::regex_search(json, m, re)) << key;
+  return m[1];
+}
+
+TEST(Sweep, RowsEqualSingleSimulateRunsBitForBit) {
+  const std::string common = " --h 2e-3 --steps 5000";
+  const Result sweep = run_cli("sweep --param d --values 3,10 --methods rk4,thesis-fr4,lp-y4,lp-kl8" + common);
+  ASSERT_EQ(sweep.code, 0) << sweep.err;
+  const auto rows = csv_rows(sweep.out);
+  ASSERT_EQ(rows.size(), 8u);
+  for (const auto& row : rows) {
+    const Result sim = run_cli("simulate --json --d " + row[0] + " --method " + row[1] + common);
+    ASSERT_EQ(sim.code, 0) << sim.err;
+    EXPECT_EQ(row[2], json_field(sim.out, "max_rel_dE")) << row[1];
+    EXPECT_EQ(row[3], json_field(sim.out, "max_rel_dK2sq")) << row[1];
+    EXPECT_EQ(row[4], json_field(sim.out, "max_abs_dK2Q")) << row[1];
+    const std::regex R("\"R\": \\[([^,]+), ([^,]+), ([^\\]]+)\\]");
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(sim.out, m, R));
+    EXPECT_EQ(row[5], m[1].str()) << row[1];
+    EXPECT_EQ(row[6], m[2].str()) << row[1];
+    EXPECT_EQ(row[7], m[3].str()) << row[1];
+    EXPECT_EQ(row[8], json_field(sim.out, "force_evals")) << row[1];
+  }
+}
+
+TEST(Sweep, HSweepAtFixedEndTimeMatchesSimulate) {
+  const Result sweep = run_cli("sweep --param h --values 0.01,0.003 --t-end 25 --d 50 --methods lp-y4");
+  ASSERT_EQ(sweep.code, 0) << sweep.err;
+  for (const auto& row : csv_rows(sweep.out)) {
+    const Result sim = run_cli("simulate --json --d 50 --t-end 25 --method lp-y4 --h " + row[0]);
+    EXPECT_EQ(row[2], json_field(sim.out, "max_rel_dE"));
+    EXPECT_EQ(row[8], json_field(sim.out, "force_evals"));
+  }
+}
+
+TEST(Sweep, ThreadCountDoesNotChangeTheOutput) {
+  const std::string args = "sweep --param Kx --from -4 --to 4 --step 2 --methods lp-verlet,rk4,thesis-euler --h 5e-3 --steps 2000";
+  const Result one = run_cli(args + " --threads 1"), two = run_cli(args + " --threads 2"),
+               five = run_cli(args + " --threads 5");
+  ASSERT_EQ(one.code, 0) << one.err;
+  auto a = csv_rows(one.out), b = csv_rows(two.out), c = csv_rows(five.out);
+  ASSERT_EQ(a.size(), 15u);
+  for (auto* rows : {&a, &b, &c})
+    for (auto& r : *rows) r.pop_back();  // wall_s differs from run to run
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(a, c);
+}
+
+TEST(Sweep, BadRangesAreRejected) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--param d --from 10 --to 5 --step 1", "never reaches --to"},
+      {"--param d --from 5 --to 10 --step -1", "never reaches --to"},
+      {"--param d --from 5 --to 10 --step 0", "--step must not be zero"},
+      {"--param q --from 5 --to 10 --step 1", "unknown parameter 'q'"},
+      {"--param d --from 5 --to 10 --step 1 --methods ''", "--methods is empty"},
+      {"--param d --from 5 --to 10 --step 1 --methods lp-y5", "unknown method 'lp-y5'"},
+      {"--param d --values 1,x", "'x' is not a number"},
+      {"--param d --from 5 --to 10", "give --step"},
+      {"--param B --values 0.5,1.5", "B = 1.5: body: D = m J - B^2 must be > 0"},
+      {"--param h --values 0.1", "fixed --t-end"},
+      {"--from 1 --to 2 --step 1", "--param is required"},
+      {"--param d --log --from 0 --to 10 --points 5", "--log needs --from and --to finite and > 0"},
+  };
+  for (const auto& [args, fragment] : cases) {
+    const Result r = run_cli("sweep --steps 10 " + args);
+    EXPECT_NE(r.code, 0) << args;
+    EXPECT_NE(r.err.find(fragment), std::string::npos) << args << " -> " << r.err;
+    EXPECT_TRUE(r.out.empty()) << args;
+  }
+}
+
+TEST(Study, QuickRecipesWriteEveryCsv) {
+  const fs::path dir = fs::temp_directory_path() / "bp_study";
+  fs::remove_all(dir);
+  const Result r = run_cli("study --quick --results " + dir.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* f : {"d_sweep.csv", "L_sweep.csv", "h_sweep.csv", "Kx_sweep.csv", "timing.csv",
+                        "force_evals.csv", "appendix1/index.csv", "appendix1/P1.1.csv", "appendix1/P1.30.csv"})
+    EXPECT_TRUE(fs::exists(dir / f)) << f;
+  std::ifstream d(dir / "d_sweep.csv");
+  std::stringstream ds;
+  ds << d.rdbuf();
+  const auto rows = csv_rows(ds.str());
+  EXPECT_EQ(rows.size(), 6u * 20u);  // 6 values of d, 20 fixed-step methods
+  std::ifstream ix(dir / "appendix1/index.csv");
+  std::stringstream is;
+  is << ix.rdbuf();
+  EXPECT_NE(is.str().find("2,-0.5,1,0.7,0.2,200,50,5,5,2,\"skipped: body: D = m J - B^2 must be > 0"), std::string::npos)
+      << "P1.2 has D < 0 and must be skipped, not integrated";
+  EXPECT_FALSE(fs::exists(dir / "appendix1/P1.2.csv"));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace bodypoint
