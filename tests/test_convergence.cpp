@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 
@@ -16,13 +17,17 @@ namespace {
 // Slope within 0.15 of the order: the tolerance STYLE.md and issue #3 ask for; the ladders below are
 // chosen in the asymptotic range, above the round-off plateau.
 constexpr double kSlopeTol = 0.15;
-// Points whose error is below this are within a factor 1000 of the round-off plateau (measured at
-// 1e-15..5e-15 relative with compensated summation) and are left out of the fit.
+// The round-off plateau of a ladder is the median error of its kPlateauPoints smallest steps (the
+// ladders run well into it: 1e-16..1e-14 relative with compensated summation). Points within a factor
+// kPlateauMargin of it (so that rounding moves them by at most ~3%) are left out of the fit, and so
+// are points below kPlateau when the ladder never reached its plateau (low orders).
 constexpr double kPlateau = 1e-12;
+constexpr double kPlateauMargin = 30.0;
+constexpr std::size_t kPlateauPoints = 5;
 // Ladder: h0 / sqrt(2)^k, k = 0..kLadder-1. The slope is fitted to the kFitPoints smallest steps
-// whose error is above kPlateau: the most asymptotic points that rounding does not disturb.
+// above the plateau: the most asymptotic points that rounding does not disturb.
 constexpr int kLadder = 24;
-constexpr std::size_t kFitPoints = 4;
+constexpr std::size_t kFitPoints = 3;
 // The two independent references (odeint rkf78 in long double, Kepler's equation) agree this well.
 constexpr double kReferenceAgreement = 1e-13;
 
@@ -54,14 +59,9 @@ Scene orbit(double B) {
 }
 constexpr double kOrbitTEnd = 30.0;
 
-// Kahan-Li and McLachlan tuned their 8th-order weights to make the h^8 error term tiny, and
-// Sofroniou-Spaletta their 10th-order ones; for B != 0 the next term (h^10, h^12) still shares the
-// window that double precision can reach above the plateau, which steepens the fitted slope by up to
-// this much (measured: 8.33 and 8.54 for mcl8 and kl8 at B = 0.7). A wrong weight lowers the order
-// by at least 2, which the lower bound (order - kSlopeTol) still catches.
-constexpr double kOptimisedSteepening = 0.7;
-// For lp-ss10 the order-10 regime itself sits at the plateau: measured slopes are 9.3 to 10.7
-// depending on the problem. Only "clearly above order 8" is asserted, which any wrong weight breaks.
+// For lp-ss10 the order-10 regime lies below the round-off plateau of double precision: in the window
+// above it the h^12 term still dominates (measured slopes 11.2 at B = 0 and 12.1 at B = 0.7 on the
+// orbit). Only "clearly above order 8" is asserted, which any wrong weight breaks.
 constexpr double kSs10Lowest = 9.0;
 
 struct Case {
@@ -79,7 +79,7 @@ double measured_slope(const Case& c, double B) {
   const Body& body = s.bodies.front();
   const State ref = B == 0.0 ? kepler_body_state(body, s.centres.front(), kTEnd)
                              : reference_state(body, s.centres, kTEnd);
-  std::vector<std::pair<double, double>> pts;
+  std::vector<std::pair<double, double>> all;
   std::string log;
   for (int k = 0; k < kLadder; ++k) {
     RunSpec spec;
@@ -90,8 +90,15 @@ double measured_slope(const Case& c, double B) {
     char buf[64];
     std::snprintf(buf, sizeof buf, " h=%.3g:%.2e", spec.h, e);
     log += buf;
-    if (e > kPlateau) pts.emplace_back(spec.h, e);
+    all.emplace_back(spec.h, e);
   }
+  std::vector<double> tail;
+  for (std::size_t i = all.size() - kPlateauPoints; i < all.size(); ++i) tail.push_back(all[i].second);
+  std::sort(tail.begin(), tail.end());
+  const double cut = std::min(kPlateau, kPlateauMargin * tail[tail.size() / 2]);
+  std::vector<std::pair<double, double>> pts;
+  for (const auto& p : all)
+    if (p.second > cut) pts.push_back(p);
   EXPECT_GE(pts.size(), kFitPoints) << c.method << " B=" << B << log;
   if (pts.size() > kFitPoints) pts.erase(pts.begin(), pts.end() - static_cast<long>(kFitPoints));
   const double slope = pts.size() >= 2 ? test::loglog_slope(pts) : 0.0;
@@ -109,15 +116,16 @@ TEST(Convergence, ReferencesAgree) {
 // Each method is measured where its asymptotic regime is reachable in double precision: the
 // close encounter for most, the bound orbit where the encounter's error is too small (high orders
 // at B = 0) or where conjugacy hides the order on the encounter (Ruth 3 at B = 0.7).
-const Case kSs10{"lp-ss10", 10, 1.5, true, 10.0, 10.0 - kSs10Lowest};
+const Case kSs10{"lp-ss10", 10, 1.5, true, 3.0, 10.0 - kSs10Lowest};
 
 TEST(Convergence, NominalOrderForBodyPoint) {
   const std::vector<Case> cases = {
       {"rk4", 4, 0.2},          {"ab4", 4, 0.1},         {"lp-euler", 1, 0.01},
       {"lp-verlet", 2, 0.1},    {"lp-verlet-dkd", 2, 0.1}, {"lp-ruth3", 3, 0.2, true},
       {"lp-y4", 4, 0.2},        {"lp-bm4", 4, 0.5},      {"lp-y6", 6, 0.5},
+      {"lp-rkn4", 4, 0.5},      {"lp-rkn6", 6, 0.5, true},
       {"lp-kl6", 6, 0.5},       {"lp-y8", 8, 1.0},       {"lp-y8d", 8, 1.0, true},
-      {"lp-mcl8", 8, 1.0, true, kOptimisedSteepening},   {"lp-kl8", 8, 1.0, true, kOptimisedSteepening},
+      {"lp-mcl8", 8, 1.0, true}, {"lp-kl8", 8, 1.0, true},
       kSs10};
   for (const Case& c : cases) {
     const double slope = measured_slope(c, 0.7);
@@ -131,6 +139,7 @@ TEST(Convergence, NominalOrderForMaterialPoint) {
       {"rk4", 4, 0.2},          {"ab4", 4, 0.1},           {"lp-euler", 1, 0.01},
       {"lp-verlet", 2, 0.1},    {"lp-verlet-dkd", 2, 0.1}, {"lp-ruth3", 3, 0.2},
       {"lp-y4", 4, 0.2},        {"lp-bm4", 4, 0.5},        {"lp-y6", 6, 0.5},
+      {"lp-rkn4", 4, 0.5},      {"lp-rkn6", 6, 0.5, true},
       {"lp-kl6", 6, 0.5, true}, {"lp-y8", 8, 1.0, true},   {"lp-y8d", 8, 1.0, true},
       {"lp-mcl8", 8, 1.0, true}, {"lp-kl8", 8, 1.0, true}, kSs10,
       // With B = 0 the gyroscopic term vanishes and the thesis's schemes are the classical splittings.

@@ -43,6 +43,8 @@ TEST(Tables, EveryTableIsConsistent) {
   expect_consistent(ruth3, "ruth3");
   expect_consistent(yoshida4, "yoshida4");
   expect_consistent(blanes_moan4, "blanes_moan4");
+  expect_consistent(blanes_moan_rkn4, "blanes_moan_rkn4");
+  expect_consistent(blanes_moan_rkn6, "blanes_moan_rkn6");
   expect_consistent(yoshida6, "yoshida6");
   expect_consistent(kahan_li6, "kahan_li6");
   expect_consistent(yoshida8, "yoshida8");
@@ -70,6 +72,8 @@ TEST(Tables, DerivedMiddleWeightsMatchPublishedOnes) {
   EXPECT_NEAR(kahan_li8_weights[8], kahan_li8_middle, kPublishedTol);
   EXPECT_NEAR(mclachlan8_weights[7], mclachlan8_middle, kPublishedTol);
   EXPECT_NEAR(sofroniou_spaletta10_weights[17], sofroniou_spaletta10_middle, kPublishedTol);
+  // Blanes-Moan SRKN_11^b: the derived middle drift, as printed in their table 3.
+  EXPECT_NEAR(blanes_moan_rkn6.a[6], 0.20477705429147, 1e-14);
   // Yoshida 1990 table 2 solution D: w0 = 1.7084530707869978 (15 digits printed for w1..w7).
   EXPECT_NEAR(yoshida8d_weights[7], 1.7084530707869978, 1e-14);
 }
@@ -110,6 +114,8 @@ TEST(Tables, ForceEvaluationsPerStep) {
   EXPECT_EQ(method_or_throw("lp-verlet").evals_per_step, 1);
   EXPECT_EQ(method_or_throw("lp-y4").evals_per_step, 3);
   EXPECT_EQ(method_or_throw("lp-bm4").evals_per_step, 6);
+  EXPECT_EQ(method_or_throw("lp-rkn4").evals_per_step, 6);
+  EXPECT_EQ(method_or_throw("lp-rkn6").evals_per_step, 11);
   EXPECT_EQ(method_or_throw("lp-kl6").evals_per_step, 9);
   EXPECT_EQ(method_or_throw("lp-y8").evals_per_step, 27);
   EXPECT_EQ(method_or_throw("lp-mcl8").evals_per_step, 15);

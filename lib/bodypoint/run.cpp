@@ -189,6 +189,8 @@ constexpr auto strang_ops = sp::flatten(sp::strang_dkd_table);
 constexpr auto ruth3_ops = sp::flatten(sp::ruth3);
 constexpr auto y4_ops = sp::flatten(sp::yoshida4);
 constexpr auto bm4_ops = sp::flatten(sp::blanes_moan4);
+constexpr auto rkn4_ops = sp::flatten(sp::blanes_moan_rkn4);
+constexpr auto rkn6_ops = sp::flatten(sp::blanes_moan_rkn6);
 constexpr auto y6_ops = sp::flatten(sp::yoshida6);
 constexpr auto kl6_ops = sp::flatten(sp::kahan_li6);
 constexpr auto y8_ops = sp::flatten(sp::yoshida8);
@@ -236,6 +238,8 @@ std::vector<MethodInfo> make_registry() {
       lie_method<ruth3_ops>("lp-ruth3", 3, "exact Lie-Poisson, Ruth 1983 third order"),
       lie_method<y4_ops>("lp-y4", 4, "exact Lie-Poisson, Yoshida/Forest-Ruth 4 (3 stages)"),
       lie_method<bm4_ops>("lp-bm4", 4, "exact Lie-Poisson, Blanes-Moan 2002 S6 (6 stages)"),
+      lie_method<rkn4_ops>("lp-rkn4", 4, "exact Lie-Poisson, Blanes-Moan 2002 SRKN_6^b (RKN, 6 stages)"),
+      lie_method<rkn6_ops>("lp-rkn6", 6, "exact Lie-Poisson, Blanes-Moan 2002 SRKN_11^b (RKN, 11 stages)"),
       lie_method<y6_ops>("lp-y6", 6, "exact Lie-Poisson, Yoshida 6 triple jump (thesis table 2.1)"),
       lie_method<kl6_ops>("lp-kl6", 6, "exact Lie-Poisson, Kahan-Li 1997 p6 s9"),
       lie_method<y8_ops>("lp-y8", 8, "exact Lie-Poisson, Yoshida 8 triple jump (27 stages)"),

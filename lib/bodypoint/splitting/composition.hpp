@@ -10,9 +10,14 @@
 // (S2 = K(h/2) D(h) K(h/2)); `triple_jump` raises the order of a symmetric method by two
 // (Yoshida 1990, eq. 5.2-5.4; thesis appendix 2, eq. P2.1-P2.3).
 //
-// The engine (`integrate`) runs n steps. When no observer needs the state at every step and the
-// kernel allows it, the last sub-flow of one step and the first of the next (same type) are merged
-// ("first same as last"), so a symmetric s-stage composition costs s force evaluations per step.
+// The engine (`integrate`) runs n steps and shares sub-flows between consecutive steps ("first same
+// as last") when the kernel allows it, so a symmetric s-stage composition costs s force evaluations
+// per step:
+// - a table that starts and ends with a kick evaluates the force once at each step boundary and
+//   uses it for the last kick of one step and the first kick of the next (the state handed to an
+//   observer in between is exact), so this works with or without an observer;
+// - a table that starts and ends with a drift merges the two drifts into one, which is possible only
+//   when no observer needs the state at the step boundary.
 #pragma once
 
 #include <array>
@@ -162,7 +167,8 @@ struct NullObserver {
 };
 
 /// Kernel concept: `state_type`, `drift(x, tau)`, `kick(x, tau)`, `begin_step(x)`,
-/// `static constexpr bool mergeable` (false when a step depends on the state at its start).
+/// `static constexpr bool mergeable` (false when a step depends on the state at its start), and for
+/// mergeable kernels `force(x)` (one evaluation) and `apply_kick(x, tau, F)`.
 template <const auto& Seq, class Kernel, class Observer>
 void integrate(Kernel& k, typename Kernel::state_type& x, double h, long n, Observer& obs) {
   constexpr std::size_t M = Seq.size;
@@ -174,8 +180,19 @@ void integrate(Kernel& k, typename Kernel::state_type& x, double h, long n, Obse
       k.drift(x, op.c * hh);
     }
   };
-  constexpr bool merge = Seq.fsal() && Kernel::mergeable && !Observer::active;
-  if constexpr (merge) {
+  constexpr bool share_force = Seq.fsal() && Seq.ops[0].kick && Kernel::mergeable;
+  constexpr bool merge_drift = Seq.fsal() && !Seq.ops[0].kick && Kernel::mergeable && !Observer::active;
+  if constexpr (share_force) {
+    if (n <= 0) return;
+    auto F = k.force(x);
+    for (long i = 0; i < n; ++i) {
+      k.apply_kick(x, Seq.ops[0].c * h, F);
+      for (std::size_t j = 1; j + 1 < M; ++j) apply(Seq.ops[j], h);
+      F = k.force(x);
+      k.apply_kick(x, Seq.ops[M - 1].c * h, F);
+      if constexpr (Observer::active) obs(i + 1, x);
+    }
+  } else if constexpr (merge_drift) {
     if (n <= 0) return;
     apply(Seq.ops[0], h);
     for (long i = 0; i < n; ++i) {

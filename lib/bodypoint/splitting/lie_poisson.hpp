@@ -140,10 +140,14 @@ struct LiePoissonKernel {
     }
   }
 
-  void kick(LieState& x, double tau) {
+  /// The force at the current position (one force evaluation).
+  Vec3 force(const LieState& x) {
     ++evals;
-    compensated_add(x.K1, x.K1_err, tau * field.force(x.R));
+    return field.force(x.R);
   }
+  /// K1 += tau F with a force already evaluated at the current position.
+  void apply_kick(LieState& x, double tau, const Vec3& F) const { compensated_add(x.K1, x.K1_err, tau * F); }
+  void kick(LieState& x, double tau) { apply_kick(x, tau, force(x)); }
 
   [[nodiscard]] State to_physical(const LieState& x) const { return to_state(p, from_lie(x)); }
 
