@@ -5,6 +5,8 @@
 // combination is its own instantiation of the generic loop.
 #include "bodypoint/run.hpp"
 
+#include "bodypoint/run_support.hpp"
+
 #include "bodypoint/field.hpp"
 #include "bodypoint/rhs.hpp"
 #include "bodypoint/rk/odeint.hpp"
@@ -18,7 +20,6 @@
 #include "bodypoint/splitting/thesis.hpp"
 #include "bodypoint/splitting/yoshida.hpp"
 
-#include <chrono>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -28,73 +29,8 @@ namespace bodypoint {
 namespace {
 
 namespace sp = splitting;
-using Clock = std::chrono::steady_clock;
-
-/// Observer that tracks the invariants at every step and hands every `every`-th state to a sink.
-template <class Field, class ToPhysical>
-class Monitor {
- public:
-  static constexpr bool active = true;
-
-  Monitor(const BodyPoint& p, const Field& f, const State& s0, const RunSpec& spec,
-          const SampleSink* sink, ToPhysical to_physical)
-      : inv_(p, f, s0), spec_(spec), sink_(sink), to_physical_(std::move(to_physical)) {
-    if (sink_) (*sink_)(Sample{0, 0.0, s0, 0.0, 0.0, 0.0});
-  }
-
-  template <class X>
-  void operator()(long i, const X& x) {
-    observe(i, static_cast<double>(i) * spec_.h, x, i == spec_.steps);
-  }
-
-  /// For methods with their own time grid: step i ends at time t; `last` marks the final state.
-  template <class X>
-  void observe(long i, double t, const X& x, bool last) {
-    const State s = to_physical_(x);
-    inv_.update(s);
-    if (sink_ && (i % spec_.every == 0 || last))
-      (*sink_)(Sample{i, t, s, inv_.last_rel_dE(), inv_.last_rel_dK2sq(), inv_.last_abs_dK2Q()});
-  }
-
-  [[nodiscard]] const InvariantStats& stats() const { return inv_.stats(); }
-
- private:
-  InvariantMonitor<Field> inv_;
-  const RunSpec& spec_;
-  const SampleSink* sink_;
-  ToPhysical to_physical_;
-};
-
-/// Runs `loop(observer)` with a null observer or a monitor, timing the loop only.
-template <class Field, class ToPhysical, class Loop>
-RunResult observe(const BodyPoint& p, const Field& field, const State& s0, const RunSpec& spec,
-                  const SampleSink* sink, ToPhysical to_physical, Loop&& loop) {
-  RunResult r;
-  r.steps = spec.steps;
-  r.t_end = static_cast<double>(spec.steps) * spec.h;
-  if (spec.track_invariants || sink) {
-    Monitor<Field, ToPhysical> mon(p, field, s0, spec, sink, to_physical);
-    const auto t0 = Clock::now();
-    r.final = loop(mon);
-    r.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
-    r.invariants = mon.stats();
-  } else {
-    sp::NullObserver none;
-    const auto t0 = Clock::now();
-    r.final = loop(none);
-    r.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
-  }
-  return r;
-}
-
-/// Calls f(field, std::bool_constant<Spin>) with the field and spin decided once.
-template <class F>
-RunResult dispatch(const Body& body, const std::vector<Centre>& centres, F&& f) {
-  return visit_field(centres, [&](const auto& field) {
-    if (body.p.B == 0.0) return f(field, std::false_type{});
-    return f(field, std::true_type{});
-  });
-}
+using detail::dispatch;
+using detail::observe;
 
 template <template <class, bool> class Kernel, const auto& Seq>
 RunResult run_splitting(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,

@@ -43,9 +43,10 @@ inline LieState to_lie(const Momenta& q) {
   const double n2 = q.K2.squaredNorm();
   return {q.R, q.K1, q.K2, Vec3::Zero(), Vec3::Zero(), n2, n2 > 0.0 ? 0.5 / n2 : 0.0};
 }
-inline Momenta from_lie(const LieState& x) { return {x.R + x.R_err, x.K1 + x.K1_err, x.K2}; }
+/// The represented values: Kahan's err holds what was added in excess, so the sum is x - err.
+inline Momenta from_lie(const LieState& x) { return {x.R - x.R_err, x.K1 - x.K1_err, x.K2}; }
 
-/// x += dx with Kahan compensation; err holds minus the low-order part not yet in x.
+/// x += dx with Kahan compensation; err accumulates the excess that rounding added to x.
 inline void compensated_add(Vec3& x, Vec3& err, const Vec3& dx) {
   const Vec3 y = dx - err;
   const Vec3 t = x + y;

@@ -1,0 +1,85 @@
+// bodypoint: the pieces every run loop shares: the invariant/sample observer, the timing wrapper
+// that picks a null observer when nothing is asked for, and the once-per-run choice of field type
+// and spin. Used by lib/bodypoint/run.cpp and adaptive/.
+#pragma once
+
+#include "bodypoint/field.hpp"
+#include "bodypoint/invariants.hpp"
+#include "bodypoint/run.hpp"
+#include "bodypoint/splitting/composition.hpp"
+
+#include <chrono>
+#include <type_traits>
+#include <vector>
+
+namespace bodypoint::detail {
+
+using Clock = std::chrono::steady_clock;
+
+/// Observer that tracks the invariants at every step and hands every `every`-th state to a sink.
+template <class Field, class ToPhysical>
+class Monitor {
+ public:
+  static constexpr bool active = true;
+
+  Monitor(const BodyPoint& p, const Field& f, const State& s0, const RunSpec& spec,
+          const SampleSink* sink, ToPhysical to_physical)
+      : inv_(p, f, s0), spec_(spec), sink_(sink), to_physical_(std::move(to_physical)) {
+    if (sink_) (*sink_)(Sample{0, 0.0, s0, 0.0, 0.0, 0.0});
+  }
+
+  template <class X>
+  void operator()(long i, const X& x) {
+    observe(i, static_cast<double>(i) * spec_.h, x, i == spec_.steps);
+  }
+
+  /// For methods with their own time grid: step i ends at time t; `last` marks the final state.
+  template <class X>
+  void observe(long i, double t, const X& x, bool last) {
+    const State s = to_physical_(x);
+    inv_.update(s);
+    if (sink_ && (i % spec_.every == 0 || last))
+      (*sink_)(Sample{i, t, s, inv_.last_rel_dE(), inv_.last_rel_dK2sq(), inv_.last_abs_dK2Q()});
+  }
+
+  [[nodiscard]] const InvariantStats& stats() const { return inv_.stats(); }
+
+ private:
+  InvariantMonitor<Field> inv_;
+  const RunSpec& spec_;
+  const SampleSink* sink_;
+  ToPhysical to_physical_;
+};
+
+/// Runs `loop(observer)` with a null observer or a monitor, timing the loop only.
+template <class Field, class ToPhysical, class Loop>
+RunResult observe(const BodyPoint& p, const Field& field, const State& s0, const RunSpec& spec,
+                  const SampleSink* sink, ToPhysical to_physical, Loop&& loop) {
+  RunResult r;
+  r.steps = spec.steps;
+  r.t_end = static_cast<double>(spec.steps) * spec.h;
+  if (spec.track_invariants || sink) {
+    Monitor<Field, ToPhysical> mon(p, field, s0, spec, sink, to_physical);
+    const auto t0 = Clock::now();
+    r.final = loop(mon);
+    r.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
+    r.invariants = mon.stats();
+  } else {
+    splitting::NullObserver none;
+    const auto t0 = Clock::now();
+    r.final = loop(none);
+    r.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  }
+  return r;
+}
+
+/// Calls f(field, std::bool_constant<Spin>) with the field and spin decided once.
+template <class F>
+RunResult dispatch(const Body& body, const std::vector<Centre>& centres, F&& f) {
+  return visit_field(centres, [&](const auto& field) {
+    if (body.p.B == 0.0) return f(field, std::false_type{});
+    return f(field, std::true_type{});
+  });
+}
+
+}  // namespace bodypoint::detail
