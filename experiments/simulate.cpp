@@ -51,7 +51,7 @@ int cmd_simulate(int argc, char** argv) {
   std::string method_name = "lp-y4";
   std::string out;
   long every = 1;
-  double tol = 1e-10;
+  double tol = 1e-10, dt_out = 0.0;
   bool json = false, no_invariants = false, with_reference = false;
   po::options_description desc("bodypoint simulate");
   add_scene_options(desc, so);
@@ -60,6 +60,7 @@ int cmd_simulate(int argc, char** argv) {
       ("method", po::value(&method_name)->default_value(method_name), "integration method (see 'bodypoint methods')")
       ("out", po::value(&out), "write the trajectory to this CSV file (atomically)")
       ("tol", po::value(&tol)->default_value(tol), "adaptive methods (odeint-*): error tolerance per step")
+      ("dt-out", po::value(&dt_out), "with --out, time-transformed methods: write states at t = k dt-out")
       ("every", po::value(&every)->default_value(every), "with --out: write every k-th step (and the last)")
       ("json", po::bool_switch(&json), "print one JSON object instead of the summary")
       ("no-invariants", po::bool_switch(&no_invariants), "do not track the invariants (fastest; final state only)")
@@ -76,6 +77,19 @@ int cmd_simulate(int argc, char** argv) {
   RunSpec spec;
   spec.tol = tol;
   apply_step_options(vm, st, spec);
+  if (is_time_transformed(method)) {
+    // --h is the fictitious step ds (never adjusted); --t-end runs to exactly that time, otherwise
+    // --steps fictitious steps are taken.
+    spec.h = st.h;
+    spec.t_end = vm.count("t-end") ? st.t_end : 0.0;
+    spec.steps = vm.count("t-end") ? 0 : st.steps;
+  }
+  if (vm.count("dt-out")) {
+    if (!is_time_transformed(method)) throw Error("--dt-out is for time-transformed methods (logh-*, ttl-*, ks)");
+    if (!(dt_out > 0.0) || !std::isfinite(dt_out)) throw Error("--dt-out must be a finite number > 0");
+    if (!vm.count("out")) throw Error("--dt-out needs --out");
+    spec.dt_out = dt_out;
+  }
   spec.every = every;
   spec.tol = tol;
   if (every < 1) throw Error("--every must be >= 1");
@@ -127,7 +141,7 @@ int cmd_simulate(int argc, char** argv) {
     const RunResult& r0 = results.front();
     std::cout << "{\"method\": \"" << method.name << "\", \"h\": " << json_number(spec.h)
               << (is_adaptive(method) ? ", \"tol\": " + json_number(spec.tol) : std::string())
-              << ", \"steps\": " << spec.steps << ", \"t_end\": " << json_number(r0.t_end) << ", "
+              << ", \"steps\": " << r0.steps << ", \"t_end\": " << json_number(r0.t_end) << ", "
               << json_body(r0, errors.front());
     if (results.size() > 1) {
       std::cout << ", \"bodies\": [";
@@ -140,8 +154,8 @@ int cmd_simulate(int argc, char** argv) {
     return 0;
   }
 
-  std::cout << "bodypoint simulate  method=" << method.name << "  h=" << fmt(spec.h)
-            << "  steps=" << spec.steps << "  t_end=" << fmt(results.front().t_end) << "\n"
+  std::cout << "bodypoint simulate  method=" << method.name << (is_time_transformed(method) ? "  ds=" : "  h=")
+            << fmt(spec.h) << "  steps=" << results.front().steps << "  t_end=" << fmt(results.front().t_end) << "\n"
             << "scene: " << scene_header(vm, so) << "  (" << scene.centres.size() << " centre(s), "
             << scene.bodies.size() << " body-point(s))\n";
   for (std::size_t b = 0; b < results.size(); ++b) {

@@ -179,7 +179,7 @@ std::vector<const MethodInfo*> parse_methods(const std::string& list) {
   }
   if (list == "fixed") {
     for (const MethodInfo& m : methods())
-      if (!is_adaptive(m)) ms.push_back(&m);
+      if (!has_variable_step(m)) ms.push_back(&m);
     return ms;
   }
   for (const std::string& n : split(list)) ms.push_back(&method_or_throw(n));
@@ -205,7 +205,7 @@ int cmd_sweep(int argc, char** argv) {
       ("log", po::bool_switch(&log), "log-spaced values from --from to --to, --points of them")
       ("points", po::value(&points), "with --log: number of values")
       ("values", po::value(&values), "explicit comma-separated values instead of a range")
-      ("methods", po::value(&methods_arg)->default_value(methods_arg), "comma-separated names, 'fixed' (all fixed-step) or 'all'")
+      ("methods", po::value(&methods_arg)->default_value(methods_arg), "comma-separated names, 'fixed' (every fixed-step method) or 'all'")
       ("tol", po::value(&tol)->default_value(tol), "adaptive methods: error tolerance")
       ("threads", po::value(&threads)->default_value(0), "worker threads (0: all cores)")
       ("out", po::value(&out), "CSV file (default: standard output)");

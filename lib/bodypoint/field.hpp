@@ -26,6 +26,21 @@ struct OriginCentre {
   }
   [[nodiscard]] double potential(const Vec3& R) const { return -A / R.norm(); }
   [[nodiscard]] Vec3 reference_point() const { return Vec3::Zero(); }
+
+  /// F and Pi in one pass (one force evaluation).
+  void force_potential(const Vec3& R, Vec3& F, double& P) const {
+    const double inv_r = 1.0 / std::sqrt(R.squaredNorm());
+    F = (-A * inv_r * inv_r * inv_r) * R;
+    P = -A * inv_r;
+  }
+  /// F, Omega = |A|/r and grad Omega = -|A| R/r^3 in one pass (the TTL's time-step function).
+  void force_omega(const Vec3& R, Vec3& F, double& Omega, Vec3& grad) const {
+    const double inv_r = 1.0 / std::sqrt(R.squaredNorm());
+    const double inv_r3 = inv_r * inv_r * inv_r;
+    F = (-A * inv_r3) * R;
+    Omega = std::abs(A) * inv_r;
+    grad = (-std::abs(A) * inv_r3) * R;
+  }
 };
 
 struct CentreList {
@@ -46,6 +61,29 @@ struct CentreList {
     double P = 0.0;
     for (const Centre& k : centres) P -= k.A / (R - k.c).norm();
     return P;
+  }
+  void force_potential(const Vec3& R, Vec3& F, double& P) const {
+    F.setZero();
+    P = 0.0;
+    for (const Centre& k : centres) {
+      const Vec3 d = R - k.c;
+      const double inv_r = 1.0 / std::sqrt(d.squaredNorm());
+      F -= (k.A * inv_r * inv_r * inv_r) * d;
+      P -= k.A * inv_r;
+    }
+  }
+  void force_omega(const Vec3& R, Vec3& F, double& Omega, Vec3& grad) const {
+    F.setZero();
+    grad.setZero();
+    Omega = 0.0;
+    for (const Centre& k : centres) {
+      const Vec3 d = R - k.c;
+      const double inv_r = 1.0 / std::sqrt(d.squaredNorm());
+      const double inv_r3 = inv_r * inv_r * inv_r;
+      F -= (k.A * inv_r3) * d;
+      Omega += std::abs(k.A) * inv_r;
+      grad -= (std::abs(k.A) * inv_r3) * d;
+    }
   }
   [[nodiscard]] bool single() const { return centres.size() == 1; }
   [[nodiscard]] Vec3 reference_point() const { return centres.front().c; }

@@ -6,6 +6,7 @@
 #include "bodypoint/run.hpp"
 
 #include "bodypoint/run_support.hpp"
+#include "bodypoint/adaptive/registry.hpp"
 
 #include "bodypoint/field.hpp"
 #include "bodypoint/rhs.hpp"
@@ -148,7 +149,7 @@ MethodInfo lie_method(std::string_view name, int order, std::string_view what) {
 }
 
 std::vector<MethodInfo> make_registry() {
-  return {
+  std::vector<MethodInfo> all = {
       {"rk4", Family::Odeint, 4, 4, 4, "classical Runge-Kutta (thesis 2.1; odeint runge_kutta4)",
        &run_odeint<rk::Rk4>},
       {"ab4", Family::Odeint, 4, 1, 1,
@@ -184,6 +185,8 @@ std::vector<MethodInfo> make_registry() {
       lie_method<kl8_ops>("lp-kl8", 8, "exact Lie-Poisson, Kahan-Li 1997 p8 s17"),
       lie_method<ss10_ops>("lp-ss10", 10, "exact Lie-Poisson, Sofroniou-Spaletta 2005 p10 s35"),
   };
+  for (const MethodInfo& m : adaptive::methods()) all.push_back(m);
+  return all;
 }
 
 }  // namespace
@@ -209,8 +212,10 @@ RunResult run(const MethodInfo& method, const Body& body, const std::vector<Cent
   validate(Scene{centres, {body}});
   if (!std::isfinite(spec.h) || spec.h <= 0.0)
     throw Error("step size h must be a finite number > 0, got " + std::to_string(spec.h));
-  if (spec.steps < 1) throw Error("number of steps must be >= 1");
   if (spec.every < 1) throw Error("--every must be >= 1");
+  // Time-transformed methods run to t_end when it is given, otherwise for spec.steps fictitious steps.
+  if (is_time_transformed(method)) return method.run(body, centres, spec, sink);
+  if (spec.steps < 1) throw Error("number of steps must be >= 1");
   if (is_adaptive(method)) {
     RunSpec s = spec;
     if (s.t_end == 0.0) s.t_end = spec.h * static_cast<double>(spec.steps);

@@ -22,6 +22,7 @@ struct RunSpec {
   long steps = 500000;   ///< fixed-step methods: number of steps (t_end = steps h)
   double t_end = 0.0;    ///< adaptive methods: end time (0: steps h)
   double tol = 1e-10;    ///< adaptive methods: relative and absolute error tolerance per step
+  double dt_out = 0.0;   ///< time-transformed methods with a sink: sample at t = k dt_out (0: every-th step)
   bool track_invariants = false;
   long every = 1;  ///< hand every `every`-th state (and the last) to the sink
 };
@@ -46,8 +47,9 @@ struct RunResult {
 };
 
 /// Thesis: the thesis's drift/kick schemes; LiePoisson: exact splittings; Odeint: fixed-step
-/// odeint steppers (rk4, ab4); OdeintAdaptive: step-size-controlled odeint steppers (--tol).
-enum class Family { Thesis, LiePoisson, Odeint, OdeintAdaptive };
+/// odeint steppers (rk4, ab4); OdeintAdaptive: step-size-controlled odeint steppers (--tol);
+/// TimeTransformed: fixed fictitious step ds (--h), variable physical step (logh-*, ttl-*, ks).
+enum class Family { Thesis, LiePoisson, Odeint, OdeintAdaptive, TimeTransformed };
 
 struct MethodInfo {
   std::string_view name;
@@ -68,8 +70,13 @@ const MethodInfo* find_method(std::string_view name);
 /// Throws Error("unknown method ...") for a name not in methods().
 const MethodInfo& method_or_throw(std::string_view name);
 
-/// True for methods that choose their own steps (spec.tol, spec.t_end apply).
+/// True for methods that choose their own steps from a tolerance (spec.tol, spec.t_end apply).
 inline bool is_adaptive(const MethodInfo& m) { return m.family == Family::OdeintAdaptive; }
+/// True for methods with a fixed fictitious step: spec.h is ds; with spec.t_end > 0 they run to
+/// exactly t_end, otherwise spec.steps fictitious steps.
+inline bool is_time_transformed(const MethodInfo& m) { return m.family == Family::TimeTransformed; }
+/// True for every method whose physical step varies (adaptive or time-transformed).
+inline bool has_variable_step(const MethodInfo& m) { return is_adaptive(m) || is_time_transformed(m); }
 
 /// Validates the inputs (scene, h > 0 and finite, steps >= 1, every >= 1, tol > 0) and runs.
 RunResult run(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,

@@ -38,9 +38,16 @@ class Monitor {
   void observe(long i, double t, const X& x, bool last) {
     const State s = to_physical_(x);
     inv_.update(s);
-    if (sink_ && (i % spec_.every == 0 || last))
+    if (sink_ && spec_.dt_out <= 0.0 && (i % spec_.every == 0 || last))
       (*sink_)(Sample{i, t, s, inv_.last_rel_dE(), inv_.last_rel_dK2sq(), inv_.last_abs_dK2Q()});
   }
+
+  /// With spec.dt_out > 0: a state at a requested output time t (made by a side step).
+  void emit(long i, double t, const State& s) {
+    inv_.update(s);
+    if (sink_) (*sink_)(Sample{i, t, s, inv_.last_rel_dE(), inv_.last_rel_dK2sq(), inv_.last_abs_dK2Q()});
+  }
+  [[nodiscard]] bool wants_times() const { return sink_ && spec_.dt_out > 0.0; }
 
   [[nodiscard]] const InvariantStats& stats() const { return inv_.stats(); }
 

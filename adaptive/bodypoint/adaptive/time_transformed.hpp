@@ -1,0 +1,145 @@
+// bodypoint: time-transformed splittings that shrink the physical step near a Coulomb centre while
+// keeping a fixed fictitious step ds, explicit and time-symmetric.
+//
+// Both kernels act on the Lie-Poisson state (R, K1, K2) extended by the physical time t and run on
+// the generic composition engine with any coefficient table (splitting/composition.hpp), so every
+// table keeps its order in ds. The physical time is accumulated with compensated summation.
+//
+// LogHKernel - logarithmic Hamiltonian (M. Mikkola, S. Tanikawa, "Explicit symplectic algorithms for
+//   time-transformed Hamiltonians", Celest. Mech. Dyn. Astron. 74 (1999) 287; M. Preto, S. Tremaine,
+//   "A class of symplectic integrators with adaptive time step for separable Hamiltonian systems",
+//   Astron. J. 118 (1999) 2532). In extended phase space with p_t = -E,
+//     H~ = ln(Pi(R)) - ln(-(T + p_t))                                 (shared/PHYSICS.md)
+//   is separable; its flows are
+//     drift for ds: dt = ds/(E - T) (T is constant along the exact kinetic drift), then the exact
+//                   kinetic drift for dt;
+//     kick for ds:  K1 += ds F(R)/Pi(R).
+//   On the energy shell dt/ds = 1/Pi ~ |R|/|A|. Needs Pi > 0 everywhere: every centre repulsive.
+//   For a material point in one centre's field each leapfrog follows the exact Kepler orbit
+//   (Mikkola-Tanikawa 1999, sec. 3): only the time along it carries error.
+//
+// TtlKernel - time-transformed leapfrog (S. Mikkola, S. J. Aarseth, "A time-transformed leapfrog
+//   scheme", Celest. Mech. Dyn. Astron. 84 (2002) 343), for any sign of A. With the time-step
+//   function Omega(R) = sum |A_i|/|R - c_i| and an auxiliary W (W = Omega at the start), integrate in
+//   s the system dR/ds = v/W, dt/ds = 1/W, dK2/ds = (B/D)(K2 x K1)/W, dK1/ds = F/Omega,
+//   dW/ds = gradOmega.v/Omega, split into two exactly solvable parts:
+//     drift for ds: dt = ds/W, exact kinetic drift for dt (K1, W constant);
+//     kick for ds:  dt' = ds/Omega(R), K1 += dt' F, W += dt' gradOmega.(v_before + v_after)/2
+//                   (v is linear in K1, so the average is the exact integral; R, K2 constant).
+//   Along the exact flow of the sum W = Omega stays true, so the solution is the physical motion
+//   reparametrised by dt/ds = 1/Omega, and any splitting table applies with its classical order.
+#pragma once
+
+#include "bodypoint/field.hpp"
+#include "bodypoint/model.hpp"
+#include "bodypoint/splitting/lie_poisson.hpp"
+
+#include <cmath>
+#include <string>
+
+namespace bodypoint::adaptive {
+
+/// Lie-Poisson state plus the physical time (compensated) and the TTL's auxiliary W.
+struct TimeState {
+  splitting::LieState q;
+  double t = 0.0;
+  double t_err = 0.0;
+  double W = 0.0;
+  [[nodiscard]] double time() const { return t - t_err; }
+};
+
+inline void advance_time(TimeState& x, double dt) {
+  const double y = dt - x.t_err;
+  const double s = x.t + y;
+  x.t_err = (s - x.t) - y;
+  x.t = s;
+}
+
+/// Kinetic energy from momenta: T = (J |K1|^2 - 2 B K1.K2 + m |K2|^2)/(2 D).
+inline double kinetic_energy(const BodyPoint& p, const Momenta& q) {
+  return (p.J * q.K1.squaredNorm() - 2.0 * p.B * q.K1.dot(q.K2) + p.m * q.K2.squaredNorm()) / (2.0 * p.D());
+}
+
+template <class Field, bool Spin>
+struct LogHKernel {
+  using state_type = TimeState;
+  static constexpr bool mergeable = true;
+
+  splitting::LiePoissonKernel<Field, Spin> lp;  ///< the physical-time exact drift and kick
+  double E = 0.0;                               ///< -p_t, constant
+
+  LogHKernel(const BodyPoint& p, const Field& f) : lp(p, f) {}
+
+  [[nodiscard]] TimeState initial_state(const State& s0) {
+    TimeState x;
+    x.q = lp.initial_state(s0);
+    E = kinetic_energy(lp.p, splitting::from_lie(x.q)) + lp.field.potential(s0.R);
+    return x;
+  }
+  void begin_step(TimeState&) const {}
+
+  void drift(TimeState& x, double ds) const {
+    const double g = E - kinetic_energy(lp.p, splitting::from_lie(x.q));  // = Pi on the energy shell
+    if (!(g > 0.0))
+      throw Error("logh: E - T = " + std::to_string(g) + " <= 0 at t = " + std::to_string(x.time()) +
+                  " (the fictitious step is too large for this encounter; reduce --h)");
+    const double dt = ds / g;
+    lp.drift(x.q, dt);
+    advance_time(x, dt);
+  }
+
+  void kick(TimeState& x, double ds) {
+    ++lp.evals;
+    Vec3 F;
+    double P;
+    lp.field.force_potential(x.q.R, F, P);
+    lp.apply_kick(x.q, ds / P, F);
+  }
+
+  [[nodiscard]] State to_physical(const TimeState& x) const { return lp.to_physical(x.q); }
+};
+
+template <class Field, bool Spin>
+struct TtlKernel {
+  using state_type = TimeState;
+  static constexpr bool mergeable = true;
+
+  splitting::LiePoissonKernel<Field, Spin> lp;
+
+  TtlKernel(const BodyPoint& p, const Field& f) : lp(p, f) {}
+
+  [[nodiscard]] TimeState initial_state(const State& s0) {
+    TimeState x;
+    x.q = lp.initial_state(s0);
+    Vec3 F, grad;
+    lp.field.force_omega(s0.R, F, x.W, grad);
+    return x;
+  }
+  void begin_step(TimeState&) const {}
+
+  void drift(TimeState& x, double ds) const {
+    const double dt = ds / x.W;
+    lp.drift(x.q, dt);
+    advance_time(x, dt);
+  }
+
+  void kick(TimeState& x, double ds) {
+    ++lp.evals;
+    Vec3 F, grad;
+    double Omega;
+    lp.field.force_omega(x.q.R, F, Omega, grad);
+    const double dtp = ds / Omega;
+    const Vec3 v_before = velocity(x);
+    lp.apply_kick(x.q, dtp, F);
+    x.W += dtp * grad.dot(0.5 * (v_before + velocity(x)));
+  }
+
+  [[nodiscard]] State to_physical(const TimeState& x) const { return lp.to_physical(x.q); }
+
+ private:
+  [[nodiscard]] Vec3 velocity(const TimeState& x) const {
+    return (lp.p.J * x.q.K1 - lp.p.B * x.q.K2) / lp.p.D();
+  }
+};
+
+}  // namespace bodypoint::adaptive

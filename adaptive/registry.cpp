@@ -1,0 +1,258 @@
+// bodypoint: run loops of the time-transformed (logh-*, ttl-*) and regularised (ks) methods.
+//
+// A run takes fixed fictitious steps ds = spec.h. With spec.t_end > 0 it stops at exactly t_end:
+// the fictitious step that would pass t_end is undone and replaced by one physical-time step of the
+// exact Lie-Poisson splitting with the same table over the remaining time (which is shorter than the
+// physical length of that fictitious step). Otherwise it takes spec.steps fictitious steps. With a
+// sink and spec.dt_out > 0, states at t = k dt_out are made by side steps of the same kind from the
+// state before the crossing step, without touching the main integration.
+#include "bodypoint/adaptive/registry.hpp"
+
+#include "bodypoint/adaptive/ks.hpp"
+#include "bodypoint/adaptive/time_transformed.hpp"
+#include "bodypoint/run_support.hpp"
+#include "bodypoint/splitting/blanes_moan.hpp"
+#include "bodypoint/splitting/classic.hpp"
+#include "bodypoint/splitting/kahan_li.hpp"
+#include "bodypoint/splitting/mclachlan.hpp"
+#include "bodypoint/splitting/sofroniou_spaletta.hpp"
+#include "bodypoint/splitting/yoshida.hpp"
+
+#include <cmath>
+#include <limits>
+#include <type_traits>
+
+namespace bodypoint::adaptive {
+namespace {
+
+namespace sp = splitting;
+using detail::dispatch;
+using detail::observe;
+
+/// A run to t_end that needs more fictitious steps than this is stopped with an error.
+constexpr long kMaxFictitiousSteps = 2'000'000'000L;
+
+struct StepStats {
+  long steps = 0;
+  double min_dt = std::numeric_limits<double>::infinity(), max_dt = 0.0;
+  void add(double dt) {
+    ++steps;
+    min_dt = std::min(min_dt, dt);
+    max_dt = std::max(max_dt, dt);
+  }
+};
+
+void require_time_target(const RunSpec& spec) {
+  if (spec.t_end < 0.0 || !std::isfinite(spec.t_end)) throw Error("end time must be a finite number >= 0");
+  if (spec.t_end == 0.0 && spec.steps < 1) throw Error("give a number of fictitious steps or an end time");
+  if (spec.dt_out < 0.0 || !std::isfinite(spec.dt_out)) throw Error("--dt-out must be a finite number >= 0");
+}
+
+template <template <class, bool> class Kernel, const auto& Seq>
+RunResult run_time_transformed(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
+                               const SampleSink* sink) {
+  require_time_target(spec);
+  return dispatch(body, centres, [&](const auto& field, auto spin) {
+    using Field = std::decay_t<decltype(field)>;
+    using K = Kernel<Field, decltype(spin)::value>;
+    K k(body.p, field);
+    auto to_physical = [&k](const TimeState& x) { return k.to_physical(x); };
+    const bool to_time = spec.t_end > 0.0;
+    StepStats st;
+    double t_reached = 0.0;
+    RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
+      constexpr bool active = std::decay_t<decltype(obs)>::active;
+      TimeState x = k.initial_state(body.s0);
+      sp::NullObserver none;
+      double next_out = spec.dt_out;
+      // States at requested output times in (prev.time(), t_upto], by side steps from prev.
+      auto outputs_until = [&](const TimeState& prev, double t_upto) {
+        if constexpr (active) {
+          if (!obs.wants_times()) return;
+          while (next_out <= t_upto) {
+            TimeState side = prev;
+            sp::integrate<Seq>(k.lp, side.q, next_out - prev.time(), 1, none);
+            obs.emit(st.steps, next_out, k.to_physical(side));
+            next_out += spec.dt_out;
+          }
+        }
+      };
+      const long cap = to_time ? kMaxFictitiousSteps : spec.steps;
+      while (st.steps < cap) {
+        const TimeState prev = x;
+        sp::integrate<Seq>(k, x, spec.h, 1, none);
+        const double t = x.time();
+        if (!std::isfinite(t) || !x.q.R.allFinite())
+          throw Error("the state became non-finite at t = " + std::to_string(prev.time()) + "; reduce --h");
+        if (to_time && t >= spec.t_end) {
+          x = prev;
+          break;
+        }
+        st.add(t - prev.time());
+        if constexpr (active) {
+          outputs_until(prev, t);
+          obs.observe(st.steps, t, x, !to_time && st.steps == cap);
+        }
+      }
+      if (to_time) {
+        if (st.steps >= cap) throw Error("more than 2e9 fictitious steps before t_end; increase --h");
+        const TimeState prev = x;
+        const double rest = spec.t_end - x.time();
+        if (rest > 0.0) {
+          sp::integrate<Seq>(k.lp, x.q, rest, 1, none);
+          st.add(rest);
+        }
+        x.t = spec.t_end;
+        x.t_err = 0.0;
+        if constexpr (active) {
+          outputs_until(prev, spec.t_end);
+          obs.observe(st.steps, spec.t_end, x, true);
+          if (obs.wants_times() && next_out - spec.dt_out < spec.t_end) obs.emit(st.steps, spec.t_end, k.to_physical(x));
+        }
+      }
+      t_reached = x.time();
+      return k.to_physical(x);
+    });
+    r.steps = st.steps;
+    r.t_end = t_reached;
+    r.force_evals = k.lp.evals;
+    r.min_step = st.steps ? st.min_dt : 0.0;
+    r.max_step = st.max_dt;
+    return r;
+  });
+}
+
+RunResult run_logh_checked(RunResult (*f)(const Body&, const std::vector<Centre>&, const RunSpec&, const SampleSink*),
+                           const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
+                           const SampleSink* sink) {
+  if (!all_repulsive(centres))
+    throw Error("logh-* needs every centre repulsive (A < 0) so that Pi > 0; use ttl-* (any sign of A) "
+                "or ks (material point, one centre)");
+  return f(body, centres, spec, sink);
+}
+
+template <const auto& Seq>
+RunResult run_logh(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec, const SampleSink* sink) {
+  return run_logh_checked(&run_time_transformed<LogHKernel, Seq>, body, centres, spec, sink);
+}
+
+template <const auto& Seq>
+RunResult run_ttl(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec, const SampleSink* sink) {
+  double total = 0.0;
+  for (const Centre& c : centres) total += std::abs(c.A);
+  if (!(total > 0.0)) throw Error("ttl-* needs a centre with A != 0 (its time step function is sum |A|/r)");
+  return run_time_transformed<TtlKernel, Seq>(body, centres, spec, sink);
+}
+
+RunResult run_ks(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec, const SampleSink* sink) {
+  if (body.p.B != 0.0) throw Error("ks regularises a material point: it needs B = 0 (use logh-* or ttl-*)");
+  if (centres.size() != 1) throw Error("ks needs exactly one centre (use logh-* or ttl-*)");
+  require_time_target(spec);
+  const Centre& c = centres.front();
+  OriginCentre shifted{c.A};  // invariants about the centre: same values as about c for one centre
+  CentreList field{centres};
+  StepStats st;
+  double t_reached = 0.0;
+  auto to_physical = [](const std::pair<KsMotion, double>& x) { return x.first.state(); };
+  RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
+    constexpr bool active = std::decay_t<decltype(obs)>::active;
+    std::pair<KsMotion, double> x{KsMotion(body.p, c, body.s0), 0.0};  // (motion, t)
+    double next_out = spec.dt_out;
+    auto outputs_until = [&](const std::pair<KsMotion, double>& prev, double t_upto) {
+      if constexpr (active) {
+        if (!obs.wants_times()) return;
+        while (next_out <= t_upto) {
+          KsMotion side = prev.first;
+          side.step(side.step_for_time(next_out - prev.second));
+          obs.emit(st.steps, next_out, side.state());
+          next_out += spec.dt_out;
+        }
+      }
+    };
+    const bool to_time = spec.t_end > 0.0;
+    const long cap = to_time ? kMaxFictitiousSteps : spec.steps;
+    while (st.steps < cap) {
+      if (to_time && x.second + x.first.elapsed(spec.h) >= spec.t_end) break;
+      const auto prev = x;
+      const double dt = x.first.step(spec.h);
+      x.second += dt;
+      st.add(dt);
+      if constexpr (active) {
+        outputs_until(prev, x.second);
+        obs.observe(st.steps, x.second, x, !to_time && st.steps == cap);
+      }
+    }
+    if (to_time) {
+      const auto prev = x;
+      const double rest = spec.t_end - x.second;
+      if (rest > 0.0) {
+        x.first.step(x.first.step_for_time(rest));
+        st.add(rest);
+      }
+      x.second = spec.t_end;
+      if constexpr (active) {
+        outputs_until(prev, spec.t_end);
+        obs.observe(st.steps, spec.t_end, x, true);
+        if (obs.wants_times() && next_out - spec.dt_out < spec.t_end) obs.emit(st.steps, spec.t_end, x.first.state());
+      }
+    }
+    t_reached = x.second;
+    return x.first.state();
+  });
+  (void)shifted;
+  r.steps = st.steps;
+  r.t_end = t_reached;
+  r.force_evals = 0;  // the regularised flow is exact: no force evaluations
+  r.min_step = st.steps ? st.min_dt : 0.0;
+  r.max_step = st.max_dt;
+  return r;
+}
+
+constexpr auto verlet_ops = sp::flatten(sp::strang_dkd_table);
+constexpr auto y4_ops = sp::flatten(sp::yoshida4);
+constexpr auto bm4_ops = sp::flatten(sp::blanes_moan4);
+constexpr auto y6_ops = sp::flatten(sp::yoshida6);
+constexpr auto kl6_ops = sp::flatten(sp::kahan_li6);
+constexpr auto y8_ops = sp::flatten(sp::yoshida8);
+constexpr auto mcl8_ops = sp::flatten(sp::mclachlan8);
+constexpr auto kl8_ops = sp::flatten(sp::kahan_li8);
+constexpr auto ss10_ops = sp::flatten(sp::sofroniou_spaletta10);
+
+template <const auto& Seq>
+MethodInfo logh(std::string_view name, int order, std::string_view what) {
+  const int s = static_cast<int>(Seq.kicks());
+  return {name, Family::TimeTransformed, order, s, s, what, &run_logh<Seq>};
+}
+template <const auto& Seq>
+MethodInfo ttl(std::string_view name, int order, std::string_view what) {
+  const int s = static_cast<int>(Seq.kicks());
+  return {name, Family::TimeTransformed, order, s, s, what, &run_ttl<Seq>};
+}
+
+}  // namespace
+
+std::vector<MethodInfo> methods() {
+  return {
+      logh<verlet_ops>("logh-verlet", 2, "logarithmic Hamiltonian, leapfrog DKD (repulsive scenes), ds = --h"),
+      logh<y4_ops>("logh-y4", 4, "logarithmic Hamiltonian, Yoshida 4"),
+      logh<bm4_ops>("logh-bm4", 4, "logarithmic Hamiltonian, Blanes-Moan S6"),
+      logh<y6_ops>("logh-y6", 6, "logarithmic Hamiltonian, Yoshida 6"),
+      logh<kl6_ops>("logh-kl6", 6, "logarithmic Hamiltonian, Kahan-Li p6 s9"),
+      logh<y8_ops>("logh-y8", 8, "logarithmic Hamiltonian, Yoshida 8 (27 stages)"),
+      logh<mcl8_ops>("logh-mcl8", 8, "logarithmic Hamiltonian, McLachlan p8 s15"),
+      logh<kl8_ops>("logh-kl8", 8, "logarithmic Hamiltonian, Kahan-Li p8 s17"),
+      logh<ss10_ops>("logh-ss10", 10, "logarithmic Hamiltonian, Sofroniou-Spaletta p10 s35"),
+      ttl<verlet_ops>("ttl-verlet", 2, "time-transformed leapfrog (Mikkola-Aarseth), any sign of A, ds = --h"),
+      ttl<y4_ops>("ttl-y4", 4, "time-transformed leapfrog, Yoshida 4"),
+      ttl<bm4_ops>("ttl-bm4", 4, "time-transformed leapfrog, Blanes-Moan S6"),
+      ttl<y6_ops>("ttl-y6", 6, "time-transformed leapfrog, Yoshida 6"),
+      ttl<kl6_ops>("ttl-kl6", 6, "time-transformed leapfrog, Kahan-Li p6 s9"),
+      ttl<mcl8_ops>("ttl-mcl8", 8, "time-transformed leapfrog, McLachlan p8 s15"),
+      ttl<kl8_ops>("ttl-kl8", 8, "time-transformed leapfrog, Kahan-Li p8 s17"),
+      {"ks", Family::TimeTransformed, 0, 0, 0,
+       "Kustaanheimo-Stiefel regularisation, exact in fictitious time (B = 0, one centre), ds = --h",
+       &run_ks},
+  };
+}
+
+}  // namespace bodypoint::adaptive
