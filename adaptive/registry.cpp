@@ -1,11 +1,13 @@
 // bodypoint: run loops of the time-transformed (logh-*, ttl-*) and regularised (ks) methods.
 //
 // A run takes fixed fictitious steps ds = spec.h. With spec.t_end > 0 it stops at exactly t_end:
-// the fictitious step that would pass t_end is undone and replaced by one physical-time step of the
-// exact Lie-Poisson splitting with the same table over the remaining time (which is shorter than the
-// physical length of that fictitious step). Otherwise it takes spec.steps fictitious steps. With a
-// sink and spec.dt_out > 0, states at t = k dt_out are made by side steps of the same kind from the
-// state before the crossing step, without touching the main integration.
+// the fictitious step that would pass t_end is undone, and the last step ds' in (0, ds) is solved
+// so that the physical time it advances is the remaining time (the advance grows monotonically with
+// ds'; a safeguarded secant iteration, a few steps). The last step is thus a step of the same scheme,
+// which keeps its properties (for logH on a material point: the exact Kepler orbit). Otherwise it
+// takes spec.steps fictitious steps. With a sink and spec.dt_out > 0, states at t = k dt_out are
+// made the same way, by side steps from the state before the crossing step, without touching the
+// main integration.
 #include "bodypoint/adaptive/registry.hpp"
 
 #include "bodypoint/adaptive/ks.hpp"
@@ -48,6 +50,42 @@ void require_time_target(const RunSpec& spec) {
   if (spec.dt_out < 0.0 || !std::isfinite(spec.dt_out)) throw Error("--dt-out must be a finite number >= 0");
 }
 
+/// From `from` (whose time is below target), the state at exactly `target`: a fictitious step ds'
+/// with advance(ds') = target - from.time(), where advance(ds) >= that gap. Regula falsi with
+/// Illinois safeguard on [0, ds]; stops when the remaining gap is below 4 ulp of the target.
+template <const auto& Seq, class K>
+TimeState step_to_time(K& k, const TimeState& from, double ds, double target) {
+  splitting::NullObserver none;
+  const double gap = target - from.time();
+  double lo = 0.0, f_lo = -gap, hi = ds;
+  TimeState x = from;
+  sp::integrate<Seq>(k, x, hi, 1, none);
+  double f_hi = x.time() - target;
+  const double tol = 4.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(target));
+  int side = 0;
+  for (int it = 0; it < 60 && std::abs(f_hi) > tol; ++it) {
+    const double mid = lo - f_lo * (hi - lo) / (f_hi - f_lo);
+    const double next = (mid > lo && mid < hi) ? mid : 0.5 * (lo + hi);
+    TimeState y = from;
+    sp::integrate<Seq>(k, y, next, 1, none);
+    const double f = y.time() - target;
+    if (std::abs(f) <= tol) return y;
+    if (f > 0) {
+      hi = next;
+      f_hi = f;
+      if (side == 1) f_lo *= 0.5;
+      side = 1;
+    } else {
+      lo = next;
+      f_lo = f;
+      if (side == -1) f_hi *= 0.5;
+      side = -1;
+    }
+    x = y;
+  }
+  return x;
+}
+
 template <template <class, bool> class Kernel, const auto& Seq>
 RunResult run_time_transformed(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
                                const SampleSink* sink) {
@@ -70,8 +108,7 @@ RunResult run_time_transformed(const Body& body, const std::vector<Centre>& cent
         if constexpr (active) {
           if (!obs.wants_times()) return;
           while (next_out <= t_upto) {
-            TimeState side = prev;
-            sp::integrate<Seq>(k.lp, side.q, next_out - prev.time(), 1, none);
+            const TimeState side = step_to_time<Seq>(k, prev, spec.h, next_out);
             obs.emit(st.steps, next_out, k.to_physical(side));
             next_out += spec.dt_out;
           }
@@ -99,7 +136,7 @@ RunResult run_time_transformed(const Body& body, const std::vector<Centre>& cent
         const TimeState prev = x;
         const double rest = spec.t_end - x.time();
         if (rest > 0.0) {
-          sp::integrate<Seq>(k.lp, x.q, rest, 1, none);
+          x = step_to_time<Seq>(k, prev, spec.h, spec.t_end);
           st.add(rest);
         }
         x.t = spec.t_end;

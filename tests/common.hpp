@@ -4,6 +4,7 @@
 #include "bodypoint/model.hpp"
 #include "bodypoint/run.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 #include <vector>
@@ -32,5 +33,32 @@ inline double loglog_slope(const std::vector<std::pair<double, double>>& h_err) 
 }
 
 inline double rel_err(const Vec3& a, const Vec3& ref) { return (a - ref).norm() / ref.norm(); }
+
+// Ladders of steps h0 / sqrt(2)^k, k = 0..kLadder-1. The round-off plateau of a ladder is the median
+// error of its kPlateauPoints smallest steps (the ladders run well into it: 1e-16..1e-14 relative with
+// compensated summation). Points within a factor kPlateauMargin of it (so that rounding moves them by
+// at most ~3%) are left out, and so are points below kPlateau when the ladder never reached its
+// plateau (low orders). The slope is fitted to the kFitPoints smallest steps that remain: the most
+// asymptotic points that rounding does not disturb.
+constexpr int kLadder = 24;
+constexpr double kPlateau = 1e-12;
+constexpr double kPlateauMargin = 30.0;
+constexpr std::size_t kPlateauPoints = 5;
+constexpr std::size_t kFitPoints = 3;
+
+/// Fitted order of (h, error) pairs ordered from large to small h; *used = points fitted.
+inline double asymptotic_slope(const std::vector<std::pair<double, double>>& all, std::size_t* used) {
+  std::vector<double> tail;
+  for (std::size_t i = all.size() - std::min(kPlateauPoints, all.size()); i < all.size(); ++i)
+    tail.push_back(all[i].second);
+  std::sort(tail.begin(), tail.end());
+  const double cut = std::min(kPlateau, kPlateauMargin * tail[tail.size() / 2]);
+  std::vector<std::pair<double, double>> pts;
+  for (const auto& p : all)
+    if (p.second > cut) pts.push_back(p);
+  if (pts.size() > kFitPoints) pts.erase(pts.begin(), pts.end() - static_cast<long>(kFitPoints));
+  *used = pts.size();
+  return pts.size() >= 2 ? loglog_slope(pts) : 0.0;
+}
 
 }  // namespace bodypoint::test

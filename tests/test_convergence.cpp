@@ -17,17 +17,6 @@ namespace {
 // Slope within 0.15 of the order: the tolerance STYLE.md and issue #3 ask for; the ladders below are
 // chosen in the asymptotic range, above the round-off plateau.
 constexpr double kSlopeTol = 0.15;
-// The round-off plateau of a ladder is the median error of its kPlateauPoints smallest steps (the
-// ladders run well into it: 1e-16..1e-14 relative with compensated summation). Points within a factor
-// kPlateauMargin of it (so that rounding moves them by at most ~3%) are left out of the fit, and so
-// are points below kPlateau when the ladder never reached its plateau (low orders).
-constexpr double kPlateau = 1e-12;
-constexpr double kPlateauMargin = 30.0;
-constexpr std::size_t kPlateauPoints = 5;
-// Ladder: h0 / sqrt(2)^k, k = 0..kLadder-1. The slope is fitted to the kFitPoints smallest steps
-// above the plateau: the most asymptotic points that rounding does not disturb.
-constexpr int kLadder = 24;
-constexpr std::size_t kFitPoints = 3;
 // The two independent references (odeint rkf78 in long double, Kepler's equation) agree this well.
 constexpr double kReferenceAgreement = 1e-13;
 
@@ -81,7 +70,7 @@ double measured_slope(const Case& c, double B) {
                              : reference_state(body, s.centres, kTEnd);
   std::vector<std::pair<double, double>> all;
   std::string log;
-  for (int k = 0; k < kLadder; ++k) {
+  for (int k = 0; k < test::kLadder; ++k) {
     RunSpec spec;
     spec.steps = std::lround(kTEnd / c.h0 * std::pow(std::sqrt(2.0), k));
     spec.h = kTEnd / static_cast<double>(spec.steps);
@@ -92,17 +81,10 @@ double measured_slope(const Case& c, double B) {
     log += buf;
     all.emplace_back(spec.h, e);
   }
-  std::vector<double> tail;
-  for (std::size_t i = all.size() - kPlateauPoints; i < all.size(); ++i) tail.push_back(all[i].second);
-  std::sort(tail.begin(), tail.end());
-  const double cut = std::min(kPlateau, kPlateauMargin * tail[tail.size() / 2]);
-  std::vector<std::pair<double, double>> pts;
-  for (const auto& p : all)
-    if (p.second > cut) pts.push_back(p);
-  EXPECT_GE(pts.size(), kFitPoints) << c.method << " B=" << B << log;
-  if (pts.size() > kFitPoints) pts.erase(pts.begin(), pts.end() - static_cast<long>(kFitPoints));
-  const double slope = pts.size() >= 2 ? test::loglog_slope(pts) : 0.0;
-  std::printf("  %-14s %s B=%.1f  slope %.3f (%zu points)%s\n", c.method.c_str(), c.on_orbit ? "orbit" : "encounter", B, slope, pts.size(), log.c_str());
+  std::size_t used = 0;
+  const double slope = test::asymptotic_slope(all, &used);
+  EXPECT_GE(used, test::kFitPoints) << c.method << " B=" << B << log;
+  std::printf("  %-14s %s B=%.1f  slope %.3f (%zu points)%s\n", c.method.c_str(), c.on_orbit ? "orbit" : "encounter", B, slope, used, log.c_str());
   return slope;
 }
 
