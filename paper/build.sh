@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# bodypoint research appendix: regenerates every CSV from the drivers and every figure from the CSVs.
+#
+#   paper/build.sh            full studies (thesis grids; ~30 min on 2 cores) into paper/results/
+#   paper/build.sh --quick    the same recipes on coarse grids (~1 min) into paper/results-quick/
+#
+# Outputs: <results>/*.csv (bodypoint study, bodypoint work-precision), <results>/figures/*.png and
+# <results>/figures/figures.md. Every number in the appendix comes from these files.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+quick=""
+results=paper/results
+if [ "${1:-}" = "--quick" ]; then
+  quick="--quick"
+  results=paper/results-quick
+fi
+scripts/setup.sh >/dev/null
+bin=build/bin/bodypoint
+mkdir -p "$results"
+$bin study $quick --results "$results"
+$bin work-precision $quick --out "$results/work_precision.csv" --summary "$results/work_precision_summary.md" \
+  > "$results/work_precision_summary.txt"
+python3 paper/make_figures.py "$results" "$results/figures"
+echo "appendix rebuilt in $results"
