@@ -10,7 +10,7 @@
 
 #include "bodypoint/field.hpp"
 #include "bodypoint/rhs.hpp"
-#include "bodypoint/rk/odeint.hpp"
+#include "bodypoint/rk/run_odeint.hpp"
 #include "bodypoint/splitting/blanes_moan.hpp"
 #include "bodypoint/splitting/classic.hpp"
 #include "bodypoint/splitting/composition.hpp"
@@ -51,74 +51,6 @@ RunResult run_splitting(const Body& body, const std::vector<Centre>& centres, co
   });
 }
 
-template <class Stepper>
-RunResult run_odeint(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
-                     const SampleSink* sink) {
-  return dispatch(body, centres, [&](const auto& field, auto spin) {
-    using Field = std::decay_t<decltype(field)>;
-    long evals = 0;
-    EquationsOfMotion<Field, decltype(spin)::value> sys{body.p, field, &evals};
-    auto to_physical = [](const OdeState<double>& x) { return from_ode(x); };
-    RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
-      OdeState<double> x = to_ode(body.s0);
-      Stepper stepper;
-      for (long i = 0; i < spec.steps; ++i) {
-        stepper.do_step(std::ref(sys), x, static_cast<double>(i) * spec.h, spec.h);
-        if constexpr (std::decay_t<decltype(obs)>::active) obs(i + 1, x);
-      }
-      return from_ode(x);
-    });
-    r.force_evals = evals;
-    return r;
-  });
-}
-
-/// Step-size-controlled odeint stepper from t = 0 to spec.t_end, hitting t_end exactly (the last
-/// trial step is cut to the remaining time). The observer sees every accepted step.
-template <class Controlled>
-RunResult run_odeint_adaptive(const Body& body, const std::vector<Centre>& centres,
-                              const RunSpec& spec, const SampleSink* sink) {
-  return dispatch(body, centres, [&](const auto& field, auto spin) {
-    using Field = std::decay_t<decltype(field)>;
-    long evals = 0;
-    EquationsOfMotion<Field, decltype(spin)::value> sys{body.p, field, &evals};
-    auto to_physical = [](const OdeState<double>& x) { return from_ode(x); };
-    const double t_end = spec.t_end;
-    long accepted = 0;
-    double min_step = std::numeric_limits<double>::infinity(), max_step = 0.0;
-    RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
-      OdeState<double> x = to_ode(body.s0);
-      Controlled stepper = rk::make_controlled<Controlled>(spec.tol);
-      double t = 0.0, dt = std::min(spec.h, t_end);
-      long rejected_in_a_row = 0;
-      while (t < t_end) {
-        const bool final_step = t + dt >= t_end;
-        if (final_step) dt = t_end - t;
-        const double t_before = t;
-        if (stepper.try_step(std::ref(sys), x, t, dt) == boost::numeric::odeint::success) {
-          if (final_step) t = t_end;  // exact end time, not t_before + dt rounded
-          const double taken = t - t_before;
-          min_step = std::min(min_step, taken);
-          max_step = std::max(max_step, taken);
-          ++accepted;
-          rejected_in_a_row = 0;
-          if constexpr (std::decay_t<decltype(obs)>::active) obs.observe(accepted, t, x, t >= t_end);
-          if (!std::isfinite(x[0])) break;
-        } else if (++rejected_in_a_row > 1000 || !(dt > 0.0)) {
-          throw Error("adaptive step size collapsed at t = " + std::to_string(t) + " (tolerance too tight?)");
-        }
-      }
-      return from_ode(x);
-    });
-    r.force_evals = evals;
-    r.steps = accepted;
-    r.t_end = t_end;
-    r.min_step = min_step;
-    r.max_step = max_step;
-    return r;
-  });
-}
-
 // Flattened op sequences (static storage, so they can be template arguments).
 constexpr auto euler_ops = sp::flatten(sp::euler);
 constexpr auto verlet_ops = sp::flatten(sp::verlet_kdk);
@@ -151,19 +83,19 @@ MethodInfo lie_method(std::string_view name, int order, std::string_view what) {
 std::vector<MethodInfo> make_registry() {
   std::vector<MethodInfo> all = {
       {"rk4", Family::Odeint, 4, 4, 4, "classical Runge-Kutta (thesis 2.1; odeint runge_kutta4)",
-       &run_odeint<rk::Rk4>},
+       &run_odeint_rk4},
       {"ab4", Family::Odeint, 4, 1, 1,
        "Adams-Bashforth 4 started by RK4 (thesis 2.2; odeint adams_bashforth<4>)",
-       &run_odeint<rk::Ab4>},
+       &run_odeint_ab4},
       {"odeint-dopri5", Family::OdeintAdaptive, 5, 6, 6,
        "Dormand-Prince 5(4) with step-size control (odeint runge_kutta_dopri5), --tol",
-       &run_odeint_adaptive<rk::Dopri5>},
+       &run_odeint_dopri5},
       {"odeint-rkf78", Family::OdeintAdaptive, 8, 13, 13,
        "Fehlberg 7(8) with step-size control (odeint runge_kutta_fehlberg78), --tol",
-       &run_odeint_adaptive<rk::Rkf78>},
+       &run_odeint_rkf78},
       {"odeint-bs", Family::OdeintAdaptive, 0, 0, 0,
        "Bulirsch-Stoer extrapolation with order and step control (odeint bulirsch_stoer), --tol",
-       &run_odeint_adaptive<rk::BulirschStoer>},
+       &run_odeint_bs},
       thesis_method<euler_ops>("thesis-euler", 1, "thesis symplectic Euler, frozen gyroscopic term"),
       thesis_method<verlet_ops>("thesis-verlet", 2, "thesis Verlet (KDK), frozen gyroscopic term"),
       thesis_method<ruth3_ops>("thesis-ruth3", 3, "thesis Ruth 3, frozen gyroscopic term"),

@@ -1,0 +1,16 @@
+// bodypoint: the Boost.Odeint run loops (fixed-step RK4/AB4 and the step-size-controlled steppers),
+// kept apart from the splitting loops of run.cpp. See run_odeint.cpp for a known cost gap of the
+// fixed-step loop against odeint driven directly.
+#pragma once
+
+#include "bodypoint/run.hpp"
+
+namespace bodypoint {
+
+RunResult run_odeint_rk4(const Body&, const std::vector<Centre>&, const RunSpec&, const SampleSink*);
+RunResult run_odeint_ab4(const Body&, const std::vector<Centre>&, const RunSpec&, const SampleSink*);
+RunResult run_odeint_dopri5(const Body&, const std::vector<Centre>&, const RunSpec&, const SampleSink*);
+RunResult run_odeint_rkf78(const Body&, const std::vector<Centre>&, const RunSpec&, const SampleSink*);
+RunResult run_odeint_bs(const Body&, const std::vector<Centre>&, const RunSpec&, const SampleSink*);
+
+}  // namespace bodypoint
