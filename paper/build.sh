@@ -20,5 +20,5 @@ mkdir -p "$results"
 $bin study $quick --results "$results"
 $bin work-precision $quick --out "$results/work_precision.csv" --summary "$results/work_precision_summary.md" \
   > "$results/work_precision_summary.txt"
-python3 paper/make_figures.py "$results" "$results/figures"
+"${PYTHON:-/usr/bin/python3}" paper/make_figures.py "$results" "$results/figures"  # Debian python3-matplotlib
 echo "appendix rebuilt in $results"

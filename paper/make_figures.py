@@ -50,9 +50,14 @@ def by_method(rows):
     return out
 
 
+# Relative deviations above this mean the run diverged (the thesis's schemes and RK4 reach 1e190 at
+# coarse steps); they are drawn at this ceiling so that the other curves stay readable.
+DIVERGED = 1e2
+
+
 def positive(values):
-    """Plots on log axes drop zeros (a deviation of exactly 0) instead of failing."""
-    return [v if v > 0 else float("nan") for v in values]
+    """Plots on log axes drop zeros (a deviation of exactly 0) and cap diverged runs at DIVERGED."""
+    return [float("nan") if not v > 0 else min(v, DIVERGED) for v in values]
 
 
 def sweep_figure(rows, param, column, ylabel, title, path, methods=None):
@@ -66,6 +71,8 @@ def sweep_figure(rows, param, column, ylabel, title, path, methods=None):
     ax.set_yscale("log")
     if param == "h":
         ax.set_xscale("log")
+    ax.axhline(DIVERGED, color="grey", linewidth=0.5)
+    ax.text(ax.get_xlim()[0], DIVERGED, " diverged", fontsize=7, va="bottom", color="grey")
     ax.set_xlabel(param)
     ax.set_ylabel(ylabel)
     ax.set_title(title)

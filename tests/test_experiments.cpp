@@ -153,6 +153,13 @@ TEST(Study, QuickRecipesWriteEveryCsv) {
   EXPECT_NE(is.str().find("2,-0.5,1,0.7,0.2,200,50,5,5,2,\"skipped: body: D = m J - B^2 must be > 0"), std::string::npos)
       << "P1.2 has D < 0 and must be skipped, not integrated";
   EXPECT_FALSE(fs::exists(dir / "appendix1/P1.2.csv"));
+  // The appendix's figures are drawn from these CSVs (Debian's python3 with python3-matplotlib).
+  const std::string plot = "/usr/bin/python3 " + std::string(BODYPOINT_SOURCE_DIR) + "/paper/make_figures.py " +
+                           dir.string() + " " + (dir / "figures").string() + " >/dev/null 2>&1";
+  EXPECT_EQ(std::system(plot.c_str()), 0) << plot;
+  for (const char* f : {"d_sweep_thesis.png", "L_sweep.png", "h_sweep_energy.png", "h_sweep_K2sq.png",
+                        "Kx_sweep_K2sq.png", "timing.png", "appendix1_trajectories.png", "figures.md"})
+    EXPECT_TRUE(fs::exists(dir / "figures" / f)) << f;
   fs::remove_all(dir);
 }
 
