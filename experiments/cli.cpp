@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <sstream>
 
 namespace bodypoint::cli {
 
@@ -51,6 +52,37 @@ void apply_step_options(const po::variables_map& vm, const StepOptions& o, RunSp
   spec.h = r.h;
   spec.steps = r.steps;
   spec.t_end = r.t_end;
+}
+
+std::vector<std::string> split_list(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  for (std::string item; std::getline(ss, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+std::vector<double> parse_numbers(const std::string& list, const std::string& option) {
+  std::vector<double> out;
+  for (const std::string& s : split_list(list)) {
+    std::size_t used = 0;
+    double v = 0;
+    try {
+      v = std::stod(s, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != s.size()) throw Error(option + ": '" + s + "' is not a number");
+    out.push_back(v);
+  }
+  if (out.empty()) throw Error(option + " is empty");
+  return out;
+}
+
+std::string command_line(int argc, char** argv) {
+  std::string command = "bodypoint";
+  for (int i = 0; i < argc; ++i) command += std::string(" ") + argv[i];
+  return command;
 }
 
 bool parse(int argc, char** argv, const po::options_description& desc, po::variables_map& vm,

@@ -44,6 +44,13 @@ int cmd_sweep(int argc, char** argv);
 int cmd_timing(int argc, char** argv);
 int cmd_study(int argc, char** argv);
 
+/// The non-empty items of a comma-separated list.
+std::vector<std::string> split_list(const std::string& s);
+/// The numbers of a comma-separated list; throws Error naming `option` for an item that is not one.
+std::vector<double> parse_numbers(const std::string& list, const std::string& option);
+/// "bodypoint <argv...>", for output headers.
+std::string command_line(int argc, char** argv);
+
 /// Method list from 'all', 'fixed' (every fixed-step method) or comma-separated names.
 std::vector<const MethodInfo*> parse_methods(const std::string& list);
 

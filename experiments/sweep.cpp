@@ -39,14 +39,6 @@ void progress_bar(std::size_t done, std::size_t total) {
   if (done == total) std::cerr << "\n";
 }
 
-std::vector<std::string> split(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  for (std::string item; std::getline(ss, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
 }  // namespace
 
 std::vector<double> linear_range(double from, double to, double step) {
@@ -182,7 +174,7 @@ std::vector<const MethodInfo*> parse_methods(const std::string& list) {
       if (!has_variable_step(m)) ms.push_back(&m);
     return ms;
   }
-  for (const std::string& n : split(list)) ms.push_back(&method_or_throw(n));
+  for (const std::string& n : split_list(list)) ms.push_back(&method_or_throw(n));
   if (ms.empty()) throw Error("--methods is empty");
   return ms;
 }
@@ -223,18 +215,7 @@ int cmd_sweep(int argc, char** argv) {
   spec.param = param;
   if (vm.count("values")) {
     if (vm.count("from") || vm.count("to") || vm.count("step") || log) throw Error("give --values or a range, not both");
-    for (const std::string& s : split(values)) {
-      std::size_t used = 0;
-      double v = 0;
-      try {
-        v = std::stod(s, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used != s.size()) throw Error("--values: '" + s + "' is not a number");
-      spec.values.push_back(v);
-    }
-    if (spec.values.empty()) throw Error("--values is empty");
+    spec.values = parse_numbers(values, "--values");
   } else {
     if (!vm.count("from") || !vm.count("to")) throw Error("give --from and --to (or --values)");
     if (log) {
@@ -259,8 +240,7 @@ int cmd_sweep(int argc, char** argv) {
   std::unique_ptr<AtomicFile> file;
   if (!out.empty()) file = std::make_unique<AtomicFile>(out);
   const auto rows = run_sweep(spec, thread_count(threads), ::isatty(2) == 1);
-  std::string command = "bodypoint";
-  for (int i = 0; i < argc; ++i) command += std::string(" ") + argv[i];
+  const std::string command = command_line(argc, argv);
   if (file) {
     write_sweep_csv(file->stream(), spec, rows, command);
     file->commit();

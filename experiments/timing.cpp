@@ -91,8 +91,7 @@ int cmd_timing(int argc, char** argv) {
   spec.methods = parse_methods(methods_arg);
   std::vector<double> ns;
   if (vm.count("values")) {
-    std::stringstream ss(values);
-    for (std::string s; std::getline(ss, s, ',');) ns.push_back(std::stod(s));
+    ns = parse_numbers(values, "--values");
   } else {
     ns = linear_range(from, to, step);
   }
@@ -103,8 +102,7 @@ int cmd_timing(int argc, char** argv) {
   std::unique_ptr<AtomicFile> file;
   if (!out.empty()) file = std::make_unique<AtomicFile>(out);
   const auto rows = run_timing(spec, ::isatty(2) == 1);
-  std::string command = "bodypoint";
-  for (int i = 0; i < argc; ++i) command += std::string(" ") + argv[i];
+  const std::string command = command_line(argc, argv);
   if (file) {
     write_timing_csv(file->stream(), spec, rows, command);
     file->commit();

@@ -1,6 +1,7 @@
 // The bodypoint command line: the acceptance run, the JSON and CSV outputs, and one clear
 // line plus a non-zero exit (and no output file) for every kind of bad input.
 #include "bodypoint/reference.hpp"
+#include "cli_helpers.hpp"
 #include "common.hpp"
 
 #include <gtest/gtest.h>
@@ -24,27 +25,8 @@ constexpr double kRk4FinalTol = 1e-5;
 // ... and reports max_rel_dE below 1e-8.
 constexpr double kRk4EnergyTol = 1e-8;
 
-struct Result {
-  int code;
-  std::string out, err;
-};
-
-Result run_cli(const std::string& args) {
-  const fs::path err = fs::temp_directory_path() / ("bp_err_" + std::to_string(::getpid()));
-  const std::string cmd = std::string(BODYPOINT_BIN) + " " + args + " 2>" + err.string() + " </dev/null";
-  Result r;
-  FILE* p = ::popen(cmd.c_str(), "r");
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), buf.size(), p)) r.out += buf.data();
-  const int status = ::pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream e(err);
-  std::stringstream ss;
-  ss << e.rdbuf();
-  r.err = ss.str();
-  fs::remove(err);
-  return r;
-}
+using Result = test::CliResult;
+using test::run_cli;
 
 Vec3 json_vec(const std::string& json, const std::string& key) {
   const std::regex re("\"" + key + "\": \\[([^,]+), ([^,]+), ([^\\]]+)\\]");

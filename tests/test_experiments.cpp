@@ -1,5 +1,6 @@
 // Experiment drivers: sweep rows equal single simulate runs bit for bit, the thread count does not
 // change the output, bad ranges are rejected, and the --quick study recipes run and write their CSVs.
+#include "cli_helpers.hpp"
 #include "common.hpp"
 
 #include <gtest/gtest.h>
@@ -17,27 +18,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int code;
-  std::string out, err;
-};
-
-Result run_cli(const std::string& args) {
-  const fs::path err = fs::temp_directory_path() / ("bp_exp_err_" + std::to_string(::getpid()));
-  const std::string cmd = std::string(BODYPOINT_BIN) + " " + args + " 2>" + err.string() + " </dev/null";
-  Result r;
-  FILE* p = ::popen(cmd.c_str(), "r");
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), buf.size(), p)) r.out += buf.data();
-  const int status = ::pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream e(err);
-  std::stringstream ss;
-  ss << e.rdbuf();
-  r.err = ss.str();
-  fs::remove(err);
-  return r;
-}
+using Result = test::CliResult;
+using test::run_cli;
 
 std::vector<std::vector<std::string>> csv_rows(const std::string& text) {
   std::vector<std::vector<std::string>> rows;
