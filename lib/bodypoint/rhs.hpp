@@ -30,31 +30,39 @@ inline State from_ode(const OdeState<double>& x) {
 }
 
 /// The system for a given field; `Spin = false` (B = 0) skips the gyroscopic terms entirely,
-/// leaving dw/dt = 0. Counts its own calls (one call = one force evaluation).
+/// leaving dw/dt = 0. Counts its own calls (one call = one force evaluation). The coefficients
+/// J/D, B^2/D, B/D and m B/D are computed once: odeint may call this out of line, and a division per
+/// call made an RK4 step 1.8x slower (bench_steps).
 template <class Field, bool Spin>
 struct EquationsOfMotion {
   BodyPoint p;
   Field field;
   long* evals = nullptr;  ///< optional counter of calls
 
+  EquationsOfMotion(const BodyPoint& bp, Field f, long* counter = nullptr)
+      : p(bp), field(std::move(f)), evals(counter), cJ_(bp.J / bp.D()), cBB_(bp.B * bp.B / bp.D()),
+        cB_(bp.B / bp.D()), cmB_(bp.m * bp.B / bp.D()), inv_m_(1.0 / bp.m) {}
+
   void operator()(const OdeState<double>& x, OdeState<double>& dxdt, double /*t*/) const {
     if (evals) ++*evals;
     const Vec3 R(x[0], x[1], x[2]);
     const Vec3 v(x[3], x[4], x[5]);
     const Vec3 F = field.force(R);
-    const double inv_D = 1.0 / p.D();
     Vec3 dv, dw;
     if constexpr (Spin) {
       const Vec3 w(x[6], x[7], x[8]);
       const Vec3 wxv = w.cross(v);
-      dv = (p.J * F - p.B * p.B * wxv) * inv_D;
-      dw = (-p.B * F + p.m * p.B * wxv) * inv_D;
+      dv = cJ_ * F - cBB_ * wxv;
+      dw = -cB_ * F + cmB_ * wxv;
     } else {
-      dv = F / p.m;
+      dv = inv_m_ * F;
       dw.setZero();
     }
     dxdt = {x[3], x[4], x[5], dv.x(), dv.y(), dv.z(), dw.x(), dw.y(), dw.z()};
   }
+
+ private:
+  double cJ_, cBB_, cB_, cmB_, inv_m_;
 };
 
 /// The same equations in any floating type, with a plain loop over centres. It shares no code
