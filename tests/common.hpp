@@ -38,8 +38,8 @@ inline double rel_err(const Vec3& a, const Vec3& ref) { return (a - ref).norm() 
 // error of its kPlateauPoints smallest steps (the ladders run well into it: 1e-16..1e-14 relative with
 // compensated summation). Points within a factor kPlateauMargin of it (so that rounding moves them by
 // at most ~3%) are left out, and so are points below kPlateau when the ladder never reached its
-// plateau (low orders). The slope is fitted to the kFitPoints smallest steps that remain: the most
-// asymptotic points that rounding does not disturb.
+// plateau (low orders); the ladder is cut at its first point below that level. The slope is fitted to
+// the kFitPoints smallest steps before the cut: the most asymptotic points rounding does not disturb.
 constexpr int kLadder = 24;
 constexpr double kPlateau = 1e-12;
 constexpr double kPlateauMargin = 30.0;
@@ -53,9 +53,13 @@ inline double asymptotic_slope(const std::vector<std::pair<double, double>>& all
     tail.push_back(all[i].second);
   std::sort(tail.begin(), tail.end());
   const double cut = std::min(kPlateau, kPlateauMargin * tail[tail.size() / 2]);
+  // The descending branch only: from the largest step until the ladder first reaches the plateau
+  // (round-off grows with the number of steps, so later points can rise above the cut again).
   std::vector<std::pair<double, double>> pts;
-  for (const auto& p : all)
-    if (p.second > cut) pts.push_back(p);
+  for (const auto& p : all) {
+    if (!(p.second > cut)) break;
+    pts.push_back(p);
+  }
   if (pts.size() > kFitPoints) pts.erase(pts.begin(), pts.end() - static_cast<long>(kFitPoints));
   *used = pts.size();
   return pts.size() >= 2 ? loglog_slope(pts) : 0.0;
