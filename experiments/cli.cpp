@@ -1,5 +1,6 @@
 #include "cli.hpp"
 
+#include "bodypoint/io.hpp"
 #include "bodypoint/scene_file.hpp"
 #include "sweep.hpp"
 
@@ -52,6 +53,14 @@ void apply_step_options(const po::variables_map& vm, const StepOptions& o, RunSp
   spec.h = r.h;
   spec.steps = r.steps;
   spec.t_end = r.t_end;
+}
+
+std::string describe(const SceneParams& p) {
+  std::ostringstream os;
+  os << "A=" << fmt(p.A) << " m=" << fmt(p.m) << " B=" << fmt(p.B) << " J=" << fmt(p.J)
+     << " K1=" << fmt(p.start.K1) << " Kx=" << fmt(p.start.Kx) << " Kz=" << fmt(p.start.Kz)
+     << " d=" << fmt(p.start.d) << " L=" << fmt(p.start.L);
+  return os.str();
 }
 
 std::vector<std::string> split_list(const std::string& s) {

@@ -44,6 +44,9 @@ int cmd_sweep(int argc, char** argv);
 int cmd_timing(int argc, char** argv);
 int cmd_study(int argc, char** argv);
 
+/// "A=.. m=.. B=.. J=.. K1=.. Kx=.. Kz=.. d=.. L=..": the thesis's parameters, for output headers.
+std::string describe(const SceneParams& p);
+
 /// The non-empty items of a comma-separated list.
 std::vector<std::string> split_list(const std::string& s);
 /// The numbers of a comma-separated list; throws Error naming `option` for an item that is not one.

@@ -18,12 +18,7 @@ bool finite(const State& s) { return s.R.allFinite() && s.v.allFinite() && s.w.a
 
 std::string scene_header(const po::variables_map& vm, const SceneOptions& o) {
   if (vm.count("scene")) return "scene=" + o.scene_file;
-  const SceneParams& p = o.params;
-  std::ostringstream os;
-  os << "A=" << fmt(p.A) << " m=" << fmt(p.m) << " B=" << fmt(p.B) << " J=" << fmt(p.J)
-     << " K1=" << fmt(p.start.K1) << " Kx=" << fmt(p.start.Kx) << " Kz=" << fmt(p.start.Kz)
-     << " d=" << fmt(p.start.d) << " L=" << fmt(p.start.L);
-  return os.str();
+  return describe(o.params);
 }
 
 std::string json_body(const RunResult& r, const std::optional<double>& err_R) {

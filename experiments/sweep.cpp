@@ -145,9 +145,7 @@ void write_sweep_csv(std::ostream& os, const SweepSpec& spec, const std::vector<
   os << "# bodypoint sweep, revision " << git_revision() << "\n"
      << "# command: " << command << "\n"
      << "# varied: " << spec.param << "\n"
-     << "# fixed: A=" << fmt(p.A) << " m=" << fmt(p.m) << " B=" << fmt(p.B) << " J=" << fmt(p.J)
-     << " K1=" << fmt(p.start.K1) << " Kx=" << fmt(p.start.Kx) << " Kz=" << fmt(p.start.Kz)
-     << " d=" << fmt(p.start.d) << " L=" << fmt(p.start.L) << " (the varied one excepted)";
+     << "# fixed: " << describe(p) << " (the varied one excepted)";
   if (spec.param != "h") os << " h=" << fmt(spec.h);
   if (spec.t_end > 0) os << " t_end=" << fmt(spec.t_end); else os << " steps=" << spec.steps;
   os << "\n"

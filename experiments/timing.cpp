@@ -54,9 +54,7 @@ void write_timing_csv(std::ostream& os, const TimingSpec& spec, const std::vecto
   const SceneParams& p = spec.base;
   os << "# bodypoint timing, revision " << git_revision() << "\n"
      << "# command: " << command << "\n"
-     << "# scene: A=" << fmt(p.A) << " m=" << fmt(p.m) << " B=" << fmt(p.B) << " J=" << fmt(p.J)
-     << " K1=" << fmt(p.start.K1) << " Kx=" << fmt(p.start.Kx) << " Kz=" << fmt(p.start.Kz)
-     << " d=" << fmt(p.start.d) << " L=" << fmt(p.start.L) << " h=" << fmt(spec.h) << "\n"
+     << "# scene: " << describe(p) << " h=" << fmt(spec.h) << "\n"
      << "# " << spec.warmup << " warm-up run(s), then " << spec.repeats
      << " timed repeats of the step loop alone (no invariants, no output), one thread\n"
      << "n,method,median_s,min_s,max_s,repeats,force_evals\n";
