@@ -186,8 +186,7 @@ RunResult run_ks(const Body& body, const std::vector<Centre>& centres, const Run
   if (centres.size() != 1) throw Error("ks needs exactly one centre (use logh-* or ttl-*)");
   require_time_target(spec);
   const Centre& c = centres.front();
-  OriginCentre shifted{c.A};  // invariants about the centre: same values as about c for one centre
-  CentreList field{centres};
+  CentreList field{centres};  // for the invariants (K2Q about c)
   StepStats st;
   double t_reached = 0.0;
   auto to_physical = [](const std::pair<KsMotion, double>& x) { return x.first.state(); };
@@ -236,7 +235,6 @@ RunResult run_ks(const Body& body, const std::vector<Centre>& centres, const Run
     t_reached = x.second;
     return x.first.state();
   });
-  (void)shifted;
   r.steps = st.steps;
   r.t_end = t_reached;
   r.force_evals = 0;  // the regularised flow is exact: no force evaluations

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # bodypoint research appendix: regenerates every CSV from the drivers and every figure from the CSVs.
 #
-#   paper/build.sh            full studies (thesis grids; ~30 min on 2 cores) into paper/results/
-#   paper/build.sh --quick    the same recipes on coarse grids (~1 min) into paper/results-quick/
+#   paper/build.sh            full studies (thesis grids; the timing recipe, 500 values of n x 22 methods
+#                             x 4 runs, dominates) into paper/results/
+#   paper/build.sh --quick    the same recipes on coarse grids (63 s on 2 cores) into paper/results-quick/
 #
 # Outputs: <results>/*.csv (bodypoint study, bodypoint work-precision), <results>/figures/*.png and
 # <results>/figures/figures.md. Every number in the appendix comes from these files.
