@@ -71,13 +71,19 @@ int cmd_simulate(int argc, char** argv) {
   const Scene scene = make_scene(vm, so);
   RunSpec spec;
   spec.tol = tol;
-  apply_step_options(vm, st, spec);
   if (is_time_transformed(method)) {
     // --h is the fictitious step ds (never adjusted); --t-end runs to exactly that time, otherwise
     // --steps fictitious steps are taken.
+    if (!std::isfinite(st.h) || st.h <= 0.0) throw Error("--h must be a finite number > 0");
+    if (vm.count("t-end") && !vm["steps"].defaulted()) throw Error("give --steps or --t-end, not both");
+    if (vm.count("t-end") && !(std::isfinite(st.t_end) && st.t_end > 0.0))
+      throw Error("--t-end must be a finite number > 0");
+    if (!vm.count("t-end") && st.steps < 1) throw Error("--steps must be >= 1");
     spec.h = st.h;
     spec.t_end = vm.count("t-end") ? st.t_end : 0.0;
     spec.steps = vm.count("t-end") ? 0 : st.steps;
+  } else {
+    apply_step_options(vm, st, spec);
   }
   if (vm.count("dt-out")) {
     if (!is_time_transformed(method)) throw Error("--dt-out is for time-transformed methods (logh-*, ttl-*, ks)");

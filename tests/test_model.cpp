@@ -111,6 +111,7 @@ TEST(Validation, RejectsNonPositiveMassInertiaAndD) {
   expect_error([] { validate(scene_with({1.0, 0.0, 0.0})); }, "inertia J must be > 0");
   expect_error([] { validate(scene_with({1.0, 1.0, 1.0})); }, "D = m J - B^2 must be > 0");
   expect_error([] { validate(scene_with({1.0, 2.0, 1.0})); }, "D = m J - B^2 must be > 0");
+  expect_error([] { validate(scene_with({1e308, 0.0, 1e308})); }, "D = m J - B^2 overflows");
 }
 
 TEST(Validation, RejectsNonFiniteNumbers) {

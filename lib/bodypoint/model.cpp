@@ -29,6 +29,8 @@ void validate(const BodyPoint& p, const std::string& who) {
   require_finite(p.J, who + ": J");
   if (p.m <= 0.0) throw Error(who + ": mass m must be > 0, got " + num(p.m));
   if (p.J <= 0.0) throw Error(who + ": inertia J must be > 0, got " + num(p.J));
+  if (!std::isfinite(p.D()))
+    throw Error(who + ": D = m J - B^2 overflows (m J = " + num(p.m * p.J) + "); rescale the units");
   if (!(p.D() > 0.0))
     throw Error(who + ": D = m J - B^2 must be > 0 (kinetic energy positive definite), got " +
                 num(p.D()));
