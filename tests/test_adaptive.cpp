@@ -40,6 +40,21 @@ constexpr double kSlopeTol = 0.15;
 constexpr double kOptimisedAbove = 0.6;
 // Forward then backward over an encounter: round-off of ~1e4 sub-steps (as for fixed steps).
 constexpr double kReversibilityTol = 1e-12;
+// A non-exact scheme's energy error on the same encounter is far above rounding (measured 1e-6 for
+// lp-y4 at h = 0.01): the control must exceed the exact-Kepler bound by this factor.
+constexpr double kNotExactFactor = 1e3;
+// The round trip must pass the closest approach of table 3.1 (near t = 40).
+constexpr double kPastEncounter = 50.0;
+// dt/ds = 1/Pi ~ r/|A| varies from ~0.1 near the centre to ~100 at r = 200: at least this range.
+constexpr double kMinStepRange = 100.0;
+// logh-kl8 at ds = 0.005 is accurate to ~1e-9 relative on the close scene; a side step to an output
+// time is a step of the same scheme, so an output state must be as good (with margin).
+constexpr double kOutputStateTol = 1e-8;
+// Issue #3's bound on |K2|^2 at every step, kept under stress.
+constexpr double kStressK2sqTol = 1e-13;
+// Issue #4's targets on the close encounter: final-position error and relative energy error.
+constexpr double kCloseTarget = 1e-8;
+constexpr double kCloseEnergyTarget = 1e-10;
 
 Scene close_material() {
   SceneParams sp;
@@ -77,7 +92,7 @@ TEST(LogH, MaterialPointFollowsTheExactKeplerOrbitAtAnyStep) {
   f.steps = 8000;
   f.h = 0.01;
   f.track_invariants = true;
-  EXPECT_GT(run(method_or_throw("lp-y4"), b, s.centres, f).invariants->max_rel_dE, 1e3 * kExactKeplerTol);
+  EXPECT_GT(run(method_or_throw("lp-y4"), b, s.centres, f).invariants->max_rel_dE, kNotExactFactor * kExactKeplerTol);
 }
 
 /// A body-point trapped between two repelling centres at x = +-5, bouncing back and forth (about
@@ -147,7 +162,7 @@ void expect_reversible(const char* name) {
   // 300 fictitious steps of 0.01 take the body of table 3.1 through its encounter (closest approach
   // near t = 40) and out again; in logH time r grows geometrically with s after the encounter.
   sp::integrate<Ops>(k, x, 0.01, 300, none);
-  EXPECT_GT(x.time(), 50.0) << name << ": the run must cover the encounter";
+  EXPECT_GT(x.time(), kPastEncounter) << name << ": the run must cover the encounter";
   sp::integrate<Ops>(k, x, -0.01, 300, none);
   const Momenta q = sp::from_lie(x.q);
   EXPECT_LT(test::rel_err(q.R, q0.R), kReversibilityTol) << name;
@@ -176,7 +191,7 @@ TEST(TimeTransformed, StepShrinksNearTheCentreAndEndTimeIsExact) {
     const RunResult r = run(method_or_throw(m), ns.scene.bodies.front(), ns.scene.centres, spec);
     EXPECT_EQ(r.t_end, 80.0) << m;
     // dt/ds = 1/Pi ~ r/|A|: from ~0.2 at closest approach to ~200 at the start.
-    EXPECT_GT(r.max_step / r.min_step, 100.0) << m << " min " << r.min_step << " max " << r.max_step;
+    EXPECT_GT(r.max_step / r.min_step, kMinStepRange) << m << " min " << r.min_step << " max " << r.max_step;
   }
 }
 
@@ -197,7 +212,7 @@ TEST(TimeTransformed, OutputAtRequestedPhysicalTimes) {
   for (std::size_t k = 0; k < times.size(); ++k) EXPECT_DOUBLE_EQ(times[k], 2.5 * static_cast<double>(k));
   // Each output state is the state at its time (checked against the reference at t = 40).
   const State ref = reference_state(ns.scene.bodies.front(), ns.scene.centres, 40.0, 1e-18L);
-  EXPECT_LT(test::rel_err(states[16].R, ref.R), 1e-8);
+  EXPECT_LT(test::rel_err(states[16].R, ref.R), kOutputStateTol);
 }
 
 TEST(TimeTransformed, RefusalsNameAMethodThatWorks) {
@@ -311,7 +326,7 @@ TEST(TimeTransformed, StressCasesFinishFiniteWithInvariantsReported) {
     EXPECT_TRUE(r.final.R.allFinite() && r.final.v.allFinite() && r.final.w.allFinite()) << c.name;
     ASSERT_TRUE(r.invariants.has_value()) << c.name;
     EXPECT_TRUE(std::isfinite(r.invariants->max_rel_dE)) << c.name;
-    EXPECT_LT(r.invariants->max_rel_dK2sq, 1e-13) << c.name;
+    EXPECT_LT(r.invariants->max_rel_dK2sq, kStressK2sqTol) << c.name;
     EXPECT_EQ(r.t_end, c.t_end) << c.name;
     std::printf("  %-8s %-9s steps %ld evals %ld min dt %.2e max dt %.2e r_min %.2e max rel dE %.2e\n",
                 c.name.c_str(), c.method.c_str(), r.steps, r.force_evals, r.min_step, r.max_step, r_min,
@@ -333,8 +348,8 @@ TEST(CloseEncounter, LogHReachesOneEMinusEightWithFarFewerEvaluations) {
   spec.track_invariants = true;
   const RunResult lh = run(method_or_throw("logh-bm4"), b, ns.scene.centres, spec);
   const double err = (lh.final.R - ref.R).norm();
-  EXPECT_LT(err, 1e-8);
-  EXPECT_LT(lh.invariants->max_rel_dE, 1e-10);
+  EXPECT_LT(err, kCloseTarget);
+  EXPECT_LT(lh.invariants->max_rel_dE, kCloseEnergyTarget);
   // Every fixed-step Lie-Poisson method given 10x the force evaluations stays above 1e-8.
   for (const MethodInfo& m : methods()) {
     if (m.family != Family::LiePoisson) continue;
@@ -342,7 +357,7 @@ TEST(CloseEncounter, LogHReachesOneEMinusEightWithFarFewerEvaluations) {
     f.steps = std::max(1L, 10 * lh.force_evals / std::max(1, m.evals_per_step));
     f.h = 80.0 / static_cast<double>(f.steps);
     const RunResult r = run(m, b, ns.scene.centres, f);
-    EXPECT_GT((r.final.R - ref.R).norm(), 1e-8) << m.name << " with " << r.force_evals << " evaluations";
+    EXPECT_GT((r.final.R - ref.R).norm(), kCloseTarget) << m.name << " with " << r.force_evals << " evaluations";
   }
   // Every Boost.Odeint configuration that reaches 1e-8 spends more force evaluations.
   for (const char* m : {"odeint-dopri5", "odeint-rkf78", "odeint-bs"}) {
@@ -351,7 +366,7 @@ TEST(CloseEncounter, LogHReachesOneEMinusEightWithFarFewerEvaluations) {
       a.tol = tol;
       a.t_end = 80.0;
       const RunResult r = run(method_or_throw(m), b, ns.scene.centres, a);
-      if ((r.final.R - ref.R).norm() <= 1e-8) {
+      if ((r.final.R - ref.R).norm() <= kCloseTarget) {
         EXPECT_GT(r.force_evals, lh.force_evals) << m << " tol " << tol;
         break;
       }
