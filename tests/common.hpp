@@ -4,8 +4,12 @@
 #include "bodypoint/model.hpp"
 #include "bodypoint/run.hpp"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -63,6 +67,26 @@ inline double asymptotic_slope(const std::vector<std::pair<double, double>>& all
   if (pts.size() > kFitPoints) pts.erase(pts.begin(), pts.end() - static_cast<long>(kFitPoints));
   *used = pts.size();
   return pts.size() >= 2 ? loglog_slope(pts) : 0.0;
+}
+
+/// Runs a ladder of kLadder points, point(k) returning (step, error) for k = 0, 1, ...; fits the
+/// asymptotic slope, checks that enough points were fitted, and prints the ladder under `label`.
+template <class Point>
+double ladder_slope(const std::string& label, Point&& point) {
+  std::vector<std::pair<double, double>> all;
+  std::string log;
+  for (int k = 0; k < kLadder; ++k) {
+    const auto [h, e] = point(k);
+    char buf[48];
+    std::snprintf(buf, sizeof buf, " %.3g:%.2e", h, e);
+    log += buf;
+    all.emplace_back(h, e);
+  }
+  std::size_t used = 0;
+  const double slope = asymptotic_slope(all, &used);
+  EXPECT_GE(used, kFitPoints) << label << log;
+  std::printf("  %-30s slope %.3f (%zu points)%s\n", label.c_str(), slope, used, log.c_str());
+  return slope;
 }
 
 }  // namespace bodypoint::test

@@ -116,24 +116,13 @@ double ds_slope(const std::string& method, double ds0, bool trapped = false) {
   const Scene s = trapped ? trap() : thesis_scene(sp);
   const double t_end = trapped ? 40.0 : 8.0;
   const State ref = reference_state(s.bodies.front(), s.centres, t_end, 1e-18L);
-  std::vector<std::pair<double, double>> all;
-  std::string log;
-  for (int k = 0; k < test::kLadder; ++k) {
+  return test::ladder_slope(method + (trapped ? " trap" : " encounter"), [&](int k) {
     RunSpec spec;
     spec.h = ds0 / std::pow(std::sqrt(2.0), k);
     spec.t_end = t_end;
     const RunResult r = run(method_or_throw(method), s.bodies.front(), s.centres, spec);
-    const double e = test::rel_err(r.final.R, ref.R);
-    char buf[48];
-    std::snprintf(buf, sizeof buf, " %.2g:%.1e", spec.h, e);
-    log += buf;
-    all.emplace_back(spec.h, e);
-  }
-  std::size_t used = 0;
-  const double slope = test::asymptotic_slope(all, &used);
-  EXPECT_GE(used, test::kFitPoints) << method << log;
-  std::printf("  %-12s %s slope %.3f%s\n", method.c_str(), trapped ? "trap" : "encounter", slope, log.c_str());
-  return slope;
+    return std::pair{spec.h, test::rel_err(r.final.R, ref.R)};
+  });
 }
 
 TEST(TimeTransformed, ConvergenceOrderInTheFictitiousStepForABodyPoint) {

@@ -68,24 +68,14 @@ double measured_slope(const Case& c, double B) {
   const Body& body = s.bodies.front();
   const State ref = B == 0.0 ? kepler_body_state(body, s.centres.front(), kTEnd)
                              : reference_state(body, s.centres, kTEnd);
-  std::vector<std::pair<double, double>> all;
-  std::string log;
-  for (int k = 0; k < test::kLadder; ++k) {
+  const std::string label = c.method + (c.on_orbit ? " orbit" : " encounter") + (B == 0.0 ? " B=0" : " B=0.7");
+  return test::ladder_slope(label, [&](int k) {
     RunSpec spec;
     spec.steps = std::lround(kTEnd / c.h0 * std::pow(std::sqrt(2.0), k));
     spec.h = kTEnd / static_cast<double>(spec.steps);
     const RunResult r = run(method_or_throw(c.method), body, s.centres, spec);
-    const double e = test::rel_err(r.final.R, ref.R);
-    char buf[64];
-    std::snprintf(buf, sizeof buf, " h=%.3g:%.2e", spec.h, e);
-    log += buf;
-    all.emplace_back(spec.h, e);
-  }
-  std::size_t used = 0;
-  const double slope = test::asymptotic_slope(all, &used);
-  EXPECT_GE(used, test::kFitPoints) << c.method << " B=" << B << log;
-  std::printf("  %-14s %s B=%.1f  slope %.3f (%zu points)%s\n", c.method.c_str(), c.on_orbit ? "orbit" : "encounter", B, slope, used, log.c_str());
-  return slope;
+    return std::pair{spec.h, test::rel_err(r.final.R, ref.R)};
+  });
 }
 
 TEST(Convergence, ReferencesAgree) {

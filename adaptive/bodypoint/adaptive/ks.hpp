@@ -128,9 +128,6 @@ class KsMotion {
     return s;
   }
 
-  /// Current distance from the centre and dt/ds.
-  [[nodiscard]] double r() const { return u_.squaredNorm(); }
-
  private:
   using Mat34 = Eigen::Matrix<double, 3, 4>;
   static Mat34 L(const Vec4& u) {
