@@ -46,7 +46,7 @@ int cmd_simulate(int argc, char** argv) {
   std::string method_name = "lp-y4";
   std::string out;
   long every = 1;
-  double tol = 1e-10, dt_out = 0.0;
+  double tol = 1e-10, dt_out = 0.0, omega_c = -1.0;
   bool json = false, no_invariants = false, with_reference = false;
   po::options_description desc("bodypoint simulate");
   add_scene_options(desc, so);
@@ -56,6 +56,8 @@ int cmd_simulate(int argc, char** argv) {
       ("out", po::value(&out), "write the trajectory to this CSV file (atomically)")
       ("tol", po::value(&tol)->default_value(tol), "adaptive methods (odeint-*): error tolerance per step")
       ("dt-out", po::value(&dt_out), "with --out, time-transformed methods: write states at t = k dt-out")
+      ("omega-c", po::value(&omega_c), "time-transformed methods: constant c added to the time-step function "
+       "(physical step <= ds/c); default: from the scene's spin-orbit rate")
       ("every", po::value(&every)->default_value(every), "with --out: write every k-th step (and the last)")
       ("json", po::bool_switch(&json), "print one JSON object instead of the summary")
       ("no-invariants", po::bool_switch(&no_invariants), "do not track the invariants (fastest; final state only)")
@@ -93,6 +95,7 @@ int cmd_simulate(int argc, char** argv) {
   }
   spec.every = every;
   spec.tol = tol;
+  spec.omega_c = omega_c;
   if (every < 1) throw Error("--every must be >= 1");
   spec.track_invariants = !no_invariants;
 

@@ -207,10 +207,7 @@ int cmd_work_precision(int argc, char** argv) {
   std::ostringstream sum;
   sum << "| scene | target err_rel | best bodypoint method | config | time [ms] | best odeint method | config | time [ms] | speed-up |\n"
       << "|---|---|---|---|---|---|---|---|---|\n";
-  auto is_odeint = [](const std::string& name) {
-    const MethodInfo& m = method_or_throw(name);
-    return m.family == Family::Odeint || m.family == Family::OdeintAdaptive;
-  };
+  auto is_odeint = [](const std::string& name) { return is_peer(method_or_throw(name)); };
   auto config = [](const Row& r) {
     std::ostringstream c;
     c << std::setprecision(3);

@@ -6,7 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(cmake ninja-build g++ git libeigen3-dev libboost-dev libboost-program-options-dev
-          libgtest-dev libbenchmark-dev libtomlplusplus-dev python3-matplotlib python3-numpy)
+          libgtest-dev libbenchmark-dev libtomlplusplus-dev libgsl-dev python3-matplotlib python3-numpy)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -11,6 +11,9 @@
 #include "bodypoint/field.hpp"
 #include "bodypoint/rhs.hpp"
 #include "bodypoint/rk/run_odeint.hpp"
+#ifdef BODYPOINT_HAVE_GSL
+#include "bodypoint/rk/run_gsl.hpp"
+#endif
 #include "bodypoint/splitting/blanes_moan.hpp"
 #include "bodypoint/splitting/classic.hpp"
 #include "bodypoint/splitting/composition.hpp"
@@ -96,6 +99,12 @@ std::vector<MethodInfo> make_registry() {
       {"odeint-bs", Family::OdeintAdaptive, 0, 0, 0,
        "Bulirsch-Stoer extrapolation with order and step control (odeint bulirsch_stoer), --tol",
        &run_odeint_bs},
+#ifdef BODYPOINT_HAVE_GSL
+      {"gsl-rk8pd", Family::Gsl, 8, 13, 13, "GSL Prince-Dormand 8(7) with step-size control (gsl_odeiv2_step_rk8pd), --tol",
+       &run_gsl_rk8pd},
+      {"gsl-rkf45", Family::Gsl, 5, 6, 6, "GSL Runge-Kutta-Fehlberg 4(5) with step-size control (gsl_odeiv2_step_rkf45), --tol",
+       &run_gsl_rkf45},
+#endif
       thesis_method<euler_ops>("thesis-euler", 1, "thesis symplectic Euler, frozen gyroscopic term"),
       thesis_method<verlet_ops>("thesis-verlet", 2, "thesis Verlet (KDK), frozen gyroscopic term"),
       thesis_method<ruth3_ops>("thesis-ruth3", 3, "thesis Ruth 3, frozen gyroscopic term"),

@@ -23,6 +23,9 @@ struct RunSpec {
   double t_end = 0.0;    ///< adaptive methods: end time (0: steps h)
   double tol = 1e-10;    ///< adaptive methods: relative and absolute error tolerance per step
   double dt_out = 0.0;   ///< time-transformed methods with a sink: sample at t = k dt_out (0: every-th step)
+  /// time-transformed methods: constant c added to the time-step function (logH: Pi + c, TTL:
+  /// sum |A_i|/r_i + c), so the physical step is at most ds/c; < 0: chosen from the scene
+  double omega_c = -1.0;
   bool track_invariants = false;
   long every = 1;  ///< hand every `every`-th state (and the last) to the sink
 };
@@ -48,8 +51,9 @@ struct RunResult {
 
 /// Thesis: the thesis's drift/kick schemes; LiePoisson: exact splittings; Odeint: fixed-step
 /// odeint steppers (rk4, ab4); OdeintAdaptive: step-size-controlled odeint steppers (--tol);
+/// Gsl: GSL's step-size-controlled steppers (--tol; peers, present when built with GSL);
 /// TimeTransformed: fixed fictitious step ds (--h), variable physical step (logh-*, ttl-*, ks).
-enum class Family { Thesis, LiePoisson, Odeint, OdeintAdaptive, TimeTransformed };
+enum class Family { Thesis, LiePoisson, Odeint, OdeintAdaptive, Gsl, TimeTransformed };
 
 struct MethodInfo {
   std::string_view name;
@@ -71,7 +75,13 @@ const MethodInfo* find_method(std::string_view name);
 const MethodInfo& method_or_throw(std::string_view name);
 
 /// True for methods that choose their own steps from a tolerance (spec.tol, spec.t_end apply).
-inline bool is_adaptive(const MethodInfo& m) { return m.family == Family::OdeintAdaptive; }
+inline bool is_adaptive(const MethodInfo& m) {
+  return m.family == Family::OdeintAdaptive || m.family == Family::Gsl;
+}
+/// True for the general-purpose peers (Boost.Odeint, GSL) that bodypoint's own methods compete with.
+inline bool is_peer(const MethodInfo& m) {
+  return m.family == Family::Odeint || m.family == Family::OdeintAdaptive || m.family == Family::Gsl;
+}
 /// True for methods with a fixed fictitious step: spec.h is ds; with spec.t_end > 0 they run to
 /// exactly t_end, otherwise spec.steps fictitious steps.
 inline bool is_time_transformed(const MethodInfo& m) { return m.family == Family::TimeTransformed; }

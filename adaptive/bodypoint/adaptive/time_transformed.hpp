@@ -72,8 +72,9 @@ struct LogHKernel {
   static constexpr bool mergeable = true;
 
   splitting::LiePoissonKernel<Field, Spin> lp;  ///< the physical-time exact drift and kick
+  double c = 0.0;  ///< constant added to Pi and to E - T: the physical step is at most ds/c
 
-  LogHKernel(const BodyPoint& p, const Field& f) : lp(p, f) {}
+  LogHKernel(const BodyPoint& p, const Field& f, double c_ = 0.0) : lp(p, f), c(c_) {}
 
   [[nodiscard]] TimeState initial_state(const State& s0) const {
     TimeState x;
@@ -84,10 +85,11 @@ struct LogHKernel {
   void begin_step(TimeState&) const {}
 
   void drift(TimeState& x, double ds) const {
-    if (!(x.g > 0.0))
-      throw Error("logh: E - T = " + std::to_string(x.g) + " <= 0 at t = " + std::to_string(x.time()) +
+    const double gc = x.g + c;
+    if (!(gc > 0.0))
+      throw Error("logh: E - T + c = " + std::to_string(gc) + " <= 0 at t = " + std::to_string(x.time()) +
                   " (the fictitious step is too large for this encounter; reduce --h)");
-    const double dt = ds / x.g;
+    const double dt = ds / gc;
     lp.drift(x.q, dt);
     advance_time(x, dt);
   }
@@ -97,7 +99,7 @@ struct LogHKernel {
     Vec3 F;
     double P;
     lp.field.force_potential(x.q.R, F, P);
-    const double tau = ds / P;
+    const double tau = ds / (P + c);
     const Vec3 delta = tau * F;
     const BodyPoint& p = lp.p;
     x.g -= (p.J * (x.q.K1.dot(delta) + 0.5 * delta.squaredNorm()) - p.B * x.q.K2.dot(delta)) / p.D();
@@ -113,14 +115,16 @@ struct TtlKernel {
   static constexpr bool mergeable = true;
 
   splitting::LiePoissonKernel<Field, Spin> lp;
+  double c = 0.0;  ///< constant added to Omega: the physical step is at most ds/c
 
-  TtlKernel(const BodyPoint& p, const Field& f) : lp(p, f) {}
+  TtlKernel(const BodyPoint& p, const Field& f, double c_ = 0.0) : lp(p, f), c(c_) {}
 
   [[nodiscard]] TimeState initial_state(const State& s0) const {
     TimeState x;
     x.q = lp.initial_state(s0);
     Vec3 F, grad;
     lp.field.force_omega(s0.R, F, x.W, grad);
+    x.W += c;
     return x;
   }
   void begin_step(TimeState&) const {}
@@ -136,7 +140,7 @@ struct TtlKernel {
     Vec3 F, grad;
     double Omega;
     lp.field.force_omega(x.q.R, F, Omega, grad);
-    const double dtp = ds / Omega;
+    const double dtp = ds / (Omega + c);
     const Vec3 v_before = velocity(x);
     lp.apply_kick(x.q, dtp, F);
     x.W += dtp * grad.dot(0.5 * (v_before + velocity(x)));

@@ -1,0 +1,104 @@
+// bodypoint: GSL's step-size-controlled Runge-Kutta steppers as peers (gsl-rk8pd, gsl-rkf45).
+//
+// The GNU Scientific Library's gsl_odeiv2 evolve/control/step framework (GSL reference manual,
+// "Ordinary Differential Equations"): rk8pd is Prince-Dormand 8(7), rkf45 Runge-Kutta-Fehlberg 4(5);
+// the standard control keeps the local error below tol (1 + |y|) per component (eps_abs = eps_rel =
+// tol). The right-hand side is the one Boost.Odeint integrates (rhs.hpp), so every peer solves the same
+// system. gsl_odeiv2_evolve_apply limits the last step to the end time, so t_end is hit exactly.
+#include "bodypoint/rk/run_gsl.hpp"
+
+#include "bodypoint/rhs.hpp"
+#include "bodypoint/run_support.hpp"
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_odeiv2.h>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <string>
+#include <type_traits>
+
+namespace bodypoint {
+namespace {
+
+using detail::dispatch;
+using detail::observe;
+
+/// An accepted step shorter than this fraction of the end time means the tolerance cannot be met.
+constexpr double kMinRelativeStep = 1e-14;
+/// A run that needs more accepted steps than this is stopped with an error.
+constexpr long kMaxSteps = 200'000'000L;
+
+template <class System>
+int gsl_rhs(double t, const double y[], double f[], void* params) {
+  const auto& sys = *static_cast<const System*>(params);
+  OdeState<double> x, dx;
+  std::copy(y, y + 9, x.begin());
+  sys(x, dx, t);
+  std::copy(dx.begin(), dx.end(), f);
+  return GSL_SUCCESS;
+}
+
+struct GslDeleter {
+  void operator()(gsl_odeiv2_step* s) const { gsl_odeiv2_step_free(s); }
+  void operator()(gsl_odeiv2_control* c) const { gsl_odeiv2_control_free(c); }
+  void operator()(gsl_odeiv2_evolve* e) const { gsl_odeiv2_evolve_free(e); }
+};
+
+RunResult run_gsl(const gsl_odeiv2_step_type* type, const Body& body, const std::vector<Centre>& centres,
+                  const RunSpec& spec, const SampleSink* sink) {
+  gsl_set_error_handler_off();
+  return dispatch(body, centres, [&](const auto& field, auto spin) {
+    using Field = std::decay_t<decltype(field)>;
+    using System = EquationsOfMotion<Field, decltype(spin)::value>;
+    long evals = 0;
+    const System sys{body.p, field, &evals};
+    gsl_odeiv2_system gsys{&gsl_rhs<System>, nullptr, 9, const_cast<System*>(&sys)};
+    std::unique_ptr<gsl_odeiv2_step, GslDeleter> step(gsl_odeiv2_step_alloc(type, 9));
+    std::unique_ptr<gsl_odeiv2_control, GslDeleter> control(gsl_odeiv2_control_y_new(spec.tol, spec.tol));
+    std::unique_ptr<gsl_odeiv2_evolve, GslDeleter> evolve(gsl_odeiv2_evolve_alloc(9));
+    if (!step || !control || !evolve) throw Error("gsl: out of memory");
+    const double t_end = spec.t_end;
+    long accepted = 0;
+    double min_step = std::numeric_limits<double>::infinity(), max_step = 0.0;
+    auto to_physical = [](const OdeState<double>& x) { return from_ode(x); };
+    RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
+      OdeState<double> x = to_ode(body.s0);
+      double t = 0.0, dt = std::min(spec.h, t_end);
+      while (t < t_end) {
+        const double t_before = t;
+        const int status =
+            gsl_odeiv2_evolve_apply(evolve.get(), control.get(), step.get(), &gsys, &t, t_end, &dt, x.data());
+        if (status != GSL_SUCCESS)
+          throw Error("gsl: step failed at t = " + std::to_string(t) + " (" + gsl_strerror(status) + ")");
+        const double taken = t - t_before;
+        if (!(taken > kMinRelativeStep * t_end) && t < t_end)
+          throw Error("gsl: the step size collapsed at t = " + std::to_string(t) + " (tolerance too tight?)");
+        if (++accepted > kMaxSteps) throw Error("gsl: more than 2e8 steps before t_end");
+        min_step = std::min(min_step, taken);
+        max_step = std::max(max_step, taken);
+        if constexpr (std::decay_t<decltype(obs)>::active) obs.observe(accepted, t, x, t >= t_end);
+        if (!std::isfinite(x[0])) break;
+      }
+      return from_ode(x);
+    });
+    r.force_evals = evals;
+    r.steps = accepted;
+    r.t_end = t_end;
+    r.min_step = min_step;
+    r.max_step = max_step;
+    return r;
+  });
+}
+
+}  // namespace
+
+RunResult run_gsl_rk8pd(const Body& b, const std::vector<Centre>& c, const RunSpec& s, const SampleSink* k) {
+  return run_gsl(gsl_odeiv2_step_rk8pd, b, c, s, k);
+}
+RunResult run_gsl_rkf45(const Body& b, const std::vector<Centre>& c, const RunSpec& s, const SampleSink* k) {
+  return run_gsl(gsl_odeiv2_step_rkf45, b, c, s, k);
+}
+
+}  // namespace bodypoint
