@@ -53,6 +53,8 @@ void require_time_target(const RunSpec& spec) {
 /// Far from every centre the spin-orbit angle per step may be this many times the orbital angle per
 /// step at closest approach (see automatic_omega_c).
 constexpr double kSpinToOrbitStepRatio = 16.0;
+/// The spin-orbit angle of one whole step far from every centre stays below this (radians).
+constexpr double kMaxSpinAngle = 2.0;
 
 }  // namespace
 
@@ -66,8 +68,18 @@ constexpr double kSpinToOrbitStepRatio = 16.0;
 // the spin angle per step is Omega_so ds/c; c = sum|A| Omega_so/(k v0) makes it k times the orbital
 // angle per step in the encounter. k = 16 was measured (logh-kl8 on the close and thesis scenes,
 // c from 0 to 2: the error at equal force evaluations is smallest for c in 0.05..0.2; k = 16 gives
-// 0.12 and 0.09). A material point (B = 0) has no spin time scale: c = 0 keeps logH's exact Kepler orbit.
-double automatic_omega_c(const Body& body, const std::vector<Centre>& centres) {
+// 0.12 and 0.09). For large ds that alone lets the far-field step dt = ds/c turn the spin by more
+// than pi per step, where the compositions meet resonances: logh-mcl8 on the thesis scene loses 40x
+// in accuracy between ds = 0.040 and 0.045 (spin angle 3.2 -> 3.5 rad per step), logh-kl8 on the
+// close scene 48x between ds = 0.113 and 0.124 (6.5 -> 7.1 rad). So c is also at least
+// Omega_so ds/kMaxSpinAngle: no step turns the spin by more than 2 rad. 3 rad was tried: logh-bm4 on
+// the two-centres scene meets a knee there (3.8x for 8% in ds). With 2 rad the error is smooth in ds
+// (logh-kl8, close scene: 2.1x for a 10% larger ds, the 2.14x of order 8), and the --tol search's
+// error estimates, which assume that smoothness, agree with the true error to 0.14..6.3x on the
+// close, thesis and two-centres scenes (27 tolerances), against up to 43x without the bound. As ds -> 0 the first term rules, so a
+// ladder of ds converges to one fixed time transformation. A material point (B = 0) has no spin time
+// scale: c = 0 keeps logH's exact Kepler orbit.
+double automatic_omega_c(const Body& body, const std::vector<Centre>& centres, double ds) {
   const BodyPoint& p = body.p;
   if (p.B == 0.0) return 0.0;
   const Momenta q = to_momenta(p, body.s0);
@@ -76,7 +88,7 @@ double automatic_omega_c(const Body& body, const std::vector<Centre>& centres) {
   double strength = 0.0;
   for (const Centre& c : centres) strength += std::abs(c.A);
   if (!(speed > 0.0) || !(spin_rate > 0.0)) return 0.0;
-  return strength * spin_rate / (kSpinToOrbitStepRatio * speed);
+  return std::max(strength * spin_rate / (kSpinToOrbitStepRatio * speed), spin_rate * std::abs(ds) / kMaxSpinAngle);
 }
 
 namespace {
@@ -124,7 +136,7 @@ RunResult run_time_transformed(const Body& body, const std::vector<Centre>& cent
   return dispatch(body, centres, [&](const auto& field, auto spin) {
     using Field = std::decay_t<decltype(field)>;
     using K = Kernel<Field, decltype(spin)::value>;
-    K k(body.p, field, spec.omega_c >= 0.0 ? spec.omega_c : automatic_omega_c(body, centres));
+    K k(body.p, field, spec.omega_c >= 0.0 ? spec.omega_c : automatic_omega_c(body, centres, spec.h));
     auto to_physical = [&k](const TimeState& x) { return k.to_physical(x); };
     const bool to_time = spec.t_end > 0.0;
     StepStats st;

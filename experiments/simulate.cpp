@@ -1,4 +1,5 @@
 // `bodypoint simulate`: one method on one scene; readable summary, --json, or a trajectory CSV.
+#include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/reference.hpp"
 #include "bodypoint/run.hpp"
@@ -21,7 +22,8 @@ std::string scene_header(const po::variables_map& vm, const SceneOptions& o) {
   return describe(o.params);
 }
 
-std::string json_body(const RunResult& r, const std::optional<double>& err_R) {
+std::string json_body(const RunResult& r, const std::optional<double>& err_R,
+                      const std::optional<double>& err_rel = std::nullopt) {
   std::ostringstream os;
   os << "\"R\": " << json_vec(r.final.R) << ", \"v\": " << json_vec(r.final.v)
      << ", \"w\": " << json_vec(r.final.w);
@@ -31,10 +33,60 @@ std::string json_body(const RunResult& r, const std::optional<double>& err_R) {
     if (r.invariants->has_K2Q) os << ", \"max_abs_dK2Q\": " << json_number(r.invariants->max_abs_dK2Q);
   }
   if (err_R) os << ", \"err_R\": " << json_number(*err_R);
+  if (err_rel) os << ", \"err_rel\": " << json_number(*err_rel);
   if (r.max_step > 0.0)
     os << ", \"accepted_steps\": " << r.steps << ", \"min_step\": " << json_number(r.min_step)
        << ", \"max_step\": " << json_number(r.max_step);
   os << ", \"force_evals\": " << r.force_evals << ", \"wall_s\": " << json_number(r.wall_s);
+  return os.str();
+}
+
+}  // namespace
+
+namespace {
+
+/// What one body's run used: the method (auto may choose per body) and, with --tol, the search.
+struct BodyRun {
+  const MethodInfo* method = nullptr;
+  RunResult result;
+  std::optional<double> err_R;
+  std::optional<double> err_rel;  ///< max(|dR|/|R_ref|, |dv|/|v_ref|), the measure --tol bounds
+  std::optional<adaptive::ToleranceResult> search;
+  std::string why;  ///< --method auto: what was chosen and why
+};
+
+/// --tol with a fixed-step or time-transformed method (or auto): the step search, then the delivered
+/// run repeated with invariants or output when they are asked for.
+BodyRun run_with_tolerance(const MethodInfo* method, const Body& body, const std::vector<Centre>& centres,
+                           double tol, double t_end, const RunSpec& spec, const SampleSink* sink) {
+  BodyRun b;
+  b.method = method ? method : &adaptive::choose_method(body, centres, tol, &b.why);
+  b.search = adaptive::run_to_tolerance(*b.method, body, centres, tol, t_end);
+  if (spec.track_invariants || sink)
+    b.result = run(*b.method, body, centres, adaptive::delivered_spec(*b.method, *b.search, t_end, spec), sink);
+  else
+    b.result = b.search->result;
+  return b;
+}
+
+std::string search_json(const BodyRun& b, double tol) {
+  if (!b.search) return "";
+  std::ostringstream os;
+  os << ", \"tol\": " << json_number(tol) << ", \"err_estimate\": " << json_number(b.search->err_estimate)
+     << ", \"h_chosen\": " << json_number(b.search->h) << ", \"search_runs\": " << b.search->runs
+     << ", \"search_force_evals\": " << b.search->total_force_evals
+     << ", \"search_wall_s\": " << json_number(b.search->total_wall_s);
+  if (!b.why.empty()) os << ", \"chosen\": \"" << b.why << "\"";
+  return os.str();
+}
+
+std::string search_line(const BodyRun& b) {
+  std::ostringstream os;
+  os << "method=" << b.method->name;
+  if (b.search)
+    os << (is_time_transformed(*b.method) ? " ds=" : " h=") << fmt(b.search->h)
+       << " err_estimate=" << fmt(b.search->err_estimate) << " search: " << b.search->runs << " runs, "
+       << b.search->total_force_evals << " force evaluations";
   return os.str();
 }
 
@@ -52,9 +104,12 @@ int cmd_simulate(int argc, char** argv) {
   add_scene_options(desc, so);
   add_step_options(desc, st);
   desc.add_options()
-      ("method", po::value(&method_name)->default_value(method_name), "integration method (see 'bodypoint methods')")
+      ("method", po::value(&method_name)->default_value(method_name),
+       "integration method (see 'bodypoint methods'), or auto (the default with --tol)")
       ("out", po::value(&out), "write the trajectory to this CSV file (atomically)")
-      ("tol", po::value(&tol)->default_value(tol), "adaptive methods (odeint-*): error tolerance per step")
+      ("tol", po::value(&tol)->default_value(tol),
+       "odeint-*/gsl-*: error tolerance per step; any other method: the final state's relative error "
+       "(R and v) to deliver, the step is chosen for it")
       ("dt-out", po::value(&dt_out), "with --out, time-transformed methods: write states at t = k dt-out")
       ("omega-c", po::value(&omega_c), "time-transformed methods: constant c added to the time-step function "
        "(physical step <= ds/c); default: from the scene's spin-orbit rate")
@@ -66,14 +121,29 @@ int cmd_simulate(int argc, char** argv) {
   po::variables_map vm;
   if (!parse(argc, argv, desc, vm,
              "usage: bodypoint simulate [options]\n"
-             "Integrates the scene (default: thesis table 3.1, h = 1e-4, n = 500000) with one method."))
+             "Integrates the scene (default: thesis table 3.1, h = 1e-4, n = 500000) with one method.\n"
+             "With --tol and no --method (or --method auto) the method and its step are chosen to deliver tol."))
     return 0;
 
-  const MethodInfo& method = method_or_throw(method_name);
+  const bool tol_given = vm.count("tol") && !vm["tol"].defaulted();
+  if (tol_given && vm["method"].defaulted()) method_name = "auto";
+  const bool automatic = method_name == "auto";
+  if (automatic && !tol_given) throw Error("--method auto needs --tol (the accuracy to deliver)");
+  const MethodInfo* fixed_method = automatic ? nullptr : &method_or_throw(method_name);
+  const bool search = automatic || (tol_given && !is_adaptive(*fixed_method));
+  if (search) {
+    adaptive::check_tolerance(tol);
+    if (!vm["h"].defaulted() || !vm["steps"].defaulted())
+      throw Error("--tol chooses the step: give --t-end, not --h or --steps");
+    if (vm.count("omega-c")) throw Error("--tol uses the automatic time-step constant: drop --omega-c");
+  }
   const Scene scene = make_scene(vm, so);
   RunSpec spec;
   spec.tol = tol;
-  if (is_time_transformed(method)) {
+  if (search) {
+    spec.t_end = vm.count("t-end") ? st.t_end : st.h * static_cast<double>(st.steps);
+    if (!(std::isfinite(spec.t_end) && spec.t_end > 0.0)) throw Error("--t-end must be a finite number > 0");
+  } else if (is_time_transformed(*fixed_method)) {
     // --h is the fictitious step ds (never adjusted); --t-end runs to exactly that time, otherwise
     // --steps fictitious steps are taken.
     if (!std::isfinite(st.h) || st.h <= 0.0) throw Error("--h must be a finite number > 0");
@@ -88,13 +158,13 @@ int cmd_simulate(int argc, char** argv) {
     apply_step_options(vm, st, spec);
   }
   if (vm.count("dt-out")) {
-    if (!is_time_transformed(method)) throw Error("--dt-out is for time-transformed methods (logh-*, ttl-*, ks)");
+    if (fixed_method && !is_time_transformed(*fixed_method))
+      throw Error("--dt-out is for time-transformed methods (logh-*, ttl-*, ks)");
     if (!(dt_out > 0.0) || !std::isfinite(dt_out)) throw Error("--dt-out must be a finite number > 0");
     if (!vm.count("out")) throw Error("--dt-out needs --out");
     spec.dt_out = dt_out;
   }
   spec.every = every;
-  spec.tol = tol;
   spec.omega_c = omega_c;
   if (every < 1) throw Error("--every must be >= 1");
   spec.track_invariants = !no_invariants;
@@ -106,15 +176,16 @@ int cmd_simulate(int argc, char** argv) {
     file = std::make_unique<AtomicFile>(out);
     std::ostream& os = file->stream();
     os << "# bodypoint simulate, revision " << git_revision() << "\n"
-       << "# method=" << method.name << " h=" << fmt(spec.h) << " steps=" << spec.steps
-       << " every=" << spec.every << " " << scene_header(vm, so) << "\n"
+       << "# method=" << method_name;
+    if (search) os << " tol=" << fmt(tol) << " t_end=" << fmt(spec.t_end);
+    else os << " h=" << fmt(spec.h) << " steps=" << spec.steps;
+    os << " every=" << spec.every << " " << scene_header(vm, so) << "\n"
        << "# rel_dE = |E-E0|/|E0|, rel_dK2sq = |K2^2-K2^2_0|/K2^2_0, abs_dK2Q = |K2Q-K2Q_0| "
           "(absent with several centres)\n";
     os.precision(17);
   }
 
-  std::vector<RunResult> results;
-  std::vector<std::optional<double>> errors;
+  std::vector<BodyRun> runs;
   for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
     const Body& body = scene.bodies[b];
     if (file) {
@@ -130,41 +201,58 @@ int cmd_simulate(int argc, char** argv) {
         os << '\n';
       };
     }
-    RunResult r = run(method, body, scene.centres, spec, file ? &sink : nullptr);
-    if (!finite(r.final))
+    BodyRun br;
+    if (search) {
+      br = run_with_tolerance(fixed_method, body, scene.centres, tol, spec.t_end, spec, file ? &sink : nullptr);
+      if (file) file->stream() << "# body " << b << ": " << search_line(br) << "\n";
+    } else {
+      br.method = fixed_method;
+      br.result = run(*fixed_method, body, scene.centres, spec, file ? &sink : nullptr);
+    }
+    if (!finite(br.result.final))
       throw Error("body '" + body.name + "': the integration produced a non-finite state (NaN/inf); "
                   "the step is too large for a close approach, or the body fell onto an attracting centre");
-    results.push_back(r);
-    std::optional<double> err;
-    if (with_reference) err = (r.final.R - reference_state(body, scene.centres, r.t_end).R).norm();
-    errors.push_back(err);
+    if (with_reference) {
+      const State ref = reference_state(body, scene.centres, br.result.t_end);
+      br.err_R = (br.result.final.R - ref.R).norm();
+      br.err_rel = adaptive::state_distance(br.result.final, ref);
+    }
+    runs.push_back(std::move(br));
   }
   if (file) file->commit();
 
   if (json) {
-    const RunResult& r0 = results.front();
-    std::cout << "{\"method\": \"" << method.name << "\", \"h\": " << json_number(spec.h)
-              << (is_adaptive(method) ? ", \"tol\": " + json_number(spec.tol) : std::string())
-              << ", \"steps\": " << r0.steps << ", \"t_end\": " << json_number(r0.t_end) << ", "
-              << json_body(r0, errors.front());
-    if (results.size() > 1) {
+    const BodyRun& r0 = runs.front();
+    const double h0 = r0.search ? r0.search->h : spec.h;
+    std::cout << "{\"method\": \"" << r0.method->name << "\", \"h\": " << json_number(h0)
+              << (is_adaptive(*r0.method) ? ", \"tol\": " + json_number(spec.tol) : std::string())
+              << search_json(r0, tol) << ", \"steps\": " << r0.result.steps
+              << ", \"t_end\": " << json_number(r0.result.t_end) << ", " << json_body(r0.result, r0.err_R, r0.err_rel);
+    if (runs.size() > 1) {
       std::cout << ", \"bodies\": [";
-      for (std::size_t b = 0; b < results.size(); ++b)
-        std::cout << (b ? ", " : "") << "{\"name\": \"" << scene.bodies[b].name << "\", "
-                  << json_body(results[b], errors[b]) << "}";
+      for (std::size_t b = 0; b < runs.size(); ++b)
+        std::cout << (b ? ", " : "") << "{\"name\": \"" << scene.bodies[b].name << "\", \"method\": \""
+                  << runs[b].method->name << "\"" << search_json(runs[b], tol) << ", "
+                  << json_body(runs[b].result, runs[b].err_R, runs[b].err_rel) << "}";
       std::cout << "]";
     }
     std::cout << "}\n";
     return 0;
   }
 
-  std::cout << "bodypoint simulate  method=" << method.name << (is_time_transformed(method) ? "  ds=" : "  h=")
-            << fmt(spec.h) << "  steps=" << results.front().steps << "  t_end=" << fmt(results.front().t_end) << "\n"
+  const BodyRun& r0 = runs.front();
+  std::cout << "bodypoint simulate  method=" << (search ? method_name : std::string(r0.method->name));
+  if (search) std::cout << "  tol=" << fmt(tol);
+  else std::cout << (is_time_transformed(*r0.method) ? "  ds=" : "  h=") << fmt(spec.h);
+  std::cout << "  steps=" << r0.result.steps << "  t_end=" << fmt(r0.result.t_end) << "\n"
             << "scene: " << scene_header(vm, so) << "  (" << scene.centres.size() << " centre(s), "
             << scene.bodies.size() << " body-point(s))\n";
-  for (std::size_t b = 0; b < results.size(); ++b) {
-    const RunResult& r = results[b];
-    std::cout << "\n[" << scene.bodies[b].name << "]\n" << std::setprecision(12)
+  for (std::size_t b = 0; b < runs.size(); ++b) {
+    const RunResult& r = runs[b].result;
+    std::cout << "\n[" << scene.bodies[b].name << "]\n";
+    if (!runs[b].why.empty()) std::cout << "  chosen: " << runs[b].why << "\n";
+    if (runs[b].search) std::cout << "  " << search_line(runs[b]) << "\n";
+    std::cout << std::setprecision(12)
               << "  R(t_end) = " << r.final.R.transpose() << "\n"
               << "  v(t_end) = " << r.final.v.transpose() << "\n"
               << "  w(t_end) = " << r.final.w.transpose() << "\n";
@@ -176,9 +264,9 @@ int cmd_simulate(int argc, char** argv) {
         std::cout << "  max |K2Q - K2Q_0|          = " << r.invariants->max_abs_dK2Q << "\n";
       std::cout << std::defaultfloat;
     }
-    if (errors[b])
+    if (runs[b].err_R)
       std::cout << std::setprecision(3) << std::scientific << "  |R - R_ref| (odeint rkf78, long double) = "
-                << *errors[b] << "\n" << std::defaultfloat;
+                << *runs[b].err_R << "\n" << std::defaultfloat;
     std::cout << "  force evaluations = " << r.force_evals << ", wall time = " << std::setprecision(3)
               << r.wall_s << " s\n";
   }

@@ -11,6 +11,7 @@
 #include "bodypoint/reference.hpp"
 #include "bodypoint/run.hpp"
 #include "bodypoint/scenes.hpp"
+#include "by_tol.hpp"
 #include "cli.hpp"
 
 #include <algorithm>
@@ -92,13 +93,17 @@ Row measure(const NamedScene& ns, const MethodInfo& m, const Body& body, const S
 int cmd_work_precision(int argc, char** argv) {
   std::string scenes_arg = "all", methods_arg = "all", out, summary;
   Options o;
-  bool quick = false;
+  bool quick = false, by_tol = false;
+  std::string tols_arg = "1e-4,1e-5,1e-6,1e-7,1e-8,1e-9,1e-10,1e-11,1e-12";
   po::options_description desc("bodypoint work-precision");
   desc.add_options()
       ("scenes", po::value(&scenes_arg)->default_value(scenes_arg), "comma-separated: thesis,close,material,long,two-centres or all")
       ("methods", po::value(&methods_arg)->default_value(methods_arg), "comma-separated method names or all")
       ("repeats", po::value(&o.repeats)->default_value(o.repeats), "timed repeats per configuration (median reported)")
       ("max-evals", po::value(&o.max_evals)->default_value(o.max_evals), "largest run of a ladder, in force evaluations")
+      ("by-tol", po::bool_switch(&by_tol), "second view: auto and every step-size-controlled peer with the same "
+       "requested tolerance; delivered error, whether it met TOL, and time")
+      ("tols", po::value(&tols_arg)->default_value(tols_arg), "with --by-tol: the tolerances")
       ("quick", po::bool_switch(&quick), "coarse: scenes thesis and material, 1 repeat, runs up to 1e6 force evaluations")
       ("out", po::value(&out), "CSV: scene, method, h, tol, err_R, err_rel, max_rel_dE, force_evals, wall_s")
       ("summary", po::value(&summary), "also write the summary table (Markdown) to this file");
@@ -129,6 +134,17 @@ int cmd_work_precision(int argc, char** argv) {
   std::unique_ptr<AtomicFile> csv, md;
   if (!out.empty()) csv = std::make_unique<AtomicFile>(out);
   if (!summary.empty()) md = std::make_unique<AtomicFile>(summary);
+  if (by_tol) {
+    std::ostringstream sum;
+    run_by_tolerance(scenes, parse_numbers(tols_arg, "--tols"), o.repeats, csv ? &csv->stream() : nullptr, sum);
+    std::cout << sum.str();
+    if (md) {
+      md->stream() << "<!-- bodypoint work-precision --by-tol, revision " << git_revision() << " -->\n" << sum.str();
+      md->commit();
+    }
+    if (csv) csv->commit();
+    return 0;
+  }
 
   std::vector<Row> rows;
   std::ostringstream refs;

@@ -10,7 +10,8 @@ namespace bodypoint::adaptive {
 /// logh-*, ttl-* and ks, in listing order.
 std::vector<MethodInfo> methods();
 
-/// The constant c of the time-step function chosen from the scene when RunSpec::omega_c < 0.
-double automatic_omega_c(const Body& body, const std::vector<Centre>& centres);
+/// The constant c of the time-step function chosen from the scene and the fictitious step ds when
+/// RunSpec::omega_c < 0 (registry.cpp says why).
+double automatic_omega_c(const Body& body, const std::vector<Centre>& centres, double ds);
 
 }  // namespace bodypoint::adaptive

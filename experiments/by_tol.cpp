@@ -1,0 +1,211 @@
+// `bodypoint work-precision --by-tol`: the same requested tolerance for everyone.
+//
+// For each named scene and each TOL, `--method auto` (which chooses its method and step and
+// estimates its own error, tolerance.hpp) and each general-purpose peer with a step-size controller
+// (Boost.Odeint dopri5, rkf78, Bulirsch-Stoer; GSL rk8pd, rkf45) are run with that TOL. The delivered
+// error is max(|dR|/|R_ref|, |dv|/|v_ref|) against Boost.Odeint rkf78 in long double at tolerance
+// 1e-18; a run meets TOL when its delivered error is at most TOL. Times are medians over repeats of
+// the step loops alone; for auto that is every run its search makes (the pilot runs, the error
+// estimate's companion run and the delivered run), so its error estimate is paid for in full.
+#include "by_tol.hpp"
+
+#include "bodypoint/adaptive/tolerance.hpp"
+#include "bodypoint/io.hpp"
+#include "bodypoint/reference.hpp"
+#include "bodypoint/run.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+namespace bodypoint::cli {
+namespace {
+
+struct TolRow {
+  std::string scene, method;
+  double tol = 0, h = 0, err_estimate = 0, err = 0, wall_s = 0;
+  long force_evals = 0;
+  int runs = 1;
+  bool met = false;
+  bool is_auto = false;
+  bool is_ladder = false;  ///< a peer's run from its tolerance ladder (oracle view), not at TOL
+};
+
+/// A peer's ladder stops once its delivered error is below this (the smallest TOL of the grid is 1e-12).
+constexpr double kLadderFloor = 1e-13;
+
+double median_of(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+std::vector<std::string> peer_names() {
+  std::vector<std::string> out;
+  for (const MethodInfo& m : methods())
+    if (is_adaptive(m)) out.emplace_back(m.name);
+  return out;
+}
+
+TolRow measure_auto(const NamedScene& ns, const State& ref, double tol, long repeats) {
+  const Body& body = ns.scene.bodies.front();
+  TolRow row;
+  row.scene = ns.name;
+  row.tol = tol;
+  row.is_auto = true;
+  const MethodInfo& m = adaptive::choose_method(body, ns.scene.centres, tol, nullptr);
+  row.method = std::string(m.name);
+  std::vector<double> times;
+  adaptive::ToleranceResult r;
+  for (long k = 0; k < repeats; ++k) {
+    r = adaptive::run_to_tolerance(m, body, ns.scene.centres, tol, ns.t_end);
+    times.push_back(r.total_wall_s);
+  }
+  row.h = r.h;
+  row.err_estimate = r.err_estimate;
+  row.err = adaptive::state_distance(r.result.final, ref);
+  row.met = row.err <= tol;
+  row.wall_s = median_of(times);
+  row.force_evals = r.total_force_evals;
+  row.runs = r.runs;
+  return row;
+}
+
+TolRow measure_peer(const NamedScene& ns, const std::string& name, const State& ref, double tol, long repeats) {
+  const Body& body = ns.scene.bodies.front();
+  TolRow row;
+  row.scene = ns.name;
+  row.method = name;
+  row.tol = tol;
+  RunSpec spec;
+  spec.tol = tol;
+  spec.t_end = ns.t_end;
+  spec.h = 1e-3;
+  spec.steps = 1;
+  std::vector<double> times;
+  RunResult r;
+  for (long k = 0; k < repeats; ++k) {
+    r = run(method_or_throw(name), body, ns.scene.centres, spec);
+    times.push_back(r.wall_s);
+  }
+  row.err = adaptive::state_distance(r.final, ref);
+  if (!std::isfinite(row.err)) row.err = std::numeric_limits<double>::infinity();
+  row.met = row.err <= tol;
+  row.wall_s = median_of(times);
+  row.force_evals = r.force_evals;
+  return row;
+}
+
+std::string sci(double x, int digits = 2) {
+  std::ostringstream os;
+  os << std::setprecision(digits) << std::scientific << x;
+  return os.str();
+}
+
+std::string ms(double s) {
+  std::ostringstream os;
+  os << std::setprecision(3) << s * 1e3;
+  return os.str();
+}
+
+}  // namespace
+
+void run_by_tolerance(const std::vector<NamedScene>& scenes, const std::vector<double>& tols, long repeats,
+                      std::ostream* csv, std::ostream& summary) {
+  std::vector<TolRow> rows;
+  const std::vector<std::string> peers = peer_names();
+  for (const NamedScene& ns : scenes) {
+    const State ref = reference_state(ns.scene.bodies.front(), ns.scene.centres, ns.t_end, 1e-18L);
+    for (double tol : tols) {
+      rows.push_back(measure_auto(ns, ref, tol, repeats));
+      std::cerr << "  " << ns.name << " tol " << sci(tol, 0) << ": auto " << rows.back().method << " err "
+                << sci(rows.back().err) << " (estimate " << sci(rows.back().err_estimate) << ") in "
+                << ms(rows.back().wall_s) << " ms\n";
+      for (const std::string& p : peers) {
+        try {
+          rows.push_back(measure_peer(ns, p, ref, tol, repeats));
+        } catch (const Error& e) {
+          std::cerr << "  " << ns.name << " " << p << " tol " << sci(tol, 0) << ": failed (" << e.what() << ")\n";
+        }
+      }
+    }
+    // The peers' own ladders, for the oracle comparison: each peer at requested tolerances from 1e-3
+    // down by half decades, as if the user had known which one delivers TOL.
+    for (const std::string& p : peers) {
+      for (int k = 6; k <= 30; ++k) {
+        const double t = std::pow(10.0, -0.5 * k);
+        try {
+          TolRow r = measure_peer(ns, p, ref, t, repeats);
+          r.is_ladder = true;
+          rows.push_back(r);
+          if (r.err < kLadderFloor) break;
+        } catch (const Error& e) {
+          break;
+        }
+      }
+    }
+  }
+  if (csv) {
+    *csv << "# bodypoint work-precision --by-tol, revision " << git_revision() << "\n"
+         << "# err = max(|dR|/|R_ref|, |dv|/|v_ref|) against odeint rkf78 in long double at tol 1e-18; met = err <= tol\n"
+         << "# wall_s = median over repeats of the step loops (auto: all runs of its search); h = ds for logh/ttl/ks\n"
+         << "scene,method,kind,tol,h,err_estimate,err,met,runs,force_evals,wall_s\n";
+    for (const TolRow& r : rows)
+      *csv << r.scene << ',' << r.method << ',' << (r.is_auto ? "auto" : r.is_ladder ? "ladder" : "at-tol") << ','
+           << fmt(r.tol) << ','
+           << (r.is_auto ? fmt(r.h) : "") << ',' << (r.is_auto ? fmt(r.err_estimate) : "") << ',' << fmt(r.err)
+           << ',' << (r.met ? "yes" : "no") << ',' << r.runs << ',' << r.force_evals << ',' << fmt(r.wall_s) << '\n';
+  }
+  summary << "| scene | TOL | auto method | ds or h | estimate | delivered | met | time [ms] | fastest peer meeting TOL "
+             "| time [ms] | speed-up | peers meeting TOL | fastest peer config delivering TOL | time [ms] | speed-up |\n"
+          << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  int met = 0, total = 0, faster3 = 0, compared = 0, oracle3 = 0, oracle_n = 0;
+  for (const TolRow& a : rows) {
+    if (!a.is_auto) continue;
+    const TolRow* best = nullptr;
+    int meeting = 0;
+    for (const TolRow& r : rows) {
+      if (r.is_auto || r.is_ladder || r.scene != a.scene || r.tol != a.tol || !r.met) continue;
+      ++meeting;
+      if (!best || r.wall_s < best->wall_s) best = &r;
+    }
+    // Oracle: the fastest ladder configuration delivering TOL whose next finer one delivers it too.
+    const TolRow* oracle = nullptr;
+    for (std::size_t i = 0; i + 1 < rows.size(); ++i) {
+      const TolRow& r = rows[i];
+      const TolRow& next = rows[i + 1];
+      if (!r.is_ladder || r.scene != a.scene || !(r.err <= a.tol)) continue;
+      if (!(next.is_ladder && next.method == r.method && next.scene == r.scene && next.err <= a.tol)) continue;
+      if (!oracle || r.wall_s < oracle->wall_s) oracle = &r;
+    }
+    ++total;
+    met += a.met ? 1 : 0;
+    summary << "| " << a.scene << " | " << sci(a.tol, 0) << " | " << a.method << " | " << std::setprecision(3)
+            << a.h << " | " << sci(a.err_estimate) << " | " << sci(a.err) << " | " << (a.met ? "yes" : "**no**")
+            << " | " << ms(a.wall_s) << " | ";
+    if (best) {
+      const double ratio = best->wall_s / a.wall_s;
+      ++compared;
+      faster3 += ratio >= 3.0 ? 1 : 0;
+      summary << best->method << " | " << ms(best->wall_s) << " | " << std::setprecision(3) << ratio << "x | ";
+    } else {
+      summary << "none | - | - | ";
+    }
+    summary << meeting << "/" << peers.size() << " | ";
+    if (oracle) {
+      const double ratio = oracle->wall_s / a.wall_s;
+      ++oracle_n;
+      oracle3 += ratio >= 3.0 ? 1 : 0;
+      summary << oracle->method << " tol=" << sci(oracle->tol, 1) << " | " << ms(oracle->wall_s) << " | "
+              << std::setprecision(3) << ratio << "x |\n";
+    } else {
+      summary << "none | - | - |\n";
+    }
+  }
+  summary << "\nauto met TOL in " << met << " of " << total << " cases; where a peer met it too, auto was >= 3x "
+          << "faster in " << faster3 << " of " << compared << "; against the fastest peer configuration that "
+          << "delivers TOL (its tolerance chosen afterwards), >= 3x in " << oracle3 << " of " << oracle_n << ".\n";
+}
+
+}  // namespace bodypoint::cli
