@@ -18,6 +18,7 @@
 #include <cmath>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <sstream>
 
 namespace bodypoint::cli {
@@ -118,7 +119,19 @@ void run_by_tolerance(const std::vector<NamedScene>& scenes, const std::vector<d
   for (const NamedScene& ns : scenes) {
     const State ref = reference_state(ns.scene.bodies.front(), ns.scene.centres, ns.t_end, 1e-18L);
     for (double tol : tols) {
-      rows.push_back(measure_auto(ns, ref, tol, repeats));
+      try {
+        rows.push_back(measure_auto(ns, ref, tol, repeats));
+      } catch (const Error& e) {  // refused (below the round-off floor, over the budget): recorded as such
+        TolRow refused;
+        refused.scene = ns.name;
+        refused.tol = tol;
+        refused.is_auto = true;
+        refused.method = "refused";
+        refused.err = refused.err_estimate = std::numeric_limits<double>::quiet_NaN();
+        rows.push_back(refused);
+        std::cerr << "  " << ns.name << " tol " << sci(tol, 0) << ": auto refused (" << e.what() << ")\n";
+        continue;
+      }
       std::cerr << "  " << ns.name << " tol " << sci(tol, 0) << ": auto " << rows.back().method << " err "
                 << sci(rows.back().err) << " (estimate " << sci(rows.back().err_estimate) << ") in "
                 << ms(rows.back().wall_s) << " ms\n";

@@ -171,7 +171,7 @@ TEST(Cli, WorkPrecisionQuickWritesRowsForEveryMethodAndASummary) {
       if (m.name == "ks" && std::string(scene) == "thesis") continue;  // ks needs B = 0: refused, noted
       EXPECT_GT(rows[std::string(scene) + "," + std::string(m.name)], 0) << scene << " " << m.name;
     }
-  EXPECT_NE(r.err.find("thesis ks h=0.1: skipped (ks regularises a material point"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("thesis ks h=0.2: skipped (ks regularises a material point"), std::string::npos) << r.err;
   for (const char* target : {"| thesis | 1e-04 |", "| thesis | 1e-07 |", "| material | 1e-10 |"})
     EXPECT_NE(r.out.find(target), std::string::npos) << r.out;
   EXPECT_NE(r.err.find("reference thesis: odeint rkf78 long double"), std::string::npos) << r.err;
