@@ -34,15 +34,7 @@ using detail::observe;
 /// A run to t_end that needs more fictitious steps than this is stopped with an error.
 constexpr long kMaxFictitiousSteps = 2'000'000'000L;
 
-struct StepStats {
-  long steps = 0;
-  double min_dt = std::numeric_limits<double>::infinity(), max_dt = 0.0;
-  void add(double dt) {
-    ++steps;
-    min_dt = std::min(min_dt, dt);
-    max_dt = std::max(max_dt, dt);
-  }
-};
+using detail::StepStats;
 
 void require_time_target(const RunSpec& spec) {
   if (spec.t_end < 0.0 || !std::isfinite(spec.t_end)) throw Error("end time must be a finite number >= 0");
@@ -209,11 +201,8 @@ RunResult run_time_transformed(const Body& body, const std::vector<Centre>& cent
       t_reached = x.time();
       return k.to_physical(x);
     });
-    r.steps = st.steps;
-    r.t_end = t_reached;
+    st.record(r, t_reached);
     r.force_evals = k.lp.evals;
-    r.min_step = st.steps ? st.min_dt : 0.0;
-    r.max_step = st.max_dt;
     return r;
   });
 }
@@ -302,11 +291,8 @@ RunResult run_ks(const Body& body, const std::vector<Centre>& centres, const Run
     t_reached = x.second;
     return x.first.state();
   });
-  r.steps = st.steps;
-  r.t_end = t_reached;
+  st.record(r, t_reached);
   r.force_evals = 0;  // the regularised flow is exact: no force evaluations
-  r.min_step = st.steps ? st.min_dt : 0.0;
-  r.max_step = st.max_dt;
   return r;
 }
 

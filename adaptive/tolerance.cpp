@@ -46,6 +46,10 @@ constexpr double kMinRefinement = 1.5;
 /// long, logh-kl8: 9.8e-8 at ds = 0.082, 1.8e-7 at 0.075, 3.0e-9 at 0.068): there a single pair
 /// underestimated the error 50x.
 constexpr double kSmoothBand = 3.0;
+/// The search gives up after this many refinements in a row that did not lower its error estimate
+/// by kStallFactor (scene long at tol 1e-12 spent 2e9 force evaluations, about 100 s, before).
+constexpr int kMaxStalls = 3;
+constexpr double kStallFactor = 2.0;
 /// The observed order of a triple is trusted up to this multiple of the nominal order.
 constexpr double kMaxOrderFactor = 2.0;
 /// Budget of force evaluations (or KS steps) over all runs of one search.
@@ -178,7 +182,8 @@ class Search {
     estimate_ = pair_estimate(a, b);
     // 2./3. Predict, estimate from a close triple, repeat until the estimate is below kAccept tol.
     Level fine = b;
-    double h_next = 0.0;
+    double h_next = 0.0, best_bound = std::numeric_limits<double>::infinity();
+    int stalled = 0;
     for (int k = 0; k < kMaxLevels; ++k) {
       const double predicted = fine.h * std::pow(kTarget * tol_ / std::max(estimate_, kRoundOff), 1.0 / p_);
       const double h_star = k == 0 || h_next == 0.0 ? std::min(predicted, fine.h / kMinRefinement) : h_next;
@@ -206,6 +211,15 @@ class Search {
       // Not accurate enough: predict again; not smooth in h (a resonance of the far-field step with the
       // spin-orbit precession): refine by kMinRefinement, which also lowers the spin angle per step.
       h_next = smooth ? 0.0 : fine.h / kMinRefinement;
+      // A search whose estimates stop falling (round-off, or resonances that refinement does not
+      // remove) says so instead of spending its whole budget.
+      if (bound < best_bound / kStallFactor) {
+        best_bound = bound;
+        stalled = 0;
+      } else if (++stalled >= kMaxStalls) {
+        throw Error("--tol " + fmt_tol() + " is out of reach of " + std::string(m_.name) +
+                    " on this scene: the error estimate stalls at " + fmt_number(best_bound));
+      }
     }
     throw Error("--tol " + fmt_tol() + ": " + std::string(m_.name) + " did not reach it in " +
                 std::to_string(kMaxLevels) + " refinements");

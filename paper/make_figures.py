@@ -24,6 +24,7 @@ FAMILIES = {  # line style per method family, so the thesis's and our methods ar
     "ab4": dict(linestyle=":"),
     "lp": dict(linestyle="-"),
     "odeint": dict(linestyle="-."),
+    "gsl": dict(linestyle="-."),
     "logh": dict(linestyle="-"),
     "ttl": dict(linestyle="-"),
     "ks": dict(linestyle="-"),

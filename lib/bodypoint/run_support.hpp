@@ -8,7 +8,9 @@
 #include "bodypoint/run.hpp"
 #include "bodypoint/splitting/composition.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <limits>
 #include <type_traits>
 #include <vector>
 
@@ -56,6 +58,24 @@ class Monitor {
   const RunSpec& spec_;
   const SampleSink* sink_;
   ToPhysical to_physical_;
+};
+
+/// Accepted steps of a variable-step run: count, smallest and largest physical step.
+struct StepStats {
+  long steps = 0;
+  double min_dt = std::numeric_limits<double>::infinity(), max_dt = 0.0;
+  void add(double dt) {
+    ++steps;
+    min_dt = std::min(min_dt, dt);
+    max_dt = std::max(max_dt, dt);
+  }
+  /// Fills r.steps, r.t_end, r.min_step and r.max_step.
+  void record(RunResult& r, double t_end) const {
+    r.steps = steps;
+    r.t_end = t_end;
+    r.min_step = steps ? min_dt : 0.0;
+    r.max_step = max_dt;
+  }
 };
 
 /// Runs `loop(observer)` with a null observer or a monitor, timing the loop only.

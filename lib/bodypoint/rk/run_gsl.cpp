@@ -60,8 +60,7 @@ RunResult run_gsl(const gsl_odeiv2_step_type* type, const Body& body, const std:
     std::unique_ptr<gsl_odeiv2_evolve, GslDeleter> evolve(gsl_odeiv2_evolve_alloc(9));
     if (!step || !control || !evolve) throw Error("gsl: out of memory");
     const double t_end = spec.t_end;
-    long accepted = 0;
-    double min_step = std::numeric_limits<double>::infinity(), max_step = 0.0;
+    detail::StepStats st;
     auto to_physical = [](const OdeState<double>& x) { return from_ode(x); };
     RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
       OdeState<double> x = to_ode(body.s0);
@@ -75,19 +74,15 @@ RunResult run_gsl(const gsl_odeiv2_step_type* type, const Body& body, const std:
         const double taken = t - t_before;
         if (!(taken > kMinRelativeStep * t_end) && t < t_end)
           throw Error("gsl: the step size collapsed at t = " + std::to_string(t) + " (tolerance too tight?)");
-        if (++accepted > kMaxSteps) throw Error("gsl: more than 2e8 steps before t_end");
-        min_step = std::min(min_step, taken);
-        max_step = std::max(max_step, taken);
-        if constexpr (std::decay_t<decltype(obs)>::active) obs.observe(accepted, t, x, t >= t_end);
+        if (st.steps >= kMaxSteps) throw Error("gsl: more than 2e8 steps before t_end");
+        st.add(taken);
+        if constexpr (std::decay_t<decltype(obs)>::active) obs.observe(st.steps, t, x, t >= t_end);
         if (!std::isfinite(x[0])) break;
       }
       return from_ode(x);
     });
     r.force_evals = evals;
-    r.steps = accepted;
-    r.t_end = t_end;
-    r.min_step = min_step;
-    r.max_step = max_step;
+    st.record(r, t_end);
     return r;
   });
 }

@@ -73,8 +73,7 @@ RunResult run_odeint_adaptive(const Body& body, const std::vector<Centre>& centr
     EquationsOfMotion<Field, decltype(spin)::value> sys{body.p, field, &evals};
     auto to_physical = [](const OdeState<double>& x) { return from_ode(x); };
     const double t_end = spec.t_end;
-    long accepted = 0;
-    double min_step = std::numeric_limits<double>::infinity(), max_step = 0.0;
+    detail::StepStats st;
     RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
       OdeState<double> x = to_ode(body.s0);
       Controlled stepper = rk::make_controlled<Controlled>(spec.tol);
@@ -87,11 +86,9 @@ RunResult run_odeint_adaptive(const Body& body, const std::vector<Centre>& centr
         if (stepper.try_step(std::ref(sys), x, t, dt) == boost::numeric::odeint::success) {
           if (final_step) t = t_end;  // exact end time, not t_before + dt rounded
           const double taken = t - t_before;
-          min_step = std::min(min_step, taken);
-          max_step = std::max(max_step, taken);
-          ++accepted;
+          st.add(taken);
           rejected_in_a_row = 0;
-          if constexpr (std::decay_t<decltype(obs)>::active) obs.observe(accepted, t, x, t >= t_end);
+          if constexpr (std::decay_t<decltype(obs)>::active) obs.observe(st.steps, t, x, t >= t_end);
           if (!std::isfinite(x[0])) break;
         } else if (++rejected_in_a_row > 1000 || !(dt > 0.0)) {
           throw Error("adaptive step size collapsed at t = " + std::to_string(t) + " (tolerance too tight?)");
@@ -100,10 +97,7 @@ RunResult run_odeint_adaptive(const Body& body, const std::vector<Centre>& centr
       return from_ode(x);
     });
     r.force_evals = evals;
-    r.steps = accepted;
-    r.t_end = t_end;
-    r.min_step = min_step;
-    r.max_step = max_step;
+    st.record(r, t_end);
     return r;
   });
 }
