@@ -83,6 +83,10 @@ std::vector<Case> cases() {
   return out;
 }
 
+// The grid stops at 1e-10. At 1e-12 auto also delivered on seven of these eight scenes, but on
+// close-long (t = 400, ~1e5 steps of logh-kl8) it delivered 1.8e-12 with an estimate of 2.2e-13: the
+// round-off of that many steps is not systematic in h, so Richardson estimates do not see it (README,
+// "Limits").
 TEST(Tolerance, AutoDeliversTolWithAnHonestEstimate) {
   int runs = 0, overestimated = 0;
   for (const Case& c : cases()) {
@@ -137,14 +141,16 @@ TEST(Tolerance, AutoChoosesByTheScene) {
   EXPECT_EQ(chosen(thesis_scene(material), 1e-8), "ks");
   SceneParams attracting;
   attracting.A = 2.0;
-  EXPECT_EQ(chosen(thesis_scene(attracting), 1e-4), "ttl-kl6");
-  EXPECT_EQ(chosen(thesis_scene(attracting), 1e-10), "ttl-kl8");
-  EXPECT_EQ(chosen(named_scene("close").scene, 1e-4), "logh-kl6");
-  EXPECT_EQ(chosen(named_scene("close").scene, 1e-10), "logh-kl8");
+  EXPECT_EQ(chosen(thesis_scene(attracting), 1e-4), "ttl-y4");
+  EXPECT_EQ(chosen(thesis_scene(attracting), 1e-8), "ttl-kl6");
+  EXPECT_EQ(chosen(thesis_scene(attracting), 1e-11), "ttl-kl8");
+  EXPECT_EQ(chosen(named_scene("close").scene, 1e-4), "logh-y4");
+  EXPECT_EQ(chosen(named_scene("close").scene, 1e-10), "logh-kl6");
+  EXPECT_EQ(chosen(named_scene("close").scene, 1e-11), "logh-kl8");
   SceneParams far;  // a spinning body passing a weak centre at a distance of 1e4
   far.A = -1e-3;
   far.start.d = 1e4;
-  EXPECT_EQ(chosen(thesis_scene(far), 1e-10), "lp-kl8");
+  EXPECT_EQ(chosen(thesis_scene(far), 1e-11), "lp-kl8");
 }
 
 TEST(Tolerance, UnreachableOrInvalidTolIsRefused) {
@@ -159,7 +165,7 @@ TEST(Tolerance, UnreachableOrInvalidTolIsRefused) {
 TEST(Tolerance, CommandLine) {
   const test::CliResult ok = test::run_cli("simulate --tol 1e-8 --Kz 0.1 --d 0.05 --t-end 80 --json");
   ASSERT_EQ(ok.code, 0) << ok.err;
-  EXPECT_NE(ok.out.find("\"method\": \"logh-kl8\""), std::string::npos) << ok.out;
+  EXPECT_NE(ok.out.find("\"method\": \"logh-kl6\""), std::string::npos) << ok.out;
   EXPECT_NE(ok.out.find("\"err_estimate\": "), std::string::npos);
   EXPECT_NE(ok.out.find("\"chosen\": "), std::string::npos);
   for (const char* bad : {"--tol 0", "--tol nan", "--tol 1e-20", "--tol -1", "--method auto",

@@ -50,10 +50,10 @@ RunSpec delivered_spec(const MethodInfo& method, const ToleranceResult& r, doubl
 
 /// `--method auto`: a one-centre material point: ks; a body far from every centre for the whole run
 /// (straight-line estimate of the closest approach, potential there below the time-step constant c):
-/// Lie-Poisson; only repelling centres: logH; any attracting centre: TTL. Kahan-Li's sixth-order
-/// table for tol >= 1e-6, their eighth-order one below (Blanes-Moan S6, tried first for the loose
-/// tolerances, has an error that is rough in ds near the bounded step's spin angle, and its Richardson
-/// estimates were off by up to 60x on the two-centres scene; Kahan-Li 6 stayed within 2x there).
+/// Lie-Poisson; only repelling centres: logH; any attracting centre: TTL. The table by measured cost:
+/// Yoshida 4 for tol >= 1e-5, Kahan-Li 6 for 1e-10 <= tol < 1e-5, Kahan-Li 8 below (Blanes-Moan S6,
+/// tried for the loose tolerances, has an error that is rough in ds near the bounded step's spin
+/// angle, and its Richardson estimates were off by up to 60x on the two-centres scene).
 /// `why` receives one line saying what was chosen and why.
 const MethodInfo& choose_method(const Body& body, const std::vector<Centre>& centres, double tol, std::string* why);
 
