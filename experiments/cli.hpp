@@ -1,11 +1,13 @@
 // bodypoint command line: options shared by the subcommands.
 #pragma once
 
+#include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/model.hpp"
 #include "bodypoint/run.hpp"
 
 #include <boost/program_options.hpp>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +34,32 @@ void add_step_options(po::options_description& desc, StepOptions& o);
 /// Fills spec.h and spec.steps. With --t-end T: steps = ceil(T/h), h = T/steps (hits T exactly).
 void apply_step_options(const po::variables_map& vm, const StepOptions& o, RunSpec& spec);
 
+/// What --method, --tol and the step options ask for: a method (nullptr: auto) run with spec, or,
+/// with search, the step search of adaptive/tolerance.hpp to spec.t_end.
+struct RunPlan {
+  const MethodInfo* method = nullptr;
+  bool automatic = false;  ///< --method auto, or --tol without --method
+  bool search = false;     ///< --tol chooses the step (any method but odeint-*/gsl-*)
+  double tol = 0.0;
+  RunSpec spec;
+};
+/// Validates the step options against the method; throws Error with the reason.
+RunPlan plan_run(const po::variables_map& vm, const StepOptions& st, const std::string& method_name,
+                 bool method_defaulted, double tol);
+
+/// What one body's run used: the method (auto may choose per body) and, with --tol, the search.
+struct BodyRun {
+  const MethodInfo* method = nullptr;
+  RunResult result;
+  std::optional<double> err_R;
+  std::optional<double> err_rel;  ///< max(|dR|/|R_ref|, |dv|/|v_ref|), the measure --tol bounds
+  std::optional<adaptive::ToleranceResult> search;
+  std::string why;  ///< --method auto: what was chosen and why
+};
+/// Runs one body as planned (spec may add invariants, output steps and a sink to plan.spec).
+BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
+                 const SampleSink* sink);
+
 /// Parses argv into vm, rejecting unknown options and positional words; returns false after
 /// printing help when --help is given.
 bool parse(int argc, char** argv, const po::options_description& desc, po::variables_map& vm,
@@ -43,6 +71,7 @@ int cmd_work_precision(int argc, char** argv);
 int cmd_sweep(int argc, char** argv);
 int cmd_timing(int argc, char** argv);
 int cmd_study(int argc, char** argv);
+int cmd_view(int argc, char** argv);
 
 /// "A=.. m=.. B=.. J=.. K1=.. Kx=.. Kz=.. d=.. L=..": the thesis's parameters, for output headers.
 std::string describe(const SceneParams& p);

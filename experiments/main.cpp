@@ -18,6 +18,7 @@ constexpr const char* usage =
     "  sweep      vary one parameter over a range for a list of methods (CSV)\n"
     "  timing     run time against the number of steps (median of repeats)\n"
     "  study      regenerate the thesis's studies (d, L, h, Kx sweeps, timing, table 4.1, appendix 1)\n"
+    "  view       write a self-contained HTML page that animates a run in 3D (three.js)\n"
     "Run 'bodypoint <command> --help' for the options of a command.";
 
 }  // namespace
@@ -35,7 +36,8 @@ int main(int argc, char** argv) {
     if (cmd == "sweep") return bodypoint::cli::cmd_sweep(argc - 1, argv + 1);
     if (cmd == "timing") return bodypoint::cli::cmd_timing(argc - 1, argv + 1);
     if (cmd == "study") return bodypoint::cli::cmd_study(argc - 1, argv + 1);
-    std::cerr << "bodypoint: error: unknown command '" << cmd << "' (simulate, methods, work-precision, sweep, timing, study)\n";
+    if (cmd == "view") return bodypoint::cli::cmd_view(argc - 1, argv + 1);
+    std::cerr << "bodypoint: error: unknown command '" << cmd << "' (simulate, methods, work-precision, sweep, timing, study, view)\n";
     return 2;
   } catch (const bodypoint::Error& e) {
     std::cerr << "bodypoint: error: " << e.what() << "\n";

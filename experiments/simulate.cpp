@@ -43,31 +43,59 @@ std::string json_body(const RunResult& r, const std::optional<double>& err_R,
 
 }  // namespace
 
-namespace {
+RunPlan plan_run(const po::variables_map& vm, const StepOptions& st, const std::string& method_name,
+                 bool method_defaulted, double tol) {
+  RunPlan plan;
+  const bool tol_given = vm.count("tol") && !vm["tol"].defaulted();
+  plan.automatic = method_name == "auto" || (tol_given && method_defaulted);
+  if (plan.automatic && !tol_given) throw Error("--method auto needs --tol (the accuracy to deliver)");
+  plan.method = plan.automatic ? nullptr : &method_or_throw(method_name);
+  plan.search = plan.automatic || (tol_given && !is_adaptive(*plan.method));
+  plan.tol = tol;
+  RunSpec& spec = plan.spec;
+  spec.tol = tol;
+  if (plan.search) {
+    adaptive::check_tolerance(tol);
+    if (!vm["h"].defaulted() || !vm["steps"].defaulted())
+      throw Error("--tol chooses the step: give --t-end, not --h or --steps");
+    spec.t_end = vm.count("t-end") ? st.t_end : st.h * static_cast<double>(st.steps);
+    if (!(std::isfinite(spec.t_end) && spec.t_end > 0.0)) throw Error("--t-end must be a finite number > 0");
+  } else if (is_time_transformed(*plan.method)) {
+    // --h is the fictitious step ds (never adjusted); --t-end runs to exactly that time, otherwise
+    // --steps fictitious steps are taken.
+    if (!std::isfinite(st.h) || st.h <= 0.0) throw Error("--h must be a finite number > 0");
+    if (vm.count("t-end") && !vm["steps"].defaulted()) throw Error("give --steps or --t-end, not both");
+    if (vm.count("t-end") && !(std::isfinite(st.t_end) && st.t_end > 0.0))
+      throw Error("--t-end must be a finite number > 0");
+    if (!vm.count("t-end") && st.steps < 1) throw Error("--steps must be >= 1");
+    spec.h = st.h;
+    spec.t_end = vm.count("t-end") ? st.t_end : 0.0;
+    spec.steps = vm.count("t-end") ? 0 : st.steps;
+  } else {
+    apply_step_options(vm, st, spec);
+  }
+  return plan;
+}
 
-/// What one body's run used: the method (auto may choose per body) and, with --tol, the search.
-struct BodyRun {
-  const MethodInfo* method = nullptr;
-  RunResult result;
-  std::optional<double> err_R;
-  std::optional<double> err_rel;  ///< max(|dR|/|R_ref|, |dv|/|v_ref|), the measure --tol bounds
-  std::optional<adaptive::ToleranceResult> search;
-  std::string why;  ///< --method auto: what was chosen and why
-};
-
-/// --tol with a fixed-step or time-transformed method (or auto): the step search, then the delivered
-/// run repeated with invariants or output when they are asked for.
-BodyRun run_with_tolerance(const MethodInfo* method, const Body& body, const std::vector<Centre>& centres,
-                           double tol, double t_end, const RunSpec& spec, const SampleSink* sink) {
+BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
+                 const SampleSink* sink) {
   BodyRun b;
-  b.method = method ? method : &adaptive::choose_method(body, centres, tol, &b.why);
-  b.search = adaptive::run_to_tolerance(*b.method, body, centres, tol, t_end);
+  if (!plan.search) {
+    b.method = plan.method;
+    b.result = run(*plan.method, body, centres, spec, sink);
+    return b;
+  }
+  // The step search, then the delivered run repeated with invariants or output when they are asked for.
+  b.method = plan.method ? plan.method : &adaptive::choose_method(body, centres, plan.tol, &b.why);
+  b.search = adaptive::run_to_tolerance(*b.method, body, centres, plan.tol, spec.t_end);
   if (spec.track_invariants || sink)
-    b.result = run(*b.method, body, centres, adaptive::delivered_spec(*b.method, *b.search, t_end, spec), sink);
+    b.result = run(*b.method, body, centres, adaptive::delivered_spec(*b.method, *b.search, spec.t_end, spec), sink);
   else
     b.result = b.search->result;
   return b;
 }
+
+namespace {
 
 std::string search_json(const BodyRun& b, double tol) {
   if (!b.search) return "";
@@ -125,38 +153,13 @@ int cmd_simulate(int argc, char** argv) {
              "With --tol and no --method (or --method auto) the method and its step are chosen to deliver tol."))
     return 0;
 
-  const bool tol_given = vm.count("tol") && !vm["tol"].defaulted();
-  if (tol_given && vm["method"].defaulted()) method_name = "auto";
-  const bool automatic = method_name == "auto";
-  if (automatic && !tol_given) throw Error("--method auto needs --tol (the accuracy to deliver)");
-  const MethodInfo* fixed_method = automatic ? nullptr : &method_or_throw(method_name);
-  const bool search = automatic || (tol_given && !is_adaptive(*fixed_method));
-  if (search) {
-    adaptive::check_tolerance(tol);
-    if (!vm["h"].defaulted() || !vm["steps"].defaulted())
-      throw Error("--tol chooses the step: give --t-end, not --h or --steps");
-    if (vm.count("omega-c")) throw Error("--tol uses the automatic time-step constant: drop --omega-c");
-  }
+  RunPlan plan = plan_run(vm, st, method_name, vm["method"].defaulted(), tol);
+  const MethodInfo* fixed_method = plan.method;
+  const bool search = plan.search;
+  if (plan.automatic) method_name = "auto";
+  if (search && vm.count("omega-c")) throw Error("--tol uses the automatic time-step constant: drop --omega-c");
   const Scene scene = make_scene(vm, so);
-  RunSpec spec;
-  spec.tol = tol;
-  if (search) {
-    spec.t_end = vm.count("t-end") ? st.t_end : st.h * static_cast<double>(st.steps);
-    if (!(std::isfinite(spec.t_end) && spec.t_end > 0.0)) throw Error("--t-end must be a finite number > 0");
-  } else if (is_time_transformed(*fixed_method)) {
-    // --h is the fictitious step ds (never adjusted); --t-end runs to exactly that time, otherwise
-    // --steps fictitious steps are taken.
-    if (!std::isfinite(st.h) || st.h <= 0.0) throw Error("--h must be a finite number > 0");
-    if (vm.count("t-end") && !vm["steps"].defaulted()) throw Error("give --steps or --t-end, not both");
-    if (vm.count("t-end") && !(std::isfinite(st.t_end) && st.t_end > 0.0))
-      throw Error("--t-end must be a finite number > 0");
-    if (!vm.count("t-end") && st.steps < 1) throw Error("--steps must be >= 1");
-    spec.h = st.h;
-    spec.t_end = vm.count("t-end") ? st.t_end : 0.0;
-    spec.steps = vm.count("t-end") ? 0 : st.steps;
-  } else {
-    apply_step_options(vm, st, spec);
-  }
+  RunSpec& spec = plan.spec;
   if (vm.count("dt-out")) {
     if (fixed_method && !is_time_transformed(*fixed_method))
       throw Error("--dt-out is for time-transformed methods (logh-*, ttl-*, ks)");
@@ -201,14 +204,8 @@ int cmd_simulate(int argc, char** argv) {
         os << '\n';
       };
     }
-    BodyRun br;
-    if (search) {
-      br = run_with_tolerance(fixed_method, body, scene.centres, tol, spec.t_end, spec, file ? &sink : nullptr);
-      if (file) file->stream() << "# body " << b << ": " << search_line(br) << "\n";
-    } else {
-      br.method = fixed_method;
-      br.result = run(*fixed_method, body, scene.centres, spec, file ? &sink : nullptr);
-    }
+    BodyRun br = run_body(plan, body, scene.centres, spec, file ? &sink : nullptr);
+    if (search && file) file->stream() << "# body " << b << ": " << search_line(br) << "\n";
     if (!finite(br.result.final))
       throw Error("body '" + body.name + "': the integration produced a non-finite state (NaN/inf); "
                   "the step is too large for a close approach, or the body fell onto an attracting centre");

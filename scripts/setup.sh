@@ -6,7 +6,11 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(cmake ninja-build g++ git libeigen3-dev libboost-dev libboost-program-options-dev
-          libgtest-dev libbenchmark-dev libtomlplusplus-dev libgsl-dev python3-matplotlib python3-numpy)
+          libgtest-dev libbenchmark-dev libtomlplusplus-dev libgsl-dev python3-matplotlib python3-numpy
+          chromium)
+# The viewer (bodypoint view) bundles three.js with esbuild under Node.js; its browser test drives
+# Debian's chromium. Debian's nodejs/npm only where no Node.js is installed already.
+command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -17,6 +21,15 @@ if ((${#missing[@]})); then
   if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
   $sudo apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# The viewer's npm packages, pinned by experiments/viewer/package-lock.json. Optional: without them (no
+# npm registry) everything else builds and `bodypoint view` says what is missing.
+viewer=experiments/viewer
+if [ ! -f "$viewer/node_modules/.package-lock.json" ] || [ "$viewer/package-lock.json" -nt "$viewer/node_modules/.package-lock.json" ]; then
+  if ! (cd "$viewer" && npm ci --no-audit --no-fund --loglevel=error >/dev/null 2>&1); then
+    echo "setup: warning: npm ci in $viewer failed; bodypoint view and its browser test are left out" >&2
+  fi
 fi
 
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DBODYPOINT_WERROR="${BODYPOINT_WERROR:-OFF}" >/dev/null

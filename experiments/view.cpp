@@ -1,0 +1,319 @@
+// `bodypoint view`: one self-contained HTML page that animates a run in 3D (experiments/viewer/).
+//
+// The page is the trajectory as JSON plus the viewer's script (three.js and viewer/src/viewer.js,
+// bundled by esbuild at build time and compiled into this binary by view_bundle.cpp): it opens from
+// disk with no server and no network. Every step of a run is seen; at most `--frames` states per body
+// are kept, at equal arc length along the path, with the state closest to a centre always kept, so a
+// run of 10^6 steps still makes a page of a few MB.
+#include "bodypoint/field.hpp"
+#include "bodypoint/io.hpp"
+#include "cli.hpp"
+#include "view_bundle.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <limits>
+#include <optional>
+#include <sstream>
+
+namespace bodypoint::cli {
+namespace {
+
+struct Frame {
+  double t = 0.0;
+  Vec3 R, v, w;
+  double dE = 0.0, dt = 0.0;  ///< relative energy deviation; the physical step that ended here
+};
+
+/// Receives every state of a run and keeps a bounded, evenly thinned subset (uniform in the step
+/// index: when `cap` states are held every other one is dropped and the stride doubles), the last
+/// state and the state closest to a centre; `frames` then picks states at equal arc length.
+class Decimator {
+ public:
+  Decimator(const std::vector<Centre>& centres, std::size_t cap) : centres_(centres), cap_(cap) {}
+
+  void add(const Sample& s) {
+    Frame f{s.t, s.s.R, s.s.v, s.s.w, s.rel_dE, seen_ > 0 ? s.t - last_.t : 0.0};
+    if (!(std::isfinite(f.t) && f.R.allFinite() && f.v.allFinite() && f.w.allFinite()) && !bad_) bad_ = f.t;
+    if (seen_ == 1 && kept_.size() == 1) kept_.front().dt = f.dt;  // the first state shows the first step
+    for (const Centre& c : centres_) {
+      const double r = (f.R - c.c).norm();
+      if (r < r_min_) {
+        r_min_ = r;
+        closest_ = f;
+      }
+    }
+    if (seen_ % stride_ == 0) {
+      kept_.push_back(f);
+      if (kept_.size() >= cap_) {
+        std::size_t j = 0;
+        for (std::size_t i = 0; i < kept_.size(); i += 2) kept_[j++] = kept_[i];
+        kept_.resize(j);
+        stride_ *= 2;
+      }
+    }
+    last_ = f;
+    ++seen_;
+  }
+
+  [[nodiscard]] long seen() const { return seen_; }
+  [[nodiscard]] std::optional<double> non_finite_at() const { return bad_; }
+  [[nodiscard]] double r_min() const { return r_min_; }
+  [[nodiscard]] const Frame& closest() const { return closest_; }
+
+  /// At most n states (n >= 2): the first, the last, the closest approach, the rest at equal arc length.
+  [[nodiscard]] std::vector<Frame> frames(std::size_t n) const {
+    std::vector<Frame> all = kept_;
+    if (all.empty() || all.back().t != last_.t) all.push_back(last_);
+    if (all.size() <= n) return with_closest(all);
+    std::vector<double> arc(all.size(), 0.0);
+    for (std::size_t i = 1; i < all.size(); ++i) arc[i] = arc[i - 1] + (all[i].R - all[i - 1].R).norm();
+    const double total = arc.back();
+    std::vector<Frame> out;
+    out.reserve(n + 1);
+    std::size_t i = 0;
+    const std::size_t picks = n - 1;  // one place is kept for the closest approach
+    for (std::size_t k = 0; k < picks; ++k) {
+      // Equal arc length; a body that does not move (total 0) gets equal shares of its states.
+      const double frac = static_cast<double>(k) / static_cast<double>(picks - 1);
+      if (total > 0.0) {
+        while (i + 1 < all.size() && arc[i] < frac * total) ++i;
+      } else {
+        i = static_cast<std::size_t>(std::lround(frac * static_cast<double>(all.size() - 1)));
+      }
+      if (out.empty() || all[i].t > out.back().t) out.push_back(all[i]);
+    }
+    if (out.back().t != all.back().t) out.push_back(all.back());
+    return with_closest(out);
+  }
+
+ private:
+  [[nodiscard]] std::vector<Frame> with_closest(std::vector<Frame> f) const {
+    if (!centres_.empty() && std::isfinite(r_min_)) {
+      const auto at = std::lower_bound(f.begin(), f.end(), closest_.t, [](const Frame& a, double t) { return a.t < t; });
+      if (at == f.end() || at->t != closest_.t) f.insert(at, closest_);
+    }
+    return f;
+  }
+
+  const std::vector<Centre>& centres_;
+  std::size_t cap_;
+  std::vector<Frame> kept_;
+  Frame last_, closest_;
+  long seen_ = 0, stride_ = 1;
+  double r_min_ = std::numeric_limits<double>::infinity();
+  std::optional<double> bad_;
+};
+
+/// A JSON string literal that is also safe inside an HTML <script> element.
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (const unsigned char c : s) {
+    char buf[8];
+    if (c == '"' || c == '\\' || c < 0x20 || c == '<' || c == '>' || c == '&') {
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      out += buf;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out + "\"";
+}
+
+/// x with `digits` significant digits (JSON: non-finite values never reach here, Decimator refuses them).
+void put(std::string& out, double x, int digits) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, x);
+  out += buf;
+}
+
+template <class Get>
+void put_array(std::string& out, const char* name, const std::vector<Frame>& frames, int digits, Get get) {
+  out += '"';
+  out += name;
+  out += "\": [";
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    if (i) out += ',';
+    get(out, frames[i], digits);
+  }
+  out += ']';
+}
+
+void put_vec(std::string& out, const Vec3& v, int digits) {
+  put(out, v.x(), digits);
+  out += ',';
+  put(out, v.y(), digits);
+  out += ',';
+  put(out, v.z(), digits);
+}
+
+/// Digits kept: positions carry the shape of a close approach at |R| ~ 1e5 |r_min|; the rest is drawn.
+constexpr int kPositionDigits = 10;
+constexpr int kOtherDigits = 6;
+/// Bytes a frame takes in the page (13 numbers), for the size estimate made before the run.
+constexpr double kBytesPerFrame = 150.0;
+
+struct TrackJson {
+  std::string json;
+  double t_end = 0.0;
+};
+
+TrackJson body_json(const Body& body, const std::vector<Centre>& centres, const RunPlan& plan, RunSpec spec,
+                    std::size_t frames, const std::string& method_label) {
+  spec.track_invariants = true;  // the energy panel and the header show the deviations
+  spec.every = 1;
+  spec.dt_out = 0.0;
+  Decimator d(centres, std::max<std::size_t>(8 * frames, 1 << 16));
+  const SampleSink sink = [&d](const Sample& s) { d.add(s); };
+  const BodyRun br = run_body(plan, body, centres, spec, &sink);
+  const std::string who = "body '" + body.name + "' with " + method_label;
+  if (d.non_finite_at())
+    throw Error(who + ": the state became non-finite at t = " + fmt(*d.non_finite_at()) + "; no page written");
+  if (d.seen() < 2) throw Error(who + ": the run produced no trajectory (fewer than two states); no page written");
+  const std::vector<Frame> f = d.frames(frames);
+  std::string out = "{\"name\": " + json_string(body.name) + ", \"steps\": " + std::to_string(br.result.steps) +
+                    ", \"force_evals\": " + std::to_string(br.result.force_evals) + ", \"invariants\": {";
+  if (br.result.invariants) {
+    const InvariantStats& inv = *br.result.invariants;
+    out += "\"max_rel_dE\": " + json_number(inv.max_rel_dE) + ", \"max_rel_dK2sq\": " + json_number(inv.max_rel_dK2sq);
+    if (inv.has_K2Q) out += ", \"max_abs_dK2Q\": " + json_number(inv.max_abs_dK2Q);
+  }
+  out += "}, \"closest\": {\"t\": " + json_number(d.closest().t) + ", \"r\": " +
+         json_number(centres.empty() ? 0.0 : d.r_min()) + "}, \"frames\": {";
+  put_array(out, "t", f, kPositionDigits, [](std::string& o, const Frame& x, int g) { put(o, x.t, g); });
+  out += ", ";
+  put_array(out, "R", f, kPositionDigits, [](std::string& o, const Frame& x, int g) { put_vec(o, x.R, g); });
+  out += ", ";
+  put_array(out, "v", f, kOtherDigits, [](std::string& o, const Frame& x, int g) { put_vec(o, x.v, g); });
+  out += ", ";
+  put_array(out, "w", f, kOtherDigits, [](std::string& o, const Frame& x, int g) { put_vec(o, x.w, g); });
+  out += ", ";
+  put_array(out, "dE", f, kOtherDigits, [](std::string& o, const Frame& x, int g) {
+    put(o, std::isfinite(x.dE) ? x.dE : 0.0, g);
+  });
+  out += ", ";
+  put_array(out, "dt", f, kOtherDigits, [](std::string& o, const Frame& x, int g) { put(o, x.dt, g); });
+  out += "}}";
+  return {out, br.result.t_end};
+}
+
+/// The step the run used, as the header shows it.
+std::string step_label(const RunPlan& plan) {
+  if (plan.search) return "tol=" + fmt(plan.tol);
+  if (is_adaptive(*plan.method)) return "tol=" + fmt(plan.spec.tol);
+  if (is_time_transformed(*plan.method)) return "ds=" + fmt(plan.spec.h);
+  return "h=" + fmt(plan.spec.h) + " steps=" + std::to_string(plan.spec.steps);
+}
+
+/// plan's spec made to end at time t_end (--compare follows the first run's end time).
+RunSpec ending_at(const RunPlan& plan, double t_end) {
+  RunSpec s = plan.spec;
+  if (plan.search || has_variable_step(*plan.method)) {
+    s.t_end = t_end;
+    s.steps = 0;
+  } else {
+    s.steps = std::max(1L, static_cast<long>(std::ceil(t_end / s.h * (1.0 - 1e-12))));
+    s.h = t_end / static_cast<double>(s.steps);
+  }
+  return s;
+}
+
+}  // namespace
+
+int cmd_view(int argc, char** argv) {
+  SceneOptions so;
+  StepOptions st;
+  std::string method_name = "lp-y4", compare, out = "bodypoint-view.html";
+  double tol = 1e-10, compare_h = 0.0, max_mb = 32.0;
+  long frames = 3000;
+  po::options_description desc("bodypoint view");
+  add_scene_options(desc, so);
+  add_step_options(desc, st);
+  desc.add_options()
+      ("method", po::value(&method_name)->default_value(method_name), "integration method, or auto with --tol")
+      ("tol", po::value(&tol)->default_value(tol), "as for simulate: per-step tolerance of odeint-*/gsl-*, "
+       "otherwise the final state's relative error to deliver")
+      ("compare", po::value(&compare), "a second method on the same scene, drawn in a second colour")
+      ("compare-h", po::value(&compare_h), "step (or ds) of the --compare method (default: --h)")
+      ("frames", po::value(&frames)->default_value(frames), "states kept per body (equal arc length, closest approach kept)")
+      ("max-mb", po::value(&max_mb)->default_value(max_mb), "refuse to write a page larger than this many MB")
+      ("out", po::value(&out)->default_value(out), "the HTML file to write (atomically)");
+  po::variables_map vm;
+  if (!parse(argc, argv, desc, vm,
+             "usage: bodypoint view [options]\n"
+             "Writes one self-contained HTML page (three.js inlined, no server or network needed) that animates\n"
+             "the run in 3D: centres, bodies, trails coloured by the physical step, spin and velocity arrows,\n"
+             "the energy error against t. Options as for simulate."))
+    return 0;
+  if (!viewer_bundle())
+    throw Error("this binary was built without the viewer's script: run scripts/setup.sh (it needs npm) to "
+                "install experiments/viewer's packages, then rebuild");
+  if (frames < 16 || frames > 10'000'000) throw Error("--frames must be between 16 and 10000000");
+  if (!(std::isfinite(max_mb) && max_mb > 0.0)) throw Error("--max-mb must be a finite number > 0");
+  if (vm.count("compare-h") && !vm.count("compare")) throw Error("--compare-h needs --compare");
+  if (vm.count("compare-h") && !(std::isfinite(compare_h) && compare_h > 0.0))
+    throw Error("--compare-h must be a finite number > 0");
+
+  std::vector<RunPlan> plans{plan_run(vm, st, method_name, vm["method"].defaulted(), tol)};
+  std::vector<std::string> labels{plans[0].automatic ? "auto" : std::string(plans[0].method->name)};
+  if (vm.count("compare")) {
+    StepOptions st2 = st;
+    if (vm.count("compare-h")) st2.h = compare_h;
+    plans.push_back(plan_run(vm, st2, compare, false, tol));
+    labels.push_back(plans[1].automatic ? "auto" : std::string(plans[1].method->name));
+  }
+  const Scene scene = make_scene(vm, so);
+  const std::string_view bundle = *viewer_bundle();
+  const double estimate = static_cast<double>(bundle.size()) +
+                          kBytesPerFrame * static_cast<double>(frames + 2) *
+                              static_cast<double>(scene.bodies.size() * plans.size());
+  const double limit = max_mb * 1e6;
+  if (estimate > limit)
+    throw Error("the page would hold about " + fmt(std::round(estimate / 1e5) / 10) + " MB (" + std::to_string(frames) +
+                " frames x " + std::to_string(scene.bodies.size()) + " bodies x " + std::to_string(plans.size()) +
+                " runs), above --max-mb " + fmt(max_mb) + ": lower --frames or raise --max-mb");
+  AtomicFile file(out);  // an unwritable path fails before the runs
+
+  std::string json = "{\"title\": " + json_string("bodypoint view: " + labels[0] + (plans.size() > 1 ? " vs " + labels[1] : "")) +
+                     ", \"scene\": " + json_string(vm.count("scene") ? "scene=" + so.scene_file : describe(so.params)) +
+                     ", \"revision\": " + json_string(git_revision()) + ", \"centres\": [";
+  for (std::size_t i = 0; i < scene.centres.size(); ++i)
+    json += (i ? ", " : "") + std::string("{\"c\": ") + json_vec(scene.centres[i].c) + ", \"A\": " +
+            json_number(scene.centres[i].A) + "}";
+  json += "], \"runs\": [";
+  std::vector<double> t_end(scene.bodies.size(), 0.0);
+  for (std::size_t k = 0; k < plans.size(); ++k) {
+    json += (k ? ", " : "") + std::string("{\"method\": ") + json_string(labels[k]) +
+            ", \"step\": " + json_string(step_label(plans[k])) + ", \"bodies\": [";
+    for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
+      const RunSpec spec = k == 0 ? plans[k].spec : ending_at(plans[k], t_end[b]);
+      const TrackJson tr = body_json(scene.bodies[b], scene.centres, plans[k], spec,
+                                     static_cast<std::size_t>(frames), labels[k]);
+      if (k == 0) t_end[b] = tr.t_end;
+      json += (b ? ", " : "") + tr.json;
+    }
+    json += "]}";
+  }
+  json += "]}";
+
+  const std::string title = "bodypoint view: " + labels[0] + (plans.size() > 1 ? " vs " + labels[1] : "");
+  std::ostream& os = file.stream();
+  os << "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+     << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
+     << "<meta name=\"generator\" content=\"bodypoint " << git_revision() << "\">"
+     << "<title>" << title << "</title></head>\n<body>\n"
+     << "<script id=\"bodypoint-data\" type=\"application/json\">" << json << "</script>\n"
+     << "<script>" << bundle << "</script>\n</body></html>\n";
+  const double size = static_cast<double>(os.tellp());
+  if (size > limit)
+    throw Error("the page holds " + fmt(std::round(size / 1e5) / 10) + " MB, above --max-mb " + fmt(max_mb) +
+                ": lower --frames or raise --max-mb; nothing written");
+  file.commit();
+  std::cout << "wrote " << out << " (" << std::round(size / 1e3) << " kB, " << scene.bodies.size() << " body-point(s), "
+            << plans.size() << " run(s)); open it in a browser\n";
+  return 0;
+}
+
+}  // namespace bodypoint::cli
