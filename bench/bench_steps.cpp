@@ -63,7 +63,13 @@ void BM_MethodStep(benchmark::State& st, const std::string& method, const std::s
   spec.tol = 1e-10;
   long steps = 0, evals = 0;
   for (auto _ : st) {
-    const RunResult r = run(m, ns.scene.bodies.front(), ns.scene.centres, spec);
+    RunResult r;
+    try {
+      r = run(m, ns.scene.bodies.front(), ns.scene.centres, spec);
+    } catch (const Error& e) {  // a method that refuses the scene is reported, not fatal for the rest
+      st.SkipWithError(e.what());
+      return;
+    }
     benchmark::DoNotOptimize(r.final.R);
     steps += r.steps;
     evals += r.force_evals;
@@ -75,6 +81,8 @@ void BM_MethodStep(benchmark::State& st, const std::string& method, const std::s
 void register_method_benchmarks() {
   for (const MethodInfo& m : methods()) {
     for (const char* scene : {"thesis", "material"}) {
+      // ks regularises a material point (B = 0); it refuses the spinning thesis scene.
+      if (m.name == "ks" && std::string(scene) == "thesis") continue;
       benchmark::RegisterBenchmark(("BM_Step/" + std::string(m.name) + "/" + scene).c_str(),
                                    [name = std::string(m.name), scene](benchmark::State& st) {
                                      BM_MethodStep(st, name, scene);
