@@ -34,6 +34,25 @@ using detail::observe;
 /// A run to t_end that needs more fictitious steps than this is stopped with an error.
 constexpr long kMaxFictitiousSteps = 2'000'000'000L;
 
+/// Checked every kProgressCheck fictitious steps: the run would need this many more times its budget
+/// of steps at the rate it advances physical time (logH at --h 1e-300 ran 18 minutes into the cap).
+constexpr long kProgressCheck = 1L << 20;
+
+/// Physical time must advance with every fictitious step (a time transformation that breaks down,
+/// e.g. TTL with D ~ 1e-12, turns it backwards), and at a rate that reaches t_end within `cap` steps.
+void check_progress(long steps, double t_prev, double t, double t_end, long cap) {
+  if (!(t > t_prev))
+    throw Error("physical time stopped advancing at t = " + detail::short_number(t_prev) + " (step dt = " +
+                detail::short_number(t - t_prev) + "): the time transformation broke down; reduce --h or check D = m J - B^2");
+  if (t_end > 0.0 && steps > 0 && steps % kProgressCheck == 0) {
+    const double needed = static_cast<double>(steps) * t_end / t;
+    if (needed > static_cast<double>(cap))
+      throw Error("at its rate so far (t = " + detail::short_number(t) + " after " + std::to_string(steps) +
+                  " fictitious steps) the run needs about " + detail::short_number(needed) +
+                  " steps to reach t_end, more than the budget of 2e9; increase --h");
+  }
+}
+
 using detail::StepStats;
 
 void require_time_target(const RunSpec& spec) {
@@ -170,6 +189,7 @@ RunResult run_time_transformed(const Body& body, const std::vector<Centre>& cent
         const double t = x.time();
         if (!std::isfinite(t) || !x.q.R.allFinite())
           throw Error("the state became non-finite at t = " + std::to_string(prev.time()) + "; reduce --h");
+        check_progress(st.steps, prev.time(), t, to_time ? spec.t_end : 0.0, cap);
         if (to_time && t >= spec.t_end) {
           x = prev;
           t_over = t;
@@ -261,6 +281,7 @@ RunResult run_ks(const Body& body, const std::vector<Centre>& centres, const Run
       const double dt = x.first.step(spec.h);
       if (!std::isfinite(dt) || !x.first.state().R.allFinite())
         throw Error("ks: the state became non-finite at t = " + std::to_string(prev.second) + "; reduce --h");
+      check_progress(st.steps, prev.second, prev.second + dt, to_time ? spec.t_end : 0.0, cap);
       if (to_time && prev.second + dt >= spec.t_end) {
         x = prev;
         break;

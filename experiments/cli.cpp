@@ -4,7 +4,10 @@
 #include "bodypoint/scene_file.hpp"
 #include "sweep.hpp"
 
+#include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <iostream>
 #include <sstream>
 
@@ -71,19 +74,28 @@ std::vector<std::string> split_list(const std::string& s) {
   return out;
 }
 
+double parse_number(const std::string& s, const std::string& option) {
+  // strtod, not stod: a value below the smallest normal double (1e-320) is a valid subnormal, which
+  // std::stod rejects as out of range.
+  errno = 0;
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  if (s.empty() || end != s.c_str() + s.size() || std::isspace(static_cast<unsigned char>(s.front())))
+    throw Error(option + ": '" + s + "' is not a number");
+  if (errno == ERANGE && std::abs(v) > 1.0) throw Error(option + ": '" + s + "' is beyond the range of a double");
+  return v;
+}
+
+long whole_number(double x, const std::string& what, double max) {
+  if (!std::isfinite(x) || x != std::floor(x)) throw Error(what + " must be a whole number, got " + fmt(x));
+  if (x < 1.0) throw Error(what + " must be >= 1, got " + fmt(x));
+  if (x > max) throw Error(what + " must be at most " + fmt(max) + ", got " + fmt(x));
+  return static_cast<long>(x);  // in range: no undefined conversion
+}
+
 std::vector<double> parse_numbers(const std::string& list, const std::string& option) {
   std::vector<double> out;
-  for (const std::string& s : split_list(list)) {
-    std::size_t used = 0;
-    double v = 0;
-    try {
-      v = std::stod(s, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != s.size()) throw Error(option + ": '" + s + "' is not a number");
-    out.push_back(v);
-  }
+  for (const std::string& s : split_list(list)) out.push_back(parse_number(s, option));
   if (out.empty()) throw Error(option + " is empty");
   return out;
 }

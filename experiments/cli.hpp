@@ -78,6 +78,10 @@ std::string describe(const SceneParams& p);
 
 /// The non-empty items of a comma-separated list.
 std::vector<std::string> split_list(const std::string& s);
+/// One number (subnormals accepted); throws Error naming `option` for text that is not one or overflows.
+double parse_number(const std::string& s, const std::string& option);
+/// x as a count in [1, max], checked before the conversion; throws Error with the reason.
+long whole_number(double x, const std::string& what, double max);
 /// The numbers of a comma-separated list; throws Error naming `option` for an item that is not one.
 std::vector<double> parse_numbers(const std::string& list, const std::string& option);
 /// "bodypoint <argv...>", for output headers.

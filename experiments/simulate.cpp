@@ -15,8 +15,6 @@
 namespace bodypoint::cli {
 namespace {
 
-bool finite(const State& s) { return s.R.allFinite() && s.v.allFinite() && s.w.allFinite(); }
-
 std::string scene_header(const po::variables_map& vm, const SceneOptions& o) {
   if (vm.count("scene")) return "scene=" + o.scene_file;
   return describe(o.params);
@@ -71,6 +69,15 @@ RunPlan plan_run(const po::variables_map& vm, const StepOptions& st, const std::
     spec.h = st.h;
     spec.t_end = vm.count("t-end") ? st.t_end : 0.0;
     spec.steps = vm.count("t-end") ? 0 : st.steps;
+  } else if (is_adaptive(*plan.method)) {
+    // The method chooses its steps: --h is only the first trial step, --t-end (or h steps) the end.
+    if (!std::isfinite(st.h) || st.h <= 0.0) throw Error("--h must be a finite number > 0");
+    if (vm.count("t-end") && !vm["steps"].defaulted()) throw Error("give --steps or --t-end, not both");
+    if (!vm.count("t-end") && st.steps < 1) throw Error("--steps must be >= 1");
+    spec.t_end = vm.count("t-end") ? st.t_end : st.h * static_cast<double>(st.steps);
+    if (!(std::isfinite(spec.t_end) && spec.t_end > 0.0)) throw Error("--t-end must be a finite number > 0");
+    spec.h = std::min(st.h, spec.t_end);
+    spec.steps = 1;
   } else {
     apply_step_options(vm, st, spec);
   }
@@ -206,9 +213,12 @@ int cmd_simulate(int argc, char** argv) {
     }
     BodyRun br = run_body(plan, body, scene.centres, spec, file ? &sink : nullptr);
     if (search && file) file->stream() << "# body " << b << ": " << search_line(br) << "\n";
-    if (!finite(br.result.final))
-      throw Error("body '" + body.name + "': the integration produced a non-finite state (NaN/inf); "
-                  "the step is too large for a close approach, or the body fell onto an attracting centre");
+    const Health health = assess(br.result);
+    if (health.status != "ok")
+      throw Error("body '" + body.name + "' (" + std::string(br.method->name) + "): " + health.why +
+                  (health.status == "collision" ? "; a time-transformed method (ttl-*) or a smaller --h can follow it"
+                                                : "; the step is too large for this scene (reduce --h)") +
+                  "; no output written");
     if (with_reference) {
       const State ref = reference_state(body, scene.centres, br.result.t_end);
       br.err_R = (br.result.final.R - ref.R).norm();

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cmath>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <sstream>
@@ -113,16 +114,24 @@ std::vector<SweepRow> run_sweep(const SweepSpec& spec, unsigned threads, bool pr
   }
   std::vector<SweepRow> rows(tasks.size());
   std::atomic<std::size_t> next{0}, done{0};
-  std::mutex err_mutex, progress_mutex;
-  std::string first_error;
+  std::mutex progress_mutex;
+  const CooperativeInterrupt stop_at_row_boundary;  // a signal stops the sweep between rows
   auto worker = [&] {
-    for (std::size_t i; (i = next++) < tasks.size();) {
+    for (std::size_t i; !interrupted() && (i = next++) < tasks.size();) {
       const Task& t = tasks[i];
+      SweepRow& row = rows[i];
+      row.value = t.value;
+      row.method = t.method;
       try {
-        rows[i] = {t.value, t.method, run(*t.method, t.scene.bodies.front(), t.scene.centres, t.run)};
+        row.result = run(*t.method, t.scene.bodies.front(), t.scene.centres, t.run);
+        const Health h = assess(row.result);
+        row.status = h.status;
+        row.reason = h.why;
       } catch (const std::exception& e) {
-        std::lock_guard<std::mutex> lock(err_mutex);
-        if (first_error.empty()) first_error = spec.param + " = " + fmt(t.value) + ", " + std::string(t.method->name) + ": " + e.what();
+        row.status = "refused";
+        row.reason = e.what();
+        const Vec3 nan = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+        row.result.final = State{nan, nan, nan};
       }
       const std::size_t d = ++done;
       if (progress) {
@@ -135,7 +144,7 @@ std::vector<SweepRow> run_sweep(const SweepSpec& spec, unsigned threads, bool pr
   for (unsigned k = 1; k < std::min<std::size_t>(threads, tasks.size()); ++k) pool.emplace_back(worker);
   worker();
   for (std::thread& t : pool) t.join();
-  if (!first_error.empty()) throw Error(first_error);
+  CooperativeInterrupt::check();
   return rows;
 }
 
@@ -151,13 +160,19 @@ void write_sweep_csv(std::ostream& os, const SweepSpec& spec, const std::vector<
   os << "\n"
      << "# columns: " << spec.param << " = value of the varied parameter; method; max_rel_dE = max_i |E_i-E_0|/|E_0|;"
      << " max_rel_dK2sq = max_i |K2^2_i-K2^2_0|/K2^2_0; max_abs_dK2Q = max_i |K2Q_i-K2Q_0|;"
-     << " Rx,Ry,Rz = final position; force_evals; wall_s = step-loop time (runs share the cores)\n"
-     << spec.param << ",method,max_rel_dE,max_rel_dK2sq,max_abs_dK2Q,Rx,Ry,Rz,force_evals,wall_s\n";
+     << " Rx,Ry,Rz = final position; force_evals; wall_s = step-loop time (runs share the cores);"
+     << " status = ok | diverged (non-finite, or energy error above 1) | collision (diverged after a fall onto"
+     << " an attracting centre) | refused (not run); reason = why, when not ok\n"
+     << spec.param << ",method,max_rel_dE,max_rel_dK2sq,max_abs_dK2Q,Rx,Ry,Rz,force_evals,wall_s,status,reason\n";
+  const double nan = std::numeric_limits<double>::quiet_NaN();
   for (const SweepRow& r : rows) {
-    const InvariantStats& s = *r.result.invariants;
+    const InvariantStats s = r.result.invariants ? *r.result.invariants : InvariantStats{nan, nan, nan};
+    std::string reason = r.reason;
+    std::replace(reason.begin(), reason.end(), '"', '\'');
     os << fmt(r.value) << ',' << r.method->name << ',' << fmt(s.max_rel_dE) << ',' << fmt(s.max_rel_dK2sq) << ','
        << fmt(s.max_abs_dK2Q) << ',' << fmt(r.result.final.R.x()) << ',' << fmt(r.result.final.R.y()) << ','
-       << fmt(r.result.final.R.z()) << ',' << r.result.force_evals << ',' << fmt(r.result.wall_s) << '\n';
+       << fmt(r.result.final.R.z()) << ',' << r.result.force_evals << ',' << fmt(r.result.wall_s) << ','
+       << r.status << ",\"" << reason << "\"\n";
   }
 }
 

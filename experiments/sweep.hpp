@@ -32,10 +32,14 @@ struct SweepSpec {
   double tol = 1e-10; ///< adaptive methods
 };
 
+/// One (value, method) run. status: ok, diverged or collision (assess() in run.hpp), or refused (the
+/// method or a budget refused the run; `reason` says why); a row that is not ok says why in `reason`.
 struct SweepRow {
-  double value;
-  const MethodInfo* method;
+  double value = 0.0;
+  const MethodInfo* method = nullptr;
   RunResult result;
+  std::string status = "refused";
+  std::string reason;
 };
 
 /// Resolves (h, steps) exactly as `simulate` does: with t_end > 0, steps = ceil(t_end/h) and
@@ -43,7 +47,8 @@ struct SweepRow {
 RunSpec resolve_steps(double h, long steps, double t_end, double tol);
 
 /// Runs every (value, method) pair on `threads` threads; rows come back in (value, method) order
-/// whatever the thread count. Throws Error for an invalid scene value before running anything.
+/// whatever the thread count. Throws Error for an invalid scene value before running anything, and
+/// after the running rows finish when a signal arrived (no row is started after it).
 std::vector<SweepRow> run_sweep(const SweepSpec& spec, unsigned threads, bool progress);
 
 /// CSV with a commented header (revision, parameters, columns) and one row per (value, method).

@@ -172,6 +172,7 @@ TrackJson body_json(const Body& body, const std::vector<Centre>& centres, const 
   if (d.non_finite_at())
     throw Error(who + ": the state became non-finite at t = " + fmt(*d.non_finite_at()) + "; no page written");
   if (d.seen() < 2) throw Error(who + ": the run produced no trajectory (fewer than two states); no page written");
+  if (const Health h = assess(br.result); h.status != "ok") throw Error(who + ": " + h.why + "; no page written");
   const std::vector<Frame> f = d.frames(frames);
   std::string out = "{\"name\": " + json_string(body.name) + ", \"steps\": " + std::to_string(br.result.steps) +
                     ", \"force_evals\": " + std::to_string(br.result.force_evals) + ", \"invariants\": {";

@@ -86,7 +86,7 @@ TEST(Sweep, ThreadCountDoesNotChangeTheOutput) {
   auto a = csv_rows(one.out), b = csv_rows(two.out), c = csv_rows(five.out);
   ASSERT_EQ(a.size(), 15u);
   for (auto* rows : {&a, &b, &c})
-    for (auto& r : *rows) r.pop_back();  // wall_s differs from run to run
+    for (auto& r : *rows) r.erase(r.begin() + 9);  // wall_s (the 10th column) differs from run to run
   EXPECT_EQ(a, b);
   EXPECT_EQ(a, c);
 }

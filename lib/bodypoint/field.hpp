@@ -9,7 +9,9 @@
 
 #include "bodypoint/model.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 namespace bodypoint {
@@ -26,6 +28,10 @@ struct OriginCentre {
   }
   [[nodiscard]] double potential(const Vec3& R) const { return -A / R.norm(); }
   [[nodiscard]] Vec3 reference_point() const { return Vec3::Zero(); }
+  /// Distance to the nearest attracting centre (infinite when none attracts).
+  [[nodiscard]] double nearest_attracting(const Vec3& R) const {
+    return A > 0.0 ? R.norm() : std::numeric_limits<double>::infinity();
+  }
 
   /// F and Pi in one pass (one force evaluation).
   void force_potential(const Vec3& R, Vec3& F, double& P) const {
@@ -61,6 +67,12 @@ struct CentreList {
     double P = 0.0;
     for (const Centre& k : centres) P -= k.A / (R - k.c).norm();
     return P;
+  }
+  [[nodiscard]] double nearest_attracting(const Vec3& R) const {
+    double r = std::numeric_limits<double>::infinity();
+    for (const Centre& k : centres)
+      if (k.A > 0.0) r = std::min(r, (R - k.c).norm());
+    return r;
   }
   void force_potential(const Vec3& R, Vec3& F, double& P) const {
     F.setZero();

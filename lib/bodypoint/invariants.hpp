@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 namespace bodypoint {
@@ -46,6 +47,10 @@ struct InvariantStats {
   double max_rel_dK2sq = 0.0;
   double max_abs_dK2Q = 0.0;
   bool has_K2Q = false;
+  /// Closest observed distance to an attracting centre, and the distance at the start (both infinite
+  /// without an attracting centre): a fall onto a centre shows as min/start ~ 0.
+  double min_r_attracting = std::numeric_limits<double>::infinity();
+  double r0_attracting = std::numeric_limits<double>::infinity();
 };
 
 inline double relative_deviation(double x, double x0) {
@@ -63,19 +68,25 @@ class InvariantMonitor {
     K2sq0_ = proper_momentum_sq(p_, s0);
     if (c_) K2Q0_ = total_angular_momentum(p_, s0, *c_);
     stats_.has_K2Q = c_.has_value();
+    stats_.r0_attracting = stats_.min_r_attracting = f_.nearest_attracting(s0.R);
   }
 
   void update(const State& s) {
     last_rel_dE_ = relative_deviation(energy(p_, f_, s), E0_);
-    stats_.max_rel_dE = std::max(stats_.max_rel_dE, last_rel_dE_);
+    stats_.max_rel_dE = max_keeping_nan(stats_.max_rel_dE, last_rel_dE_);
     last_rel_dK2sq_ = relative_deviation(proper_momentum_sq(p_, s), K2sq0_);
-    stats_.max_rel_dK2sq = std::max(stats_.max_rel_dK2sq, last_rel_dK2sq_);
+    stats_.max_rel_dK2sq = max_keeping_nan(stats_.max_rel_dK2sq, last_rel_dK2sq_);
     if (c_) {
       last_abs_dK2Q_ = (total_angular_momentum(p_, s, *c_) - K2Q0_).norm();
-      stats_.max_abs_dK2Q = std::max(stats_.max_abs_dK2Q, last_abs_dK2Q_);
+      stats_.max_abs_dK2Q = max_keeping_nan(stats_.max_abs_dK2Q, last_abs_dK2Q_);
     }
-    // A NaN anywhere poisons every later comparison; remember it instead of losing it in max().
-    if (!std::isfinite(last_rel_dE_)) stats_.max_rel_dE = last_rel_dE_;
+    stats_.min_r_attracting = std::min(stats_.min_r_attracting, f_.nearest_attracting(s.R));
+  }
+
+  /// max that propagates NaN: std::max(x, NaN) is x, which would report a run full of NaN as clean.
+  static double max_keeping_nan(double so_far, double x) {
+    if (std::isnan(so_far) || std::isnan(x)) return std::numeric_limits<double>::quiet_NaN();
+    return std::max(so_far, x);
   }
 
   [[nodiscard]] const InvariantStats& stats() const { return stats_; }

@@ -1,8 +1,11 @@
 // bodypoint: output helpers shared by every driver.
 //
 // `AtomicFile` writes to a temporary file beside the target and renames it over the target on
-// commit(), so a failed or interrupted run never leaves a half-written result. Numbers are written
-// so that a value read back is exactly the value computed.
+// commit(), so a failed or interrupted run never leaves a half-written result: each output has its
+// own temporary name, a lock file (<path>.lock with the writer's pid) refuses a second writer of the
+// same path, an output that is another output or an input of the same run is refused, and SIGINT,
+// SIGTERM and SIGHUP remove every temporary and lock file (install_signal_cleanup). Numbers are
+// written so that a value read back is exactly the value computed.
 #pragma once
 
 #include "bodypoint/model.hpp"
@@ -27,9 +30,34 @@ class AtomicFile {
   void commit();
 
  private:
-  std::string path_, tmp_;
+  void release() noexcept;
+
+  std::string path_, tmp_, lock_, key_;
   std::ofstream out_;
   bool committed_ = false;
+  int slot_ = -1;
+};
+
+/// Records a file this run reads (a scene file), so that no output of the run may replace it.
+void register_input(const std::string& path);
+
+/// Installs handlers for SIGINT, SIGTERM and SIGHUP that remove the temporary and lock files of every
+/// open AtomicFile and then end the process with the signal (exit status 128 + signal). While a
+/// `CooperativeInterrupt` is alive the handler only records the signal, so that a loop can stop at a
+/// boundary of its own (a sweep's row) and unwind normally.
+void install_signal_cleanup();
+
+/// The signal received since install_signal_cleanup(), or 0.
+int interrupted();
+
+class CooperativeInterrupt {
+ public:
+  CooperativeInterrupt();
+  ~CooperativeInterrupt();
+  CooperativeInterrupt(const CooperativeInterrupt&) = delete;
+  CooperativeInterrupt& operator=(const CooperativeInterrupt&) = delete;
+  /// Throws Error("interrupted by signal N") when a signal has arrived.
+  static void check();
 };
 
 /// x in the shortest form that reads back exactly ("nan"/"inf" spelled as such).

@@ -34,6 +34,12 @@ void validate(const BodyPoint& p, const std::string& who) {
   if (!(p.D() > 0.0))
     throw Error(who + ": D = m J - B^2 must be > 0 (kinetic energy positive definite), got " +
                 num(p.D()));
+  // D is computed with a rounding error of about eps m J; a D within a few dozen of those is not
+  // resolved (m = 0.49, J = 1, B = 0.7 gives D = 5.6e-17 for an exact 0) and every velocity built
+  // from 1/D would be noise.
+  if (p.D() <= kMinRelativeD * p.m * p.J)
+    throw Error(who + ": D = m J - B^2 = " + num(p.D()) + " is zero within rounding (it must exceed " +
+                num(kMinRelativeD) + " m J)");
 }
 
 void validate(const Scene& scene) {

@@ -25,6 +25,10 @@ struct Error : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// D = m J - B^2 must exceed this multiple of m J (about 45 rounding errors of m J - B^2): below it
+/// the sign and size of D are not resolved in double precision.
+constexpr double kMinRelativeD = 1e-14;
+
 /// Inertial parameters of one body-point.
 struct BodyPoint {
   double m = 1.0;

@@ -148,6 +148,30 @@ const MethodInfo& method_or_throw(std::string_view name) {
   throw Error("unknown method '" + std::string(name) + "' (see 'bodypoint methods')");
 }
 
+namespace {
+/// Per-step tolerance floor of the step-size-controlled methods: a step's own rounding is ~1e-16.
+constexpr double kMinStepTolerance = 1e-15;
+}  // namespace
+
+Health assess(const RunResult& r) {
+  const State& f = r.final;
+  const bool finite = f.R.allFinite() && f.v.allFinite() && f.w.allFinite();
+  const InvariantStats* inv = r.invariants ? &*r.invariants : nullptr;
+  const bool fell = inv && inv->min_r_attracting < kCollisionFraction * inv->r0_attracting;
+  std::string why;
+  if (!finite) why = "the state became non-finite (NaN/inf)";
+  else if (inv && !(std::isfinite(inv->max_rel_dE) && std::isfinite(inv->max_rel_dK2sq) && std::isfinite(inv->max_abs_dK2Q)))
+    why = "an invariant became non-finite";
+  else if (inv && inv->max_rel_dE > kDivergedEnergy)
+    why = "the relative energy error reached " + detail::short_number(inv->max_rel_dE) + " (above 1)";
+  if (why.empty()) return {"ok", ""};
+  if (fell)
+    return {"collision", why + " after a fall onto an attracting centre (closest approach " +
+                             detail::short_number(inv->min_r_attracting) + " from a start at " +
+                             detail::short_number(inv->r0_attracting) + ")"};
+  return {"diverged", why};
+}
+
 RunResult run(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
               const RunSpec& spec, const SampleSink* sink) {
   validate(Scene{centres, {body}});
@@ -162,6 +186,9 @@ RunResult run(const MethodInfo& method, const Body& body, const std::vector<Cent
     if (s.t_end == 0.0) s.t_end = spec.h * static_cast<double>(spec.steps);
     if (!std::isfinite(s.t_end) || s.t_end <= 0.0) throw Error("end time must be a finite number > 0");
     if (!std::isfinite(s.tol) || s.tol <= 0.0) throw Error("--tol must be a finite number > 0");
+    if (s.tol < kMinStepTolerance)
+      throw Error("--tol " + detail::short_number(s.tol) + " is below what double precision can deliver (a step's rounding "
+                  "is ~1e-16 relative; the smallest tolerance taken is 1e-15)");
     return method.run(body, centres, s, sink);
   }
   return method.run(body, centres, spec, sink);

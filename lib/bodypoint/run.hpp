@@ -88,6 +88,19 @@ inline bool is_time_transformed(const MethodInfo& m) { return m.family == Family
 /// True for every method whose physical step varies (adaptive or time-transformed).
 inline bool has_variable_step(const MethodInfo& m) { return is_adaptive(m) || is_time_transformed(m); }
 
+/// Whether a run stayed in the regime its numbers mean something in: "ok"; "diverged" (a non-finite
+/// state or invariant, or a relative energy error above kDivergedEnergy); "collision" (diverged after
+/// coming closer to an attracting centre than kCollisionFraction of its starting distance).
+struct Health {
+  std::string status;  ///< ok, diverged or collision
+  std::string why;     ///< one line for a message, empty when ok
+};
+/// An energy error larger than the energy itself: the numbers no longer describe the motion.
+constexpr double kDivergedEnergy = 1.0;
+/// Closer than this fraction of the starting distance to an attracting centre is a fall onto it.
+constexpr double kCollisionFraction = 1e-6;
+Health assess(const RunResult& r);
+
 /// Validates the inputs (scene, h > 0 and finite, steps >= 1, every >= 1, tol > 0) and runs.
 RunResult run(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
               const RunSpec& spec, const SampleSink* sink = nullptr);

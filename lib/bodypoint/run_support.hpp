@@ -10,6 +10,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <string>
 #include <limits>
 #include <type_traits>
 #include <vector>
@@ -17,6 +20,24 @@
 namespace bodypoint::detail {
 
 using Clock = std::chrono::steady_clock;
+
+/// Step-size-controlled runs (Boost.Odeint, GSL): more than kMaxAdaptiveSteps accepted steps (a
+/// minute or more of work) means the tolerance or the end time is out of proportion.
+constexpr long kMaxAdaptiveSteps = 200'000'000L;
+
+/// False when a step from t_before to t did not move time by more than a few of its last bits: such
+/// steps would repeat forever (a tolerance below double precision, a fall onto a centre).
+inline bool time_advances(double t_before, double t) {
+  constexpr double kUlps = 16.0;
+  return t - t_before > kUlps * std::numeric_limits<double>::epsilon() * std::abs(t);
+}
+
+/// x with three significant digits, for messages.
+inline std::string short_number(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", x);
+  return buf;
+}
 
 /// Observer that tracks the invariants at every step and hands every `every`-th state to a sink.
 template <class Field, class ToPhysical>

@@ -1,5 +1,7 @@
 #include "bodypoint/scene_file.hpp"
 
+#include "bodypoint/io.hpp"
+
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -117,6 +119,7 @@ Scene parse_scene(const std::string& text, const std::string& origin) {
 Scene read_scene_file(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw Error(path + ": cannot open scene file");
+  register_input(path);
   std::ostringstream ss;
   ss << in.rdbuf();
   return parse_scene(ss.str(), path);

@@ -25,10 +25,6 @@ namespace {
 using detail::dispatch;
 using detail::observe;
 
-/// An accepted step shorter than this fraction of the end time means the tolerance cannot be met.
-constexpr double kMinRelativeStep = 1e-14;
-/// A run that needs more accepted steps than this is stopped with an error.
-constexpr long kMaxSteps = 200'000'000L;
 
 template <class System>
 int gsl_rhs(double t, const double y[], double f[], void* params) {
@@ -72,9 +68,9 @@ RunResult run_gsl(const gsl_odeiv2_step_type* type, const Body& body, const std:
         if (status != GSL_SUCCESS)
           throw Error("gsl: step failed at t = " + std::to_string(t) + " (" + gsl_strerror(status) + ")");
         const double taken = t - t_before;
-        if (!(taken > kMinRelativeStep * t_end) && t < t_end)
+        if (!detail::time_advances(t_before, t))
           throw Error("gsl: the step size collapsed at t = " + std::to_string(t) + " (tolerance too tight?)");
-        if (st.steps >= kMaxSteps) throw Error("gsl: more than 2e8 steps before t_end");
+        if (st.steps >= detail::kMaxAdaptiveSteps) throw Error("gsl: more than 2e8 steps before t_end");
         st.add(taken);
         if constexpr (std::decay_t<decltype(obs)>::active) obs.observe(st.steps, t, x, t >= t_end);
         if (!std::isfinite(x[0])) break;

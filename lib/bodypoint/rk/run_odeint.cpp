@@ -86,6 +86,14 @@ RunResult run_odeint_adaptive(const Body& body, const std::vector<Centre>& centr
         if (stepper.try_step(std::ref(sys), x, t, dt) == boost::numeric::odeint::success) {
           if (final_step) t = t_end;  // exact end time, not t_before + dt rounded
           const double taken = t - t_before;
+          // An accepted step that does not move t (dt below the resolution of t) would repeat forever.
+          if (!detail::time_advances(t_before, t))
+            throw Error("the step stopped advancing time at t = " + detail::short_number(t) + " (accepted step " +
+                        detail::short_number(taken) + "): the tolerance is below what double precision resolves, "
+                        "or the body fell onto a centre");
+          if (st.steps >= detail::kMaxAdaptiveSteps)
+            throw Error("more than 2e8 accepted steps before t_end = " + detail::short_number(t_end) +
+                        " (reached t = " + detail::short_number(t) + "); loosen --tol or shorten --t-end");
           st.add(taken);
           rejected_in_a_row = 0;
           if constexpr (std::decay_t<decltype(obs)>::active) obs.observe(st.steps, t, x, t >= t_end);
