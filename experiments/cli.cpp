@@ -110,7 +110,9 @@ bool parse(int argc, char** argv, const po::options_description& desc, po::varia
            const std::string& usage) {
   po::options_description all(desc);
   all.add_options()("help", "show this help");
-  po::store(po::command_line_parser(argc, argv).options(all).positional({}).run(), vm);
+  // Whole option names only: with boost's default prefix guessing, "--ou x" would mean "--out x".
+  const int style = po::command_line_style::default_style & ~po::command_line_style::allow_guessing;
+  po::store(po::command_line_parser(argc, argv).options(all).positional({}).style(style).run(), vm);
   if (vm.count("help")) {
     std::cout << usage << "\n\n" << all << "\n";
     return false;

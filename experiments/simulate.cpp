@@ -3,6 +3,7 @@
 #include "bodypoint/io.hpp"
 #include "bodypoint/reference.hpp"
 #include "bodypoint/run.hpp"
+#include "budget.hpp"
 #include "cli.hpp"
 
 #include <cmath>
@@ -134,7 +135,8 @@ int cmd_simulate(int argc, char** argv) {
   std::string out;
   long every = 1;
   double tol = 1e-10, dt_out = 0.0, omega_c = -1.0;
-  bool json = false, no_invariants = false, with_reference = false;
+  bool json = false, no_invariants = false, with_reference = false, dry_run = false, quiet = false;
+  double max_seconds = 3600.0, max_rows = 1e7;
   po::options_description desc("bodypoint simulate");
   add_scene_options(desc, so);
   add_step_options(desc, st);
@@ -151,6 +153,11 @@ int cmd_simulate(int argc, char** argv) {
       ("every", po::value(&every)->default_value(every), "with --out: write every k-th step (and the last)")
       ("json", po::bool_switch(&json), "print one JSON object instead of the summary")
       ("no-invariants", po::bool_switch(&no_invariants), "do not track the invariants (fastest; final state only)")
+      ("dry-run", po::bool_switch(&dry_run), "check every option and the scene, print what would run, run nothing")
+      ("max-seconds", po::value(&max_seconds)->default_value(max_seconds),
+       "refuse a run whose calibrated estimate exceeds this many seconds")
+      ("max-rows", po::value(&max_rows)->default_value(max_rows), "with --out: refuse to write more rows than this")
+      ("quiet", po::bool_switch(&quiet), "no estimate and no progress bar on stderr")
       ("reference", po::bool_switch(&with_reference),
        "also report err_R = |R - R_ref| against Boost.Odeint rkf78 in long double at tolerance 1e-16");
   po::variables_map vm;
@@ -179,6 +186,27 @@ int cmd_simulate(int argc, char** argv) {
   if (every < 1) throw Error("--every must be >= 1");
   spec.track_invariants = !no_invariants;
 
+  if (!(max_seconds > 0.0)) throw Error("--max-seconds must be > 0");
+  if (!(max_rows >= 1.0)) throw Error("--max-rows must be >= 1");
+  if (vm.count("out") && !search) {
+    // Rows the output would get: one per dt-out, or per every-th step (fictitious steps to t_end are
+    // not known in advance: counted when the run ends, below).
+    const double rows = spec.dt_out > 0.0 ? spec.t_end / spec.dt_out
+                        : spec.steps > 0 ? static_cast<double>(spec.steps) / static_cast<double>(spec.every) : 0.0;
+    if (rows * static_cast<double>(scene.bodies.size()) > max_rows)
+      throw Error("--out would get about " + fmt(std::ceil(rows)) + " rows per body, more than --max-rows " +
+                  fmt(max_rows) + " (raise --every or --dt-out, or --max-rows)");
+  }
+  if (dry_run) {
+    std::cout << "would run " << (search ? method_name + " with --tol " + fmt(tol) : std::string(fixed_method->name))
+              << " on " << scene.bodies.size() << " body-point(s) and " << scene.centres.size() << " centre(s): ";
+    if (search) std::cout << "step search to t_end = " << fmt(spec.t_end);
+    else if (is_time_transformed(*fixed_method)) std::cout << "ds = " << fmt(spec.h) << (spec.t_end > 0 ? " to t_end = " + fmt(spec.t_end) : " for " + std::to_string(spec.steps) + " fictitious steps");
+    else if (is_adaptive(*fixed_method)) std::cout << "tol = " << fmt(spec.tol) << " to t_end = " << fmt(spec.t_end);
+    else std::cout << spec.steps << " steps of h = " << fmt(spec.h);
+    std::cout << "\n";
+    return 0;
+  }
   // Open the output before computing, so an unwritable path fails at once.
   std::unique_ptr<AtomicFile> file;
   SampleSink sink;
@@ -211,7 +239,16 @@ int cmd_simulate(int argc, char** argv) {
         os << '\n';
       };
     }
-    BodyRun br = run_body(plan, body, scene.centres, spec, file ? &sink : nullptr);
+    std::optional<WorkEstimate> estimate;
+    if (!search) {
+      estimate = estimate_work(*fixed_method, body, scene.centres, spec);
+      if (estimate) check_budget(*estimate, max_seconds, quiet || json);
+    }
+    BodyRun br;
+    {
+      const ProgressBar bar(estimate, progress_wanted(quiet));
+      br = run_body(plan, body, scene.centres, spec, file ? &sink : nullptr);
+    }
     if (search && file) file->stream() << "# body " << b << ": " << search_line(br) << "\n";
     const Health health = assess(br.result);
     if (health.status != "ok")

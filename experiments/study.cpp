@@ -15,6 +15,7 @@
 //   with identical parameters; both are run.
 #include "bodypoint/io.hpp"
 #include "cli.hpp"
+#include "stress.hpp"
 #include "sweep.hpp"
 #include "timing.hpp"
 
@@ -198,10 +199,25 @@ void study_appendix(const StudyContext& c) {
   std::cerr << "wrote " << dir.string() << "/ (30 sets)\n";
 }
 
+/// Hostile scenes for one method of each family (issue #12): not part of "all" (the thesis's studies).
+void study_stress(const StudyContext& c) {
+  AtomicFile csv((c.dir / "stress.csv").string()), md((c.dir / "stress.md").string());
+  const auto rows = run_stress(c.quick, [&](const StressRow& r) {
+    if (c.progress) std::cerr << "  " << r.case_name << " / " << r.method << ": " << r.status << "\n";
+  });
+  write_stress(csv.stream(), md.stream(), rows);
+  csv.commit();
+  md.commit();
+  std::size_t ok = 0, refused = 0, flagged = 0;
+  for (const StressRow& r : rows) (r.status == "ok" ? ok : r.status == "refused" ? refused : flagged)++;
+  std::cerr << "wrote " << (c.dir / "stress.csv").string() << " and stress.md: " << rows.size() << " runs, " << ok
+            << " ok, " << refused << " refused with a reason, " << flagged << " diverged or collided (flagged)\n";
+}
+
 const std::vector<std::pair<std::string, void (*)(const StudyContext&)>>& recipes() {
   static const std::vector<std::pair<std::string, void (*)(const StudyContext&)>> r = {
       {"d", study_d},         {"L", study_L},          {"h", study_h},         {"Kx", study_Kx},
-      {"timing", study_timing}, {"evals", study_evals}, {"appendix", study_appendix}};
+      {"timing", study_timing}, {"evals", study_evals}, {"appendix", study_appendix}, {"stress", study_stress}};
   return r;
 }
 
@@ -213,7 +229,7 @@ int cmd_study(int argc, char** argv) {
   long threads = 0;
   po::options_description desc("bodypoint study");
   desc.add_options()
-      ("name", po::value(&which)->default_value(which), "recipe: d, L, h, Kx, timing, evals, appendix, or all")
+      ("name", po::value(&which)->default_value(which), "recipe: d, L, h, Kx, timing, evals, appendix, all (these), or stress (hostile scenes, issue #12)")
       ("results", po::value(&results)->default_value(results), "folder for the CSVs (created if missing)")
       ("quick", po::bool_switch(&quick), "coarser grids, same recipes (under two minutes on 2 cores)")
       ("threads", po::value(&threads)->default_value(0), "worker threads for the sweeps (0: all cores)");
@@ -229,12 +245,12 @@ int cmd_study(int argc, char** argv) {
   c.progress = ::isatty(2) == 1;
   bool found = false;
   for (const auto& [name, fn] : recipes()) found = found || name == which;
-  if (!found && which != "all") throw Error("unknown study '" + which + "' (d, L, h, Kx, timing, evals, appendix, all)");
+  if (!found && which != "all") throw Error("unknown study '" + which + "' (d, L, h, Kx, timing, evals, appendix, all, stress)");
   std::error_code ec;
   fs::create_directories(c.dir, ec);
   if (ec || !fs::is_directory(c.dir)) throw Error("cannot create results folder '" + results + "'");
   for (const auto& [name, fn] : recipes())
-    if (which == "all" || which == name) fn(c);
+    if ((which == "all" && name != "stress") || which == name) fn(c);
   return 0;
 }
 

@@ -229,6 +229,7 @@ int cmd_view(int argc, char** argv) {
   std::string method_name = "lp-y4", compare, out = "bodypoint-view.html";
   double tol = 1e-10, compare_h = 0.0, max_mb = 32.0;
   long frames = 3000;
+  bool dry_run = false;
   po::options_description desc("bodypoint view");
   add_scene_options(desc, so);
   add_step_options(desc, st);
@@ -240,7 +241,8 @@ int cmd_view(int argc, char** argv) {
       ("compare-h", po::value(&compare_h), "step (or ds) of the --compare method (default: --h)")
       ("frames", po::value(&frames)->default_value(frames), "states kept per body (equal arc length, closest approach kept)")
       ("max-mb", po::value(&max_mb)->default_value(max_mb), "refuse to write a page larger than this many MB")
-      ("out", po::value(&out)->default_value(out), "the HTML file to write (atomically)");
+      ("out", po::value(&out)->default_value(out), "the HTML file to write (atomically)")
+      ("dry-run", po::bool_switch(&dry_run), "check every option and the scene, run nothing, write nothing");
   po::variables_map vm;
   if (!parse(argc, argv, desc, vm,
              "usage: bodypoint view [options]\n"
@@ -275,7 +277,12 @@ int cmd_view(int argc, char** argv) {
     throw Error("the page would hold about " + fmt(std::round(estimate / 1e5) / 10) + " MB (" + std::to_string(frames) +
                 " frames x " + std::to_string(scene.bodies.size()) + " bodies x " + std::to_string(plans.size()) +
                 " runs), above --max-mb " + fmt(max_mb) + ": lower --frames or raise --max-mb");
-  AtomicFile file(out);  // an unwritable path fails before the runs
+  if (dry_run) {
+    std::cout << "would write " << out << ": " << plans.size() << " run(s) of " << scene.bodies.size()
+              << " body-point(s), about " << std::round(estimate / 1e3) << " kB\n";
+    return 0;
+  }
+    AtomicFile file(out);  // an unwritable path fails before the runs
 
   std::string json = "{\"title\": " + json_string("bodypoint view: " + labels[0] + (plans.size() > 1 ? " vs " + labels[1] : "")) +
                      ", \"scene\": " + json_string(vm.count("scene") ? "scene=" + so.scene_file : describe(so.params)) +

@@ -62,6 +62,17 @@ void validate(const Scene& scene) {
       if ((b.s0.R - scene.centres[k].c).norm() == 0.0)
         throw Error(who + " starts on centre " + std::to_string(k + 1) + " (R = c); move it off the centre");
     }
+    // The integrals at the start must be representable: |R| |K1| and the energies of a scene of
+    // scale 1e308 overflow, and every deviation after that is NaN.
+    const Momenta k = to_momenta(b.p, b.s0);
+    double potential = 0.0;
+    for (const Centre& c : scene.centres) potential -= c.A / (b.s0.R - c.c).norm();
+    const double kinetic = 0.5 * (b.p.m * b.s0.v.squaredNorm() + 2.0 * b.p.B * b.s0.v.dot(b.s0.w) +
+                                  b.p.J * b.s0.w.squaredNorm());
+    if (!(k.K1.allFinite() && k.K2.allFinite() && (k.R.cross(k.K1) + k.K2).allFinite() && std::isfinite(kinetic) &&
+          std::isfinite(potential) && std::isfinite(kinetic + potential)))
+      throw Error(who + ": the energy or angular momentum at the start overflows a double (|R| = " + num(b.s0.R.norm()) +
+                  ", |v| = " + num(b.s0.v.norm()) + "); rescale the units");
   }
 }
 

@@ -41,7 +41,9 @@ inline State reference_state(const Body& body, const std::vector<Centre>& centre
 #pragma GCC diagnostic push
   // GCC 12 reports odeint's default-constructed stepper members as maybe-uninitialized when the
   // controller copies them (a false positive inside Boost; the members are arrays it fills first).
+#ifndef __clang__  // a GCC-only warning group
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
   odeint::controlled_runge_kutta<Stepper> stepper{Checker(tol, tol)};
   odeint::integrate_adaptive(stepper, std::cref(sys), x, 0.0L, static_cast<long double>(t_end), 1e-3L);
 #pragma GCC diagnostic pop

@@ -25,6 +25,25 @@ using Clock = std::chrono::steady_clock;
 /// minute or more of work) means the tolerance or the end time is out of proportion.
 constexpr long kMaxAdaptiveSteps = 200'000'000L;
 
+/// x with three significant digits, for messages.
+inline std::string short_number(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", x);
+  return buf;
+}
+
+/// Checked every 2^20 accepted steps: throws when the rate so far would need more than
+/// kMaxAdaptiveSteps to reach t_end (odeint-dopri5 to t_end = 1e12 spent 68 s before its cap).
+inline void check_adaptive_rate(long steps, double t, double t_end) {
+  constexpr long kEvery = 1L << 20;
+  if (steps == 0 || steps % kEvery != 0 || !(t > 0.0)) return;
+  const double needed = static_cast<double>(steps) * t_end / t;
+  if (needed > static_cast<double>(kMaxAdaptiveSteps))
+    throw Error("at its rate so far (t = " + short_number(t) + " after " + std::to_string(steps) +
+                " accepted steps) the run needs about " + short_number(needed) + " steps to reach t_end = " +
+                short_number(t_end) + ", more than the budget of 2e8; loosen --tol or shorten --t-end");
+}
+
 /// False when a step from t_before to t did not move time by more than a few of its last bits: such
 /// steps would repeat forever (a tolerance below double precision, a fall onto a centre).
 inline bool time_advances(double t_before, double t) {
@@ -32,12 +51,6 @@ inline bool time_advances(double t_before, double t) {
   return t - t_before > kUlps * std::numeric_limits<double>::epsilon() * std::abs(t);
 }
 
-/// x with three significant digits, for messages.
-inline std::string short_number(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", x);
-  return buf;
-}
 
 /// Observer that tracks the invariants at every step and hands every `every`-th state to a sink.
 template <class Field, class ToPhysical>

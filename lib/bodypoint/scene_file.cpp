@@ -2,6 +2,7 @@
 
 #include "bodypoint/io.hpp"
 
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -52,6 +53,9 @@ const toml::array* array_of_tables(const toml::table& root, std::string_view key
 }
 
 }  // namespace
+
+/// Largest scene file read (a scene of 10^5 bodies is about 10 MB).
+constexpr std::uintmax_t kMaxSceneFileBytes = 16u << 20;
 
 Scene parse_scene(const std::string& text, const std::string& origin) {
   toml::table root;
@@ -117,6 +121,13 @@ Scene parse_scene(const std::string& text, const std::string& origin) {
 }
 
 Scene read_scene_file(const std::string& path) {
+  // A scene file is a few lines; a device (/dev/zero) or a huge file would be read forever.
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) throw Error(path + ": cannot open scene file");
+  if (!std::filesystem::is_regular_file(status)) throw Error(path + ": the scene file is not a regular file");
+  if (std::filesystem::file_size(path, ec) > kMaxSceneFileBytes)
+    throw Error(path + ": the scene file is larger than 16 MB");
   std::ifstream in(path);
   if (!in) throw Error(path + ": cannot open scene file");
   register_input(path);

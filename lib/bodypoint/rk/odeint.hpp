@@ -35,7 +35,9 @@ using BulirschStoer = odeint::bulirsch_stoer<OdeState<double>>;
 #pragma GCC diagnostic push
 // GCC 12 reports the default-constructed stepper that odeint's controller copies as (maybe-)
 // uninitialised: a false positive inside Boost (its members are work arrays written before use).
+#ifndef __clang__  // a GCC-only warning group
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #pragma GCC diagnostic ignored "-Wuninitialized"
 template <class Controlled>
 Controlled make_controlled(double tol) {

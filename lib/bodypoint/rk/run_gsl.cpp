@@ -72,6 +72,7 @@ RunResult run_gsl(const gsl_odeiv2_step_type* type, const Body& body, const std:
           throw Error("gsl: the step size collapsed at t = " + std::to_string(t) + " (tolerance too tight?)");
         if (st.steps >= detail::kMaxAdaptiveSteps) throw Error("gsl: more than 2e8 steps before t_end");
         st.add(taken);
+        detail::check_adaptive_rate(st.steps, t, t_end);
         if constexpr (std::decay_t<decltype(obs)>::active) obs.observe(st.steps, t, x, t >= t_end);
         if (!std::isfinite(x[0])) break;
       }

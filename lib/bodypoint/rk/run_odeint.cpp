@@ -96,6 +96,7 @@ RunResult run_odeint_adaptive(const Body& body, const std::vector<Centre>& centr
                         " (reached t = " + detail::short_number(t) + "); loosen --tol or shorten --t-end");
           st.add(taken);
           rejected_in_a_row = 0;
+          detail::check_adaptive_rate(st.steps, t, t_end);
           if constexpr (std::decay_t<decltype(obs)>::active) obs.observe(st.steps, t, x, t >= t_end);
           if (!std::isfinite(x[0])) break;
         } else if (++rejected_in_a_row > 1000 || !(dt > 0.0)) {

@@ -1,0 +1,103 @@
+#include "budget.hpp"
+
+#include "bodypoint/io.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <unistd.h>
+
+namespace bodypoint::cli {
+namespace {
+
+/// Runs longer than this many steps are calibrated first (10^6 steps take 0.03..0.3 s).
+constexpr long kCalibrateAbove = 1'000'000;
+/// Steps of the calibration run: long enough for a stable time per step (> 1 ms), short enough to
+/// cost < 1 % of a run worth calibrating.
+constexpr long kCalibrationSteps = 20'000;
+/// Estimates above this are announced on stderr before the run starts.
+constexpr double kAnnounceSeconds = 10.0;
+/// A bar is drawn only for runs expected to take longer than this.
+constexpr double kBarSeconds = 2.0;
+
+std::string duration(double s) {
+  char buf[64];
+  if (s < 120) std::snprintf(buf, sizeof buf, "%.3g s", s);
+  else if (s < 7200) std::snprintf(buf, sizeof buf, "%.3g min", s / 60);
+  else if (s < 2 * 86400) std::snprintf(buf, sizeof buf, "%.3g h", s / 3600);
+  else std::snprintf(buf, sizeof buf, "%.3g days", s / 86400);
+  return buf;
+}
+
+}  // namespace
+
+std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
+                                          const RunSpec& spec) {
+  if (is_adaptive(m)) return std::nullopt;
+  RunSpec cal = spec;
+  cal.steps = kCalibrationSteps;
+  cal.every = 1;
+  cal.dt_out = 0.0;
+  if (is_time_transformed(m)) {
+    if (spec.t_end <= 0.0 && spec.steps <= kCalibrateAbove) return std::nullopt;
+    cal.t_end = 0.0;  // a fixed number of fictitious steps: how much physical time do they cover?
+    RunResult r;
+    try {
+      r = run(m, body, centres, cal);
+    } catch (const Error&) {
+      // Without an end time the calibration can run away (ks's physical step grows with r, which
+      // grows with t): no estimate then; the run's own checks still bound it.
+      return std::nullopt;
+    }
+    const double steps = spec.t_end > 0.0 ? (r.t_end > 0.0 ? kCalibrationSteps * spec.t_end / r.t_end : HUGE_VAL)
+                                          : static_cast<double>(spec.steps);
+    if (spec.t_end > 0.0 && r.t_end >= spec.t_end) return std::nullopt;  // shorter than the calibration
+    return WorkEstimate{steps, r.wall_s * steps / kCalibrationSteps};
+  }
+  if (spec.steps <= kCalibrateAbove) return std::nullopt;
+  const RunResult r = run(m, body, centres, cal);
+  const double steps = static_cast<double>(spec.steps);
+  return WorkEstimate{steps, r.wall_s * steps / kCalibrationSteps};
+}
+
+void check_budget(const WorkEstimate& e, double max_seconds, bool quiet) {
+  char steps[32];
+  std::snprintf(steps, sizeof steps, "%.3g", e.steps);
+  const std::string what = std::string(steps) + " steps, about " + duration(e.seconds) + " (calibrated on " +
+                           std::to_string(kCalibrationSteps) + " steps)";
+  if (e.seconds > max_seconds)
+    throw Error("the run would take " + what + ", above --max-seconds " + fmt(max_seconds) +
+                ": shorten it, take a larger step, or raise --max-seconds");
+  if (!quiet && e.seconds > kAnnounceSeconds) std::cerr << "bodypoint: " << what << "\n";
+}
+
+bool progress_wanted(bool quiet) { return !quiet && ::isatty(2) == 1 && std::getenv("CI") == nullptr; }
+
+ProgressBar::ProgressBar(const std::optional<WorkEstimate>& e, bool enabled) {
+  if (!enabled || !e || e->seconds < kBarSeconds) return;
+  const double expected = e->seconds;
+  thread_ = std::thread([this, expected] {
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
+    while (!stop_.load()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(250));
+      const double el = std::chrono::duration<double>(Clock::now() - t0).count();
+      const double f = std::min(el / expected, 0.99);
+      const int filled = static_cast<int>(f * 30);
+      std::fprintf(stderr, "\r[%.*s%*s] %3d%%  %s left ", filled, "##############################", 30 - filled, "",
+                   static_cast<int>(100 * f), duration(std::max(expected - el, 0.0)).c_str());
+      std::fflush(stderr);
+    }
+    std::fprintf(stderr, "\r%60s\r", "");
+    std::fflush(stderr);
+  });
+}
+
+ProgressBar::~ProgressBar() {
+  stop_.store(true);
+  if (thread_.joinable()) thread_.join();
+}
+
+}  // namespace bodypoint::cli

@@ -1,0 +1,47 @@
+// bodypoint: a work estimate before a long run, a budget it must fit, and a progress bar.
+//
+// A run of more than kCalibrateAbove steps (or any time-transformed run to an end time) is first
+// calibrated on kCalibrationSteps steps of the same method and body; the estimate (steps and seconds)
+// is printed when it is long, refused when it exceeds the budget, and drives a progress bar on a
+// terminal (never under CI, with --quiet, or when standard error is not a terminal).
+#pragma once
+
+#include "bodypoint/run.hpp"
+
+#include <atomic>
+#include <optional>
+#include <thread>
+
+namespace bodypoint::cli {
+
+struct WorkEstimate {
+  double steps = 0.0;    ///< steps (fictitious steps for time-transformed methods)
+  double seconds = 0.0;  ///< of the step loop, extrapolated from the calibration
+};
+
+/// The estimate for a run that may be long, or nothing when the run is short (or adaptive: those are
+/// bounded by their own step cap).
+std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
+                                          const RunSpec& spec);
+
+/// Throws Error when the estimate exceeds max_seconds; prints it on stderr when it exceeds
+/// kAnnounceSeconds and `quiet` is false.
+void check_budget(const WorkEstimate& e, double max_seconds, bool quiet);
+
+/// True when a progress bar may be drawn: stderr is a terminal, CI is unset and not quiet.
+bool progress_wanted(bool quiet);
+
+/// Draws elapsed/expected time on stderr from a thread while alive (when enabled and the run is long).
+class ProgressBar {
+ public:
+  ProgressBar(const std::optional<WorkEstimate>& e, bool enabled);
+  ~ProgressBar();
+  ProgressBar(const ProgressBar&) = delete;
+  ProgressBar& operator=(const ProgressBar&) = delete;
+
+ private:
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+}  // namespace bodypoint::cli

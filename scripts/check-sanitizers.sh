@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# bodypoint: the test suite under AddressSanitizer + UndefinedBehaviorSanitizer (clang, whose UBSan
+# also checks float-to-integer overflow), then each libFuzzer target for FUZZ_SECONDS (default 60) on
+# a copy of its seed corpus (tests/fuzz/corpus). One clang build in ./build-asan serves both. Run after
+# scripts/setup.sh (it installs clang and libclang-rt-14-dev). CI (.ci/run) runs it.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds="${FUZZ_SECONDS:-60}"
+
+CC=clang CXX=clang++ cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DBODYPOINT_FUZZ=ON \
+  -DBODYPOINT_BUILD_BENCH=OFF -DBODYPOINT_WERROR="${BODYPOINT_WERROR:-OFF}" >/dev/null
+cmake --build build-asan --parallel "$(nproc)"
+
+# The browser test runs in the main build; under the sanitizers it would only test Chromium again.
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+ctest --test-dir build-asan --output-on-failure -j2 -E ViewerInChromium
+
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+for target in scene cli; do
+  cp -r "tests/fuzz/corpus/$target" "$work/$target"
+  echo "fuzz_$target: ${seconds} s"
+  (cd "$work" && "$OLDPWD/build-asan/bin/fuzz_$target" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+     -close_fd_mask=1 -print_final_stats=1 "$work/$target" 2>"$work/$target.log") ||
+    { tail -n 40 "$work/$target.log"; echo "fuzz_$target found a failure" >&2; exit 1; }
+  grep -E "^stat::number_of_executed_units" "$work/$target.log" || true
+done

@@ -1,0 +1,249 @@
+// Hostile input and interrupted runs (issue #12): every run ends with a result or a one-line reason,
+// never a hang or a number that means nothing; outputs are complete or absent.
+#include "cli_helpers.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <algorithm>
+#include <csignal>
+#include <fcntl.h>
+#include <filesystem>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <spawn.h>
+#include <string>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+#include <vector>
+
+extern char** environ;
+
+namespace bodypoint {
+namespace {
+
+namespace fs = std::filesystem;
+using test::run_cli;
+
+/// Files in dir whose name starts with `stem` (the output, its temporaries, its lock).
+std::vector<std::string> leftovers(const fs::path& dir, const std::string& stem) {
+  std::vector<std::string> out;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().filename().string().rfind(stem, 0) == 0) out.push_back(e.path().filename().string());
+  return out;
+}
+
+/// Starts `bodypoint args...` with stderr to err_file; returns its pid.
+pid_t spawn(const std::vector<std::string>& args, const fs::path& err_file) {
+  std::vector<std::string> all{BODYPOINT_BIN};
+  all.insert(all.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&fa, 2, err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  pid_t pid = 0;
+  const int rc = posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  return rc == 0 ? pid : -1;
+}
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+/// A run long enough to be interrupted: signals arrive after kSignalDelay, well inside it.
+constexpr auto kSignalDelay = std::chrono::milliseconds(700);
+
+struct Example {
+  std::string args, fragment;
+};
+
+TEST(Reliability, EveryIssueExampleEndsWithItsReason) {
+  // The examples of issue #12, each with the reason it must give (all finish in well under a second).
+  const std::vector<Example> cases = {
+      {"simulate --method odeint-dopri5 --t-end 1 --tol 1e-25", "below what double precision can deliver"},
+      {"simulate --method logh-y4 --h 1e-300 --t-end 5", "would take"},
+      // Without the calibrated budget the loop's own rate check stops it.
+      {"simulate --method logh-y4 --h 1e-300 --t-end 5 --max-seconds 1e300 --quiet", "more than the budget of 2e9"},
+      {"simulate --method ks --B 0 --K1 1e8 --t-end 50 --h 0.1", "non-finite"},
+      {"simulate --method ttl-y4 --B 0.99999999999 --h 0.01 --t-end 50", "would take"},
+      {"simulate --steps 1000000000000", "would take"},
+      {"simulate --t-end 1e8 --max-seconds 60", "would take"},
+      {"simulate --method logh-y4 --h 1e-2 --t-end 5 --out /tmp/bp_rel_dt.csv --dt-out 1e-320", "--max-rows"},
+      {"simulate --m 0.49 --J 1 --steps 10", "zero within rounding"},
+      {"simulate --d 1e308 --steps 10", "overflows a double"},
+      {"simulate --A 2 --Kz 0 --d 1e-12 --h 1e-3 --t-end 80 --method rk4", "relative energy error reached"},
+      {"simulate --A 2 --Kz 0 --d 1e-12 --h 1e-3 --t-end 80 --method ttl-y4", "fall onto an attracting centre"},
+      {"simulate --method odeint-dopri5 --t-end 1e12 --L 1e12 --tol 1e-6 --h 1e5", "more than the budget of 2e8"},
+      {"timing --values 1e308", "must be at most"},
+      {"simulate --scene /dev/zero", "not a regular file"},
+      {"simulate --ou x.csv --steps 10", "unrecognised option '--ou'"},
+  };
+  for (const Example& c : cases) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto r = run_cli(c.args);
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_NE(r.code, 0) << c.args;
+    EXPECT_NE(r.err.find(c.fragment), std::string::npos) << c.args << " -> " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.args << " -> " << r.err;
+    std::printf("  %-100s %.2f s\n", c.args.c_str(), s);
+  }
+  EXPECT_FALSE(fs::exists("/tmp/bp_rel_dt.csv"));
+}
+
+TEST(Reliability, SubnormalValuesAreNumbersAndSweepRowsCarryAStatus) {
+  const auto ok = run_cli("sweep --param d --values 1e-320 --steps 10 --methods lp-y4");
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  EXPECT_NE(ok.out.find(",ok,"), std::string::npos) << ok.out;
+  // A thesis scheme at a step where it blows up, and a method that refuses the scene: flagged rows,
+  // the sweep itself succeeds.
+  const auto mixed = run_cli("sweep --param Kx --values 2 --h 0.01 --steps 5000 --methods thesis-euler,ks,lp-y4");
+  ASSERT_EQ(mixed.code, 0) << mixed.err;
+  EXPECT_NE(mixed.out.find("thesis-euler,"), std::string::npos);
+  EXPECT_NE(mixed.out.find(",diverged,\"the relative energy error reached"), std::string::npos) << mixed.out;
+  EXPECT_NE(mixed.out.find(",refused,\"ks regularises a material point"), std::string::npos) << mixed.out;
+  EXPECT_NE(mixed.out.find(",ok,\"\""), std::string::npos) << mixed.out;
+}
+
+TEST(Reliability, DryRunChecksEverythingAndRunsNothing) {
+  const fs::path out = fs::temp_directory_path() / "bp_rel_dry.csv";
+  fs::remove(out);
+  const auto r = run_cli("simulate --dry-run --steps 1000000000000 --every 1000000 --out " + out.string());
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("would run lp-y4"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(Reliability, ASignalRemovesTemporaryAndLockFiles) {
+  const fs::path dir = fs::temp_directory_path() / "bp_rel_sig";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  // 2e8 steps take ~30 s: the signal arrives while the trajectory is being written.
+  const pid_t pid = spawn({"simulate", "--steps", "200000000", "--every", "1000", "--quiet", "--out",
+                           (dir / "traj.csv").string()}, dir / "err.txt");
+  ASSERT_GT(pid, 0);
+  std::this_thread::sleep_for(kSignalDelay);
+  EXPECT_FALSE(leftovers(dir, "traj.csv.lock").empty()) << "the run holds a lock while it writes";
+  ::kill(pid, SIGINT);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGINT) << "ends with the signal (exit status 130)";
+  EXPECT_TRUE(leftovers(dir, "traj.csv").empty()) << "left: " << leftovers(dir, "traj.csv").size() << " files";
+  fs::remove_all(dir);
+}
+
+TEST(Reliability, ASweepStopsAtARowBoundaryOnSignal) {
+  const fs::path dir = fs::temp_directory_path() / "bp_rel_sweep";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const pid_t pid = spawn({"sweep", "--param", "d", "--from", "5", "--to", "200", "--step", "5", "--methods",
+                           "lp-y4", "--steps", "2000000", "--threads", "1", "--out", (dir / "d.csv").string()},
+                          dir / "err.txt");
+  ASSERT_GT(pid, 0);
+  std::this_thread::sleep_for(kSignalDelay);
+  ::kill(pid, SIGTERM);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  EXPECT_NE(read(dir / "err.txt").find("interrupted by signal 15"), std::string::npos) << read(dir / "err.txt");
+  EXPECT_TRUE(leftovers(dir, "d.csv").empty());
+  fs::remove_all(dir);
+}
+
+TEST(Reliability, OutputsCollideWithNothing) {
+  const fs::path dir = fs::temp_directory_path() / "bp_rel_out";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  // Two outputs of one run on one path.
+  const fs::path both = dir / "x.csv";
+  const auto twice = run_cli("work-precision --quick --out " + both.string() + " --summary " + both.string());
+  EXPECT_NE(twice.code, 0);
+  EXPECT_NE(twice.err.find("two outputs of this run write"), std::string::npos) << twice.err;
+  // The output is the scene file being read.
+  const fs::path scene = dir / "scene.toml";
+  fs::copy_file(fs::path(BODYPOINT_SOURCE_DIR) / "scenes/two-centres.toml", scene);
+  const auto same = run_cli("simulate --scene " + scene.string() + " --steps 10 --out " + scene.string());
+  EXPECT_NE(same.code, 0);
+  EXPECT_NE(same.err.find("is an input of this run"), std::string::npos) << same.err;
+  EXPECT_NE(read(scene).find("[[centre]]"), std::string::npos) << "the scene file is intact";
+  // A second writer of the same path: the lock names a live process (this test).
+  const fs::path out = dir / "y.csv";
+  std::ofstream(dir / "y.csv.lock") << ::getpid() << "\n";
+  const auto locked = run_cli("simulate --steps 10 --out " + out.string());
+  EXPECT_NE(locked.code, 0);
+  EXPECT_NE(locked.err.find("another run (pid " + std::to_string(::getpid()) + ")"), std::string::npos) << locked.err;
+  EXPECT_FALSE(fs::exists(out));
+  // A stale lock (its writer is gone) is taken over, and released after the run.
+  const pid_t gone = spawn({"methods"}, dir / "err.txt");
+  ::waitpid(gone, nullptr, 0);
+  std::ofstream(dir / "y.csv.lock", std::ios::trunc) << gone << "\n";
+  const auto stale = run_cli("simulate --steps 10 --out " + out.string());
+  EXPECT_EQ(stale.code, 0) << stale.err;
+  EXPECT_TRUE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(dir / "y.csv.lock"));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace bodypoint
+
+namespace bodypoint {
+namespace {
+
+/// Fields of one CSV line with double-quoted fields (no quotes inside them).
+std::vector<std::string> csv_fields(const std::string& line) {
+  std::vector<std::string> out(1);
+  bool quoted = false;
+  for (const char c : line) {
+    if (c == '"') quoted = !quoted;
+    else if (c == ',' && !quoted) out.emplace_back();
+    else out.back() += c;
+  }
+  return out;
+}
+
+// Bound on the energy error of a run the study calls ok (assess(): kDivergedEnergy).
+constexpr double kOkEnergyBound = 1.0;
+
+TEST(Reliability, StressStudyEndsEveryRunWithAMeaningfulOutcome) {
+  const fs::path dir = fs::temp_directory_path() / "bp_rel_stress";
+  fs::remove_all(dir);
+  const auto r = run_cli("study --name stress --quick --results " + dir.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(dir / "stress.csv");
+  std::string line;
+  std::map<std::string, int> outcomes;
+  int rows = 0;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#' || line.rfind("case,", 0) == 0) continue;
+    const auto f = csv_fields(line);
+    ASSERT_EQ(f.size(), 7u) << line;
+    ++rows;
+    const std::string& status = f[2];
+    ++outcomes[status];
+    if (status == "ok") {
+      const double dE = std::stod(f[3]);
+      EXPECT_TRUE(std::isfinite(dE) && dE <= kOkEnergyBound) << line;
+      EXPECT_EQ(f[6], "") << line;
+    } else {
+      EXPECT_TRUE(status == "refused" || status == "diverged" || status == "collision") << line;
+      EXPECT_FALSE(f[6].empty()) << "a row that is not ok says why: " << line;
+    }
+  }
+  // 19 cases x 7 or 8 methods (gsl-rk8pd when GSL is present).
+  EXPECT_GE(rows, 19 * 7);
+  EXPECT_GT(outcomes["ok"], 0);
+  EXPECT_GT(outcomes["refused"], 0);
+  EXPECT_GT(outcomes["diverged"], 0);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace bodypoint
