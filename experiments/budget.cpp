@@ -12,11 +12,14 @@
 namespace bodypoint::cli {
 namespace {
 
-/// Runs longer than this many steps are calibrated first (10^6 steps take 0.03..0.3 s).
-constexpr long kCalibrateAbove = 1'000'000;
-/// Steps of the calibration run: long enough for a stable time per step (> 1 ms), short enough to
-/// cost < 1 % of a run worth calibrating.
-constexpr long kCalibrationSteps = 20'000;
+/// Runs longer than this many steps are calibrated first (10^7 steps take 0.3..3 s).
+constexpr long kCalibrateAbove = 10'000'000;
+/// Steps of the calibration run: long enough for a stable time per step (several ms), at most 1 % of
+/// a run worth calibrating.
+constexpr long kCalibrationSteps = 100'000;
+/// Time-transformed runs to an end time first take this many fictitious steps to see how much
+/// physical time they cover: a run that is shorter than that is not calibrated further.
+constexpr long kProbeSteps = 1'000;
 /// Estimates above this are announced on stderr before the run starts.
 constexpr double kAnnounceSeconds = 10.0;
 /// A bar is drawn only for runs expected to take longer than this.
@@ -38,23 +41,42 @@ std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body,
   if (is_adaptive(m)) return std::nullopt;
   RunSpec cal = spec;
   cal.steps = kCalibrationSteps;
+  cal.track_invariants = spec.track_invariants;
   cal.every = 1;
   cal.dt_out = 0.0;
   if (is_time_transformed(m)) {
-    if (spec.t_end <= 0.0 && spec.steps <= kCalibrateAbove) return std::nullopt;
-    cal.t_end = 0.0;  // a fixed number of fictitious steps: how much physical time do they cover?
-    RunResult r;
+    if (spec.t_end <= 0.0) {
+      if (spec.steps <= kCalibrateAbove) return std::nullopt;
+    } else {
+      // How much physical time do kProbeSteps fictitious steps cover? (No end time in the probe, so it
+      // can run away: ks's physical step grows with r. No estimate then; the run's own checks bound it.)
+      cal.t_end = 0.0;
+      cal.steps = kProbeSteps;
+      RunResult probe;
+      try {
+        probe = run(m, body, centres, cal);
+      } catch (const Error&) {
+        return std::nullopt;
+      }
+      if (probe.t_end >= spec.t_end) return std::nullopt;  // shorter than the probe
+      const double needed = probe.t_end > 0.0 ? kProbeSteps * spec.t_end / probe.t_end : HUGE_VAL;
+      if (needed <= static_cast<double>(kCalibrateAbove)) return std::nullopt;
+      cal.steps = kCalibrationSteps;
+      RunResult r;
+      try {
+        r = run(m, body, centres, cal);
+      } catch (const Error&) {
+        return std::nullopt;
+      }
+      const double steps = r.t_end > 0.0 ? kCalibrationSteps * spec.t_end / r.t_end : HUGE_VAL;
+      return WorkEstimate{steps, r.wall_s * steps / kCalibrationSteps};
+    }
     try {
-      r = run(m, body, centres, cal);
+      const RunResult r = run(m, body, centres, cal);
+      return WorkEstimate{static_cast<double>(spec.steps), r.wall_s * static_cast<double>(spec.steps) / kCalibrationSteps};
     } catch (const Error&) {
-      // Without an end time the calibration can run away (ks's physical step grows with r, which
-      // grows with t): no estimate then; the run's own checks still bound it.
       return std::nullopt;
     }
-    const double steps = spec.t_end > 0.0 ? (r.t_end > 0.0 ? kCalibrationSteps * spec.t_end / r.t_end : HUGE_VAL)
-                                          : static_cast<double>(spec.steps);
-    if (spec.t_end > 0.0 && r.t_end >= spec.t_end) return std::nullopt;  // shorter than the calibration
-    return WorkEstimate{steps, r.wall_s * steps / kCalibrationSteps};
   }
   if (spec.steps <= kCalibrateAbove) return std::nullopt;
   const RunResult r = run(m, body, centres, cal);

@@ -1,7 +1,7 @@
 // bodypoint: a work estimate before a long run, a budget it must fit, and a progress bar.
 //
-// A run of more than kCalibrateAbove steps (or any time-transformed run to an end time) is first
-// calibrated on kCalibrationSteps steps of the same method and body; the estimate (steps and seconds)
+// A run of more than kCalibrateAbove steps (a time-transformed run to an end time: when a short probe
+// says it needs that many) is first calibrated on kCalibrationSteps steps of the same method and body; the estimate (steps and seconds)
 // is printed when it is long, refused when it exceeds the budget, and drives a progress bar on a
 // terminal (never under CI, with --quiet, or when standard error is not a terminal).
 #pragma once
