@@ -39,49 +39,34 @@ std::string duration(double s) {
 std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
                                           const RunSpec& spec) {
   if (is_adaptive(m)) return std::nullopt;
-  RunSpec cal = spec;
-  cal.steps = kCalibrationSteps;
-  cal.track_invariants = spec.track_invariants;
-  cal.every = 1;
-  cal.dt_out = 0.0;
-  if (is_time_transformed(m)) {
-    if (spec.t_end <= 0.0) {
-      if (spec.steps <= kCalibrateAbove) return std::nullopt;
-    } else {
-      // How much physical time do kProbeSteps fictitious steps cover? (No end time in the probe, so it
-      // can run away: ks's physical step grows with r. No estimate then; the run's own checks bound it.)
-      cal.t_end = 0.0;
-      cal.steps = kProbeSteps;
-      RunResult probe;
-      try {
-        probe = run(m, body, centres, cal);
-      } catch (const Error&) {
-        return std::nullopt;
-      }
-      if (probe.t_end >= spec.t_end) return std::nullopt;  // shorter than the probe
-      const double needed = probe.t_end > 0.0 ? kProbeSteps * spec.t_end / probe.t_end : HUGE_VAL;
-      if (needed <= static_cast<double>(kCalibrateAbove)) return std::nullopt;
-      cal.steps = kCalibrationSteps;
-      RunResult r;
-      try {
-        r = run(m, body, centres, cal);
-      } catch (const Error&) {
-        return std::nullopt;
-      }
-      const double steps = r.t_end > 0.0 ? kCalibrationSteps * spec.t_end / r.t_end : HUGE_VAL;
-      return WorkEstimate{steps, r.wall_s * steps / kCalibrationSteps};
-    }
+  // A calibration without an end time can run away (ks's physical step grows with r): no estimate
+  // then; the run's own checks still bound it.
+  auto calibrate = [&](long steps) -> std::optional<RunResult> {
+    RunSpec cal = spec;
+    cal.steps = steps;
+    cal.t_end = 0.0;
+    cal.every = 1;
+    cal.dt_out = 0.0;
     try {
-      const RunResult r = run(m, body, centres, cal);
-      return WorkEstimate{static_cast<double>(spec.steps), r.wall_s * static_cast<double>(spec.steps) / kCalibrationSteps};
+      return run(m, body, centres, cal);
     } catch (const Error&) {
       return std::nullopt;
     }
+  };
+  double steps = static_cast<double>(spec.steps);
+  if (is_time_transformed(m) && spec.t_end > 0.0) {
+    // How much physical time do kProbeSteps fictitious steps cover? A run shorter than the probe, or
+    // than kCalibrateAbove steps at the probe's rate, is not calibrated further.
+    const auto probe = calibrate(kProbeSteps);
+    if (!probe || probe->t_end >= spec.t_end) return std::nullopt;
+    steps = probe->t_end > 0.0 ? kProbeSteps * spec.t_end / probe->t_end : HUGE_VAL;
   }
-  if (spec.steps <= kCalibrateAbove) return std::nullopt;
-  const RunResult r = run(m, body, centres, cal);
-  const double steps = static_cast<double>(spec.steps);
-  return WorkEstimate{steps, r.wall_s * steps / kCalibrationSteps};
+  if (steps <= static_cast<double>(kCalibrateAbove)) return std::nullopt;
+  const auto r = calibrate(kCalibrationSteps);
+  if (!r) return std::nullopt;
+  if (is_time_transformed(m) && spec.t_end > 0.0)
+    steps = r->t_end > 0.0 ? kCalibrationSteps * spec.t_end / r->t_end : HUGE_VAL;
+  return WorkEstimate{steps, r->wall_s * steps / kCalibrationSteps};
 }
 
 void check_budget(const WorkEstimate& e, double max_seconds, bool quiet) {
