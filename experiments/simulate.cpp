@@ -190,7 +190,7 @@ int cmd_simulate(int argc, char** argv) {
   if (!(max_rows >= 1.0)) throw Error("--max-rows must be >= 1");
   if (vm.count("out") && !search) {
     // Rows the output would get: one per dt-out, or per every-th step (fictitious steps to t_end are
-    // not known in advance: counted when the run ends, below).
+    // not known in advance: the sink counts them and stops the run at the limit).
     const double rows = spec.dt_out > 0.0 ? spec.t_end / spec.dt_out
                         : spec.steps > 0 ? static_cast<double>(spec.steps) / static_cast<double>(spec.every) : 0.0;
     if (rows * static_cast<double>(scene.bodies.size()) > max_rows)
@@ -224,6 +224,7 @@ int cmd_simulate(int argc, char** argv) {
   }
 
   std::vector<BodyRun> runs;
+  long rows_written = 0;
   for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
     const Body& body = scene.bodies[b];
     if (file) {
@@ -231,7 +232,10 @@ int cmd_simulate(int argc, char** argv) {
       const bool k2q = scene.centres.size() == 1;
       if (b == 0)
         os << "body,t,Rx,Ry,Rz,vx,vy,vz,wx,wy,wz,rel_dE,rel_dK2sq" << (k2q ? ",abs_dK2Q" : "") << "\n";
-      sink = [&os, b, k2q](const Sample& s) {
+      sink = [&os, b, k2q, &rows_written, max_rows](const Sample& s) {
+        if (static_cast<double>(++rows_written) > max_rows)
+          throw Error("--out reached --max-rows " + fmt(max_rows) + " rows; raise --every or --dt-out, or --max-rows; "
+                      "no output written");
         os << b << ',' << s.t << ',' << s.s.R.x() << ',' << s.s.R.y() << ',' << s.s.R.z() << ','
            << s.s.v.x() << ',' << s.s.v.y() << ',' << s.s.v.z() << ',' << s.s.w.x() << ','
            << s.s.w.y() << ',' << s.s.w.z() << ',' << s.rel_dE << ',' << s.rel_dK2sq;

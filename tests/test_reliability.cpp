@@ -76,6 +76,7 @@ TEST(Reliability, EveryIssueExampleEndsWithItsReason) {
       {"simulate --steps 1000000000000", "would take"},
       {"simulate --t-end 1e8 --max-seconds 60", "would take"},
       {"simulate --method logh-y4 --h 1e-2 --t-end 5 --out /tmp/bp_rel_dt.csv --dt-out 1e-320", "--max-rows"},
+      {"simulate --method logh-y4 --h 1e-4 --t-end 50 --out /tmp/bp_rel_rows.csv --max-rows 1000", "reached --max-rows"},
       {"simulate --m 0.49 --J 1 --steps 10", "zero within rounding"},
       {"simulate --d 1e308 --steps 10", "overflows a double"},
       {"simulate --A 2 --Kz 0 --d 1e-12 --h 1e-3 --t-end 80 --method rk4", "relative energy error reached"},
@@ -95,6 +96,7 @@ TEST(Reliability, EveryIssueExampleEndsWithItsReason) {
     std::printf("  %-100s %.2f s\n", c.args.c_str(), s);
   }
   EXPECT_FALSE(fs::exists("/tmp/bp_rel_dt.csv"));
+  EXPECT_FALSE(fs::exists("/tmp/bp_rel_rows.csv"));
 }
 
 TEST(Reliability, SubnormalValuesAreNumbersAndSweepRowsCarryAStatus) {
