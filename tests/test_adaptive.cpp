@@ -46,9 +46,6 @@ constexpr double kReversibilityTol = 1e-12;
 constexpr double kNotExactFactor = 1e3;
 // The round trip must pass the closest approach of table 3.1 (near t = 40).
 constexpr double kPastEncounter = 50.0;
-// For a material point (c = 0) dt/ds = 1/Pi ~ r/|A| varies from ~0.1 near the centre to ~100 at
-// r = 200: at least this range.
-constexpr double kMinStepRange = 100.0;
 // The material point of the close scene comes to r ~ 2.2 from r = 200: dt/ds = r/|A| spans ~90.
 constexpr double kMinMaterialStepRange = 50.0;
 // For a body-point the physical step is bounded by ds/c; the encounter still shrinks it by this much.
