@@ -316,6 +316,9 @@ ToleranceResult run_to_tolerance(const MethodInfo& method, const Body& body, con
   if (method.order == 0 && method.name != "ks")
     throw Error(std::string(method.name) + " has no fixed order for the error estimate");
   validate(Scene{centres, {body}});
+  if (non_coulomb(centres))
+    throw Error("--tol assumes Coulomb's law (its error model and time transformations do); run the thesis code's "
+                "force law with a fixed step --h");
   return Search(method, body, centres, tol, t_end).search();
 }
 

@@ -13,6 +13,22 @@
 
 namespace bodypoint::cli {
 
+ForceLaw parse_force_law(const std::string& name) {
+  if (name == "coulomb") return ForceLaw::coulomb;
+  if (name == "thesis-code") return ForceLaw::thesis_code;
+  if (name == "thesis-code-force") return ForceLaw::thesis_code_force;
+  throw Error("unknown --force-law '" + name + "' (coulomb, thesis-code, thesis-code-force)");
+}
+
+const char* force_law_name(ForceLaw law) {
+  switch (law) {
+    case ForceLaw::thesis_code: return "thesis-code";
+    case ForceLaw::thesis_code_force: return "thesis-code-force";
+    case ForceLaw::coulomb: break;
+  }
+  return "coulomb";
+}
+
 void add_scene_options(po::options_description& desc, SceneOptions& o) {
   SceneParams& p = o.params;
   desc.add_options()
@@ -25,12 +41,17 @@ void add_scene_options(po::options_description& desc, SceneOptions& o) {
       ("Kz", po::value(&p.start.Kz)->default_value(p.start.Kz), "K2(0) = Kx i - Kz k")
       ("d", po::value(&p.start.d)->default_value(p.start.d), "impact parameter")
       ("L", po::value(&p.start.L)->default_value(p.start.L), "initial distance along -x")
+      ("force-law", po::value<std::string>()->default_value("coulomb")->notifier([&p](const std::string& v) {
+         p.law = parse_force_law(v);
+       }),
+       "coulomb (the model); thesis-code (the thesis's published code: F ~ R/|R|^1.5 and its third-kick slip, "
+       "to regenerate its figures as published); thesis-code-force (that force law alone)")
       ("scene", po::value(&o.scene_file), "TOML scene file with several centres and bodies (see scenes/)");
 }
 
 Scene make_scene(const po::variables_map& vm, const SceneOptions& o) {
   if (vm.count("scene")) {
-    for (const char* k : {"A", "m", "B", "J", "K1", "Kx", "Kz", "d", "L"})
+    for (const char* k : {"A", "m", "B", "J", "K1", "Kx", "Kz", "d", "L", "force-law"})
       if (vm.count(k) && !vm[k].defaulted())
         throw Error(std::string("--") + k + " cannot be combined with --scene (set it in the scene file)");
     return read_scene_file(o.scene_file);
@@ -63,6 +84,7 @@ std::string describe(const SceneParams& p) {
   os << "A=" << fmt(p.A) << " m=" << fmt(p.m) << " B=" << fmt(p.B) << " J=" << fmt(p.J)
      << " K1=" << fmt(p.start.K1) << " Kx=" << fmt(p.start.Kx) << " Kz=" << fmt(p.start.Kz)
      << " d=" << fmt(p.start.d) << " L=" << fmt(p.start.L);
+  if (p.law != ForceLaw::coulomb) os << " force-law=" << force_law_name(p.law);
   return os.str();
 }
 

@@ -21,6 +21,9 @@ struct SceneOptions {
   std::string scene_file;
 };
 void add_scene_options(po::options_description& desc, SceneOptions& o);
+/// --force-law NAME: coulomb, thesis-code or thesis-code-force (model.hpp, ForceLaw).
+ForceLaw parse_force_law(const std::string& name);
+const char* force_law_name(ForceLaw law);
 /// The scene from --scene or from the thesis's parameters (never both).
 Scene make_scene(const po::variables_map& vm, const SceneOptions& o);
 

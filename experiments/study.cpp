@@ -15,6 +15,7 @@
 //   with identical parameters; both are run.
 #include "bodypoint/io.hpp"
 #include "cli.hpp"
+#include "errata.hpp"
 #include "stress.hpp"
 #include "sweep.hpp"
 #include "timing.hpp"
@@ -34,9 +35,19 @@ struct StudyContext {
   bool quick = false;
   unsigned threads = 1;
   bool progress = false;
+  /// Set by the "published" recipe: the thesis's code's force law and its seven methods, files
+  /// prefixed "published_" (model.hpp, ForceLaw::thesis_code).
+  bool published = false;
 };
 
-void write_sweep(const StudyContext& c, const std::string& file, const SweepSpec& spec, const std::string& note) {
+void write_sweep(const StudyContext& c, const std::string& name, SweepSpec spec, std::string note) {
+  std::string file = name;
+  if (c.published) {
+    spec.base.law = ForceLaw::thesis_code;
+    spec.methods = parse_methods("thesis-euler,thesis-verlet,thesis-ruth3,thesis-fr4,thesis-y6,rk4,ab4");
+    file = "published_" + name;
+    note += "; as published: the thesis code's force law F = -A R/|R|^1.5 and third-kick slip";
+  }
   AtomicFile f((c.dir / file).string());
   const auto rows = run_sweep(spec, c.threads, c.progress);
   write_sweep_csv(f.stream(), spec, rows, "bodypoint study" + std::string(c.quick ? " --quick" : "") + " (" + note + ")");
@@ -143,6 +154,23 @@ std::vector<AppendixSet> appendix_sets() {
           {28, {{"A", -1}}},            {29, {{"A", -2}}},           {30, {{"A", -5}}}};
 }
 
+void study_errata(const StudyContext& c) {
+  AtomicFile f((c.dir / "errata.csv").string());
+  write_errata(f.stream());
+  f.commit();
+  std::cerr << "wrote " << (c.dir / "errata.csv").string() << "\n";
+}
+
+/// Chapter 4's sweeps as the thesis's code computed them, beside the corrected ones.
+void study_published(const StudyContext& c) {
+  StudyContext p = c;
+  p.published = true;
+  study_d(p);
+  study_L(p);
+  study_h(p);
+  study_Kx(p);
+}
+
 void study_appendix(const StudyContext& c) {
   const fs::path dir = c.dir / "appendix1";
   fs::create_directories(dir);
@@ -217,7 +245,8 @@ void study_stress(const StudyContext& c) {
 const std::vector<std::pair<std::string, void (*)(const StudyContext&)>>& recipes() {
   static const std::vector<std::pair<std::string, void (*)(const StudyContext&)>> r = {
       {"d", study_d},         {"L", study_L},          {"h", study_h},         {"Kx", study_Kx},
-      {"timing", study_timing}, {"evals", study_evals}, {"appendix", study_appendix}, {"stress", study_stress}};
+      {"timing", study_timing}, {"evals", study_evals}, {"appendix", study_appendix}, {"errata", study_errata},
+      {"published", study_published}, {"stress", study_stress}};
   return r;
 }
 
@@ -229,13 +258,14 @@ int cmd_study(int argc, char** argv) {
   long threads = 0;
   po::options_description desc("bodypoint study");
   desc.add_options()
-      ("name", po::value(&which)->default_value(which), "recipe: d, L, h, Kx, timing, evals, appendix, all (these), or stress (hostile scenes, issue #12)")
+      ("name", po::value(&which)->default_value(which), "recipe: d, L, h, Kx, timing, evals, appendix, errata, published (chapter 4 with the thesis code's force "
+       "law), all (these), or stress (hostile scenes, issue #12)")
       ("results", po::value(&results)->default_value(results), "folder for the CSVs (created if missing)")
       ("quick", po::bool_switch(&quick), "coarser grids, same recipes (under two minutes on 2 cores)")
       ("threads", po::value(&threads)->default_value(0), "worker threads for the sweeps (0: all cores)");
   po::variables_map vm;
   if (!parse(argc, argv, desc, vm,
-             "usage: bodypoint study [--name d|L|h|Kx|timing|evals|appendix|all] [--results DIR] [--quick]\n"
+             "usage: bodypoint study [--name d|L|h|Kx|timing|evals|appendix|errata|published|all|stress] [--results DIR] [--quick]\n"
              "Regenerates the thesis's studies for its methods and ours side by side."))
     return 0;
   StudyContext c;
@@ -245,7 +275,7 @@ int cmd_study(int argc, char** argv) {
   c.progress = ::isatty(2) == 1;
   bool found = false;
   for (const auto& [name, fn] : recipes()) found = found || name == which;
-  if (!found && which != "all") throw Error("unknown study '" + which + "' (d, L, h, Kx, timing, evals, appendix, all, stress)");
+  if (!found && which != "all") throw Error("unknown study '" + which + "' (d, L, h, Kx, timing, evals, appendix, errata, published, all, stress)");
   std::error_code ec;
   fs::create_directories(c.dir, ec);
   if (ec || !fs::is_directory(c.dir)) throw Error("cannot create results folder '" + results + "'");

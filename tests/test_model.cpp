@@ -10,6 +10,7 @@
 
 #include <limits>
 #include <random>
+#include <type_traits>
 
 namespace bodypoint {
 namespace {
@@ -105,6 +106,55 @@ void expect_error(const std::function<void()>& f, const std::string& fragment) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
   }
+}
+
+// The thesis code's law, written out: F = -A R/|R|^1.5 (BodyPointEquationWithoutTensors.java divides by
+// Math.pow(|R|, 3.0/2.0)). Two evaluations of the same formula in a different order: a few roundings.
+constexpr double kLawTol = 1e-15;
+
+TEST(ForceLaw, ThesisCodeDividesByRToTheOneAndAHalf) {
+  const Vec3 R(3, -4, 12);  // |R| = 13
+  const double A = -2.0;
+  CentreList code{{Centre{Vec3::Zero(), A, ForceLaw::thesis_code_force}}};
+  CentreList coulomb{{Centre{Vec3::Zero(), A, ForceLaw::coulomb}}};
+  EXPECT_NEAR((code.force(R) - (-A / std::pow(13.0, 1.5)) * R).norm(), 0.0, kLawTol);
+  EXPECT_NEAR((coulomb.force(R) - (-A / (13.0 * 13.0 * 13.0)) * R).norm(), 0.0, kLawTol);
+  // The code's energy diagnostic keeps -A/|R| (Energy.java, getPotentialEnergy).
+  EXPECT_DOUBLE_EQ(code.potential(R), -A / 13.0);
+  // A non-Coulomb centre never takes the OriginCentre fast path.
+  const bool list = visit_field(code.centres, [](const auto& f) {
+    return std::is_same_v<std::decay_t<decltype(f)>, CentreList>;
+  });
+  EXPECT_TRUE(list);
+}
+
+TEST(ForceLaw, SlipMovesOnlyThirdKickSchemesAndOnlyUnderTheCodeLaw) {
+  SceneParams sp;
+  sp.law = ForceLaw::thesis_code_force;
+  const Scene force_only = thesis_scene(sp);
+  sp.law = ForceLaw::thesis_code;
+  const Scene code = thesis_scene(sp);
+  RunSpec rs;
+  rs.h = 1e-3;
+  rs.steps = 5000;
+  auto final_R = [&](const char* m, const Scene& sc) { return run(method_or_throw(m), sc.bodies.front(), sc.centres, rs).final.R; };
+  // Schemes with fewer than three kicks and every non-thesis method are untouched, bit for bit.
+  for (const char* m : {"thesis-euler", "thesis-verlet", "lp-y4", "rk4"})
+    EXPECT_EQ(final_R(m, force_only), final_R(m, code)) << m;
+  // Ruth 3, Forest-Ruth 4 and Yoshida 6 take the slip: their results move.
+  for (const char* m : {"thesis-ruth3", "thesis-fr4", "thesis-y6"})
+    EXPECT_NE(final_R(m, force_only), final_R(m, code)) << m;
+}
+
+TEST(ForceLaw, TimeTransformedMethodsAndTolRefuseTheCodeLaw) {
+  SceneParams sp;
+  sp.law = ForceLaw::thesis_code;
+  const Scene sc = thesis_scene(sp);
+  RunSpec rs;
+  rs.h = 1e-2;
+  rs.steps = 10;
+  for (const char* m : {"logh-y4", "ttl-y4"})
+    EXPECT_THROW((void)run(method_or_throw(m), sc.bodies.front(), sc.centres, rs), Error) << m;
 }
 
 TEST(Validation, RejectsNonPositiveMassInertiaAndD) {

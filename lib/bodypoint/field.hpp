@@ -49,6 +49,12 @@ struct OriginCentre {
   }
 };
 
+/// |F|/(|A| r) for centre k at distance 1/inv_r: 1/r^3 (Coulomb), or 1/r^1.5 for the thesis code's law
+/// (model.hpp, ForceLaw). Scenes with a non-Coulomb centre always take CentreList.
+inline double inverse_cube(const Centre& k, double inv_r) {
+  return k.law == ForceLaw::coulomb ? inv_r * inv_r * inv_r : inv_r * std::sqrt(inv_r);
+}
+
 struct CentreList {
   std::vector<Centre> centres;
   /// With one centre at c, K2Q = (R - c) x K1 + K2 is still conserved.
@@ -59,7 +65,7 @@ struct CentreList {
     for (const Centre& k : centres) {
       const Vec3 d = R - k.c;
       const double inv_r = 1.0 / std::sqrt(d.squaredNorm());
-      F -= (k.A * inv_r * inv_r * inv_r) * d;
+      F -= (k.A * inverse_cube(k, inv_r)) * d;
     }
     return F;
   }
@@ -80,7 +86,7 @@ struct CentreList {
     for (const Centre& k : centres) {
       const Vec3 d = R - k.c;
       const double inv_r = 1.0 / std::sqrt(d.squaredNorm());
-      F -= (k.A * inv_r * inv_r * inv_r) * d;
+      F -= (k.A * inverse_cube(k, inv_r)) * d;
       P -= k.A * inv_r;
     }
   }
@@ -92,7 +98,7 @@ struct CentreList {
       const Vec3 d = R - k.c;
       const double inv_r = 1.0 / std::sqrt(d.squaredNorm());
       const double inv_r3 = inv_r * inv_r * inv_r;
-      F -= (k.A * inv_r3) * d;
+      F -= (k.A * inverse_cube(k, inv_r)) * d;
       Omega += std::abs(k.A) * inv_r;
       grad -= (std::abs(k.A) * inv_r3) * d;
     }
@@ -108,10 +114,11 @@ inline bool all_repulsive(const std::vector<Centre>& centres) {
   return true;
 }
 
-/// Calls f(OriginCentre) for one centre at the origin, f(CentreList) otherwise.
+/// Calls f(OriginCentre) for one Coulomb centre at the origin, f(CentreList) otherwise.
 template <class F>
 decltype(auto) visit_field(const std::vector<Centre>& centres, F&& f) {
-  if (centres.size() == 1 && centres.front().c.isZero(0.0)) return f(OriginCentre{centres.front().A});
+  if (centres.size() == 1 && centres.front().c.isZero(0.0) && centres.front().law == ForceLaw::coulomb)
+    return f(OriginCentre{centres.front().A});
   return f(CentreList{centres});
 }
 

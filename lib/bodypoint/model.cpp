@@ -88,7 +88,7 @@ Scene thesis_scene(const SceneParams& sp) {
   validate(p, "body");
   Body body{p, to_state(p, thesis_momenta(sp.start)), "body"};
   Scene s;
-  s.centres.push_back(Centre{Vec3::Zero(), sp.A});
+  s.centres.push_back(Centre{Vec3::Zero(), sp.A, sp.law});
   s.bodies.push_back(body);
   validate(s);
   return s;

@@ -37,11 +37,27 @@ struct BodyPoint {
   [[nodiscard]] double D() const { return m * J - B * B; }
 };
 
+/// The force law of a centre. `coulomb` is the model. The other two reproduce the thesis's published
+/// Java code (github.com/axothy/Body-point-dynamics, BodyPointEquationWithoutTensors.java), which the
+/// thesis's figures came from: it divides by |R|^1.5 where |R|^3 is meant, so F = -A (R - c)/|R - c|^1.5
+/// (a force of size |A|/sqrt(r) that grows with distance), while its energy diagnostic keeps -A/|R|.
+/// `thesis_code` also reinstates the code's third-kick index slip in Ruth 3, Forest-Ruth 4 and
+/// Yoshida 6 (see splitting/thesis.hpp); `thesis_code_force` is the force law alone.
+enum class ForceLaw { coulomb, thesis_code_force, thesis_code };
+
 /// A fixed Coulomb centre at c with constant A (A < 0 repels, A > 0 attracts).
 struct Centre {
   Vec3 c = Vec3::Zero();
   double A = 0.0;
+  ForceLaw law = ForceLaw::coulomb;
 };
+
+/// True when some centre does not follow Coulomb's law (a reproduction of the thesis's code).
+inline bool non_coulomb(const std::vector<Centre>& centres) {
+  for (const Centre& k : centres)
+    if (k.law != ForceLaw::coulomb) return true;
+  return false;
+}
 
 /// Physical variables (R, v, w).
 struct State {
@@ -107,6 +123,7 @@ struct SceneParams {
   double B = 0.7;
   double J = 1.0;
   ThesisStart start;
+  ForceLaw law = ForceLaw::coulomb;
 };
 
 /// Scene of one body and one centre at the origin from the thesis's parameters.

@@ -71,11 +71,12 @@ struct EquationsOfMotion {
 template <class Scalar>
 struct PreciseEquations {
   Scalar m, B, J;
-  std::vector<std::array<Scalar, 4>> centres;  ///< (cx, cy, cz, A)
+  std::vector<std::array<Scalar, 5>> centres;  ///< (cx, cy, cz, A, 1 for the thesis code's |R|^1.5 law)
 
   PreciseEquations(const BodyPoint& p, const std::vector<Centre>& cs)
       : m(p.m), B(p.B), J(p.J) {
-    for (const Centre& k : cs) centres.push_back({k.c.x(), k.c.y(), k.c.z(), k.A});
+    for (const Centre& k : cs)
+      centres.push_back({k.c.x(), k.c.y(), k.c.z(), k.A, Scalar(k.law == ForceLaw::coulomb ? 0 : 1)});
   }
 
   void operator()(const OdeState<Scalar>& x, OdeState<Scalar>& dxdt, Scalar /*t*/) const {
@@ -83,7 +84,7 @@ struct PreciseEquations {
     for (const auto& k : centres) {
       const Scalar d[3] = {x[0] - k[0], x[1] - k[1], x[2] - k[2]};
       const Scalar r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-      const Scalar s = -k[3] / (r2 * std::sqrt(r2));
+      const Scalar s = k[4] == 0 ? -k[3] / (r2 * std::sqrt(r2)) : -k[3] / std::sqrt(std::sqrt(r2) * r2);
       for (int i = 0; i < 3; ++i) F[i] += s * d[i];
     }
     const Scalar* v = &x[3];

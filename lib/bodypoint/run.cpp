@@ -36,13 +36,22 @@ namespace sp = splitting;
 using detail::dispatch;
 using detail::observe;
 
-template <template <class, bool> class Kernel, const auto& Seq>
+/// True when the scene asks for the published code, index slip included (model.hpp, ForceLaw).
+bool reproduces_code(const std::vector<Centre>& centres) {
+  for (const Centre& k : centres)
+    if (k.law == ForceLaw::thesis_code) return true;
+  return false;
+}
+
+template <template <class, bool> class Kernel, const auto& Seq, sp::CodeSlip Slip = sp::CodeSlip::none>
 RunResult run_splitting(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
                         const SampleSink* sink) {
   return dispatch(body, centres, [&](const auto& field, auto spin) {
     using Field = std::decay_t<decltype(field)>;
     using K = Kernel<Field, decltype(spin)::value>;
     K kernel(body.p, field);
+    if constexpr (Slip != sp::CodeSlip::none)
+      if (reproduces_code(centres)) kernel.slip = Slip;
     auto to_physical = [&kernel](const typename K::state_type& x) { return kernel.to_physical(x); };
     RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
       typename K::state_type x = kernel.initial_state(body.s0);
@@ -71,10 +80,10 @@ constexpr auto mcl8_ops = sp::flatten(sp::mclachlan8);
 constexpr auto kl8_ops = sp::flatten(sp::kahan_li8);
 constexpr auto ss10_ops = sp::flatten(sp::sofroniou_spaletta10);
 
-template <const auto& Seq>
+template <const auto& Seq, sp::CodeSlip Slip = sp::CodeSlip::none>
 MethodInfo thesis_method(std::string_view name, int order, std::string_view what) {
   return {name, Family::Thesis, order, static_cast<int>(Seq.kicks()), static_cast<int>(Seq.kicks()),
-          what, &run_splitting<sp::ThesisKernel, Seq>};
+          what, &run_splitting<sp::ThesisKernel, Seq, Slip>};
 }
 
 template <const auto& Seq>
@@ -107,9 +116,9 @@ std::vector<MethodInfo> make_registry() {
 #endif
       thesis_method<euler_ops>("thesis-euler", 1, "thesis symplectic Euler, frozen gyroscopic term"),
       thesis_method<verlet_ops>("thesis-verlet", 2, "thesis Verlet (KDK), frozen gyroscopic term"),
-      thesis_method<ruth3_ops>("thesis-ruth3", 3, "thesis Ruth 3, frozen gyroscopic term"),
-      thesis_method<y4_ops>("thesis-fr4", 4, "thesis Forest-Ruth 4 (eq. 2.9-2.10), frozen gyroscopic term"),
-      thesis_method<y6_ops>("thesis-y6", 6, "thesis Yoshida 6 (table 2.1), frozen gyroscopic term"),
+      thesis_method<ruth3_ops, sp::CodeSlip::third_v_z>("thesis-ruth3", 3, "thesis Ruth 3, frozen gyroscopic term"),
+      thesis_method<y4_ops, sp::CodeSlip::third_v_z>("thesis-fr4", 4, "thesis Forest-Ruth 4 (eq. 2.9-2.10), frozen gyroscopic term"),
+      thesis_method<y6_ops, sp::CodeSlip::third_vw_z>("thesis-y6", 6, "thesis Yoshida 6 (table 2.1), frozen gyroscopic term"),
       lie_method<euler_ops>("lp-euler", 1, "exact Lie-Poisson splitting, Lie-Trotter D K"),
       lie_method<verlet_ops>("lp-verlet", 2, "exact Lie-Poisson Strang, kick-drift-kick"),
       lie_method<strang_ops>("lp-verlet-dkd", 2, "exact Lie-Poisson Strang, drift-kick-drift"),
@@ -178,6 +187,9 @@ RunResult run(const MethodInfo& method, const Body& body, const std::vector<Cent
   if (!std::isfinite(spec.h) || spec.h <= 0.0)
     throw Error("step size h must be a finite number > 0, got " + std::to_string(spec.h));
   if (spec.every < 1) throw Error("--every must be >= 1");
+  if (is_time_transformed(method) && non_coulomb(centres))
+    throw Error(std::string(method.name) + " assumes Coulomb's law (its time transformation is built on -A/|R|); the "
+                "thesis code's force law runs with the fixed-step, Runge-Kutta and step-size-controlled methods");
   // Time-transformed methods run to t_end when it is given, otherwise for spec.steps fictitious steps.
   if (is_time_transformed(method)) return method.run(body, centres, spec, sink);
   if (spec.steps < 1) throw Error("number of steps must be >= 1");

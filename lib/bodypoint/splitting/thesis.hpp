@@ -14,9 +14,18 @@
 
 namespace bodypoint::splitting {
 
+/// The thesis's published Java code (github.com/axothy/Body-point-dynamics) has an index slip in its
+/// third kick: RuthMethodForSystem and YoshidaMethodForSystem (Forest-Ruth 4) give the z-component of
+/// the third velocity kick the force at the first stage's position, r_first, instead of r_third;
+/// YoshidaMethod6thOrder does the same for the z-component of the third spin kick as well. It is
+/// reproduced only under ForceLaw::thesis_code (model.hpp), to regenerate the figures as published.
+enum class CodeSlip { none, third_v_z, third_vw_z };
+
 struct ThesisState {
   State s;
   Vec3 gyro = Vec3::Zero();  ///< w x v frozen at the start of the step
+  int kick = 0;              ///< kicks taken in this step (for the code's slip only)
+  double first_Fz = 0.0;     ///< z-component of the first kick's force (for the code's slip only)
 };
 
 template <class Field, bool Spin>
@@ -33,19 +42,31 @@ struct ThesisKernel {
 
   [[nodiscard]] ThesisState initial_state(const State& s0) const { return {s0, Vec3::Zero()}; }
 
+  /// CodeSlip::none unless the scene reproduces the published code (set by the registry).
+  CodeSlip slip = CodeSlip::none;
+
   void begin_step(ThesisState& x) const {
     if constexpr (Spin) x.gyro = x.s.w.cross(x.s.v);
+    x.kick = 0;
   }
 
   void drift(ThesisState& x, double tau) const { x.s.R += tau * x.s.v; }
 
   void kick(ThesisState& x, double tau) {
     ++evals;
-    const Vec3 F = field.force(x.s.R);
+    Vec3 F = field.force(x.s.R);
+    Vec3 Fw = F;  // the force the spin kick sees (differs from F only under the code's slip)
+    if (slip != CodeSlip::none) {
+      if (++x.kick == 1) x.first_Fz = F.z();
+      if (x.kick == 3) {
+        F.z() = x.first_Fz;
+        if (slip == CodeSlip::third_vw_z) Fw.z() = x.first_Fz;
+      }
+    }
     if constexpr (Spin) {
       const double c = tau * inv_D_;
       x.s.v += c * (p.J * F - p.B * p.B * x.gyro);
-      x.s.w += c * (-p.B * F + p.m * p.B * x.gyro);
+      x.s.w += c * (-p.B * Fw + p.m * p.B * x.gyro);
     } else {
       x.s.v += (tau / p.m) * F;
     }
