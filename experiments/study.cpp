@@ -16,6 +16,7 @@
 #include "bodypoint/io.hpp"
 #include "cli.hpp"
 #include "errata.hpp"
+#include "orders.hpp"
 #include "stress.hpp"
 #include "sweep.hpp"
 #include "timing.hpp"
@@ -82,7 +83,7 @@ void study_h(const StudyContext& c) {
   s.base.start.d = 50;
   s.steps = 0;
   s.t_end = 25;
-  s.values = c.quick ? log_range(1e-3, 0.5, 6) : log_range(1e-4, 0.5, 25);
+  s.values = c.quick ? log_range(1e-4, 0.5, 7) : log_range(1e-4, 0.5, 25);
   write_sweep(c, "h_sweep.csv", s, "fig. 4.5-4.9: T = h n = 25, d = 50, L = 200; h log-spaced (our choice)");
 }
 
@@ -159,6 +160,13 @@ void study_errata(const StudyContext& c) {
   write_errata(f.stream());
   f.commit();
   std::cerr << "wrote " << (c.dir / "errata.csv").string() << "\n";
+}
+
+void study_orders(const StudyContext& c) {
+  AtomicFile f((c.dir / "orders.csv").string());
+  write_orders(f.stream());
+  f.commit();
+  std::cerr << "wrote " << (c.dir / "orders.csv").string() << "\n";
 }
 
 /// Chapter 4's sweeps as the thesis's code computed them, beside the corrected ones.
@@ -245,7 +253,7 @@ void study_stress(const StudyContext& c) {
 const std::vector<std::pair<std::string, void (*)(const StudyContext&)>>& recipes() {
   static const std::vector<std::pair<std::string, void (*)(const StudyContext&)>> r = {
       {"d", study_d},         {"L", study_L},          {"h", study_h},         {"Kx", study_Kx},
-      {"timing", study_timing}, {"evals", study_evals}, {"appendix", study_appendix}, {"errata", study_errata},
+      {"timing", study_timing}, {"evals", study_evals}, {"appendix", study_appendix}, {"errata", study_errata}, {"orders", study_orders},
       {"published", study_published}, {"stress", study_stress}};
   return r;
 }
@@ -258,14 +266,14 @@ int cmd_study(int argc, char** argv) {
   long threads = 0;
   po::options_description desc("bodypoint study");
   desc.add_options()
-      ("name", po::value(&which)->default_value(which), "recipe: d, L, h, Kx, timing, evals, appendix, errata, published (chapter 4 with the thesis code's force "
+      ("name", po::value(&which)->default_value(which), "recipe: d, L, h, Kx, timing, evals, appendix, errata, orders, published (chapter 4 with the thesis code's force "
        "law), all (these), or stress (hostile scenes, issue #12)")
       ("results", po::value(&results)->default_value(results), "folder for the CSVs (created if missing)")
       ("quick", po::bool_switch(&quick), "coarser grids, same recipes (under two minutes on 2 cores)")
       ("threads", po::value(&threads)->default_value(0), "worker threads for the sweeps (0: all cores)");
   po::variables_map vm;
   if (!parse(argc, argv, desc, vm,
-             "usage: bodypoint study [--name d|L|h|Kx|timing|evals|appendix|errata|published|all|stress] [--results DIR] [--quick]\n"
+             "usage: bodypoint study [--name d|L|h|Kx|timing|evals|appendix|errata|orders|published|all|stress] [--results DIR] [--quick]\n"
              "Regenerates the thesis's studies for its methods and ours side by side."))
     return 0;
   StudyContext c;
@@ -275,7 +283,7 @@ int cmd_study(int argc, char** argv) {
   c.progress = ::isatty(2) == 1;
   bool found = false;
   for (const auto& [name, fn] : recipes()) found = found || name == which;
-  if (!found && which != "all") throw Error("unknown study '" + which + "' (d, L, h, Kx, timing, evals, appendix, errata, published, all, stress)");
+  if (!found && which != "all") throw Error("unknown study '" + which + "' (d, L, h, Kx, timing, evals, appendix, errata, orders, published, all, stress)");
   std::error_code ec;
   fs::create_directories(c.dir, ec);
   if (ec || !fs::is_directory(c.dir)) throw Error("cannot create results folder '" + results + "'");

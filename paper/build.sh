@@ -1,30 +1,68 @@
 #!/usr/bin/env bash
-# bodypoint research appendix: regenerates every CSV from the drivers and every figure from the CSVs.
+# bodypoint research appendix: regenerates every CSV from the drivers, every figure and every number
+# of the paper from the CSVs, and compiles paper/build/bodypoint.pdf.
 #
-#   paper/build.sh            full studies (thesis grids; the timing recipe, 500 values of n x 22 methods
-#                             x 4 runs, dominates) into paper/results/
-#   paper/build.sh --quick    the same recipes on coarse grids (63 s on 2 cores) into paper/results-quick/
+#   paper/build.sh            thesis grids, every named scene, 3 timed repeats, into paper/results/
+#   paper/build.sh --quick    the same recipes, scenes and sections on coarse grids into paper/results-quick/
 #
-# Outputs: <results>/*.csv (bodypoint study, bodypoint work-precision and its --by-tol view),
-# <results>/figures/*.png and
-# <results>/figures/figures.md. Every number in the appendix comes from these files.
+# Steps: bodypoint study (d, L, h, Kx sweeps, timing, force evaluations, appendix 1, errata, the sweeps
+# as published, stress), bodypoint work-precision (ladders and --by-tol), bench_steps (cost per step),
+# make_figures.py (vector PDF), make_macros.py (LaTeX macros and tables), latexmk.
+# BODYPOINT_NO_SETUP=1 skips scripts/setup.sh and BODYPOINT_BUILD_DIR names the build tree (default
+# build/); the ctest that builds the quick paper sets both.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-quick=""
+mode=full
 results=paper/results
 if [ "${1:-}" = "--quick" ]; then
-  quick="--quick"
+  mode=quick
   results=paper/results-quick
+elif [ -n "${1:-}" ]; then
+  echo "usage: paper/build.sh [--quick]" >&2
+  exit 2
 fi
-scripts/setup.sh >/dev/null
-bin=build/bin/bodypoint
+[ "${BODYPOINT_NO_SETUP:-0}" = 1 ] || scripts/setup.sh >/dev/null
+bindir="${BODYPOINT_BUILD_DIR:-build}/bin"
+bin=$bindir/bodypoint
+py="${PYTHON:-/usr/bin/python3}"  # Debian's python3 with python3-matplotlib
+start=$(date +%s)
 mkdir -p "$results"
-$bin study $quick --results "$results"
-$bin work-precision $quick --out "$results/work_precision.csv" --summary "$results/work_precision_summary.md" \
+
+q=()
+[ $mode = quick ] && q=(--quick)
+$bin study "${q[@]}" --results "$results"
+$bin study "${q[@]}" --name stress --results "$results"
+
+if [ $mode = quick ]; then
+  wp=(--quick --scenes all --max-evals 3e5)
+  by_tol=(--tols 1e-4,1e-7,1e-10 --repeats 1)
+  bench=(--benchmark_min_time=0.02)
+else
+  wp=()
+  by_tol=()
+  bench=(--benchmark_repetitions=3 --benchmark_report_aggregates_only=true)
+fi
+$bin work-precision "${wp[@]}" --out "$results/work_precision.csv" --summary "$results/work_precision_summary.md" \
   > "$results/work_precision_summary.txt"
-by_tol=()  # auto and every step-size-controlled peer at the same requested tolerance
-[ -n "$quick" ] && by_tol=(--scenes close,thesis --tols 1e-4,1e-7,1e-10 --repeats 1)
 $bin work-precision --by-tol "${by_tol[@]}" --out "$results/by_tol.csv" --summary "$results/by_tol_summary.md" \
   > "$results/by_tol_summary.txt"
-"${PYTHON:-/usr/bin/python3}" paper/make_figures.py "$results" "$results/figures"  # Debian python3-matplotlib
-echo "appendix rebuilt in $results"
+# Cost per step of every method on the thesis scene (medians with repetitions in the full build).
+"$bindir/bench_steps" --benchmark_filter='BM_Step/.*/thesis' "${bench[@]}" --benchmark_format=csv \
+  > "$results/bench_steps.csv.tmp" 2>/dev/null
+if [ $mode = full ]; then  # keep the medians only
+  { grep -v '^"BM_Step/.*_\(mean\|stddev\|cv\)"' "$results/bench_steps.csv.tmp" | sed 's#/thesis_median"#/thesis"#'; } \
+    > "$results/bench_steps.csv.tmp2" && mv "$results/bench_steps.csv.tmp2" "$results/bench_steps.csv.tmp"
+fi
+mv "$results/bench_steps.csv.tmp" "$results/bench_steps.csv"
+
+out=paper/build
+mkdir -p "$out"
+"$py" paper/make_figures.py "$results" "$out/figures"
+"$py" paper/make_macros.py "$results" "$out/generated" "$mode"
+cp paper/bodypoint.tex paper/bodypoint.bib "$out/"
+(cd "$out" && latexmk -pdf -interaction=nonstopmode -halt-on-error bodypoint.tex > latexmk.out 2>&1) || {
+  tail -40 "$out/latexmk.out" >&2
+  echo "paper/build.sh: LaTeX failed; the log is $out/bodypoint.log" >&2
+  exit 1
+}
+echo "paper/build.sh: $out/bodypoint.pdf ($mode, $(( $(date +%s) - start )) s; results in $results)"

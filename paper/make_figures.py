@@ -1,15 +1,16 @@
 #!/usr/bin/env python3
-"""Draws every figure of the bodypoint research appendix from the CSVs the drivers wrote.
+"""Draws every figure of the bodypoint research appendix, as vector PDF, from the CSVs the drivers wrote.
 
 usage: make_figures.py RESULTS_DIR FIGURES_DIR
 
-Reads (all produced by `bodypoint study` and `bodypoint work-precision`, see paper/build.sh):
-  d_sweep.csv, L_sweep.csv, h_sweep.csv, Kx_sweep.csv, timing.csv, force_evals.csv,
-  appendix1/index.csv and appendix1/P1.*.csv, work_precision.csv
-Writes one PNG per figure and figures.md, a list of the figures with the thesis figure each
-one reproduces. Nothing here computes physics: it only plots what the drivers measured.
+Reads (all written by paper/build.sh through `bodypoint study`, `bodypoint work-precision`):
+  {d,L,h,Kx}_sweep.csv and published_{d,L,h,Kx}_sweep.csv, timing.csv, appendix1/index.csv and
+  appendix1/P1.*.csv, work_precision.csv, by_tol.csv
+Writes fig_*.pdf and figures.md (which thesis figure each one stands for). Nothing here computes
+physics: it only draws what the drivers measured.
 """
 import csv
+import math
 import os
 import sys
 
@@ -18,24 +19,34 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-FAMILIES = {  # line style per method family, so the thesis's and our methods are told apart
-    "thesis": dict(linestyle="--"),
-    "rk4": dict(linestyle=":"),
-    "ab4": dict(linestyle=":"),
-    "lp": dict(linestyle="-"),
-    "odeint": dict(linestyle="-."),
-    "gsl": dict(linestyle="-."),
-    "logh": dict(linestyle="-"),
-    "ttl": dict(linestyle="-"),
-    "ks": dict(linestyle="-"),
-}
+plt.rcParams.update({"font.size": 8, "axes.titlesize": 8, "legend.fontsize": 6, "figure.dpi": 100,
+                     "pdf.fonttype": 42, "savefig.bbox": "tight"})
+
+THESIS_SEVEN = ["thesis-euler", "thesis-verlet", "thesis-ruth3", "thesis-fr4", "thesis-y6", "rk4", "ab4"]
+# Families of the work-precision figures, in drawing order, with a colour each.
+FAMILIES = [("thesis's seven", "tab:red"), ("Lie-Poisson", "tab:blue"), ("time-transformed", "tab:green"),
+            ("KS", "tab:purple"), ("Boost.Odeint", "tab:orange"), ("GSL", "tab:brown")]
+# Deviations above this mean the run diverged (the thesis's schemes reach 1e190 at coarse steps); they
+# are drawn at this ceiling so the other curves stay readable.
+DIVERGED = 1e2
+# Width of a figure spanning the text, in inches (the article's text block is 6.3 in).
+WIDE = 6.3
 
 
-def style(method):
-    for prefix, s in FAMILIES.items():
-        if method.startswith(prefix):
-            return s
-    return {}
+def family(method):
+    if method in THESIS_SEVEN:
+        return "thesis's seven"
+    if method.startswith("lp-"):
+        return "Lie-Poisson"
+    if method.startswith(("logh-", "ttl-")):
+        return "time-transformed"
+    if method == "ks":
+        return "KS"
+    if method.startswith("odeint-"):
+        return "Boost.Odeint"
+    if method.startswith("gsl-"):
+        return "GSL"
+    return None
 
 
 def read_csv(path):
@@ -51,126 +62,191 @@ def by_method(rows):
     return out
 
 
-# Relative deviations above this mean the run diverged (the thesis's schemes and RK4 reach 1e190 at
-# coarse steps); they are drawn at this ceiling so that the other curves stay readable.
-DIVERGED = 1e2
+def num(s):
+    try:
+        return float(s)
+    except (TypeError, ValueError):
+        return float("nan")
 
 
-def positive(values):
-    """Plots on log axes drop zeros (a deviation of exactly 0) and cap diverged runs at DIVERGED."""
-    return [float("nan") if not v > 0 else min(v, DIVERGED) for v in values]
+def capped(v):
+    """Log axes drop zeros (a deviation of exactly 0); diverged runs are drawn at DIVERGED."""
+    return float("nan") if not v > 0 else min(v, DIVERGED)
 
 
-def sweep_figure(rows, param, column, ylabel, title, path, methods=None):
-    fig, ax = plt.subplots(figsize=(8, 5))
-    for method, rs in by_method(rows).items():
-        if methods and method not in methods:
+def save(fig, path, listing, what):
+    fig.savefig(path)
+    plt.close(fig)
+    listing.append((os.path.basename(path), what))
+
+
+def sweep_panel(ax, rows, param, column, methods, title, legend=True):
+    groups = by_method(rows)
+    cmap = plt.get_cmap("tab20")
+    for i, m in enumerate(methods):
+        rs = groups.get(m)
+        if not rs:
             continue
-        xs = [float(r[param]) for r in rs]
-        ys = positive([float(r[column]) for r in rs])
-        ax.plot(xs, ys, label=method, **style(method))
+        xs = [num(r[param]) for r in rs]
+        ys = [capped(num(r[column])) for r in rs]
+        ax.plot(xs, ys, label=m, color=cmap(i % 20), linewidth=0.9,
+                linestyle="--" if m.startswith("thesis-") else "-")
     ax.set_yscale("log")
     if param == "h":
         ax.set_xscale("log")
-    ax.axhline(DIVERGED, color="grey", linewidth=0.5)
-    ax.text(ax.get_xlim()[0], DIVERGED, " diverged", fontsize=7, va="bottom", color="grey")
+    ax.axhline(DIVERGED, color="grey", linewidth=0.4)
     ax.set_xlabel(param)
-    ax.set_ylabel(ylabel)
     ax.set_title(title)
-    ax.legend(fontsize=6, ncol=3)
-    ax.grid(True, which="both", alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    if legend:  # below the panel, so that no curve is hidden
+        ax.legend(ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.28), frameon=False)
+
+
+def sweep_figures(res, figs, listing):
+    thesis_figs = {"d": "4.1-4.2", "L": "4.3-4.4", "h": "4.5-4.7", "Kx": "4.10-4.11"}
+    for param, tfig in thesis_figs.items():
+        rows = read_csv(os.path.join(res, f"{param}_sweep.csv"))
+        published = read_csv(os.path.join(res, f"published_{param}_sweep.csv"))
+        lp = sorted({r["method"] for r in rows if r["method"].startswith("lp-")})
+        fig, axes = plt.subplots(1, 3, figsize=(WIDE, 2.7), sharey=True)
+        sweep_panel(axes[0], published, param, "max_rel_dE", THESIS_SEVEN, "as published: code's force law")
+        sweep_panel(axes[1], rows, param, "max_rel_dE", THESIS_SEVEN, "the same seven, corrected", legend=False)
+        sweep_panel(axes[2], rows, param, "max_rel_dE", lp, "exact Lie-Poisson, corrected")
+        axes[0].set_ylabel("max relative energy deviation")
+        save(fig, os.path.join(figs, f"fig_sweep_{param}.pdf"), listing,
+             f"thesis fig. {tfig}: max relative energy deviation against {param}")
+    rows = read_csv(os.path.join(res, "h_sweep.csv"))
+    lp = sorted({r["method"] for r in rows if r["method"].startswith("lp-")})
+    fig, axes = plt.subplots(1, 2, figsize=(WIDE * 2 / 3, 2.9), sharey=True)
+    sweep_panel(axes[0], rows, "h", "max_rel_dK2sq", THESIS_SEVEN, "thesis's seven")
+    sweep_panel(axes[1], rows, "h", "max_rel_dK2sq", lp, "exact Lie-Poisson")
+    axes[0].set_ylabel("max relative deviation of |K2|^2")
+    save(fig, os.path.join(figs, "fig_k2sq_h.pdf"), listing, "thesis fig. 4.8-4.9: |K2|^2 deviation against h")
+
+
+def timing_figure(res, figs, listing):
+    rows = read_csv(os.path.join(res, "timing.csv"))
+    groups = by_method(rows)
+    shown = THESIS_SEVEN + ["lp-verlet", "lp-y4", "lp-kl6", "lp-kl8"]
+    fig, ax = plt.subplots(figsize=(WIDE / 2, 2.6))
+    cmap = plt.get_cmap("tab20")
+    for i, m in enumerate(shown):
+        rs = groups.get(m, [])
+        ax.plot([num(r["n"]) for r in rs], [num(r["median_s"]) * 1e3 for r in rs], label=m, color=cmap(i),
+                linewidth=0.9, linestyle="--" if m.startswith("thesis-") else "-")
+    ax.set_xlabel("number of steps n")
+    ax.set_ylabel("median run time [ms]")
+    ax.legend(ncol=2)
+    save(fig, os.path.join(figs, "fig_timing.pdf"), listing, "thesis fig. 4.12-4.13: run time against n")
+
+
+def appendix_figure(res, figs, listing):
+    index = read_csv(os.path.join(res, "appendix1", "index.csv"))
+    fig, axes = plt.subplots(5, 6, figsize=(WIDE, 5.6))
+    for ax, row in zip(axes.flat, index):
+        ax.set_xticks([])
+        ax.set_yticks([])
+        label = f"P1.{row['figure']}"
+        if row["status"] != "ok":
+            ax.text(0.5, 0.5, "D <= 0:\nnot run", ha="center", va="center", fontsize=6, transform=ax.transAxes)
+        else:
+            traj = read_csv(os.path.join(res, "appendix1", row["file"]))
+            xs = [num(r["Rx"]) for r in traj]
+            ys = [num(r["Ry"]) for r in traj]
+            ok = [(x, y) for x, y in zip(xs, ys) if math.isfinite(x) and math.isfinite(y) and abs(x) < 1e4 and abs(y) < 1e4]
+            if ok:
+                ax.plot([p[0] for p in ok], [p[1] for p in ok], linewidth=0.7)
+            ax.plot([0], [0], "k.", markersize=3)
+            if len(ok) < len(xs):
+                label += " (leaves)"
+        ax.set_title(label, fontsize=6, pad=2)
+    save(fig, os.path.join(figs, "fig_appendix1.pdf"), listing,
+         "thesis appendix 1 (fig. P1.1-P1.30): trajectories in the (x, y) plane, thesis-euler, h = 1e-4")
+
+
+def pareto(points):
+    """Points (time, error, label) not dominated by a faster and more accurate one, by time."""
+    front, best = [], float("inf")
+    for t, e, lab in sorted(points):
+        if e < best:
+            front.append((t, e, lab))
+            best = e
+    return front
+
+
+def work_precision_figures(res, figs, listing):
+    rows = read_csv(os.path.join(res, "work_precision.csv"))
+    scenes = []
+    for r in rows:
+        if r["scene"] not in scenes:
+            scenes.append(r["scene"])
+    for scene in scenes:
+        fig, ax = plt.subplots(figsize=(WIDE / 2, 2.8))
+        for fam, colour in FAMILIES:
+            pts = [(num(r["wall_s"]) * 1e3, num(r["err_rel"]), r["method"]) for r in rows
+                   if r["scene"] == scene and family(r["method"]) == fam]
+            pts = [p for p in pts if p[0] > 0 and 0 < p[1] < 1]
+            front = pareto(pts)
+            if not front:
+                continue
+            ax.step([p[0] for p in front], [p[1] for p in front], where="post", color=colour, label=fam, linewidth=1)
+            ax.plot([p[0] for p in front], [p[1] for p in front], ".", color=colour, markersize=3)
+            # Label the methods that hold the longest stretches of the front (at most three).
+            counts = {}
+            for p in front:
+                counts[p[2]] = counts.get(p[2], 0) + 1
+            for lab in sorted(counts, key=lambda k: -counts[k])[:3]:
+                t, e, _ = min(p for p in front if p[2] == lab)
+                ax.annotate(lab, (t, e), fontsize=5, color=colour, xytext=(2, 2), textcoords="offset points")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("run time [ms]")
+        ax.set_ylabel("final-position error |dR|/|R|")
+        ax.set_title(f"scene {scene}: Pareto front per family")
+        ax.legend(loc="upper right")
+        save(fig, os.path.join(figs, f"fig_wp_{scene}.pdf"), listing, f"work-precision on scene {scene}")
+
+
+def by_tol_figure(res, figs, listing):
+    rows = read_csv(os.path.join(res, "by_tol.csv"))
+    scenes = []
+    for r in rows:
+        if r["scene"] not in scenes:
+            scenes.append(r["scene"])
+    fig, axes = plt.subplots(1, len(scenes), figsize=(WIDE, 2.2), sharey=True, squeeze=False)
+    for ax, scene in zip(axes[0], scenes):
+        sr = [r for r in rows if r["scene"] == scene and r["kind"] in ("auto", "at-tol")]
+        for name in sorted({r["method"] if r["kind"] == "at-tol" else "auto" for r in sr}):
+            rs = [r for r in sr if (r["kind"] == "auto" and name == "auto") or (r["kind"] == "at-tol" and r["method"] == name)]
+            ax.plot([num(r["tol"]) for r in rs], [capped(num(r["err"])) for r in rs], "o-" if name == "auto" else ".--",
+                    label=name, markersize=3, linewidth=1.2 if name == "auto" else 0.7)
+        lo = min(num(r["tol"]) for r in sr)
+        hi = max(num(r["tol"]) for r in sr)
+        ax.plot([lo, hi], [lo, hi], color="grey", linewidth=0.5)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_title(scene)
+        ax.set_xlabel("requested TOL")
+    axes[0][0].set_ylabel("delivered error")
+    axes[0][0].legend(loc="lower right")
+    save(fig, os.path.join(figs, "fig_by_tol.pdf"), listing, "delivered error against requested TOL")
 
 
 def main():
     if len(sys.argv) != 3:
-        sys.exit(__doc__)
-    res, out = sys.argv[1], sys.argv[2]
-    os.makedirs(out, exist_ok=True)
+        sys.exit("usage: make_figures.py RESULTS_DIR FIGURES_DIR")
+    res, figs = sys.argv[1], sys.argv[2]
+    os.makedirs(figs, exist_ok=True)
     listing = []
-
-    def figure(name, thesis_ref, what):
-        listing.append(f"| `{name}` | {thesis_ref} | {what} |")
-        return os.path.join(out, name)
-
-    thesis = ["rk4", "ab4", "thesis-euler", "thesis-verlet", "thesis-ruth3", "thesis-fr4", "thesis-y6"]
-    d = read_csv(os.path.join(res, "d_sweep.csv"))
-    sweep_figure(d, "d", "max_rel_dE", "max |E-E0|/|E0|", "Energy deviation against d (thesis methods)",
-                 figure("d_sweep_thesis.png", "fig. 4.1-4.2", "max rel. energy deviation vs d, the thesis's seven methods"),
-                 thesis)
-    sweep_figure(d, "d", "max_rel_dE", "max |E-E0|/|E0|", "Energy deviation against d (all fixed-step methods)",
-                 figure("d_sweep_all.png", "fig. 4.1 (extended)", "the same with the Lie-Poisson methods"))
-    L = read_csv(os.path.join(res, "L_sweep.csv"))
-    sweep_figure(L, "L", "max_rel_dE", "max |E-E0|/|E0|", "Energy deviation against L (d = 50)",
-                 figure("L_sweep.png", "fig. 4.3-4.4", "max rel. energy deviation vs L"))
-    h = read_csv(os.path.join(res, "h_sweep.csv"))
-    sweep_figure(h, "h", "max_rel_dE", "max |E-E0|/|E0|", "Energy deviation against h (T = 25)",
-                 figure("h_sweep_energy.png", "fig. 4.5-4.7", "max rel. energy deviation vs h"))
-    sweep_figure(h, "h", "max_rel_dK2sq", "max |K2^2-K2^2_0|/K2^2_0", "|K2|^2 deviation against h",
-                 figure("h_sweep_K2sq.png", "fig. 4.8-4.9", "max rel. |K2|^2 deviation vs h"))
-    kx = read_csv(os.path.join(res, "Kx_sweep.csv"))
-    sweep_figure(kx, "Kx", "max_rel_dK2sq", "max |K2^2-K2^2_0|/K2^2_0", "|K2|^2 deviation against Kx",
-                 figure("Kx_sweep_K2sq.png", "fig. 4.10-4.11", "max rel. |K2|^2 deviation vs Kx"))
-
-    timing = read_csv(os.path.join(res, "timing.csv"))
-    fig, ax = plt.subplots(figsize=(8, 5))
-    for method, rs in by_method(timing).items():
-        ns = [int(r["n"]) for r in rs]
-        ax.plot(ns, [float(r["median_s"]) for r in rs], label=method, **style(method))
-        ax.fill_between(ns, [float(r["min_s"]) for r in rs], [float(r["max_s"]) for r in rs], alpha=0.15)
-    ax.set_yscale("log")
-    ax.set_xlabel("n (steps)")
-    ax.set_ylabel("run time of the step loop [s] (median, min-max band)")
-    ax.set_title("Run time against n (h = 1e-4, table 3.1)")
-    ax.legend(fontsize=6, ncol=3)
-    ax.grid(True, which="both", alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(figure("timing.png", "fig. 4.12-4.13", "run time vs n, median of repeats"), dpi=120)
-    plt.close(fig)
-
-    wp_path = os.path.join(res, "work_precision.csv")
-    if os.path.exists(wp_path):
-        wp = read_csv(wp_path)
-        for scene in sorted({r["scene"] for r in wp}):
-            fig, ax = plt.subplots(figsize=(8, 5))
-            for method, rs in by_method([r for r in wp if r["scene"] == scene]).items():
-                pts = [(float(r["wall_s"]), float(r["err_rel"])) for r in rs if float(r["err_rel"]) > 0]
-                pts = [(t, e) for t, e in pts if e == e and e < 1]
-                if pts:
-                    ax.plot([p[0] for p in pts], [p[1] for p in pts], marker=".", label=method, **style(method))
-            ax.set_xscale("log")
-            ax.set_yscale("log")
-            ax.set_xlabel("run time [s] (median)")
-            ax.set_ylabel("final-position error |R - R_ref|/|R_ref|")
-            ax.set_title(f"Work-precision: scene '{scene}'")
-            ax.legend(fontsize=5, ncol=4)
-            ax.grid(True, which="both", alpha=0.3)
-            fig.tight_layout()
-            fig.savefig(figure(f"work_precision_{scene}.png", "new", f"error vs run time, scene {scene}"), dpi=120)
-            plt.close(fig)
-
-    index = read_csv(os.path.join(res, "appendix1", "index.csv"))
-    fig, axes = plt.subplots(5, 6, figsize=(18, 14))
-    for ax, row in zip(axes.flat, index):
-        ax.set_title(f"P1.{row['figure']}", fontsize=8)
-        if row["status"] != "ok":
-            ax.text(0.5, 0.5, "skipped:\nD = mJ - B^2 <= 0", ha="center", va="center", fontsize=8)
-            ax.set_axis_off()
-            continue
-        traj = read_csv(os.path.join(res, "appendix1", row["file"]))
-        ax.plot([float(r["Rx"]) for r in traj], [float(r["Ry"]) for r in traj], linewidth=0.8)
-        ax.plot([0], [0], "r*")
-        ax.tick_params(labelsize=6)
-    fig.tight_layout()
-    fig.savefig(figure("appendix1_trajectories.png", "appendix 1, fig. P1.1-P1.30",
-                       "trajectories (x, y) of the 30 parameter sets, thesis-euler"), dpi=100)
-    plt.close(fig)
-
-    with open(os.path.join(out, "figures.md"), "w") as f:
-        f.write("| figure | reproduces | content |\n|---|---|---|\n" + "\n".join(listing) + "\n")
-    print(f"wrote {len(listing)} figures to {out}")
+    sweep_figures(res, figs, listing)
+    timing_figure(res, figs, listing)
+    appendix_figure(res, figs, listing)
+    work_precision_figures(res, figs, listing)
+    by_tol_figure(res, figs, listing)
+    with open(os.path.join(figs, "figures.md"), "w") as f:
+        f.write("| file | what it shows |\n|---|---|\n")
+        for name, what in listing:
+            f.write(f"| {name} | {what} |\n")
+    print(f"wrote {len(listing)} figures to {figs}")
 
 
 if __name__ == "__main__":

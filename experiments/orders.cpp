@@ -1,0 +1,119 @@
+// bodypoint study orders: for every fixed-step and time-transformed method, a ladder of steps h0/sqrt(2)^k
+// on the two scenes of tests/test_convergence.cpp, the final position against a long-double reference,
+// and the slope fitted above round-off (bodypoint/order_fit.hpp):
+//   encounter  table 3.1 moved close (L = 20, d = 1), stopped at t = 3 next to the closest approach;
+//   orbit      a bound eccentric orbit (A = 1, e ~ 0.44) for two periods (t = 30): a longer run widens
+//              the window above round-off, which the order-8 and order-10 tables need.
+// B = 0.7 (ks: B = 0). h0 is found per method, halved from kFirstStep until the error is below
+// kStartError. Time-transformed methods run with c = 0 (--omega-c 0): the automatic c grows with the
+// fictitious step and would change the transformation along the ladder. The thesis's drift/kick schemes
+// are measured on the encounter only (first order: their orbit ladder would need 1e8 steps).
+#include "orders.hpp"
+
+#include "bodypoint/io.hpp"
+#include "bodypoint/order_fit.hpp"
+#include "bodypoint/reference.hpp"
+#include "bodypoint/run.hpp"
+
+#include <cmath>
+#include <iostream>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace bodypoint::cli {
+namespace {
+
+constexpr double kTEnd = 3.0;
+constexpr double kOrbitTEnd = 30.0;
+constexpr double kFirstStep = 1.5;
+/// A ladder starts where the relative error is below this: the leading error term dominates there for
+/// every method here (the drift/kick schemes with B != 0 are first order from 1e-2 down).
+constexpr double kStartError = 1e-2;
+constexpr double kSmallestStart = 1e-5;  // no method here needs a smaller first step
+constexpr int kPoints = 13;              // h0 down to h0/64
+
+struct Probe {
+  Scene scene;
+  double t_end;
+  State ref;
+};
+
+Probe encounter(double B) {
+  SceneParams sp;
+  sp.B = B;
+  sp.start.L = 20;
+  sp.start.d = 1;
+  Probe p{thesis_scene(sp), kTEnd, {}};
+  p.ref = reference_state(p.scene.bodies.front(), p.scene.centres, p.t_end);
+  return p;
+}
+
+Probe orbit(double B) {
+  Scene s;
+  s.centres.push_back({Vec3::Zero(), 1.0});
+  const BodyPoint p{1.0, B, 1.0};
+  const Momenta q{Vec3(1, 0, 0), Vec3(0, 1.2, 0), Vec3(0.3, 0, 0.5)};
+  s.bodies.push_back({p, to_state(p, q), "orbit"});
+  Probe pr{s, kOrbitTEnd, {}};
+  pr.ref = reference_state(s.bodies.front(), s.centres, pr.t_end);
+  return pr;
+}
+
+double error_at(const MethodInfo& m, const Probe& p, double h) {
+  RunSpec rs;
+  if (is_time_transformed(m)) {
+    rs.h = h;  // the fictitious step; the run ends exactly at t_end
+    rs.t_end = p.t_end;
+    rs.steps = 1;
+    rs.omega_c = 0.0;
+  } else {
+    rs.steps = std::max(1L, std::lround(p.t_end / h));
+    rs.h = p.t_end / static_cast<double>(rs.steps);
+  }
+  try {
+    const RunResult r = run(m, p.scene.bodies.front(), p.scene.centres, rs);
+    return (r.final.R - p.ref.R).norm() / p.ref.R.norm();
+  } catch (const Error&) {
+    return std::numeric_limits<double>::infinity();  // a step too large for this encounter (logH's E - T + c <= 0)
+  }
+}
+
+/// The fitted slope, or NaN when the method does not run on the scene or no ladder start was found.
+double measured_order(const MethodInfo& m, const Probe& p, std::size_t* used) {
+  *used = 0;
+  double h = kFirstStep;
+  while (h > kSmallestStart && !(error_at(m, p, h) < kStartError)) h /= 2.0;
+  if (!(h > kSmallestStart)) return std::numeric_limits<double>::quiet_NaN();
+  std::vector<std::pair<double, double>> ladder;
+  for (int k = 0; k < kPoints; ++k) {
+    const double hk = h / std::pow(std::sqrt(2.0), k);
+    ladder.emplace_back(hk, error_at(m, p, hk));
+  }
+  const double slope = asymptotic_slope(ladder, used);
+  return *used >= 2 ? slope : std::numeric_limits<double>::quiet_NaN();
+}
+
+}  // namespace
+
+void write_orders(std::ostream& csv) {
+  csv << "# bodypoint study orders: slope of the final-position error against the step, fitted above\n"
+      << "# round-off (lib/bodypoint/order_fit.hpp), on the encounter (L = 20, d = 1, t = 3) and the bound\n"
+      << "# orbit (A = 1, t = 30) of tests/test_convergence.cpp, B = 0.7 (ks: B = 0); time-transformed\n"
+      << "# methods with c = 0; empty: the method does not run there; revision " << git_revision() << "\n"
+      << "method,nominal,encounter,encounter_points,orbit,orbit_points\n";
+  const Probe enc_spin = encounter(0.7), enc_material = encounter(0.0);
+  const Probe orb_spin = orbit(0.7), orb_material = orbit(0.0);
+  auto cell = [](double x) { return std::isfinite(x) ? fmt(x) : std::string(); };
+  for (const MethodInfo& m : methods()) {
+    if (is_adaptive(m)) continue;  // no step to refine: a tolerance
+    const bool ks = m.name == "ks";
+    std::size_t ue = 0, uo = 0;
+    const double enc = measured_order(m, ks ? enc_material : enc_spin, &ue);
+    const double orb = m.family == Family::Thesis ? std::numeric_limits<double>::quiet_NaN()
+                                                   : measured_order(m, ks ? orb_material : orb_spin, &uo);
+    csv << m.name << ',' << m.order << ',' << cell(enc) << ',' << ue << ',' << cell(orb) << ',' << uo << '\n';
+  }
+}
+
+}  // namespace bodypoint::cli

@@ -1,0 +1,98 @@
+#!/usr/bin/env python3
+"""Checks of the research appendix (ctest runs both; see tests/CMakeLists.txt).
+
+usage: check_paper.py literals paper/bodypoint.tex
+       check_paper.py pdf paper/build
+
+literals: fails if the body of the .tex types a number that is not a scene parameter or a reference to
+          the thesis (every measured figure must come from generated/macros.tex).
+pdf:      fails unless bodypoint.pdf exists with every required section, and the LaTeX log has no
+          undefined reference or citation and no overfull box wider than MAX_OVERFULL_PT.
+"""
+import re
+import sys
+
+# Inputs, not measurements, that the text may type: the thesis's scene parameters (table 3.1: d = 10,
+# L = 200, B = 0.7; the sweeps' d = 50, T = hn = 25, n = 250000, t = 50; appendix set P1.2's J = 0.2;
+# the close scene's Kz = 0.1, d = 0.05, t = 80; the convergence scenes' L = 20, t = 30).
+ALLOWED = {"10", "200", "0.7", "50", "25", "250000", "0.2", "0.1", "0.05", "80", "20", "30"}
+# Powers of ten are step sizes, targets and tolerances the reader or a recipe chooses (h = 10^{-4},
+# targets 10^{-7}, the reference's tolerance 10^{-18}), never results.
+POWER_OF_TEN = re.compile(r"10\^\{?-?\d+\}?")
+# References into the thesis ("eq.~1.10", "table 3.1", "fig.~4.1--4.2", "P1.2") and pieces of names
+# that carry digits (\cmd{lp-y4}, \texttt{...}).
+THESIS_REF = re.compile(r"(?i)(eqs?\.|tables?|figs?\.|sec\.|chapter|appendix|set|sets|P)[~\s]*\d+(\.\d+)?(--\d+(\.\d+)?)?")
+NAMES = re.compile(r"\\(cmd|texttt|cite|citet|citep|ref|label|eqref|includegraphics|tablebody|input|setlength|begin|end)"
+                   r"(\[[^\]]*\])?\{[^}]*\}(\{[^}]*\})?")
+NUMBER = re.compile(r"(?<![A-Za-z\\_^{])\d+(\.\d+)?")
+MAX_OVERFULL_PT = 10.0
+SECTIONS = ["Introduction", "The model and its corrected equations", "Errata", "Methods", "Chapter 4 reproduced",
+            "Close encounters", "Work against precision", "Numerical stability", "Conclusions"]
+
+
+def body_of(tex):
+    text = tex[tex.index("\\begin{document}"):]
+    return "\n".join(re.sub(r"(?<!\\)%.*", "", line) for line in text.splitlines())
+
+
+def literals(path):
+    with open(path) as f:
+        text = body_of(f.read())
+    text = re.sub(r"\\verb\|[^|]*\|", " ", text)  # quoted code, e.g. Math.pow(r, 3.0/2.0)
+    text = NAMES.sub(" ", text)
+    text = THESIS_REF.sub(" ", text)
+    text = POWER_OF_TEN.sub(" ", text)
+    bad = []
+    for lineno, line in enumerate(text.splitlines(), 1):
+        for m in NUMBER.finditer(line):
+            tok = m.group(0)
+            if len(tok) == 1 or tok in ALLOWED:  # single digits: orders, counts of stages, ordinals
+                continue
+            bad.append(f"  line {lineno} of the body: {tok!r} in: {line.strip()[:100]}")
+    if bad:
+        print(f"{path}: literal numbers (write them as macros from paper/make_macros.py):")
+        print("\n".join(bad))
+        return 1
+    print(f"{path}: no literal measured number")
+    return 0
+
+
+def pdf(build):
+    failures = []
+    try:
+        with open(f"{build}/bodypoint.pdf", "rb") as f:
+            if f.read(5) != b"%PDF-":
+                failures.append("bodypoint.pdf is not a PDF")
+    except OSError as e:
+        failures.append(f"no PDF: {e}")
+    with open(f"{build}/bodypoint.log", errors="replace") as f:
+        log = f.read()
+    for pattern in [r"Reference `[^']*' on page \d+ undefined", r"Citation `[^']*' on page \d+ undefined",
+                    r"There were undefined references", r"Undefined control sequence"]:
+        for m in re.finditer(pattern, log):
+            failures.append(f"log: {m.group(0)}")
+    for m in re.finditer(r"Overfull \\[hv]box \(([\d.]+)pt too (wide|high)\)", log):
+        if float(m.group(1)) > MAX_OVERFULL_PT:
+            failures.append(f"log: overfull box of {m.group(1)} pt (limit {MAX_OVERFULL_PT} pt)")
+    with open(f"{build}/bodypoint.aux", errors="replace") as f:
+        aux = f.read()
+    for title in SECTIONS:
+        if not re.search(r"\\contentsline \{section\}\{\\numberline \{\d+\}" + re.escape(title) + r"\}", aux):
+            failures.append(f"missing section: {title}")
+    pages = re.search(r"Output written on bodypoint\.pdf \((\d+) pages", log)
+    if failures:
+        print("\n".join(failures))
+        return 1
+    print(f"{build}/bodypoint.pdf: {pages.group(1) if pages else '?'} pages, {len(SECTIONS)} sections, "
+          f"no undefined reference or citation, no overfull box above {MAX_OVERFULL_PT} pt")
+    return 0
+
+
+def main():
+    if len(sys.argv) != 3 or sys.argv[1] not in ("literals", "pdf"):
+        sys.exit(__doc__)
+    sys.exit(literals(sys.argv[2]) if sys.argv[1] == "literals" else pdf(sys.argv[2]))
+
+
+if __name__ == "__main__":
+    main()
