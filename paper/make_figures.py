@@ -195,8 +195,9 @@ def work_precision_figures(res, figs, listing):
             for p in front:
                 counts[p[2]] = counts.get(p[2], 0) + 1
             for lab in sorted(counts, key=lambda k: -counts[k])[:3]:
-                t, e, _ = min(p for p in front if p[2] == lab)
-                ax.annotate(lab, (t, e), fontsize=5, color=colour, xytext=(2, 2), textcoords="offset points")
+                mine = [p for p in front if p[2] == lab]
+                t, e, _ = mine[len(mine) // 2]  # the middle of its stretch: labels of one front spread out
+                ax.annotate(lab, (t, e), fontsize=5, color=colour, xytext=(3, 3), textcoords="offset points")
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel("run time [ms]")

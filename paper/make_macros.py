@@ -169,11 +169,13 @@ def sweeps(res, M):
         M.add(f"PubFlagged{camel(param)}", count(diverged))
     # The h sweep: each method's deviation at the smallest step, and the smallest step at which a
     # drift/kick scheme of the thesis is flagged (diverged).
+    for prefix, name in [("", "h_sweep.csv"), ("Pub", "published_h_sweep.csv")]:
+        rows, _ = read_csv(os.path.join(res, name))
+        hmin = min(num(r["h"]) for r in rows)
+        for r in rows:
+            if num(r["h"]) == hmin:
+                M.add(f"HAtMin{prefix}{camel(r['method'])}", sci(num(r["max_rel_dE"])))
     rows, _ = read_csv(os.path.join(res, "h_sweep.csv"))
-    hmin = min(num(r["h"]) for r in rows)
-    for r in rows:
-        if num(r["h"]) == hmin:
-            M.add(f"HAtMin{camel(r['method'])}", sci(num(r["max_rel_dE"])))
     flagged = [num(r["h"]) for r in rows if r["method"].startswith("thesis-") and r.get("status") != "ok"]
     M.add("HDivergeThesis", sci(min(flagged)) if flagged else "n/a")
     # Energy error against h: fitted slopes where the deviation lies between round-off and 1e-1.
@@ -270,6 +272,47 @@ def speedup_table(res, out, M):
     M.add("NumSpeedupRows", count(len(body)))
 
 
+def family(method):
+    if method in THESIS_SEVEN:
+        return "thesis's seven"
+    for prefix, name in [("lp-", "Lie-Poisson"), ("logh-", "time-transformed"), ("ttl-", "time-transformed"),
+                         ("odeint-", "Boost.Odeint"), ("gsl-", "GSL")]:
+        if method.startswith(prefix):
+            return name
+    return "KS" if method == "ks" else None
+
+
+def close_table(res, out, M):
+    """Cheapest configuration of each family reaching each target on the close encounter."""
+    rows, _ = read_csv(os.path.join(res, "work_precision.csv"))
+    rows = [r for r in rows if r["scene"] == "close"]
+    families = ["thesis's seven", "Lie-Poisson", "time-transformed", "Boost.Odeint", "GSL"]
+    targets = ["1e-4", "1e-7", "1e-10"]
+    with open(os.path.join(out, "tab_close.tex"), "w") as f:
+        for i, target in enumerate(targets):
+            power = f"$10^{{{int(math.log10(float(target)))}}}$"
+            for fam in families:
+                ok = [r for r in rows if family(r["method"]) == fam and num(r["err_rel"]) <= float(target)]
+                if not ok:
+                    f.write(f"{power} & {fam} & none & & & \\\\\n")
+                    continue
+                best = min(ok, key=lambda r: num(r["wall_s"]))
+                m = best["method"]
+                if best["tol"]:
+                    cfg = f"tol={num(best['tol']):.2g}"
+                else:
+                    cfg = f"{'ds' if has_fictitious_step(m) else 'h'}={num(best['h']):.3g}"
+                evals = int(num(best["force_evals"]))
+                f.write(f"{power} & {fam} & {tt(m)} & {cfg} & {count(evals)} & {num(best['wall_s']) * 1e3:.3g} \\\\\n")
+                M.add(f"CloseEvals{camel(fam)}{target_word(target)}", count(evals))
+            if i + 1 < len(targets):
+                f.write("\\midrule\n")
+
+
+def has_fictitious_step(method):
+    return method.startswith(("logh-", "ttl-")) or method == "ks"
+
+
 def by_tol(res, out, M):
     rows, _ = read_csv(os.path.join(res, "by_tol.csv"))
     auto = [r for r in rows if r["kind"] == "auto"]
@@ -286,6 +329,17 @@ def by_tol(res, out, M):
     M.add("NumByTolScenes", count(len({r["scene"] for r in auto})))
     head, body = md_table(os.path.join(res, "by_tol_summary.md"))
     keep = [0, 1, 2, 3, 5, 7, 12, 13, 14]  # scene, TOL, auto, ds, delivered, time, peer best case, time, ratio
+    ratios = {}
+    for row in body:  # auto against the peer's best case, per scene (a "-": no peer delivers TOL)
+        if row[14].endswith("x"):
+            ratios.setdefault(row[0], []).append(num(row[14].rstrip("x")))
+    spinning = [r for scene, rs in ratios.items() if scene != "material" for r in rs]
+    if spinning:
+        M.add("AutoVsPeerSpinLow", sci(min(spinning)))
+        M.add("AutoVsPeerSpinHigh", sci(max(spinning)))
+    if ratios.get("material"):
+        M.add("AutoVsPeerMaterialLow", sci(min(ratios["material"])))
+        M.add("AutoVsPeerMaterialHigh", sci(max(ratios["material"])))
     with open(os.path.join(out, "tab_by_tol.tex"), "w") as f:
         for row in body:
             f.write(" & ".join(latex_cell(row[i]) for i in keep) + " \\\\\n")
@@ -352,6 +406,7 @@ def main():
     sweeps(res, M)
     methods_table(res, out, M)
     speedup_table(res, out, M)
+    close_table(res, out, M)
     by_tol(res, out, M)
     stress(res, out, M)
     appendix(res, M)

@@ -142,11 +142,15 @@ TEST(Cli, BadInputGivesOneLineErrorNonZeroExitAndNoOutputFile) {
       {"--scene /nonexistent.toml", "cannot open scene file"},
       {"--scene " + bad_scene.string() + " --d 3", "cannot be combined with --scene"},
       {"--h abc", "invalid"},
+      {"--force-law newton", "unknown --force-law 'newton'"},
+      {"--force-law thesis-code --method logh-y4 --h 0.1", "assumes Coulomb's law"},
+      {"--force-law thesis-code --tol 1e-6 --t-end 5", "--tol assumes Coulomb's law"},
+      {"--scene " + bad_scene.string() + " --force-law thesis-code", "cannot be combined with --scene"},
   };
   const fs::path out = dir / "out.csv";
   for (const BadInput& c : cases) {
     fs::remove(out);
-    const bool sets_steps = c.args.find("--steps") != std::string::npos;
+    const bool sets_steps = c.args.find("--steps") != std::string::npos || c.args.find("--t-end") != std::string::npos;
     const Result r = run_cli(std::string("simulate ") + (sets_steps ? "" : "--steps 100 ") + c.args + " --out " + out.string());
     EXPECT_NE(r.code, 0) << c.args;
     EXPECT_NE(r.err.find(c.fragment), std::string::npos) << c.args << " -> " << r.err;
