@@ -371,9 +371,21 @@ def stress(res, out, M):
                     cells.append(f"${sci(num(r['max_rel_dE']), 1)}$")
                 else:
                     cells.append({"refused": "ref.", "diverged": "\\textbf{div.}", "collision": "\\textbf{col.}"}[r["status"]])
-            label = c.replace("|K1|", "$|K_1|$").replace("_", "\\_")
+            label = c.replace("_", "\\_").replace("|K1|", "$|K_1|$")
             f.write(f"{label} & " + " & ".join(cells) + " \\\\\n")
+        f.write("\\midrule\n")
+        for title, statuses in [("ended normally", ("ok",)), ("refused with a reason", ("refused",)),
+                                ("flagged (div., col.)", ("diverged", "collision"))]:
+            n = [sum(1 for c in cases if cell.get((c, m)) and cell[(c, m)]["status"] in statuses) for m in methods]
+            f.write(f"\\emph{{{title}}} & " + " & ".join(str(k) for k in n) + " \\\\\n")
     M.add("StressMethodCount", str(len(methods)), math_mode=False)  # a column count, used in the preamble
+    M.add("StressCases", count(len(cases)))
+    for m in methods:
+        M.add(f"StressFlagged{camel(m)}", count(sum(1 for r in rows if r["method"] == m and r["status"] in ("diverged", "collision"))))
+    far = [num(r["max_rel_dE"]) for r in rows if r["status"] == "ok" and r["method"] in ("lp-y4", "logh-y4", "ttl-y4")
+           and (r["case"].startswith("L=") or r["case"].startswith("|K1|"))]
+    if far:
+        M.add("StressFarWorst", sci(max(far)))
     bound = {r["method"]: r for r in rows if r["case"].startswith("bound orbit")}
     for m, r in bound.items():
         if r["status"] == "ok":
