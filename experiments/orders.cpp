@@ -14,6 +14,7 @@
 #include "bodypoint/order_fit.hpp"
 #include "bodypoint/reference.hpp"
 #include "bodypoint/run.hpp"
+#include "bodypoint/scenes.hpp"
 
 #include <cmath>
 #include <iostream>
@@ -24,8 +25,6 @@
 namespace bodypoint::cli {
 namespace {
 
-constexpr double kTEnd = 3.0;
-constexpr double kOrbitTEnd = 30.0;
 constexpr double kFirstStep = 1.5;
 /// A ladder starts where the relative error is below this: the leading error term dominates there for
 /// every method here (the drift/kick schemes with B != 0 are first order from 1e-2 down).
@@ -39,25 +38,10 @@ struct Probe {
   State ref;
 };
 
-Probe encounter(double B) {
-  SceneParams sp;
-  sp.B = B;
-  sp.start.L = 20;
-  sp.start.d = 1;
-  Probe p{thesis_scene(sp), kTEnd, {}};
+Probe probe(const NamedScene& ns) {
+  Probe p{ns.scene, ns.t_end, {}};
   p.ref = reference_state(p.scene.bodies.front(), p.scene.centres, p.t_end);
   return p;
-}
-
-Probe orbit(double B) {
-  Scene s;
-  s.centres.push_back({Vec3::Zero(), 1.0});
-  const BodyPoint p{1.0, B, 1.0};
-  const Momenta q{Vec3(1, 0, 0), Vec3(0, 1.2, 0), Vec3(0.3, 0, 0.5)};
-  s.bodies.push_back({p, to_state(p, q), "orbit"});
-  Probe pr{s, kOrbitTEnd, {}};
-  pr.ref = reference_state(s.bodies.front(), s.centres, pr.t_end);
-  return pr;
 }
 
 double error_at(const MethodInfo& m, const Probe& p, double h) {
@@ -102,8 +86,8 @@ void write_orders(std::ostream& csv) {
       << "# orbit (A = 1, t = 30) of tests/test_convergence.cpp, B = 0.7 (ks: B = 0); time-transformed\n"
       << "# methods with c = 0; empty: the method does not run there; revision " << git_revision() << "\n"
       << "method,nominal,encounter,encounter_points,orbit,orbit_points\n";
-  const Probe enc_spin = encounter(0.7), enc_material = encounter(0.0);
-  const Probe orb_spin = orbit(0.7), orb_material = orbit(0.0);
+  const Probe enc_spin = probe(convergence_encounter(0.7)), enc_material = probe(convergence_encounter(0.0));
+  const Probe orb_spin = probe(convergence_orbit(0.7)), orb_material = probe(convergence_orbit(0.0));
   auto cell = [](double x) { return std::isfinite(x) ? fmt(x) : std::string(); };
   for (const MethodInfo& m : methods()) {
     if (is_adaptive(m)) continue;  // no step to refine: a tolerance

@@ -62,6 +62,11 @@ def by_method(rows):
     return out
 
 
+def scenes_of(rows):
+    """The scenes of a driver's CSV in the order it ran them."""
+    return list(dict.fromkeys(r["scene"] for r in rows))
+
+
 def num(s):
     try:
         return float(s)
@@ -175,10 +180,7 @@ def pareto(points):
 
 def work_precision_figures(res, figs, listing):
     rows = read_csv(os.path.join(res, "work_precision.csv"))
-    scenes = []
-    for r in rows:
-        if r["scene"] not in scenes:
-            scenes.append(r["scene"])
+    scenes = scenes_of(rows)
     for scene in scenes:
         fig, ax = plt.subplots(figsize=(WIDE / 2, 2.8))
         for fam, colour in FAMILIES:
@@ -209,10 +211,7 @@ def work_precision_figures(res, figs, listing):
 
 def by_tol_figure(res, figs, listing):
     rows = read_csv(os.path.join(res, "by_tol.csv"))
-    scenes = []
-    for r in rows:
-        if r["scene"] not in scenes:
-            scenes.append(r["scene"])
+    scenes = scenes_of(rows)
     fig, axes = plt.subplots(1, len(scenes), figsize=(WIDE, 2.2), sharey=True, squeeze=False)
     for ax, scene in zip(axes[0], scenes):
         sr = [r for r in rows if r["scene"] == scene and r["kind"] in ("auto", "at-tol")]

@@ -226,7 +226,7 @@ def methods_table(res, out, M):
     with open(os.path.join(out, "tab_methods.tex"), "w") as f:
         for r in rows:
             m = r["method"]
-            nominal = r["order"] if r["order"] != "0" else "var."
+            nominal = "exact" if m == "ks" else r["order"] if r["order"] != "0" else "var."
             enc, orb = orders.get(m, (float("nan"), float("nan")))
             meas = " & ".join(f"{x:.2f}" if math.isfinite(x) else "--" for x in (enc, orb))
             b = f"{bns[m]:.0f}" if m in bns else "--"

@@ -3,6 +3,7 @@
 // Boost.Odeint rkf78 in long double for B != 0, the analytic Rutherford hyperbola for B = 0.
 #include "bodypoint/reference.hpp"
 #include "bodypoint/run.hpp"
+#include "bodypoint/scenes.hpp"
 #include "common.hpp"
 
 #include <gtest/gtest.h>
@@ -20,33 +21,12 @@ constexpr double kSlopeTol = 0.15;
 // The two independent references (odeint rkf78 in long double, Kepler's equation) agree this well.
 constexpr double kReferenceAgreement = 1e-13;
 
-/// The encounter used for convergence: table 3.1 moved close (L = 20, d = 1), stopped at t = 3,
-/// next to the closest approach (~1 from the centre). Stopping inside the encounter matters: on a
-/// complete scattering run the start and end states are force-free, and a method conjugate to a
-/// higher-order one (Ruth 3 is, to order 4) shows that higher "effective" order instead.
-Scene encounter(double B) {
-  SceneParams sp;
-  sp.B = B;
-  sp.start.L = 20;
-  sp.start.d = 1;
-  return thesis_scene(sp);
-}
-constexpr double test_t_end = 3.0;
-
-/// A bound, eccentric orbit about an attracting centre (A = 1, e ~ 0.44, period ~ 15), run for two
-/// periods: truncation error grows with t while round-off grows only like sqrt(n), which widens the
-/// asymptotic window of the high-order methods.
-Scene orbit(double B) {
-  Scene s;
-  s.centres.push_back({Vec3::Zero(), 1.0});
-  const BodyPoint p{1.0, B, 1.0};
-  // K1 = (0, 1.2, 0), K2 = (0.3, 0, 0.5) give the spin a component off the orbit normal.
-  const Momenta q{Vec3(1, 0, 0), Vec3(0, 1.2, 0), Vec3(0.3, 0, 0.5)};
-  s.bodies.push_back({p, to_state(p, q), "orbit"});
-  validate(s);
-  return s;
-}
-constexpr double kOrbitTEnd = 30.0;
+// The scenes (bodypoint/scenes.hpp): the encounter stopped at its closest approach and two periods of
+// a bound orbit.
+Scene encounter(double B) { return convergence_encounter(B).scene; }
+Scene orbit(double B) { return convergence_orbit(B).scene; }
+const double test_t_end = convergence_encounter(0.0).t_end;
+const double kOrbitTEnd = convergence_orbit(0.0).t_end;
 
 // For lp-ss10 the order-10 regime lies below the round-off plateau of double precision: in the window
 // above it the h^12 term still dominates (measured slopes 11.2 at B = 0 and 12.1 at B = 0.7 on the
