@@ -2,6 +2,7 @@
 #include "bodypoint/io.hpp"
 #include "bodypoint/model.hpp"
 #include "cli.hpp"
+#include "rows_file.hpp"
 
 #include <cstring>
 #include <exception>
@@ -16,7 +17,8 @@ constexpr const char* usage =
     "  simulate   integrate a scene with one method (default: thesis table 3.1)\n"
     "  methods    list the integration methods\n"
     "  work-precision  final-position error against run time, every method and Boost.Odeint\n"
-    "  sweep      vary one parameter over a range for a list of methods (CSV)\n"
+    "  sweep      vary one parameter, or a grid of several, for a list of methods (CSV; --shard, --resume)\n"
+    "  merge      the CSV of a sweep from its shards' rows files\n"
     "  timing     run time against the number of steps (median of repeats)\n"
     "  study      regenerate the thesis's studies (d, L, h, Kx sweeps, timing, table 4.1, appendix 1)\n"
     "  view       write a self-contained HTML page that animates a run in 3D (three.js)\n"
@@ -36,10 +38,11 @@ int main(int argc, char** argv) {
     if (cmd == "methods") return bodypoint::cli::cmd_methods(argc - 1, argv + 1);
     if (cmd == "work-precision") return bodypoint::cli::cmd_work_precision(argc - 1, argv + 1);
     if (cmd == "sweep") return bodypoint::cli::cmd_sweep(argc - 1, argv + 1);
+    if (cmd == "merge") return bodypoint::cli::cmd_merge(argc - 1, argv + 1);
     if (cmd == "timing") return bodypoint::cli::cmd_timing(argc - 1, argv + 1);
     if (cmd == "study") return bodypoint::cli::cmd_study(argc - 1, argv + 1);
     if (cmd == "view") return bodypoint::cli::cmd_view(argc - 1, argv + 1);
-    std::cerr << "bodypoint: error: unknown command '" << cmd << "' (simulate, methods, work-precision, sweep, timing, study, view)\n";
+    std::cerr << "bodypoint: error: unknown command '" << cmd << "' (simulate, methods, work-precision, sweep, merge, timing, study, view)\n";
     return 2;
   } catch (const bodypoint::Error& e) {
     std::cerr << "bodypoint: error: " << e.what() << "\n";

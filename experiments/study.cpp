@@ -17,6 +17,7 @@
 #include "cli.hpp"
 #include "errata.hpp"
 #include "orders.hpp"
+#include "rows_file.hpp"
 #include "stress.hpp"
 #include "sweep.hpp"
 #include "timing.hpp"
@@ -39,6 +40,8 @@ struct StudyContext {
   /// Set by the "published" recipe: the thesis's code's force law and its seven methods, files
   /// prefixed "published_" (model.hpp, ForceLaw::thesis_code).
   bool published = false;
+  /// --resume: sweeps continue from the journals of an interrupted run.
+  bool resume = false;
 };
 
 void write_sweep(const StudyContext& c, const std::string& name, SweepSpec spec, std::string note) {
@@ -49,16 +52,20 @@ void write_sweep(const StudyContext& c, const std::string& name, SweepSpec spec,
     file = "published_" + name;
     note += "; as published: the thesis code's force law F = -A R/|R|^1.5 and third-kick slip";
   }
-  AtomicFile f((c.dir / file).string());
-  const auto rows = run_sweep(spec, c.threads, c.progress);
-  write_sweep_csv(f.stream(), spec, rows, "bodypoint study" + std::string(c.quick ? " --quick" : "") + " (" + note + ")");
+  const std::string path = (c.dir / file).string(), command = "bodypoint study" + std::string(c.quick ? " --quick" : "") + " (" + note + ")";
+  AtomicFile f(path);
+  validate_sweep(spec);
+  RowJournal journal(path + ".journal", sweep_key(spec), task_count(spec), sweep_header(spec, command), c.resume);
+  const auto rows = run_sweep(spec, SweepControl{c.threads, c.progress, 0, 1, &journal});
+  write_sweep_csv(f.stream(), spec, rows, command);
   f.commit();
+  journal.remove();
   std::cerr << "wrote " << (c.dir / file).string() << " (" << rows.size() << " rows)\n";
 }
 
 SweepSpec thesis_sweep(const std::string& param) {
   SweepSpec s;
-  s.param = param;
+  s.axes = {{param, {}}};
   s.methods = parse_methods("fixed");
   s.h = 1e-4;
   s.steps = 250000;
@@ -67,14 +74,14 @@ SweepSpec thesis_sweep(const std::string& param) {
 
 void study_d(const StudyContext& c) {
   SweepSpec s = thesis_sweep("d");
-  s.values = c.quick ? linear_range(5, 200, 39) : linear_range(5, 200, 5);
+  s.axes[0].values = c.quick ? linear_range(5, 200, 39) : linear_range(5, 200, 5);
   write_sweep(c, "d_sweep.csv", s, "fig. 4.1-4.2: d = 5..200, h = 1e-4, n = 250000, table 3.1 otherwise");
 }
 
 void study_L(const StudyContext& c) {
   SweepSpec s = thesis_sweep("L");
   s.base.start.d = 50;
-  s.values = c.quick ? linear_range(5, 1000, 199) : linear_range(5, 1000, 5);
+  s.axes[0].values = c.quick ? linear_range(5, 1000, 199) : linear_range(5, 1000, 5);
   write_sweep(c, "L_sweep.csv", s, "fig. 4.3-4.4: L = 5..1000 step 5, d = 50, h = 1e-4, n = 250000");
 }
 
@@ -83,15 +90,25 @@ void study_h(const StudyContext& c) {
   s.base.start.d = 50;
   s.steps = 0;
   s.t_end = 25;
-  s.values = c.quick ? log_range(1e-4, 0.5, 7) : log_range(1e-4, 0.5, 25);
+  s.axes[0].values = c.quick ? log_range(1e-4, 0.5, 7) : log_range(1e-4, 0.5, 25);
   write_sweep(c, "h_sweep.csv", s, "fig. 4.5-4.9: T = h n = 25, d = 50, L = 200; h log-spaced (our choice)");
 }
 
 void study_Kx(const StudyContext& c) {
   SweepSpec s = thesis_sweep("Kx");
   s.base.start.d = 50;
-  s.values = c.quick ? linear_range(-10, 10, 5) : linear_range(-10, 10, 0.5);
+  s.axes[0].values = c.quick ? linear_range(-10, 10, 5) : linear_range(-10, 10, 0.5);
   write_sweep(c, "Kx_sweep.csv", s, "fig. 4.10-4.11: d = 50, L = 200, h = 1e-4, n = 250000; Kx = -10..10 (our choice)");
+}
+
+// The (d, L) stability map (issue #14): the d and L sweeps' ranges at once, every fixed-step method.
+void study_dL_map(const StudyContext& c) {
+  SweepSpec s = thesis_sweep("d");
+  s.axes = {{"d", c.quick ? linear_range(5, 200, 65) : linear_range(5, 200, 5)},
+            {"L", c.quick ? linear_range(5, 1000, 199) : linear_range(5, 1000, 5)}};
+  write_sweep(c, "dL_map.csv", s,
+              std::string("(d, L) map: d = 5..200 step ") + (c.quick ? "65" : "5") + " x L = 5..1000 step " + (c.quick ? "199" : "5") +
+                  ", h = 1e-4, n = 250000, table 3.1 otherwise");
 }
 
 void study_timing(const StudyContext& c) {
@@ -254,7 +271,7 @@ const std::vector<std::pair<std::string, void (*)(const StudyContext&)>>& recipe
   static const std::vector<std::pair<std::string, void (*)(const StudyContext&)>> r = {
       {"d", study_d},         {"L", study_L},          {"h", study_h},         {"Kx", study_Kx},
       {"timing", study_timing}, {"evals", study_evals}, {"appendix", study_appendix}, {"errata", study_errata}, {"orders", study_orders},
-      {"published", study_published}, {"stress", study_stress}};
+      {"published", study_published}, {"stress", study_stress}, {"dL-map", study_dL_map}};
   return r;
 }
 
@@ -263,32 +280,33 @@ const std::vector<std::pair<std::string, void (*)(const StudyContext&)>>& recipe
 int cmd_study(int argc, char** argv) {
   std::string which = "all", results = "results";
   bool quick = false;
+  StudyContext c;
   long threads = 0;
   po::options_description desc("bodypoint study");
   desc.add_options()
       ("name", po::value(&which)->default_value(which), "recipe: d, L, h, Kx, timing, evals, appendix, errata, orders, published (chapter 4 with the thesis code's force "
-       "law), all (these), or stress (hostile scenes, issue #12)")
+       "law), all (these), stress (hostile scenes, issue #12) or dL-map (the (d, L) stability map, issue #14)")
       ("results", po::value(&results)->default_value(results), "folder for the CSVs (created if missing)")
       ("quick", po::bool_switch(&quick), "coarser grids, same recipes (under two minutes on 2 cores)")
-      ("threads", po::value(&threads)->default_value(0), "worker threads for the sweeps (0: all cores)");
+      ("threads", po::value(&threads)->default_value(0), "worker threads for the sweeps (0: all cores)")
+      ("resume", po::bool_switch(&c.resume), "finish the sweeps of an interrupted run from their journals (<csv>.journal)");
   po::variables_map vm;
   if (!parse(argc, argv, desc, vm,
-             "usage: bodypoint study [--name d|L|h|Kx|timing|evals|appendix|errata|orders|published|all|stress] [--results DIR] [--quick]\n"
+             "usage: bodypoint study [--name d|L|h|Kx|timing|evals|appendix|errata|orders|published|all|stress|dL-map] [--results DIR] [--quick]\n"
              "Regenerates the thesis's studies for its methods and ours side by side."))
     return 0;
-  StudyContext c;
   c.dir = results;
   c.quick = quick;
   c.threads = thread_count(threads);
   c.progress = ::isatty(2) == 1;
   bool found = false;
   for (const auto& [name, fn] : recipes()) found = found || name == which;
-  if (!found && which != "all") throw Error("unknown study '" + which + "' (d, L, h, Kx, timing, evals, appendix, errata, orders, published, all, stress)");
+  if (!found && which != "all") throw Error("unknown study '" + which + "' (d, L, h, Kx, timing, evals, appendix, errata, orders, published, all, stress, dL-map)");
   std::error_code ec;
   fs::create_directories(c.dir, ec);
   if (ec || !fs::is_directory(c.dir)) throw Error("cannot create results folder '" + results + "'");
   for (const auto& [name, fn] : recipes())
-    if ((which == "all" && name != "stress") || which == name) fn(c);
+    if ((which == "all" && name != "stress" && name != "dL-map") || which == name) fn(c);
   return 0;
 }
 

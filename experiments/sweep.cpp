@@ -3,6 +3,7 @@
 
 #include "bodypoint/io.hpp"
 #include "cli.hpp"
+#include "rows_file.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -91,89 +92,175 @@ unsigned thread_count(long requested) {
   return std::max(1u, std::thread::hardware_concurrency());
 }
 
-std::vector<SweepRow> run_sweep(const SweepSpec& spec, unsigned threads, bool progress) {
-  if (spec.methods.empty()) throw Error("the method list is empty");
-  if (spec.values.empty()) throw Error("the sweep has no values");
-  // Build and validate every scene first, so a bad value fails before any work.
-  struct Task {
-    double value;
-    const MethodInfo* method;
-    Scene scene;
-    RunSpec run;
-  };
-  std::vector<Task> tasks;
-  for (double v : spec.values) {
-    Scene scene;
-    try {
-      scene = thesis_scene(with_value(spec.base, spec.param, v));
-    } catch (const Error& e) {
-      throw Error(spec.param + " = " + fmt(v) + ": " + e.what());
-    }
-    const RunSpec rs = resolve_steps(spec.param == "h" ? v : spec.h, spec.steps, spec.t_end, spec.tol);
-    for (const MethodInfo* m : spec.methods) tasks.push_back({v, m, scene, rs});
+namespace {
+
+/// The scene parameters at grid point p.
+SceneParams point_params(const SweepSpec& spec, const std::vector<double>& point) {
+  SceneParams p = spec.base;
+  for (std::size_t a = 0; a < spec.axes.size(); ++a) p = with_value(p, spec.axes[a].param, point[a]);
+  return p;
+}
+
+double point_h(const SweepSpec& spec, const std::vector<double>& point) {
+  for (std::size_t a = 0; a < spec.axes.size(); ++a)
+    if (spec.axes[a].param == "h") return point[a];
+  return spec.h;
+}
+
+std::string point_label(const SweepSpec& spec, const std::vector<double>& point) {
+  std::string s;
+  for (std::size_t a = 0; a < spec.axes.size(); ++a) {
+    if (a) s += ", ";
+    s.append(spec.axes[a].param).append(" = ").append(fmt(point[a]));
   }
-  std::vector<SweepRow> rows(tasks.size());
-  std::atomic<std::size_t> next{0}, done{0};
-  std::mutex progress_mutex;
+  return s;
+}
+
+/// One CSV row (the columns of sweep_header).
+std::string format_row(const std::vector<double>& point, const MethodInfo& method, const RunResult& result,
+                       const std::string& status, std::string reason) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const InvariantStats s = result.invariants ? *result.invariants : InvariantStats{nan, nan, nan};
+  std::replace(reason.begin(), reason.end(), '"', '\'');
+  std::ostringstream os;
+  for (double v : point) os << fmt(v) << ',';
+  os << method.name << ',' << fmt(s.max_rel_dE) << ',' << fmt(s.max_rel_dK2sq) << ',' << fmt(s.max_abs_dK2Q) << ','
+     << fmt(result.final.R.x()) << ',' << fmt(result.final.R.y()) << ',' << fmt(result.final.R.z()) << ','
+     << result.force_evals << ',' << fmt(result.wall_s) << ',' << status << ",\"" << reason << '"';
+  return os.str();
+}
+
+/// Runs task i and returns its row.
+std::string run_task(const SweepSpec& spec, std::size_t i) {
+  const MethodInfo& method = *spec.methods[i % spec.methods.size()];
+  const std::vector<double> point = grid_point(spec, i / spec.methods.size());
+  RunResult result;
+  std::string status = "refused", reason;
+  try {
+    const Scene scene = thesis_scene(point_params(spec, point));
+    const RunSpec rs = resolve_steps(point_h(spec, point), spec.steps, spec.t_end, spec.tol);
+    result = run(method, scene.bodies.front(), scene.centres, rs);
+    const Health h = assess(result);
+    status = h.status;
+    reason = h.why;
+  } catch (const std::exception& e) {
+    reason = e.what();
+    const Vec3 nan = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+    result.final = State{nan, nan, nan};
+  }
+  return format_row(point, method, result, status, reason);
+}
+
+}  // namespace
+
+void validate_sweep(const SweepSpec& spec) {
+  if (spec.methods.empty()) throw Error("the method list is empty");
+  if (spec.axes.empty()) throw Error("the sweep has no varied parameter");
+  for (const Axis& a : spec.axes)
+    if (a.values.empty()) throw Error("the sweep has no values of " + a.param);
+  const std::size_t points = task_count(spec) / spec.methods.size();
+  for (std::size_t p = 0; p < points; ++p) {
+    const std::vector<double> point = grid_point(spec, p);
+    try {
+      thesis_scene(point_params(spec, point));
+    } catch (const Error& e) {
+      throw Error(point_label(spec, point) + ": " + e.what());
+    }
+    resolve_steps(point_h(spec, point), spec.steps, spec.t_end, spec.tol);
+  }
+}
+
+std::size_t task_count(const SweepSpec& spec) {
+  double n = static_cast<double>(spec.methods.size());
+  for (const Axis& a : spec.axes) n *= static_cast<double>(a.values.size());
+  if (n > 1e9) throw Error("the sweep has more than 1e9 (grid point, method) runs");
+  return static_cast<std::size_t>(n);
+}
+
+std::vector<double> grid_point(const SweepSpec& spec, std::size_t p) {
+  std::vector<double> point(spec.axes.size());
+  for (std::size_t a = spec.axes.size(); a-- > 0;) {
+    const std::size_t n = spec.axes[a].values.size();
+    point[a] = spec.axes[a].values[p % n];
+    p /= n;
+  }
+  return point;
+}
+
+std::vector<std::string> run_sweep(const SweepSpec& spec, const SweepControl& control) {
+  validate_sweep(spec);
+  const std::size_t n = task_count(spec);
+  std::vector<std::string> rows(n);
+  std::vector<std::size_t> todo;
+  for (std::size_t i = control.shard; i < n; i += std::max<std::size_t>(control.shards, 1)) {
+    const auto* done = control.journal ? &control.journal->done() : nullptr;
+    const auto it = done ? done->find(i) : decltype(done->find(i)){};
+    if (done && it != done->end()) rows[i] = it->second;
+    else todo.push_back(i);
+  }
+  std::atomic<std::size_t> next{0}, finished{0};
+  std::mutex mutex;  // the progress bar and the journal
   const CooperativeInterrupt stop_at_row_boundary;  // a signal stops the sweep between rows
   auto worker = [&] {
-    for (std::size_t i; !interrupted() && (i = next++) < tasks.size();) {
-      const Task& t = tasks[i];
-      SweepRow& row = rows[i];
-      row.value = t.value;
-      row.method = t.method;
-      try {
-        row.result = run(*t.method, t.scene.bodies.front(), t.scene.centres, t.run);
-        const Health h = assess(row.result);
-        row.status = h.status;
-        row.reason = h.why;
-      } catch (const std::exception& e) {
-        row.status = "refused";
-        row.reason = e.what();
-        const Vec3 nan = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
-        row.result.final = State{nan, nan, nan};
-      }
-      const std::size_t d = ++done;
-      if (progress) {
-        std::lock_guard<std::mutex> lock(progress_mutex);
-        progress_bar(d, tasks.size());
-      }
+    for (std::size_t k; !interrupted() && (k = next++) < todo.size();) {
+      rows[todo[k]] = run_task(spec, todo[k]);
+      std::lock_guard<std::mutex> lock(mutex);
+      if (control.journal) control.journal->append(todo[k], rows[todo[k]]);
+      if (control.progress) progress_bar(++finished, todo.size());
     }
   };
   std::vector<std::thread> pool;
-  for (unsigned k = 1; k < std::min<std::size_t>(threads, tasks.size()); ++k) pool.emplace_back(worker);
+  for (unsigned k = 1; k < std::min<std::size_t>(control.threads, todo.size()); ++k) pool.emplace_back(worker);
   worker();
   for (std::thread& t : pool) t.join();
   CooperativeInterrupt::check();
   return rows;
 }
 
-void write_sweep_csv(std::ostream& os, const SweepSpec& spec, const std::vector<SweepRow>& rows,
-                     const std::string& command) {
-  const SceneParams& p = spec.base;
-  os << "# bodypoint sweep, revision " << git_revision() << "\n"
-     << "# command: " << command << "\n"
-     << "# varied: " << spec.param << "\n"
-     << "# fixed: " << describe(p) << " (the varied one excepted)";
-  if (spec.param != "h") os << " h=" << fmt(spec.h);
-  if (spec.t_end > 0) os << " t_end=" << fmt(spec.t_end); else os << " steps=" << spec.steps;
-  os << "\n"
-     << "# columns: " << spec.param << " = value of the varied parameter; method; max_rel_dE = max_i |E_i-E_0|/|E_0|;"
-     << " max_rel_dK2sq = max_i |K2^2_i-K2^2_0|/K2^2_0; max_abs_dK2Q = max_i |K2Q_i-K2Q_0|;"
-     << " Rx,Ry,Rz = final position; force_evals; wall_s = step-loop time (runs share the cores);"
-     << " status = ok | diverged (non-finite, or energy error above 1) | collision (diverged after a fall onto"
-     << " an attracting centre) | refused (not run); reason = why, when not ok\n"
-     << spec.param << ",method,max_rel_dE,max_rel_dK2sq,max_abs_dK2Q,Rx,Ry,Rz,force_evals,wall_s,status,reason\n";
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  for (const SweepRow& r : rows) {
-    const InvariantStats s = r.result.invariants ? *r.result.invariants : InvariantStats{nan, nan, nan};
-    std::string reason = r.reason;
-    std::replace(reason.begin(), reason.end(), '"', '\'');
-    os << fmt(r.value) << ',' << r.method->name << ',' << fmt(s.max_rel_dE) << ',' << fmt(s.max_rel_dK2sq) << ','
-       << fmt(s.max_abs_dK2Q) << ',' << fmt(r.result.final.R.x()) << ',' << fmt(r.result.final.R.y()) << ','
-       << fmt(r.result.final.R.z()) << ',' << r.result.force_evals << ',' << fmt(r.result.wall_s) << ','
-       << r.status << ",\"" << reason << "\"\n";
+std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& command) {
+  std::string names, varied, values;
+  bool sweeps_h = false;
+  for (std::size_t a = 0; a < spec.axes.size(); ++a) {
+    if (a) {
+      names += ",";
+      varied += ", ";
+    }
+    names += spec.axes[a].param;
+    varied += spec.axes[a].param;
+    sweeps_h = sweeps_h || spec.axes[a].param == "h";
   }
+  const bool grid = spec.axes.size() > 1;
+  std::string fixed = "# fixed: " + describe(spec.base) + (grid ? " (the varied ones excepted)" : " (the varied one excepted)");
+  if (!sweeps_h) fixed += " h=" + fmt(spec.h);
+  fixed += spec.t_end > 0 ? " t_end=" + fmt(spec.t_end) : " steps=" + std::to_string(spec.steps);
+  return {"# bodypoint sweep, revision " + std::string(git_revision()),
+          "# command: " + command,
+          "# varied: " + varied + (grid ? " (a grid: every combination, the last one varying fastest)" : ""),
+          fixed,
+          "# columns: " + varied + (grid ? " = values of the varied parameters" : " = value of the varied parameter") +
+              "; method; max_rel_dE = max_i |E_i-E_0|/|E_0|;"
+              " max_rel_dK2sq = max_i |K2^2_i-K2^2_0|/K2^2_0; max_abs_dK2Q = max_i |K2Q_i-K2Q_0|;"
+              " Rx,Ry,Rz = final position; force_evals; wall_s = step-loop time (runs share the cores);"
+              " status = ok | diverged (non-finite, or energy error above 1) | collision (diverged after a fall onto"
+              " an attracting centre) | refused (not run); reason = why, when not ok",
+          names + ",method,max_rel_dE,max_rel_dK2sq,max_abs_dK2Q,Rx,Ry,Rz,force_evals,wall_s,status,reason"};
+}
+
+std::string sweep_key(const SweepSpec& spec) {
+  std::string s = std::string(git_revision()) + "|" + describe(spec.base) + "|" + fmt(spec.h) + "|" +
+                  std::to_string(spec.steps) + "|" + fmt(spec.t_end) + "|" + fmt(spec.tol);
+  for (const Axis& a : spec.axes) {
+    s.append("|").append(a.param);
+    for (double v : a.values) s.append(",").append(fmt(v));
+  }
+  for (const MethodInfo* m : spec.methods) s.append("|").append(m->name);
+  return hex64(fnv1a(s));
+}
+
+void write_sweep_csv(std::ostream& os, const SweepSpec& spec, const std::vector<std::string>& rows,
+                     const std::string& command) {
+  for (const std::string& line : sweep_header(spec, command)) os << line << "\n";
+  for (const std::string& row : rows) os << row << "\n";
 }
 
 std::vector<const MethodInfo*> parse_methods(const std::string& list) {
@@ -192,74 +279,198 @@ std::vector<const MethodInfo*> parse_methods(const std::string& list) {
   return ms;
 }
 
-int cmd_sweep(int argc, char** argv) {
+Axis parse_axis(const std::string& item) {
+  const std::size_t eq = item.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw Error("--grid '" + item + "': give NAME=FROM:TO:STEP, NAME=log:FROM:TO:POINTS or NAME=a,b,c");
+  Axis axis{item.substr(0, eq), {}};
+  const auto& ps = sweep_parameters();
+  if (std::find(ps.begin(), ps.end(), axis.param) == ps.end())
+    throw Error("unknown parameter '" + axis.param + "' (d, L, h, Kx, Kz, K1, A, B, J, m)");
+  std::string spec = item.substr(eq + 1);
+  const bool log = spec.rfind("log:", 0) == 0;
+  if (log) spec = spec.substr(4);
+  std::vector<std::string> parts;
+  for (std::size_t from = 0;;) {
+    const std::size_t colon = spec.find(':', from);
+    parts.push_back(spec.substr(from, colon - from));
+    if (colon == std::string::npos) break;
+    from = colon + 1;
+  }
+  const std::string what = "--grid " + axis.param;
+  if (parts.size() == 1 && !log) {
+    axis.values = parse_numbers(spec, what);
+  } else if (parts.size() == 3) {
+    const double a = parse_number(parts[0], what), b = parse_number(parts[1], what), c = parse_number(parts[2], what);
+    axis.values = log ? log_range(a, b, whole_number(c, what + " points", 1e6)) : linear_range(a, b, c);
+  } else {
+    throw Error("--grid '" + item + "': give NAME=FROM:TO:STEP, NAME=log:FROM:TO:POINTS or NAME=a,b,c");
+  }
+  if (axis.values.empty()) throw Error(what + " has no values");
+  return axis;
+}
+
+namespace {
+
+/// What `sweep` was asked, beyond the SweepSpec: output, resuming, threads and shard.
+struct SweepJob {
+  SweepSpec spec;
+  std::string out;
+  bool resume = false;
+  long threads = 0;
+  std::size_t shard = 0, shards = 1;
+  std::string command;  ///< the command without the options that do not change the rows
+};
+
+/// --shard K/N with 1 <= K <= N.
+void parse_shard(const std::string& text, SweepJob& job) {
+  const std::size_t slash = text.find('/');
+  if (slash == std::string::npos) throw Error("--shard takes K/N (this process's shard K of N, 1 <= K <= N)");
+  const double k = parse_number(text.substr(0, slash), "--shard"), n = parse_number(text.substr(slash + 1), "--shard");
+  job.shards = static_cast<std::size_t>(whole_number(n, "--shard N", 1e6));
+  const long kk = whole_number(k, "--shard K", 1e6);
+  if (static_cast<std::size_t>(kk) > job.shards) throw Error("--shard K/N needs K <= N, got " + text);
+  job.shard = static_cast<std::size_t>(kk - 1);
+}
+
+/// The command line without --out, --threads, --shard and --resume: the same for every shard, resumed
+/// run and thread count of one sweep, so that their CSVs are identical.
+std::string science_command(int argc, char** argv) {
+  std::string command = "bodypoint";
+  for (int i = 0; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--resume") continue;
+    if ((a == "--out" || a == "--threads" || a == "--shard") && i + 1 < argc) {
+      ++i;
+      continue;
+    }
+    if (a.rfind("--out=", 0) == 0 || a.rfind("--threads=", 0) == 0 || a.rfind("--shard=", 0) == 0) continue;
+    command += " " + a;
+  }
+  return command;
+}
+
+/// The varied parameters from --param and a range or --values, or from --grid items.
+std::vector<Axis> parse_axes(const po::variables_map& vm, const std::vector<std::string>& grid) {
+  if (!grid.empty()) {
+    for (const char* o : {"param", "from", "to", "step", "values", "points"})
+      if (vm.count(o)) throw Error("give --grid or --param with a range, not both");
+    std::vector<Axis> axes;
+    for (const std::string& g : grid) {
+      axes.push_back(parse_axis(g));
+      for (std::size_t a = 0; a + 1 < axes.size(); ++a)
+        if (axes[a].param == axes.back().param) throw Error("--grid names " + axes.back().param + " twice");
+    }
+    return axes;
+  }
+  if (!vm.count("param")) throw Error("--param (or --grid) is required (d, L, h, Kx, Kz, K1, A, B, J, m)");
+  const std::string param = vm["param"].as<std::string>();
+  const auto& ps = sweep_parameters();
+  if (std::find(ps.begin(), ps.end(), param) == ps.end())
+    throw Error("unknown parameter '" + param + "' (d, L, h, Kx, Kz, K1, A, B, J, m)");
+  const bool log = vm["log"].as<bool>();
+  if (vm.count("values")) {
+    if (vm.count("from") || vm.count("to") || vm.count("step") || log) throw Error("give --values or a range, not both");
+    return {{param, parse_numbers(vm["values"].as<std::string>(), "--values")}};
+  }
+  if (!vm.count("from") || !vm.count("to")) throw Error("give --from and --to (or --values)");
+  const double from = vm["from"].as<double>(), to = vm["to"].as<double>();
+  if (log) return {{param, log_range(from, to, vm.count("points") ? vm["points"].as<long>() : 0)}};
+  if (!vm.count("step")) throw Error("give --step (or --log --points N)");
+  return {{param, linear_range(from, to, vm["step"].as<double>())}};
+}
+
+SweepJob parse_sweep(int argc, char** argv, bool& help) {
   SceneOptions so;
   StepOptions st;
-  std::string param, methods_arg = "fixed", values, out;
-  double from = 0, to = 0, step = 0, tol = 1e-10;
-  long points = 0, threads = 0;
-  bool log = false;
+  SweepJob job;
+  std::string methods_arg = "fixed", shard;
+  std::vector<std::string> grid;
   po::options_description desc("bodypoint sweep");
   add_scene_options(desc, so);
   add_step_options(desc, st);
   desc.add_options()
-      ("param", po::value(&param), "parameter to vary: d, L, h, Kx, Kz, K1, A, B, J, m")
-      ("from", po::value(&from), "first value")
-      ("to", po::value(&to), "last value")
-      ("step", po::value(&step), "linear increment")
-      ("log", po::bool_switch(&log), "log-spaced values from --from to --to, --points of them")
-      ("points", po::value(&points), "with --log: number of values")
-      ("values", po::value(&values), "explicit comma-separated values instead of a range")
+      ("param", po::value<std::string>(), "parameter to vary: d, L, h, Kx, Kz, K1, A, B, J, m")
+      ("from", po::value<double>(), "first value")
+      ("to", po::value<double>(), "last value")
+      ("step", po::value<double>(), "linear increment")
+      ("log", po::bool_switch(), "log-spaced values from --from to --to, --points of them")
+      ("points", po::value<long>(), "with --log: number of values")
+      ("values", po::value<std::string>(), "explicit comma-separated values instead of a range")
+      ("grid", po::value(&grid)->composing(), "instead of --param: one varied parameter of a grid, NAME=FROM:TO:STEP, "
+       "NAME=log:FROM:TO:POINTS or NAME=a,b,c; repeat for each (every combination is run)")
       ("methods", po::value(&methods_arg)->default_value(methods_arg), "comma-separated names, 'fixed' (every fixed-step method) or 'all'")
-      ("tol", po::value(&tol)->default_value(tol), "adaptive methods: error tolerance")
-      ("threads", po::value(&threads)->default_value(0), "worker threads (0: all cores)")
-      ("out", po::value(&out), "CSV file (default: standard output)");
+      ("tol", po::value(&job.spec.tol)->default_value(1e-10), "adaptive methods: error tolerance")
+      ("threads", po::value(&job.threads)->default_value(0), "worker threads (0: all cores)")
+      ("out", po::value(&job.out), "CSV file (default: standard output); with --shard, this shard's rows file")
+      ("resume", po::bool_switch(&job.resume), "finish an interrupted run of the same sweep and --out from its journal")
+      ("shard", po::value(&shard), "K/N: run only shard K of N (tasks i with i % N = K-1) and write a rows file for 'bodypoint merge'");
   po::variables_map vm;
-  if (!parse(argc, argv, desc, vm,
-             "usage: bodypoint sweep --param P (--from A --to B --step S | --log --from A --to B --points N | --values a,b,c) [options]\n"
-             "One CSV row per (value, method): the deviations of the invariants, the final position and the cost."))
-    return 0;
-  if (param.empty()) throw Error("--param is required (d, L, h, Kx, Kz, K1, A, B, J, m)");
-  const auto& ps = sweep_parameters();
-  if (std::find(ps.begin(), ps.end(), param) == ps.end())
-    throw Error("unknown parameter '" + param + "' (d, L, h, Kx, Kz, K1, A, B, J, m)");
+  help = !parse(argc, argv, desc, vm,
+                "usage: bodypoint sweep (--param P (--from A --to B --step S | --log --from A --to B --points N | --values a,b,c)"
+                " | --grid P=... --grid Q=...) [options]\n"
+                "One CSV row per (grid point, method): the deviations of the invariants, the final position and the cost.");
+  if (help) return job;
+  job.spec.axes = parse_axes(vm, grid);
   if (vm.count("scene")) throw Error("sweep varies the thesis's scene parameters; --scene is not supported");
-  SweepSpec spec;
-  spec.param = param;
-  if (vm.count("values")) {
-    if (vm.count("from") || vm.count("to") || vm.count("step") || log) throw Error("give --values or a range, not both");
-    spec.values = parse_numbers(values, "--values");
-  } else {
-    if (!vm.count("from") || !vm.count("to")) throw Error("give --from and --to (or --values)");
-    if (log) {
-      spec.values = log_range(from, to, points);
-    } else {
-      if (!vm.count("step")) throw Error("give --step (or --log --points N)");
-      spec.values = linear_range(from, to, step);
-    }
-  }
-  spec.methods = parse_methods(methods_arg);
-  spec.base = so.params;
-  spec.h = st.h;
-  spec.tol = tol;
+  if (!shard.empty()) parse_shard(shard, job);
+  if (job.resume && job.out.empty()) throw Error("--resume needs --out (the journal is <out>.journal)");
+  if (job.shards > 1 && job.out.empty()) throw Error("--shard needs --out (the shard's rows file)");
+  job.spec.methods = parse_methods(methods_arg);
+  job.spec.base = so.params;
+  job.spec.h = st.h;
+  bool sweeps_h = false;
+  for (const Axis& a : job.spec.axes) sweeps_h = sweeps_h || a.param == "h";
   if (vm.count("t-end")) {
     if (!vm["steps"].defaulted()) throw Error("give --steps or --t-end, not both");
-    spec.t_end = st.t_end;
-    if (!std::isfinite(spec.t_end) || spec.t_end <= 0.0) throw Error("--t-end must be a finite number > 0");
+    job.spec.t_end = st.t_end;
+    if (!std::isfinite(job.spec.t_end) || job.spec.t_end <= 0.0) throw Error("--t-end must be a finite number > 0");
   } else {
-    spec.steps = st.steps;
-    if (param == "h") throw Error("sweeping h needs a fixed --t-end (the thesis's T = h n)");
+    job.spec.steps = st.steps;
+    if (sweeps_h) throw Error("sweeping h needs a fixed --t-end (the thesis's T = h n)");
   }
+  job.command = science_command(argc, argv);
+  return job;
+}
+
+/// Runs the job and writes its CSV (or, for a shard, its rows file), through a journal when it has a file.
+void run_job(const SweepJob& job) {
   std::unique_ptr<AtomicFile> file;
-  if (!out.empty()) file = std::make_unique<AtomicFile>(out);
-  const auto rows = run_sweep(spec, thread_count(threads), ::isatty(2) == 1);
-  const std::string command = command_line(argc, argv);
-  if (file) {
-    write_sweep_csv(file->stream(), spec, rows, command);
-    file->commit();
-  } else {
-    write_sweep_csv(std::cout, spec, rows, command);
+  if (!job.out.empty()) file = std::make_unique<AtomicFile>(job.out);
+  validate_sweep(job.spec);  // before a journal exists
+  const std::vector<std::string> header = sweep_header(job.spec, job.command);
+  const std::size_t tasks = task_count(job.spec);
+  std::unique_ptr<RowJournal> journal;
+  if (file) journal = std::make_unique<RowJournal>(job.out + ".journal", sweep_key(job.spec), tasks, header, job.resume);
+  SweepControl control{thread_count(job.threads), ::isatty(2) == 1, job.shard, job.shards, journal.get()};
+  std::vector<std::string> rows;
+  try {
+    rows = run_sweep(job.spec, control);
+  } catch (const Error& e) {
+    if (journal && interrupted()) throw Error(std::string(e.what()) + "; the finished rows are in " + journal->path() + ", finish with --resume");
+    throw;
   }
+  if (!file) {
+    write_sweep_csv(std::cout, job.spec, rows, job.command);
+    return;
+  }
+  if (job.shards > 1) {
+    RowsContent mine{sweep_key(job.spec), tasks, header, {}};
+    for (std::size_t i = job.shard; i < tasks; i += job.shards) mine.rows.emplace(i, rows[i]);
+    file->stream() << rows_file_text(mine);
+  } else {
+    write_sweep_csv(file->stream(), job.spec, rows, job.command);
+  }
+  file->commit();
+  journal->remove();
+}
+
+}  // namespace
+
+int cmd_sweep(int argc, char** argv) {
+  bool help = false;
+  const SweepJob job = parse_sweep(argc, argv, help);
+  if (!help) run_job(job);
   return 0;
 }
 

@@ -20,10 +20,16 @@ inline const std::vector<std::string>& sweep_parameters() {
 std::vector<double> linear_range(double from, double to, double step);
 std::vector<double> log_range(double from, double to, long points);
 
-/// One sweep: a parameter, its values, methods, and everything else fixed.
-struct SweepSpec {
+/// One varied parameter and its values.
+struct Axis {
   std::string param;
   std::vector<double> values;
+};
+
+/// One sweep: the varied parameters (one, or a grid: every combination, the last axis fastest),
+/// methods, and everything else fixed.
+struct SweepSpec {
+  std::vector<Axis> axes;
   std::vector<const MethodInfo*> methods;
   SceneParams base;   ///< the fixed scene parameters (table 3.1 unless changed)
   double h = 1e-4;    ///< fixed step (unless param == "h")
@@ -32,27 +38,48 @@ struct SweepSpec {
   double tol = 1e-10; ///< adaptive methods
 };
 
-/// One (value, method) run. status: ok, diverged or collision (assess() in run.hpp), or refused (the
-/// method or a budget refused the run; `reason` says why); a row that is not ok says why in `reason`.
-struct SweepRow {
-  double value = 0.0;
-  const MethodInfo* method = nullptr;
-  RunResult result;
-  std::string status = "refused";
-  std::string reason;
+/// Parses one --grid item: NAME=FROM:TO:STEP (linear), NAME=log:FROM:TO:POINTS or NAME=a,b,c.
+Axis parse_axis(const std::string& item);
+
+/// Number of (grid point, method) tasks; task i is point i / methods, method i % methods.
+std::size_t task_count(const SweepSpec& spec);
+/// The values of the varied parameters at grid point p (in axis order).
+std::vector<double> grid_point(const SweepSpec& spec, std::size_t p);
+
+/// Throws Error for an empty sweep or a grid point whose scene or step is invalid.
+void validate_sweep(const SweepSpec& spec);
+
+/// How a sweep runs: threads, which tasks (shard K of N takes the tasks i with i % N == K), and a
+/// journal that keeps finished rows durably and supplies those of an interrupted run (rows_file.hpp).
+class RowJournal;
+struct SweepControl {
+  unsigned threads = 1;
+  bool progress = false;
+  std::size_t shard = 0, shards = 1;
+  RowJournal* journal = nullptr;
 };
 
 /// Resolves (h, steps) exactly as `simulate` does: with t_end > 0, steps = ceil(t_end/h) and
 /// h = t_end/steps.
 RunSpec resolve_steps(double h, long steps, double t_end, double tol);
 
-/// Runs every (value, method) pair on `threads` threads; rows come back in (value, method) order
-/// whatever the thread count. Throws Error for an invalid scene value before running anything, and
-/// after the running rows finish when a signal arrived (no row is started after it).
-std::vector<SweepRow> run_sweep(const SweepSpec& spec, unsigned threads, bool progress);
+/// Runs the tasks of this shard that the journal does not hold yet, on control.threads threads, and
+/// returns every task's CSV row by task index (empty for tasks of other shards). A row's status is ok,
+/// diverged or collision (assess() in run.hpp), or refused (not run; the reason column says why).
+/// Throws Error for an invalid scene value before running anything, and after the running rows finish
+/// when a signal arrived (no row is started after it; the journal keeps the finished ones).
+std::vector<std::string> run_sweep(const SweepSpec& spec, const SweepControl& control);
+inline std::vector<std::string> run_sweep(const SweepSpec& spec, unsigned threads, bool progress) {
+  return run_sweep(spec, SweepControl{threads, progress});
+}
 
-/// CSV with a commented header (revision, parameters, columns) and one row per (value, method).
-void write_sweep_csv(std::ostream& os, const SweepSpec& spec, const std::vector<SweepRow>& rows,
+/// The CSV header: commented lines (revision, command, parameters, columns) and the column names.
+std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& command);
+/// A key of everything that decides the rows (parameters, values, methods, build): shards and
+/// journals of one sweep share it.
+std::string sweep_key(const SweepSpec& spec);
+/// The header and one row per (grid point, method).
+void write_sweep_csv(std::ostream& os, const SweepSpec& spec, const std::vector<std::string>& rows,
                      const std::string& command);
 
 /// Number of worker threads: --threads, or the hardware concurrency.

@@ -1,14 +1,20 @@
-// Running the bodypoint command line from a test: exit code, standard output, standard error.
+// Running the bodypoint command line from a test: exit code, standard output, standard error; or
+// started in the background (spawn) to be signalled; and the files a run leaves.
 #pragma once
 
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <fcntl.h>
 #include <fstream>
+#include <spawn.h>
 #include <sstream>
 #include <string>
+#include <vector>
 #include <sys/wait.h>
 #include <unistd.h>
+
+extern char** environ;
 
 namespace bodypoint::test {
 
@@ -34,6 +40,38 @@ inline CliResult run_cli(const std::string& args) {
   r.err = ss.str();
   fs::remove(err);
   return r;
+}
+
+namespace fs = std::filesystem;
+
+/// Files in dir whose name starts with `stem` (the output, its temporaries, its lock).
+inline std::vector<std::string> leftovers(const fs::path& dir, const std::string& stem) {
+  std::vector<std::string> out;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().filename().string().rfind(stem, 0) == 0) out.push_back(e.path().filename().string());
+  return out;
+}
+
+/// Starts `bodypoint args...` with stderr to err_file; returns its pid.
+inline pid_t spawn(const std::vector<std::string>& args, const fs::path& err_file) {
+  std::vector<std::string> all{BODYPOINT_BIN};
+  all.insert(all.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&fa, 2, err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  pid_t pid = 0;
+  const int rc = posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  return rc == 0 ? pid : -1;
+}
+
+inline std::string read(const fs::path& p) {
+  std::ifstream in(p);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 }  // namespace bodypoint::test

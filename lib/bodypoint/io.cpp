@@ -74,6 +74,17 @@ extern "C" void on_signal(int sig) {
 /// True when a process with this pid exists (a lock whose writer has died is stale).
 bool process_alive(long pid) { return pid > 0 && (::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM); }
 
+/// Removes "<target>.tmp.<pid>.*", the temporaries a writer killed without cleanup (kill -9) left.
+void remove_temporaries(const std::string& target, long pid) {
+  namespace fs = std::filesystem;
+  const fs::path t(target);
+  const std::string prefix = t.filename().string() + ".tmp." + std::to_string(pid) + ".";
+  std::error_code ec;
+  const fs::path dir = t.has_parent_path() ? t.parent_path() : fs::path(".");
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+    if (it->path().filename().string().rfind(prefix, 0) == 0) fs::remove(it->path(), ec);
+}
+
 /// Creates path exclusively with our pid in it; a stale lock (its writer is gone) is replaced once.
 void take_lock(const std::string& lock, const std::string& target) {
   for (int attempt = 0; attempt < 2; ++attempt) {
@@ -95,7 +106,8 @@ void take_lock(const std::string& lock, const std::string& target) {
     if (process_alive(pid))
       throw Error("another run (pid " + std::to_string(pid) + ") is writing '" + target + "' (lock file " + lock +
                   "); wait for it or choose another path");
-    ::unlink(lock.c_str());  // stale: its writer is gone
+    ::unlink(lock.c_str());  // stale: its writer is gone (kill -9, power loss): so are its temporaries
+    remove_temporaries(target, pid);
   }
   throw Error("cannot take the lock file " + lock + " of '" + target + "'");
 }

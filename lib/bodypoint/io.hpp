@@ -3,7 +3,8 @@
 // `AtomicFile` writes to a temporary file beside the target and renames it over the target on
 // commit(), so a failed or interrupted run never leaves a half-written result: each output has its
 // own temporary name, a lock file (<path>.lock with the writer's pid) refuses a second writer of the
-// same path, an output that is another output or an input of the same run is refused, and SIGINT,
+// same path (a lock whose writer died without cleanup, as by kill -9, is taken over and that writer's
+// temporaries removed), an output that is another output or an input of the same run is refused, and SIGINT,
 // SIGTERM and SIGHUP remove every temporary and lock file (install_signal_cleanup). Numbers are
 // written so that a value read back is exactly the value computed.
 #pragma once

@@ -1,0 +1,226 @@
+// Rows files: the journal of a running sweep and the output of a shard (format in rows_file.hpp).
+#include "rows_file.hpp"
+
+#include "bodypoint/io.hpp"
+#include "bodypoint/model.hpp"
+#include "cli.hpp"
+
+#include <cerrno>
+#include <charconv>
+#include <chrono>
+#include <cstring>
+#include <fcntl.h>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace bodypoint::cli {
+namespace {
+
+constexpr const char* kMagic = "#bodypoint-rows 1";
+
+std::string record(std::size_t index, const std::string& row) {
+  const std::string body = "R\t" + std::to_string(index) + "\t" + row;
+  return body + "\t" + hex64(fnv1a(body)) + "\n";
+}
+
+/// Parses "R\t<index>\t<row>\t<check>" (without the newline); false for a torn or corrupt record.
+bool parse_record(const std::string& line, std::size_t& index, std::string& row) {
+  const std::size_t last = line.rfind('\t');
+  if (line.rfind("R\t", 0) != 0 || last == std::string::npos || last < 2) return false;
+  const std::string body = line.substr(0, last);
+  if (line.substr(last + 1) != hex64(fnv1a(body))) return false;
+  const std::size_t second = body.find('\t', 2);
+  if (second == std::string::npos) return false;
+  const char* first = body.data() + 2;
+  const auto [end, ec] = std::from_chars(first, body.data() + second, index);
+  if (ec != std::errc() || end != body.data() + second) return false;
+  row = body.substr(second + 1);
+  return true;
+}
+
+/// Parses the first line; throws Error naming `path` when it is not a rows file.
+void parse_magic(const std::string& line, const std::string& path, RowsContent& c) {
+  std::istringstream in(line.substr(std::min(line.size(), std::strlen(kMagic))));
+  std::string key, tasks;
+  if (line.rfind(kMagic, 0) != 0 || !(in >> key >> tasks) || key.rfind("key=", 0) != 0 || tasks.rfind("tasks=", 0) != 0)
+    throw Error("'" + path + "' is not a bodypoint rows file (a sweep's journal or shard output)");
+  c.key = key.substr(4);
+  c.tasks = static_cast<std::size_t>(std::stoull(tasks.substr(6)));
+}
+
+/// Cuts a torn last line (no newline: the writer died in the middle of it) off the file at `fd`.
+void cut_torn_tail(int fd, const std::string& path) {
+  struct stat st{};
+  if (::fstat(fd, &st) != 0) throw Error("cannot read the journal '" + path + "': " + std::strerror(errno));
+  off_t end = st.st_size;
+  char c = '\n';
+  while (end > 0 && ::pread(fd, &c, 1, end - 1) == 1 && c != '\n') --end;
+  if (end != st.st_size && ::ftruncate(fd, end) != 0)
+    throw Error("cannot repair the journal '" + path + "': " + std::strerror(errno));
+}
+
+void write_all(int fd, const std::string& s, const std::string& path) {
+  std::size_t off = 0;
+  while (off < s.size()) {
+    const ssize_t n = ::write(fd, s.data() + off, s.size() - off);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) throw Error("cannot write the journal '" + path + "': " + std::strerror(errno));
+    off += static_cast<std::size_t>(n);
+  }
+}
+
+}  // namespace
+
+std::uint64_t fnv1a(const std::string& s, std::uint64_t h) {
+  for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
+  return h;
+}
+
+std::string hex64(std::uint64_t x) {
+  static const char* digits = "0123456789abcdef";
+  std::string s(16, '0');
+  for (int i = 15; i >= 0; --i, x >>= 4) s[static_cast<std::size_t>(i)] = digits[x & 15u];
+  return s;
+}
+
+RowsContent read_rows_file(const std::string& path, std::size_t* dropped) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error("cannot read '" + path + "'");
+  RowsContent c;
+  std::string line;
+  if (!std::getline(in, line)) throw Error("'" + path + "' is empty, not a bodypoint rows file");
+  parse_magic(line, path, c);
+  std::size_t bad = 0;
+  while (std::getline(in, line)) {
+    if (in.eof()) {  // no newline after it: a torn last record
+      ++bad;
+      break;
+    }
+    if (line.rfind("H\t", 0) == 0) {
+      c.header.push_back(line.substr(2));
+      continue;
+    }
+    std::size_t index = 0;
+    std::string row;
+    if (!parse_record(line, index, row) || index >= c.tasks) {
+      ++bad;
+      continue;
+    }
+    c.rows.emplace(index, std::move(row));  // a repeated index keeps its first row
+  }
+  if (dropped) *dropped = bad;
+  return c;
+}
+
+std::string rows_file_text(const RowsContent& c) {
+  std::string s = std::string(kMagic) + " key=" + c.key + " tasks=" + std::to_string(c.tasks) + "\n";
+  for (const std::string& h : c.header) s += "H\t" + h + "\n";
+  for (const auto& [index, row] : c.rows) s += record(index, row);
+  return s;
+}
+
+RowJournal::RowJournal(std::string path, const std::string& key, std::size_t tasks,
+                       const std::vector<std::string>& header, bool resume)
+    : path_(std::move(path)) {
+  const bool exists = ::access(path_.c_str(), F_OK) == 0;
+  if (exists && !resume)
+    throw Error("'" + path_ + "' holds the rows of an interrupted run of this output: add --resume to finish it, or delete it");
+  if (exists) {
+    std::size_t dropped = 0;
+    const RowsContent old = read_rows_file(path_, &dropped);
+    if (old.key != key || old.tasks != tasks)
+      throw Error("the journal '" + path_ + "' belongs to another sweep (other parameters, methods or build); delete it to start over");
+    done_ = old.rows;
+    if (dropped > 0)
+      std::cerr << "bodypoint: resuming: dropped " << dropped << " torn record(s) of '" << path_ << "', they run again\n";
+  }
+  fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw Error("cannot write the journal '" + path_ + "': " + std::strerror(errno));
+  if (exists) {
+    cut_torn_tail(fd_, path_);
+  } else {
+    RowsContent fresh;
+    fresh.key = key;
+    fresh.tasks = tasks;
+    fresh.header = header;
+    write_all(fd_, rows_file_text(fresh), path_);
+  }
+  sync();
+}
+
+RowJournal::~RowJournal() {
+  if (fd_ >= 0) {
+    ::fsync(fd_);
+    ::close(fd_);
+  }
+}
+
+void RowJournal::append(std::size_t index, const std::string& row) {
+  write_all(fd_, record(index, row), path_);
+  const auto now = std::chrono::steady_clock::now();
+  if (now - last_sync_ >= kSyncInterval) sync();
+}
+
+void RowJournal::sync() {
+  if (fd_ >= 0 && ::fsync(fd_) != 0) throw Error("cannot write the journal '" + path_ + "': " + std::strerror(errno));
+  last_sync_ = std::chrono::steady_clock::now();
+}
+
+void RowJournal::remove() {
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+  ::unlink(path_.c_str());
+}
+
+int cmd_merge(int argc, char** argv) {
+  std::string out;
+  std::vector<std::string> inputs;
+  po::options_description desc("bodypoint merge");
+  desc.add_options()("out", po::value(&out), "the merged CSV (default: standard output)")(
+      "input", po::value(&inputs)->multitoken(), "rows files of the shards (sweep --shard K/N --out FILE)");
+  po::variables_map vm;
+  if (!parse(argc, argv, desc, vm,
+             "usage: bodypoint merge --input SHARD1 SHARD2 ... [--out FILE]\n"
+             "The CSV of a sweep from its shards: every row exactly once, in the order a single run writes them."))
+    return 0;
+  if (inputs.empty()) throw Error("give the shards' files with --input");
+  RowsContent all;
+  std::map<std::size_t, std::string> from;
+  for (const std::string& path : inputs) register_input(path);
+  for (const std::string& path : inputs) {
+    std::size_t dropped = 0;
+    RowsContent c = read_rows_file(path, &dropped);
+    if (dropped > 0) throw Error("'" + path + "' has " + std::to_string(dropped) + " torn or corrupt record(s)");
+    if (all.key.empty()) {
+      all.key = c.key;
+      all.tasks = c.tasks;
+      all.header = c.header;
+    } else if (c.key != all.key || c.tasks != all.tasks) {
+      throw Error("'" + path + "' is a shard of another sweep than '" + inputs.front() + "'");
+    }
+    for (auto& [index, row] : c.rows) {
+      if (from.count(index)) throw Error("row " + std::to_string(index) + " is in both '" + from[index] + "' and '" + path + "'");
+      from[index] = path;
+      all.rows.emplace(index, std::move(row));
+    }
+  }
+  if (all.rows.size() != all.tasks) {
+    std::size_t missing = 0;
+    while (all.rows.count(missing)) ++missing;
+    throw Error("the shards hold " + std::to_string(all.rows.size()) + " of " + std::to_string(all.tasks) +
+                " rows (row " + std::to_string(missing) + " is missing): merge every shard");
+  }
+  std::unique_ptr<AtomicFile> file;
+  if (!out.empty()) file = std::make_unique<AtomicFile>(out);
+  std::ostream& os = file ? static_cast<std::ostream&>(file->stream()) : std::cout;
+  for (const std::string& h : all.header) os << h << "\n";
+  for (const auto& [index, row] : all.rows) os << row << "\n";
+  if (file) file->commit();
+  return 0;
+}
+
+}  // namespace bodypoint::cli
