@@ -2,6 +2,7 @@
 #include "bodypoint/io.hpp"
 #include "bodypoint/model.hpp"
 #include "cli.hpp"
+#include "mpi_sweep.hpp"
 #include "rows_file.hpp"
 
 #include <cstring>
@@ -44,12 +45,8 @@ int main(int argc, char** argv) {
     if (cmd == "view") return bodypoint::cli::cmd_view(argc - 1, argv + 1);
     std::cerr << "bodypoint: error: unknown command '" << cmd << "' (simulate, methods, work-precision, sweep, merge, timing, study, view)\n";
     return 2;
-  } catch (const bodypoint::Error& e) {
-    std::cerr << "bodypoint: error: " << e.what() << "\n";
-  } catch (const boost::program_options::error& e) {
-    std::cerr << "bodypoint: error: " << e.what() << "\n";
-  } catch (const std::exception& e) {
-    std::cerr << "bodypoint: error: " << e.what() << "\n";
+  } catch (const std::exception& e) {  // bodypoint::Error, boost::program_options::error and the rest
+    if (bodypoint::cli::launcher_rank() == 0) std::cerr << "bodypoint: error: " << e.what() << "\n";
   }
   return 2;
 }

@@ -3,11 +3,13 @@
 
 #include "bodypoint/io.hpp"
 #include "cli.hpp"
+#include "mpi_sweep.hpp"
 #include "rows_file.hpp"
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <exception>
 #include <iostream>
 #include <limits>
 #include <memory>
@@ -130,8 +132,9 @@ std::string format_row(const std::vector<double>& point, const MethodInfo& metho
   return os.str();
 }
 
-/// Runs task i and returns its row.
-std::string run_task(const SweepSpec& spec, std::size_t i) {
+}  // namespace
+
+std::string run_sweep_task(const SweepSpec& spec, std::size_t i) {
   const MethodInfo& method = *spec.methods[i % spec.methods.size()];
   const std::vector<double> point = grid_point(spec, i / spec.methods.size());
   RunResult result;
@@ -150,8 +153,6 @@ std::string run_task(const SweepSpec& spec, std::size_t i) {
   }
   return format_row(point, method, result, status, reason);
 }
-
-}  // namespace
 
 void validate_sweep(const SweepSpec& spec) {
   if (spec.methods.empty()) throw Error("the method list is empty");
@@ -194,18 +195,23 @@ std::vector<std::string> run_sweep(const SweepSpec& spec, const SweepControl& co
   std::vector<std::size_t> todo;
   for (std::size_t i = control.shard; i < n; i += std::max<std::size_t>(control.shards, 1)) {
     const auto* done = control.journal ? &control.journal->done() : nullptr;
-    const auto it = done ? done->find(i) : decltype(done->find(i)){};
-    if (done && it != done->end()) rows[i] = it->second;
+    if (done && done->count(i)) rows[i] = done->at(i);
     else todo.push_back(i);
   }
   std::atomic<std::size_t> next{0}, finished{0};
-  std::mutex mutex;  // the progress bar and the journal
+  std::mutex mutex;  // the progress bar, the journal and the first error
+  std::exception_ptr error;
   const CooperativeInterrupt stop_at_row_boundary;  // a signal stops the sweep between rows
   auto worker = [&] {
     for (std::size_t k; !interrupted() && (k = next++) < todo.size();) {
-      rows[todo[k]] = run_task(spec, todo[k]);
+      rows[todo[k]] = run_sweep_task(spec, todo[k]);
       std::lock_guard<std::mutex> lock(mutex);
-      if (control.journal) control.journal->append(todo[k], rows[todo[k]]);
+      try {
+        if (control.journal) control.journal->append(todo[k], rows[todo[k]]);
+      } catch (...) {  // the journal cannot be written: stop handing out rows, report after the join
+        if (!error) error = std::current_exception();
+        next = todo.size();
+      }
       if (control.progress) progress_bar(++finished, todo.size());
     }
   };
@@ -213,6 +219,7 @@ std::vector<std::string> run_sweep(const SweepSpec& spec, const SweepControl& co
   for (unsigned k = 1; k < std::min<std::size_t>(control.threads, todo.size()); ++k) pool.emplace_back(worker);
   worker();
   for (std::thread& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
   CooperativeInterrupt::check();
   return rows;
 }
@@ -433,8 +440,52 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
   return job;
 }
 
+/// Writes the rows: the CSV, or for a shard its rows file; then the journal is no longer needed.
+void write_output(const SweepJob& job, AtomicFile* file, RowJournal* journal, const std::vector<std::string>& rows) {
+  if (!file) {
+    write_sweep_csv(std::cout, job.spec, rows, job.command);
+    return;
+  }
+  if (job.shards > 1) {
+    RowsContent mine{sweep_key(job.spec), rows.size(), sweep_header(job.spec, job.command), {}};
+    for (std::size_t i = job.shard; i < rows.size(); i += job.shards) mine.rows.emplace(i, rows[i]);
+    file->stream() << rows_file_text(mine);
+  } else {
+    write_sweep_csv(file->stream(), job.spec, rows, job.command);
+  }
+  file->commit();
+  journal->remove();
+}
+
+/// Under mpirun: rank 0 opens the output and the journal and coordinates; the other ranks compute.
+void run_job_mpi(const SweepJob& job) {
+  if (job.shards > 1) throw Error("give --shard or run under mpirun, not both");
+  MpiSession mpi;
+  const unsigned threads = job.threads > 0 ? thread_count(job.threads) : 1;  // one per rank unless asked
+  if (mpi.rank() != 0) {
+    if (mpi.agree(false)) run_sweep_mpi(mpi, job.spec, SweepControl{});
+    return;
+  }
+  std::unique_ptr<AtomicFile> file;
+  std::unique_ptr<RowJournal> journal;
+  try {
+    validate_sweep(job.spec);
+    if (!job.out.empty()) file = std::make_unique<AtomicFile>(job.out);
+    if (file)
+      journal = std::make_unique<RowJournal>(job.out + ".journal", sweep_key(job.spec), task_count(job.spec),
+                                             sweep_header(job.spec, job.command), job.resume);
+  } catch (...) {
+    mpi.agree(false);  // the other ranks stop without running anything
+    throw;
+  }
+  mpi.agree(true);
+  const auto rows = run_sweep_mpi(mpi, job.spec, SweepControl{threads, ::isatty(2) == 1, 0, 1, journal.get()});
+  write_output(job, file.get(), journal.get(), rows);
+}
+
 /// Runs the job and writes its CSV (or, for a shard, its rows file), through a journal when it has a file.
 void run_job(const SweepJob& job) {
+  if (launched_by_mpi()) return run_job_mpi(job);
   std::unique_ptr<AtomicFile> file;
   if (!job.out.empty()) file = std::make_unique<AtomicFile>(job.out);
   validate_sweep(job.spec);  // before a journal exists
@@ -450,19 +501,7 @@ void run_job(const SweepJob& job) {
     if (journal && interrupted()) throw Error(std::string(e.what()) + "; the finished rows are in " + journal->path() + ", finish with --resume");
     throw;
   }
-  if (!file) {
-    write_sweep_csv(std::cout, job.spec, rows, job.command);
-    return;
-  }
-  if (job.shards > 1) {
-    RowsContent mine{sweep_key(job.spec), tasks, header, {}};
-    for (std::size_t i = job.shard; i < tasks; i += job.shards) mine.rows.emplace(i, rows[i]);
-    file->stream() << rows_file_text(mine);
-  } else {
-    write_sweep_csv(file->stream(), job.spec, rows, job.command);
-  }
-  file->commit();
-  journal->remove();
+  write_output(job, file.get(), journal.get(), rows);
 }
 
 }  // namespace

@@ -46,6 +46,9 @@ std::size_t task_count(const SweepSpec& spec);
 /// The values of the varied parameters at grid point p (in axis order).
 std::vector<double> grid_point(const SweepSpec& spec, std::size_t p);
 
+/// Runs task i (grid point i / methods, method i % methods) and returns its CSV row.
+std::string run_sweep_task(const SweepSpec& spec, std::size_t i);
+
 /// Throws Error for an empty sweep or a grid point whose scene or step is invalid.
 void validate_sweep(const SweepSpec& spec);
 

@@ -7,9 +7,11 @@ cd "$(dirname "$0")/.."
 
 packages=(cmake ninja-build g++ git libeigen3-dev libboost-dev libboost-program-options-dev
           libgtest-dev libbenchmark-dev libtomlplusplus-dev libgsl-dev python3-matplotlib python3-numpy
-          chromium clang libclang-rt-14-dev texlive-latex-base texlive-latex-recommended latexmk)
+          chromium clang libclang-rt-14-dev texlive-latex-base texlive-latex-recommended latexmk
+          libopenmpi-dev openmpi-bin)
 # TeX Live (base and recommended LaTeX, about 48 MB to download) and latexmk compile the research
 # appendix, paper/build.sh.
+# Open MPI (about 12 MB to download) runs a sweep across processes: mpirun -np N bodypoint sweep ...
 # clang and its runtime serve the sanitizer build and the libFuzzer targets (scripts/check-sanitizers.sh).
 # The viewer (bodypoint view) bundles three.js with esbuild under Node.js; its browser test drives
 # Debian's chromium. Debian's nodejs/npm only where no Node.js is installed already.
