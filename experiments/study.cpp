@@ -42,6 +42,8 @@ struct StudyContext {
   bool published = false;
   /// --resume: sweeps continue from the journals of an interrupted run.
   bool resume = false;
+  /// --no-simd: every trajectory alone (the scalar loop), for timing comparisons.
+  bool no_simd = false;
 };
 
 void write_sweep(const StudyContext& c, const std::string& name, SweepSpec spec, std::string note) {
@@ -56,7 +58,7 @@ void write_sweep(const StudyContext& c, const std::string& name, SweepSpec spec,
   AtomicFile f(path);
   validate_sweep(spec);
   RowJournal journal(path + ".journal", sweep_key(spec), task_count(spec), sweep_header(spec, command), c.resume);
-  const auto rows = run_sweep(spec, SweepControl{c.threads, c.progress, 0, 1, &journal});
+  const auto rows = run_sweep(spec, SweepControl{c.threads, c.progress, 0, 1, &journal, !c.no_simd});
   write_sweep_csv(f.stream(), spec, rows, command);
   f.commit();
   journal.remove();
@@ -289,7 +291,8 @@ int cmd_study(int argc, char** argv) {
       ("results", po::value(&results)->default_value(results), "folder for the CSVs (created if missing)")
       ("quick", po::bool_switch(&quick), "coarser grids, same recipes (under two minutes on 2 cores)")
       ("threads", po::value(&threads)->default_value(0), "worker threads for the sweeps (0: all cores)")
-      ("resume", po::bool_switch(&c.resume), "finish the sweeps of an interrupted run from their journals (<csv>.journal)");
+      ("resume", po::bool_switch(&c.resume), "finish the sweeps of an interrupted run from their journals (<csv>.journal)")
+      ("no-simd", po::bool_switch(&c.no_simd), "sweeps run every trajectory alone, not in batches of vector lanes (same numbers, slower)");
   po::variables_map vm;
   if (!parse(argc, argv, desc, vm,
              "usage: bodypoint study [--name d|L|h|Kx|timing|evals|appendix|errata|orders|published|all|stress|dL-map] [--results DIR] [--quick]\n"

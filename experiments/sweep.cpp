@@ -1,6 +1,7 @@
 // `bodypoint sweep`: one scene or run parameter varied over a range, for a list of methods.
 #include "sweep.hpp"
 
+#include "bodypoint/batch.hpp"
 #include "bodypoint/io.hpp"
 #include "cli.hpp"
 #include "mpi_sweep.hpp"
@@ -11,11 +12,13 @@
 #include <cmath>
 #include <exception>
 #include <iostream>
+#include <map>
 #include <limits>
 #include <memory>
 #include <mutex>
 #include <sstream>
 #include <thread>
+#include <utility>
 #include <unistd.h>
 
 namespace bodypoint::cli {
@@ -134,24 +137,71 @@ std::string format_row(const std::vector<double>& point, const MethodInfo& metho
 
 }  // namespace
 
-std::string run_sweep_task(const SweepSpec& spec, std::size_t i) {
-  const MethodInfo& method = *spec.methods[i % spec.methods.size()];
-  const std::vector<double> point = grid_point(spec, i / spec.methods.size());
+std::string run_sweep_task(const SweepSpec& spec, std::size_t i) { return run_sweep_unit(spec, {i}).front(); }
+
+namespace {
+
+/// A task's row when its run threw (a budget or the method refused it).
+std::string refused_row(const std::vector<double>& point, const MethodInfo& method, const std::string& why) {
   RunResult result;
-  std::string status = "refused", reason;
-  try {
-    const Scene scene = thesis_scene(point_params(spec, point));
-    const RunSpec rs = resolve_steps(point_h(spec, point), spec.steps, spec.t_end, spec.tol);
-    result = run(method, scene.bodies.front(), scene.centres, rs);
-    const Health h = assess(result);
-    status = h.status;
-    reason = h.why;
-  } catch (const std::exception& e) {
-    reason = e.what();
-    const Vec3 nan = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
-    result.final = State{nan, nan, nan};
+  const Vec3 nan = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+  result.final = State{nan, nan, nan};
+  return format_row(point, method, result, "refused", why);
+}
+
+std::string ok_row(const std::vector<double>& point, const MethodInfo& method, const RunResult& result) {
+  const Health h = assess(result);
+  return format_row(point, method, result, h.status, h.why);
+}
+
+}  // namespace
+
+std::vector<std::string> run_sweep_unit(const SweepSpec& spec, const std::vector<std::size_t>& unit) {
+  const std::size_t M = spec.methods.size();
+  const MethodInfo& method = *spec.methods[unit.front() % M];
+  std::vector<std::vector<double>> points;
+  std::vector<batch::Member> members;
+  for (std::size_t i : unit) {
+    points.push_back(grid_point(spec, i / M));
+    const Scene scene = thesis_scene(point_params(spec, points.back()));
+    members.push_back({scene.bodies.front().p, scene.bodies.front().s0, scene.centres.front().A});
   }
-  return format_row(point, method, result, status, reason);
+  std::vector<std::string> rows;
+  if (unit.size() > 1) {  // a batch: one method, one step (plan_units), lanes that accept it
+    const RunSpec rs = resolve_steps(point_h(spec, points.front()), spec.steps, spec.t_end, spec.tol);
+    const auto results = batch::run(method, members, rs);
+    for (std::size_t k = 0; k < unit.size(); ++k) rows.push_back(ok_row(points[k], method, results[k]));
+    return rows;
+  }
+  try {
+    const Scene scene = thesis_scene(point_params(spec, points.front()));
+    const RunSpec rs = resolve_steps(point_h(spec, points.front()), spec.steps, spec.t_end, spec.tol);
+    rows.push_back(ok_row(points.front(), method, run(method, scene.bodies.front(), scene.centres, rs)));
+  } catch (const std::exception& e) {
+    rows.push_back(refused_row(points.front(), method, e.what()));
+  }
+  return rows;
+}
+
+std::vector<std::vector<std::size_t>> plan_units(const SweepSpec& spec, const std::vector<std::size_t>& todo, bool simd) {
+  std::vector<std::vector<std::size_t>> units;
+  const std::size_t M = spec.methods.size(), lanes = simd ? batch::width() : 1;
+  std::map<std::pair<std::size_t, double>, std::vector<std::size_t>> open;  // (method, h) -> a filling batch
+  for (std::size_t i : todo) {
+    const MethodInfo& method = *spec.methods[i % M];
+    const std::vector<double> point = grid_point(spec, i / M);
+    const Scene scene = thesis_scene(point_params(spec, point));
+    if (lanes < 2 || !batch::accepts(method, scene.bodies.front(), scene.centres)) {
+      units.push_back({i});
+      continue;
+    }
+    auto& filling = open[{i % M, point_h(spec, point)}];
+    filling.push_back(i);
+    if (filling.size() == lanes) units.push_back(std::exchange(filling, {}));
+  }
+  for (auto& [key, rest] : open)
+    if (!rest.empty()) units.push_back(rest);
+  return units;
 }
 
 void validate_sweep(const SweepSpec& spec) {
@@ -198,25 +248,30 @@ std::vector<std::string> run_sweep(const SweepSpec& spec, const SweepControl& co
     if (done && done->count(i)) rows[i] = done->at(i);
     else todo.push_back(i);
   }
+  const auto units = plan_units(spec, todo, control.simd);
   std::atomic<std::size_t> next{0}, finished{0};
   std::mutex mutex;  // the progress bar, the journal and the first error
   std::exception_ptr error;
-  const CooperativeInterrupt stop_at_row_boundary;  // a signal stops the sweep between rows
+  const CooperativeInterrupt stop_at_row_boundary;  // a signal stops the sweep between units
   auto worker = [&] {
-    for (std::size_t k; !interrupted() && (k = next++) < todo.size();) {
-      rows[todo[k]] = run_sweep_task(spec, todo[k]);
+    for (std::size_t k; !interrupted() && (k = next++) < units.size();) {
+      const auto unit_rows = run_sweep_unit(spec, units[k]);
       std::lock_guard<std::mutex> lock(mutex);
       try {
-        if (control.journal) control.journal->append(todo[k], rows[todo[k]]);
-      } catch (...) {  // the journal cannot be written: stop handing out rows, report after the join
+        for (std::size_t j = 0; j < units[k].size(); ++j) {
+          rows[units[k][j]] = unit_rows[j];
+          if (control.journal) control.journal->append(units[k][j], unit_rows[j]);
+        }
+      } catch (...) {  // the journal cannot be written: stop handing out units, report after the join
         if (!error) error = std::current_exception();
-        next = todo.size();
+        next = units.size();
       }
-      if (control.progress) progress_bar(++finished, todo.size());
+      finished += units[k].size();
+      if (control.progress) progress_bar(finished, todo.size());
     }
   };
   std::vector<std::thread> pool;
-  for (unsigned k = 1; k < std::min<std::size_t>(control.threads, todo.size()); ++k) pool.emplace_back(worker);
+  for (unsigned k = 1; k < std::min<std::size_t>(control.threads, units.size()); ++k) pool.emplace_back(worker);
   worker();
   for (std::thread& t : pool) t.join();
   if (error) std::rethrow_exception(error);
@@ -247,7 +302,8 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
           "# columns: " + varied + (grid ? " = values of the varied parameters" : " = value of the varied parameter") +
               "; method; max_rel_dE = max_i |E_i-E_0|/|E_0|;"
               " max_rel_dK2sq = max_i |K2^2_i-K2^2_0|/K2^2_0; max_abs_dK2Q = max_i |K2Q_i-K2Q_0|;"
-              " Rx,Ry,Rz = final position; force_evals; wall_s = step-loop time (runs share the cores);"
+              " Rx,Ry,Rz = final position; force_evals; wall_s = step-loop time (runs share the cores; a batch of"
+              " trajectories run in vector lanes shares its time equally);"
               " status = ok | diverged (non-finite, or energy error above 1) | collision (diverged after a fall onto"
               " an attracting centre) | refused (not run); reason = why, when not ok",
           names + ",method,max_rel_dE,max_rel_dK2sq,max_abs_dK2Q,Rx,Ry,Rz,force_evals,wall_s,status,reason"};
@@ -326,6 +382,7 @@ struct SweepJob {
   bool resume = false;
   long threads = 0;
   std::size_t shard = 0, shards = 1;
+  bool no_simd = false;
   std::string command;  ///< the command without the options that do not change the rows
 };
 
@@ -346,7 +403,7 @@ std::string science_command(int argc, char** argv) {
   std::string command = "bodypoint";
   for (int i = 0; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--resume") continue;
+    if (a == "--resume" || a == "--no-simd") continue;
     if ((a == "--out" || a == "--threads" || a == "--shard") && i + 1 < argc) {
       ++i;
       continue;
@@ -411,6 +468,7 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
       ("threads", po::value(&job.threads)->default_value(0), "worker threads (0: all cores)")
       ("out", po::value(&job.out), "CSV file (default: standard output); with --shard, this shard's rows file")
       ("resume", po::bool_switch(&job.resume), "finish an interrupted run of the same sweep and --out from its journal")
+      ("no-simd", po::bool_switch(&job.no_simd), "run every trajectory alone instead of in batches of vector lanes (same numbers, slower; for comparison)")
       ("shard", po::value(&shard), "K/N: run only shard K of N (tasks i with i % N = K-1) and write a rows file for 'bodypoint merge'");
   po::variables_map vm;
   help = !parse(argc, argv, desc, vm,
@@ -493,7 +551,7 @@ void run_job(const SweepJob& job) {
   const std::size_t tasks = task_count(job.spec);
   std::unique_ptr<RowJournal> journal;
   if (file) journal = std::make_unique<RowJournal>(job.out + ".journal", sweep_key(job.spec), tasks, header, job.resume);
-  SweepControl control{thread_count(job.threads), ::isatty(2) == 1, job.shard, job.shards, journal.get()};
+  SweepControl control{thread_count(job.threads), ::isatty(2) == 1, job.shard, job.shards, journal.get(), !job.no_simd};
   std::vector<std::string> rows;
   try {
     rows = run_sweep(job.spec, control);

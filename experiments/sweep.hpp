@@ -48,6 +48,11 @@ std::vector<double> grid_point(const SweepSpec& spec, std::size_t p);
 
 /// Runs task i (grid point i / methods, method i % methods) and returns its CSV row.
 std::string run_sweep_task(const SweepSpec& spec, std::size_t i);
+/// Runs a unit of plan_units (one task, or a batch) and returns its rows in the unit's order.
+std::vector<std::string> run_sweep_unit(const SweepSpec& spec, const std::vector<std::size_t>& unit);
+/// The tasks in units: batches of up to batch::width() tasks of one method and step whose scenes
+/// a batch kernel accepts (with simd), single tasks otherwise.
+std::vector<std::vector<std::size_t>> plan_units(const SweepSpec& spec, const std::vector<std::size_t>& todo, bool simd);
 
 /// Throws Error for an empty sweep or a grid point whose scene or step is invalid.
 void validate_sweep(const SweepSpec& spec);
@@ -60,6 +65,9 @@ struct SweepControl {
   bool progress = false;
   std::size_t shard = 0, shards = 1;
   RowJournal* journal = nullptr;
+  /// Run tasks that share method and step in batches of vector lanes (bodypoint/batch.hpp): the
+  /// same bits, faster; false runs every task alone (--no-simd, for comparison).
+  bool simd = true;
 };
 
 /// Resolves (h, steps) exactly as `simulate` does: with t_end > 0, steps = ceil(t_end/h) and

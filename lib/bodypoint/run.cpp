@@ -22,6 +22,7 @@
 #include "bodypoint/splitting/mclachlan.hpp"
 #include "bodypoint/splitting/sofroniou_spaletta.hpp"
 #include "bodypoint/splitting/thesis.hpp"
+#include "bodypoint/splitting/sequences.hpp"
 #include "bodypoint/splitting/yoshida.hpp"
 
 #include <cmath>
@@ -33,6 +34,7 @@ namespace bodypoint {
 namespace {
 
 namespace sp = splitting;
+using namespace splitting::ops;
 using detail::dispatch;
 using detail::observe;
 
@@ -62,23 +64,6 @@ RunResult run_splitting(const Body& body, const std::vector<Centre>& centres, co
     return r;
   });
 }
-
-// Flattened op sequences (static storage, so they can be template arguments).
-constexpr auto euler_ops = sp::flatten(sp::euler);
-constexpr auto verlet_ops = sp::flatten(sp::verlet_kdk);
-constexpr auto strang_ops = sp::flatten(sp::strang_dkd_table);
-constexpr auto ruth3_ops = sp::flatten(sp::ruth3);
-constexpr auto y4_ops = sp::flatten(sp::yoshida4);
-constexpr auto bm4_ops = sp::flatten(sp::blanes_moan4);
-constexpr auto rkn4_ops = sp::flatten(sp::blanes_moan_rkn4);
-constexpr auto rkn6_ops = sp::flatten(sp::blanes_moan_rkn6);
-constexpr auto y6_ops = sp::flatten(sp::yoshida6);
-constexpr auto kl6_ops = sp::flatten(sp::kahan_li6);
-constexpr auto y8_ops = sp::flatten(sp::yoshida8);
-constexpr auto y8d_ops = sp::flatten(sp::yoshida8d);
-constexpr auto mcl8_ops = sp::flatten(sp::mclachlan8);
-constexpr auto kl8_ops = sp::flatten(sp::kahan_li8);
-constexpr auto ss10_ops = sp::flatten(sp::sofroniou_spaletta10);
 
 template <const auto& Seq, sp::CodeSlip Slip = sp::CodeSlip::none>
 MethodInfo thesis_method(std::string_view name, int order, std::string_view what) {
