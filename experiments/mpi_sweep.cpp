@@ -44,30 +44,33 @@ std::vector<std::string> run_sweep_mpi(const MpiSession&, const SweepSpec&, cons
 
 namespace {
 
-constexpr int kTagRow = 1;   // rank r -> 0: "" (ready) or "<index>\t<row>" (a finished task)
-constexpr int kTagTask = 2;  // 0 -> rank r: the next task index, or -1 (no more)
+constexpr int kTagRow = 1;   // rank r -> 0: "" (ready) or "<index>\t<row>\n" per task of a finished unit
+constexpr int kTagTask = 2;  // 0 -> rank r: the task indices of the next unit, or none (no more)
 /// The coordinator polls for messages this often while rank 0's threads compute: short against a
 /// task (milliseconds to seconds), long enough to leave the core to the computing threads.
 constexpr auto kPoll = std::chrono::microseconds(500);
 
-/// Rank 0's queue of tasks and its rows; shared by the coordinator and the local worker threads.
+/// Rank 0's queue of units (plan_units: batches of vector lanes or single tasks) and its rows;
+/// shared by the coordinator and the local worker threads.
 class Board {
  public:
   Board(const SweepSpec& spec, const SweepControl& control) : control_(control), rows_(task_count(spec)) {
+    std::vector<std::size_t> todo;
     for (std::size_t i = 0; i < rows_.size(); ++i) {
       const auto* done = control.journal ? &control.journal->done() : nullptr;
       if (done && done->count(i)) rows_[i] = done->at(i);
-      else queue_.push_back(i);
+      else todo.push_back(i);
     }
-    total_ = queue_.size();
+    total_ = todo.size();
+    for (auto& unit : plan_units(spec, todo, control.simd)) queue_.push_back(std::move(unit));
   }
-  /// The next task, or -1 when there is none or a signal or an error stopped the sweep.
-  long take() {
+  /// The next unit, or none when there is none or a signal or an error stopped the sweep.
+  std::vector<std::size_t> take() {
     std::lock_guard<std::mutex> g(mutex_);
-    if (queue_.empty() || interrupted() || error_) return -1;
-    const std::size_t i = queue_.front();
+    if (queue_.empty() || interrupted() || error_) return {};
+    std::vector<std::size_t> unit = std::move(queue_.front());
     queue_.pop_front();
-    return static_cast<long>(i);
+    return unit;
   }
   void finish(std::size_t i, std::string row) {
     std::lock_guard<std::mutex> g(mutex_);
@@ -88,7 +91,7 @@ class Board {
  private:
   const SweepControl& control_;
   std::vector<std::string> rows_;
-  std::deque<std::size_t> queue_;
+  std::deque<std::vector<std::size_t>> queue_;
   std::size_t total_ = 0, finished_ = 0;
   std::mutex mutex_;
   std::exception_ptr error_;
@@ -108,29 +111,37 @@ void coordinate(const MpiSession& mpi, Board& board) {
     MPI_Get_count(&st, MPI_CHAR, &len);
     std::string msg(static_cast<std::size_t>(len), '\0');
     MPI_Recv(msg.data(), len, MPI_CHAR, st.MPI_SOURCE, kTagRow, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-    if (!msg.empty()) {
-      const std::size_t tab = msg.find('\t');
-      try {
-        board.finish(std::stoul(msg.substr(0, tab)), msg.substr(tab + 1));
-      } catch (...) {
-        board.fail(std::current_exception());
+    try {
+      for (std::size_t from = 0, end; (end = msg.find('\n', from)) != std::string::npos; from = end + 1) {
+        const std::size_t tab = msg.find('\t', from);
+        board.finish(std::stoul(msg.substr(from, tab - from)), msg.substr(tab + 1, end - tab - 1));
       }
+    } catch (...) {
+      board.fail(std::current_exception());
     }
-    long next = board.take();
-    MPI_Send(&next, 1, MPI_LONG, st.MPI_SOURCE, kTagTask, MPI_COMM_WORLD);
-    if (next < 0) --active;
+    const std::vector<std::size_t> unit = board.take();
+    const std::vector<long> next(unit.begin(), unit.end());
+    MPI_Send(next.data(), static_cast<int>(next.size()), MPI_LONG, st.MPI_SOURCE, kTagTask, MPI_COMM_WORLD);
+    if (next.empty()) --active;
   }
 }
 
-/// A rank other than 0: asks for a task, runs it, sends its row with the next request.
+/// A rank other than 0: asks for a unit, runs it, sends its rows with the next request.
 void serve(const SweepSpec& spec) {
   std::string msg;
   for (;;) {
     MPI_Send(msg.data(), static_cast<int>(msg.size()), MPI_CHAR, 0, kTagRow, MPI_COMM_WORLD);
-    long next = -1;
-    MPI_Recv(&next, 1, MPI_LONG, 0, kTagTask, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-    if (next < 0) return;
-    msg = std::to_string(next) + "\t" + run_sweep_task(spec, static_cast<std::size_t>(next));
+    MPI_Status st;
+    MPI_Probe(0, kTagTask, MPI_COMM_WORLD, &st);
+    int count = 0;
+    MPI_Get_count(&st, MPI_LONG, &count);
+    std::vector<long> next(static_cast<std::size_t>(count));
+    MPI_Recv(next.data(), count, MPI_LONG, 0, kTagTask, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    if (next.empty()) return;
+    const std::vector<std::size_t> unit(next.begin(), next.end());
+    const std::vector<std::string> rows = run_sweep_unit(spec, unit);
+    msg.clear();
+    for (std::size_t k = 0; k < unit.size(); ++k) msg += std::to_string(unit[k]) + "\t" + rows[k] + "\n";
   }
 }
 
@@ -160,8 +171,10 @@ std::vector<std::string> run_sweep_mpi(const MpiSession& mpi, const SweepSpec& s
   Board board(spec, control);
   auto worker = [&] {
     try {
-      for (long i; (i = board.take()) >= 0;)
-        board.finish(static_cast<std::size_t>(i), run_sweep_task(spec, static_cast<std::size_t>(i)));
+      for (std::vector<std::size_t> unit; !(unit = board.take()).empty();) {
+        const std::vector<std::string> rows = run_sweep_unit(spec, unit);
+        for (std::size_t k = 0; k < unit.size(); ++k) board.finish(unit[k], rows[k]);
+      }
     } catch (...) {
       board.fail(std::current_exception());
     }

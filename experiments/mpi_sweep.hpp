@@ -1,6 +1,7 @@
 // bodypoint: a sweep across the processes of `mpirun -np N bodypoint sweep ...` (Open MPI's C API).
 //
-// Rank 0 hands out one task at a time to whichever rank asks (dynamic load balancing: a close
+// Rank 0 hands out one unit at a time (a batch of vector lanes, or one task: sweep.hpp plan_units)
+// to whichever rank asks (dynamic load balancing: a close
 // encounter of a time-transformed method can cost a hundred times a far pass), runs tasks itself on
 // its own worker threads between messages, gathers every row and writes the output and its journal.
 // Every rank computes a task exactly as a single process would, so the CSV is the single-process CSV.
@@ -39,7 +40,7 @@ class MpiSession {
 
 /// The rows of the whole sweep on rank 0 (by task index; the journal's rows are not run again), an
 /// empty vector on the other ranks. control.threads is the number of worker threads on rank 0; the
-/// other ranks run one task at a time each.
+/// other ranks run one unit at a time each.
 std::vector<std::string> run_sweep_mpi(const MpiSession& mpi, const SweepSpec& spec, const SweepControl& control);
 
 }  // namespace bodypoint::cli

@@ -537,7 +537,7 @@ void run_job_mpi(const SweepJob& job) {
     throw;
   }
   mpi.agree(true);
-  const auto rows = run_sweep_mpi(mpi, job.spec, SweepControl{threads, ::isatty(2) == 1, 0, 1, journal.get()});
+  const auto rows = run_sweep_mpi(mpi, job.spec, SweepControl{threads, ::isatty(2) == 1, 0, 1, journal.get(), !job.no_simd});
   write_output(job, file.get(), journal.get(), rows);
 }
 
