@@ -1,5 +1,6 @@
 // `bodypoint simulate`: one method on one scene; readable summary, --json, or a trajectory CSV.
 #include "bodypoint/adaptive/tolerance.hpp"
+#include "bodypoint/batch.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/reference.hpp"
 #include "bodypoint/run.hpp"
@@ -333,6 +334,12 @@ int cmd_methods(int argc, char** argv) {
               << (m.order ? std::to_string(m.order) : "var") << std::setw(8)
               << (is_adaptive(m) ? "-" : std::to_string(m.stages)) << std::setw(14)
               << (is_adaptive(m) ? "adaptive" : std::to_string(m.evals_per_step)) << m.description << "\n";
+  const Scene probe = thesis_scene(SceneParams{});
+  std::string batched;
+  for (const MethodInfo& m : methods())
+    if (batch::accepts(m, probe.bodies.front(), probe.centres)) batched += (batched.empty() ? "" : ", ") + std::string(m.name);
+  std::cout << "\nsweeps run " << batched << " in batches of " << batch::width() << " vector lanes (" << batch::isa()
+            << "; one Coulomb centre at the origin, B != 0; the same bits as alone)\n";
   return 0;
 }
 

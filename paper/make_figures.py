@@ -5,7 +5,7 @@ usage: make_figures.py RESULTS_DIR FIGURES_DIR
 
 Reads (all written by paper/build.sh through `bodypoint study`, `bodypoint work-precision`):
   {d,L,h,Kx}_sweep.csv and published_{d,L,h,Kx}_sweep.csv, timing.csv, appendix1/index.csv and
-  appendix1/P1.*.csv, work_precision.csv, by_tol.csv
+  appendix1/P1.*.csv, work_precision.csv, by_tol.csv, and dL_map.csv when present
 Writes fig_*.pdf and figures.md (which thesis figure each one stands for). Nothing here computes
 physics: it only draws what the drivers measured.
 """
@@ -231,6 +231,41 @@ def by_tol_figure(res, figs, listing):
     save(fig, os.path.join(figs, "fig_by_tol.pdf"), listing, "delivered error against requested TOL")
 
 
+def map_figure(res, figs, listing):
+    """The (d, L) stability map (bodypoint study --name dL-map): one heat map of log10 max relative
+    energy deviation per fixed-step method; cells whose run is not ok (diverged, collision) in black."""
+    path = os.path.join(res, "dL_map.csv")
+    if not os.path.exists(path):
+        return
+    rows = read_csv(path)
+    ds = sorted({num(r["d"]) for r in rows})
+    Ls = sorted({num(r["L"]) for r in rows})
+    groups = by_method(rows)
+    methods = list(groups)
+    cols = 6
+    nrows = (len(methods) + cols - 1) // cols
+    fig, axes = plt.subplots(nrows, cols, figsize=(WIDE, 1.25 * nrows + 0.5), sharex=True, sharey=True, squeeze=False)
+    cmap = plt.get_cmap("viridis").copy()
+    cmap.set_bad("black")
+    image = None
+    for ax, m in zip(axes.flat, methods):
+        grid = [[float("nan")] * len(ds) for _ in Ls]
+        for r in groups[m]:
+            v = num(r["max_rel_dE"])
+            ok = r["status"] == "ok" and v > 0
+            grid[Ls.index(num(r["L"]))][ds.index(num(r["d"]))] = math.log10(v) if ok else float("nan")
+        image = ax.pcolormesh(ds, Ls, grid, cmap=cmap, vmin=-16, vmax=0, shading="nearest")
+        ax.set_title(m, pad=2)
+    for ax in axes.flat[len(methods):]:
+        ax.axis("off")
+    for ax in axes[-1]:
+        ax.set_xlabel("d")
+    for ax in axes[:, 0]:
+        ax.set_ylabel("L")
+    fig.colorbar(image, ax=axes, shrink=0.6, label="log10 max relative energy deviation (black: not ok)")
+    save(fig, os.path.join(figs, "fig_dL_map.pdf"), listing, "the (d, L) stability map, one panel per fixed-step method")
+
+
 def main():
     if len(sys.argv) != 3:
         sys.exit("usage: make_figures.py RESULTS_DIR FIGURES_DIR")
@@ -242,6 +277,7 @@ def main():
     appendix_figure(res, figs, listing)
     work_precision_figures(res, figs, listing)
     by_tol_figure(res, figs, listing)
+    map_figure(res, figs, listing)
     with open(os.path.join(figs, "figures.md"), "w") as f:
         f.write("| file | what it shows |\n|---|---|\n")
         for name, what in listing:

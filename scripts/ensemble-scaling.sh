@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# bodypoint: throughput and parallel efficiency of one sweep run every way the tool can run it: the
+# scalar loop, vector lanes (batches), 2 threads, 2 MPI ranks, and 2 shards merged. Prints a table
+# (wall time of one run each, trajectory-steps per second, speed-up and efficiency against the same
+# mode on one core) and checks that every way wrote the same CSV (wall_s aside).
+# usage: scripts/ensemble-scaling.sh [BUILD_DIR]   (default build; run on an otherwise idle machine)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bp="${1:-build}/bin/bodypoint"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+# 40 distances x 2 launch distances x 4 methods at the thesis's n = 250000 (h = 1e-4): three with
+# batch kernels and one time-transformed method (always scalar) whose cost varies with the encounter.
+steps=250000
+sweep=(sweep --grid d=5:200:5 --grid L=200,600 --methods lp-y4,rk4,thesis-fr4,logh-kl6 --steps "$steps")
+trajectories=$((40 * 2 * 4))
+
+strip() { awk -F, 'BEGIN { OFS = "," } /^#/ { next } !col { for (i = 1; i <= NF; i++) if ($i == "wall_s") col = i; print; next }
+                   { $col = ""; print }' "$1"; }
+now() { date +%s.%N; }
+declare -A secs
+run() {  # name, then the command
+  local name="$1"; shift
+  local t0; t0="$(now)"
+  "$@"
+  secs[$name]="$(awk -v a="$(now)" -v b="$t0" 'BEGIN { print a - b }')"
+}
+
+run scalar1 "$bp" "${sweep[@]}" --no-simd --threads 1 --out "$work/scalar1.csv"
+run simd1 "$bp" "${sweep[@]}" --threads 1 --out "$work/simd1.csv"
+run simd2 "$bp" "${sweep[@]}" --threads 2 --out "$work/simd2.csv"
+if command -v mpirun >/dev/null 2>&1; then
+  run mpi2 mpirun -np 2 --oversubscribe "$bp" "${sweep[@]}" --out "$work/mpi2.csv" || unset 'secs[mpi2]'
+fi
+t0="$(now)"
+"$bp" "${sweep[@]}" --threads 1 --shard 1/2 --out "$work/s1.rows" &
+"$bp" "${sweep[@]}" --threads 1 --shard 2/2 --out "$work/s2.rows"
+wait
+"$bp" merge --input "$work/s1.rows" "$work/s2.rows" --out "$work/shards2.csv"
+secs[shards2]="$(awk -v a="$(now)" -v b="$t0" 'BEGIN { print a - b }')"
+
+for f in simd1 simd2 mpi2 shards2; do
+  [[ -f "$work/$f.csv" ]] || continue
+  cmp -s <(strip "$work/scalar1.csv") <(strip "$work/$f.csv") || { echo "FAIL: $f differs from the scalar run" >&2; exit 1; }
+done
+echo "sweep: ${sweep[*]} ($trajectories trajectories)"
+"$bp" methods | tail -n 1
+echo "every mode wrote the scalar run's CSV (wall_s aside)"
+printf '| mode | cores | wall s | trajectory-steps/s | speed-up vs scalar | parallel efficiency |\n|---|---|---|---|---|---|\n'
+for m in scalar1 simd1 simd2 mpi2 shards2; do
+  [[ -n "${secs[$m]:-}" ]] || continue
+  cores=1; base="${secs[simd1]}"
+  case $m in scalar1) base="${secs[scalar1]}";; simd2|mpi2|shards2) cores=2;; esac
+  awk -v m="$m" -v c="$cores" -v s="${secs[$m]}" -v sc="${secs[scalar1]}" -v b="$base" -v n="$trajectories" -v k="$steps" \
+    'BEGIN { printf "| %s | %d | %.2f | %.3g | %.2fx | %.0f%% |\n", m, c, s, n * k / s, sc / s, 100 * b / (c * s) }'
+done
