@@ -6,7 +6,8 @@
 #   paper/build.sh --quick    the same recipes, scenes and sections on coarse grids into paper/results-quick/
 #
 # Steps: bodypoint study (d, L, h, Kx sweeps, timing, force evaluations, appendix 1, errata, the sweeps
-# as published, stress), bodypoint work-precision (ladders and --by-tol), bench_steps (cost per step),
+# as published, stress, the (d, L) map), bodypoint work-precision (ladders and --by-tol), bench_steps
+# (cost per step), bench_batch (sweep throughput per core),
 # make_figures.py (vector PDF), make_macros.py (LaTeX macros and tables), latexmk.
 # BODYPOINT_NO_SETUP=1 skips scripts/setup.sh and BODYPOINT_BUILD_DIR names the build tree (default
 # build/); the ctest that builds the quick paper sets both.
@@ -32,6 +33,11 @@ q=()
 [ $mode = quick ] && q=(--quick)
 $bin study "${q[@]}" --results "$results"
 $bin study "${q[@]}" --name stress --results "$results"
+# The (d, L) stability map (thesis resolution in the full build), timed: its wall time is a number of
+# the paper.
+map_start=$(date +%s.%N)
+$bin study "${q[@]}" --name dL-map --results "$results"
+awk -v a="$(date +%s.%N)" -v b="$map_start" -v n="$(nproc)" 'BEGIN { print a - b, n }' > "$results/dL_map_seconds.txt"
 
 if [ $mode = quick ]; then
   wp=(--quick --scenes all --max-evals 3e5)
@@ -54,6 +60,13 @@ if [ $mode = full ]; then  # keep the medians only
     > "$results/bench_steps.csv.tmp2" && mv "$results/bench_steps.csv.tmp2" "$results/bench_steps.csv.tmp"
 fi
 mv "$results/bench_steps.csv.tmp" "$results/bench_steps.csv"
+# Sweep throughput per core: the scalar loop against batches of vector lanes (medians in the full build).
+"$bindir/bench_batch" "${bench[@]}" --benchmark_format=csv > "$results/bench_batch.csv.tmp" 2>/dev/null
+if [ $mode = full ]; then
+  grep -v '^"BM_Sweep.*_\(mean\|stddev\|cv\)"' "$results/bench_batch.csv.tmp" > "$results/bench_batch.csv.tmp2"
+  mv "$results/bench_batch.csv.tmp2" "$results/bench_batch.csv.tmp"
+fi
+mv "$results/bench_batch.csv.tmp" "$results/bench_batch.csv"
 
 out=paper/build
 mkdir -p "$out"

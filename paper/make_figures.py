@@ -255,7 +255,8 @@ def map_figure(res, figs, listing):
             ok = r["status"] == "ok" and v > 0
             grid[Ls.index(num(r["L"]))][ds.index(num(r["d"]))] = math.log10(v) if ok else float("nan")
         image = ax.pcolormesh(ds, Ls, grid, cmap=cmap, vmin=-16, vmax=0, shading="nearest")
-        ax.set_title(m, pad=2)
+        ax.grid(False)
+        ax.set_title(m, pad=2, fontsize=6)
     for ax in axes.flat[len(methods):]:
         ax.axis("off")
     for ax in axes[-1]:

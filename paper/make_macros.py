@@ -405,6 +405,51 @@ def appendix(res, M):
             M.add("AppendixPThreeD", sci(num(r["m"]) * num(r["J"]) - num(r["B"]) ** 2))
 
 
+def ensembles(res, M):
+    """The (d, L) map (study --name dL-map, timed by build.sh) and the batch throughput (bench_batch)."""
+    rows, _ = read_csv(os.path.join(res, "dL_map.csv"))
+    methods = list(dict.fromkeys(r["method"] for r in rows))
+    points = len(rows) // len(methods)
+    M.add("MapPoints", count(points))
+    M.add("MapDs", count(len({r["d"] for r in rows})))
+    M.add("MapLs", count(len({r["L"] for r in rows})))
+    M.add("MapMethods", count(len(methods)))
+    M.add("MapRuns", count(len(rows)))
+    with open(os.path.join(res, "dL_map_seconds.txt")) as f:  # wall seconds, cores
+        seconds, cores = f.read().split()
+    M.add("MapSeconds", sci(float(seconds)))
+    M.add("MapCores", count(int(cores)))
+    # Share of the map each family keeps below 1e-10 relative energy error (status ok).
+    def share(pick, bound=1e-10):
+        rs = [r for r in rows if pick(r["method"])]
+        good = sum(1 for r in rs if r["status"] == "ok" and num(r["max_rel_dE"]) < bound)
+        return 100.0 * good / len(rs)
+    M.add("MapShareLp", sci(share(lambda m: m.startswith("lp-")), 3))
+    M.add("MapShareThesis", sci(share(lambda m: m.startswith("thesis-")), 3))
+    M.add("MapShareRk", sci(share(lambda m: m in ("rk4", "ab4")), 3))
+    M.add("MapNotOk", count(sum(1 for r in rows if r["status"] != "ok")))
+    # bench_batch: items_per_second of the scalar loop and of each width, per method.
+    rate = {}
+    with open(os.path.join(res, "bench_batch.csv")) as f:
+        lines = [line for line in f if line.startswith('"BM_') or line.startswith("name,")]
+    for r in csv.DictReader(lines):
+        rate[r["name"].strip('"').replace("_median", "")] = num(r["items_per_second"])
+    widths = sorted({int(k.rsplit("/w", 1)[1]) for k in rate if k.startswith("BM_SweepBatch/")})
+    wide = widths[-1]
+    M.add("BatchWidth", count(wide))
+    M.add("MapBatchWidthText", f"{wide} lanes at a time on this machine", math_mode=False)
+    ratios = {}
+    for k, v in rate.items():
+        if k.startswith("BM_SweepScalar/"):
+            m = k.split("/", 1)[1]
+            ratios[m] = rate[f"BM_SweepBatch/{m}/w{wide}"] / v
+            M.add("BatchSpeedup" + camel(m), sci(ratios[m]))
+            M.add("BatchScalarRate" + camel(m), sci(v))
+            M.add("BatchRate" + camel(m), sci(rate[f"BM_SweepBatch/{m}/w{wide}"]))
+    M.add("BatchSpeedupMin", sci(min(ratios.values())))
+    M.add("BatchSpeedupMax", sci(max(ratios.values())))
+
+
 def main():
     if len(sys.argv) != 4:
         sys.exit("usage: make_macros.py RESULTS_DIR OUT_DIR MODE")
@@ -422,6 +467,7 @@ def main():
     by_tol(res, out, M)
     stress(res, out, M)
     appendix(res, M)
+    ensembles(res, M)
     M.write(os.path.join(out, "macros.tex"))
     print(f"wrote {len(M.defs)} macros and the tables to {out}")
 
