@@ -427,7 +427,7 @@ std::vector<Axis> parse_axes(const po::variables_map& vm, const std::vector<std:
     }
     return axes;
   }
-  if (!vm.count("param")) throw Error("--param (or --grid) is required (d, L, h, Kx, Kz, K1, A, B, J, m)");
+  if (!vm.count("param")) throw Error("--param is required (or --grid; parameters: d, L, h, Kx, Kz, K1, A, B, J, m)");
   const std::string param = vm["param"].as<std::string>();
   const auto& ps = sweep_parameters();
   if (std::find(ps.begin(), ps.end(), param) == ps.end())
