@@ -67,6 +67,11 @@ if [ $mode = full ]; then
   mv "$results/bench_batch.csv.tmp2" "$results/bench_batch.csv.tmp"
 fi
 mv "$results/bench_batch.csv.tmp" "$results/bench_batch.csv"
+# One sweep run scalar, in lanes, on 2 threads, 2 MPI ranks and 2 shards: throughput and efficiency.
+scale=()
+[ $mode = quick ] && scale=(--quick)
+scripts/ensemble-scaling.sh "${scale[@]}" --build "${BODYPOINT_BUILD_DIR:-build}" --csv "$results/scaling.csv" \
+  > "$results/scaling.md"
 
 out=paper/build
 mkdir -p "$out"

@@ -447,6 +447,14 @@ def ensembles(res, M):
             M.add("BatchScalarRate" + camel(m), sci(v))
             M.add("BatchRate" + camel(m), sci(rate[f"BM_SweepBatch/{m}/w{wide}"]))
     M.add("BatchSpeedupMin", sci(min(ratios.values())))
+    # scripts/ensemble-scaling.sh: one sweep every way it runs.
+    scaling = {r["mode"]: r for r in read_csv(os.path.join(res, "scaling.csv"))[0]}
+    for mode, name in [("simd1", "Lanes"), ("simd2", "Threads"), ("mpi2", "Mpi"), ("shards2", "Shards")]:
+        row = scaling.get(mode, {})  # mpi2 is missing where mpirun is: n/a
+        M.add("Scale" + name + "Speedup", sci(num(row.get("speedup_vs_scalar"))))
+        M.add("Scale" + name + "Efficiency", sci(100 * num(row.get("parallel_efficiency")), 2))
+    M.add("ScaleScalarRate", sci(num(scaling["scalar1"]["traj_steps_per_s"])))
+    M.add("ScaleLanesRate", sci(num(scaling["simd1"]["traj_steps_per_s"])))
     M.add("BatchSpeedupMax", sci(max(ratios.values())))
 
 

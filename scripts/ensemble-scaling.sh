@@ -3,16 +3,29 @@
 # scalar loop, vector lanes (batches), 2 threads, 2 MPI ranks, and 2 shards merged. Prints a table
 # (wall time of one run each, trajectory-steps per second, speed-up and efficiency against the same
 # mode on one core) and checks that every way wrote the same CSV (wall_s aside).
-# usage: scripts/ensemble-scaling.sh [BUILD_DIR]   (default build; run on an otherwise idle machine)
+# usage: scripts/ensemble-scaling.sh [--quick] [--build DIR] [--csv FILE]
+#   --quick: n = 25000 instead of the thesis's 250000; --build: the build tree (default build);
+#   --csv: also write the table as CSV (paper/build.sh does). Run it on an otherwise idle machine.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bp="${1:-build}/bin/bodypoint"
+build=build
+csv=""
+steps=250000
+while (($#)); do
+  case "$1" in
+    --quick) steps=25000 ;;
+    --build) build="$2"; shift ;;
+    --csv) csv="$2"; shift ;;
+    *) echo "usage: scripts/ensemble-scaling.sh [--quick] [--build DIR] [--csv FILE]" >&2; exit 2 ;;
+  esac
+  shift
+done
+bp="$build/bin/bodypoint"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
-# 40 distances x 2 launch distances x 4 methods at the thesis's n = 250000 (h = 1e-4): three with
-# batch kernels and one time-transformed method (always scalar) whose cost varies with the encounter.
-steps=250000
+# 40 distances x 2 launch distances x 4 methods at h = 1e-4: three with batch kernels and one
+# time-transformed method (always scalar) whose cost varies with the encounter.
 sweep=(sweep --grid d=5:200:5 --grid L=200,600 --methods lp-y4,rk4,thesis-fr4,logh-kl6 --steps "$steps")
 trajectories=$((40 * 2 * 4))
 
@@ -48,10 +61,17 @@ echo "sweep: ${sweep[*]} ($trajectories trajectories)"
 "$bp" methods | tail -n 1
 echo "every mode wrote the scalar run's CSV (wall_s aside)"
 printf '| mode | cores | wall s | trajectory-steps/s | speed-up vs scalar | parallel efficiency |\n|---|---|---|---|---|---|\n'
+[[ -z "$csv" ]] || echo "mode,cores,wall_s,traj_steps_per_s,speedup_vs_scalar,parallel_efficiency" > "$csv.tmp"
 for m in scalar1 simd1 simd2 mpi2 shards2; do
   [[ -n "${secs[$m]:-}" ]] || continue
   cores=1; base="${secs[simd1]}"
   case $m in scalar1) base="${secs[scalar1]}";; simd2|mpi2|shards2) cores=2;; esac
-  awk -v m="$m" -v c="$cores" -v s="${secs[$m]}" -v sc="${secs[scalar1]}" -v b="$base" -v n="$trajectories" -v k="$steps" \
-    'BEGIN { printf "| %s | %d | %.2f | %.3g | %.2fx | %.0f%% |\n", m, c, s, n * k / s, sc / s, 100 * b / (c * s) }'
+  # Efficiency: the same mode's one-core time over cores x this time (lanes on one core for simd2, mpi2, shards2).
+  row="$(awk -v m="$m" -v c="$cores" -v s="${secs[$m]}" -v sc="${secs[scalar1]}" -v b="$base" -v n="$trajectories" -v k="$steps" \
+    'BEGIN { printf "%s,%d,%.3f,%.4g,%.3f,%.3f", m, c, s, n * k / s, sc / s, b / (c * s) }')"
+  IFS=, read -r _ _ wall rate speed eff <<< "$row"
+  awk -v m="$m" -v c="$cores" -v w="$wall" -v r="$rate" -v sp="$speed" -v e="$eff" \
+    'BEGIN { printf "| %s | %d | %.2f | %.3g | %.2fx | %.0f%% |\n", m, c, w, r, sp, 100 * e }'
+  [[ -z "$csv" ]] || echo "$row" >> "$csv.tmp"
 done
+[[ -z "$csv" ]] || mv "$csv.tmp" "$csv"
