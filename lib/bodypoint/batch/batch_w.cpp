@@ -58,8 +58,6 @@ struct Physical {
 /// InvariantMonitor's arithmetic (invariants.hpp) for one centre at the origin.
 class Monitor {
  public:
-  static constexpr bool active = true;
-
   Monitor(const Params& p, const Physical& s0) : p_(p) {
     E0_ = energy(s0);
     K2sq0_ = squared_norm(K2(s0));
