@@ -31,12 +31,13 @@ mkdir -p "$results"
 
 q=()
 [ $mode = quick ] && q=(--quick)
-$bin study "${q[@]}" --results "$results"
+# --resume: an interrupted build continues its sweeps from their journals (rows of this same build).
+$bin study "${q[@]}" --resume --results "$results"
 $bin study "${q[@]}" --name stress --results "$results"
 # The (d, L) stability map (thesis resolution in the full build), timed: its wall time is a number of
 # the paper.
 map_start=$(date +%s.%N)
-$bin study "${q[@]}" --name dL-map --results "$results"
+$bin study "${q[@]}" --resume --name dL-map --results "$results"
 awk -v a="$(date +%s.%N)" -v b="$map_start" -v n="$(nproc)" 'BEGIN { print a - b, n }' > "$results/dL_map_seconds.txt"
 
 if [ $mode = quick ]; then
