@@ -238,12 +238,18 @@ std::vector<double> grid_point(const SweepSpec& spec, std::size_t p) {
   return point;
 }
 
+std::size_t shard_of(const SweepSpec& spec, std::size_t task, std::size_t shards) {
+  const std::size_t M = spec.methods.size();
+  return (task / M + task % M) % std::max<std::size_t>(shards, 1);
+}
+
 std::vector<std::string> run_sweep(const SweepSpec& spec, const SweepControl& control) {
   validate_sweep(spec);
   const std::size_t n = task_count(spec);
   std::vector<std::string> rows(n);
   std::vector<std::size_t> todo;
-  for (std::size_t i = control.shard; i < n; i += std::max<std::size_t>(control.shards, 1)) {
+  for (std::size_t i = 0; i < n; ++i) {
+    if (shard_of(spec, i, control.shards) != control.shard) continue;
     const auto* done = control.journal ? &control.journal->done() : nullptr;
     if (done && done->count(i)) rows[i] = done->at(i);
     else todo.push_back(i);
@@ -469,7 +475,7 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
       ("out", po::value(&job.out), "CSV file (default: standard output); with --shard, this shard's rows file")
       ("resume", po::bool_switch(&job.resume), "finish an interrupted run of the same sweep and --out from its journal")
       ("no-simd", po::bool_switch(&job.no_simd), "run every trajectory alone instead of in batches of vector lanes (same numbers, slower; for comparison)")
-      ("shard", po::value(&shard), "K/N: run only shard K of N (tasks i with i % N = K-1) and write a rows file for 'bodypoint merge'");
+      ("shard", po::value(&shard), "K/N: run only shard K of N (every method on every N-th grid point, staggered) and write a rows file for 'bodypoint merge'");
   po::variables_map vm;
   help = !parse(argc, argv, desc, vm,
                 "usage: bodypoint sweep (--param P (--from A --to B --step S | --log --from A --to B --points N | --values a,b,c)"
@@ -506,7 +512,8 @@ void write_output(const SweepJob& job, AtomicFile* file, RowJournal* journal, co
   }
   if (job.shards > 1) {
     RowsContent mine{sweep_key(job.spec), rows.size(), sweep_header(job.spec, job.command), {}};
-    for (std::size_t i = job.shard; i < rows.size(); i += job.shards) mine.rows.emplace(i, rows[i]);
+    for (std::size_t i = 0; i < rows.size(); ++i)
+      if (shard_of(job.spec, i, job.shards) == job.shard) mine.rows.emplace(i, rows[i]);
     file->stream() << rows_file_text(mine);
   } else {
     write_sweep_csv(file->stream(), job.spec, rows, job.command);

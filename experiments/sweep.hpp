@@ -57,7 +57,12 @@ std::vector<std::vector<std::size_t>> plan_units(const SweepSpec& spec, const st
 /// Throws Error for an empty sweep or a grid point whose scene or step is invalid.
 void validate_sweep(const SweepSpec& spec);
 
-/// How a sweep runs: threads, which tasks (shard K of N takes the tasks i with i % N == K), and a
+/// The shard (0 .. shards-1) that runs task i = point * M + method: (point + method) % shards, so that
+/// every shard gets every method on an equal share of the points (a method's cost varies far more
+/// than a point's, and interleaving whole tasks would give one shard all of a method when M is even).
+std::size_t shard_of(const SweepSpec& spec, std::size_t task, std::size_t shards);
+
+/// How a sweep runs: threads, which tasks (shard K of N takes the tasks with shard_of == K), and a
 /// journal that keeps finished rows durably and supplies those of an interrupted run (rows_file.hpp).
 class RowJournal;
 struct SweepControl {

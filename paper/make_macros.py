@@ -453,6 +453,7 @@ def ensembles(res, M):
         row = scaling.get(mode, {})  # mpi2 is missing where mpirun is: n/a
         M.add("Scale" + name + "Speedup", sci(num(row.get("speedup_vs_scalar"))))
         M.add("Scale" + name + "Efficiency", sci(100 * num(row.get("parallel_efficiency")), 2))
+    M.add("ScaleMpiStartup", sci(num(scaling.get("mpi2-startup", {}).get("wall_s"))))
     M.add("ScaleScalarRate", sci(num(scaling["scalar1"]["traj_steps_per_s"])))
     M.add("ScaleLanesRate", sci(num(scaling["simd1"]["traj_steps_per_s"])))
     M.add("BatchSpeedupMax", sci(max(ratios.values())))

@@ -45,6 +45,9 @@ run simd1 "$bp" "${sweep[@]}" --threads 1 --out "$work/simd1.csv"
 run simd2 "$bp" "${sweep[@]}" --threads 2 --out "$work/simd2.csv"
 if command -v mpirun >/dev/null 2>&1; then
   run mpi2 mpirun -np 2 --oversubscribe "$bp" "${sweep[@]}" --out "$work/mpi2.csv" || unset 'secs[mpi2]'
+  # What mpirun itself costs: starting and ending 2 ranks around a sweep of two 10-step tasks.
+  run mpi2-startup mpirun -np 2 --oversubscribe "$bp" sweep --grid d=5,10 --methods lp-y4 --steps 10 \
+    --out "$work/startup.csv" || unset 'secs[mpi2-startup]'
 fi
 t0="$(now)"
 "$bp" "${sweep[@]}" --threads 1 --shard 1/2 --out "$work/s1.rows" &
@@ -74,4 +77,8 @@ for m in scalar1 simd1 simd2 mpi2 shards2; do
     'BEGIN { printf "| %s | %d | %.2f | %.3g | %.2fx | %.0f%% |\n", m, c, w, r, sp, 100 * e }'
   [[ -z "$csv" ]] || echo "$row" >> "$csv.tmp"
 done
+if [[ -n "${secs[mpi2-startup]:-}" ]]; then
+  awk -v s="${secs[mpi2-startup]}" 'BEGIN { printf "mpirun start-up and shut-down of 2 ranks (a sweep of two 10-step tasks): %.2f s\n", s }'
+  [[ -z "$csv" ]] || awk -v s="${secs[mpi2-startup]}" 'BEGIN { printf "mpi2-startup,2,%.3f,,,\n", s }' >> "$csv.tmp"
+fi
 [[ -z "$csv" ]] || mv "$csv.tmp" "$csv"
