@@ -1,4 +1,4 @@
-// bodypoint: the step search behind --tol and --method auto (tolerance.hpp).
+// bodypoint: the step search behind --tol (tolerance.hpp).
 //
 // The search, for a method of order p:
 // 1. Two runs at a coarse h0 (a fictitious step that advances the orbit by about one radian per step
@@ -15,7 +15,7 @@
 // below kAccept tol, otherwise the search reports the floor it met.
 #include "bodypoint/adaptive/tolerance.hpp"
 
-#include "bodypoint/adaptive/registry.hpp"
+#include "bodypoint/adaptive/methods.hpp"
 #include "bodypoint/field.hpp"
 #include "bodypoint/invariants.hpp"
 
@@ -266,23 +266,6 @@ class Search {
   int runs_ = 0;
 };
 
-/// auto's table: Yoshida 4 from this tolerance up, Kahan-Li 6 from kTightTolerance, Kahan-Li 8 below.
-constexpr double kLooseTolerance = 1e-5;
-constexpr double kTightTolerance = 1e-10;
-
-/// auto takes a fixed step when the potential at the estimated closest approach is below this
-/// fraction of the time-step constant c: the time transformation would then change the step by < 10%.
-constexpr double kFarFraction = 0.1;
-
-/// Straight-line estimate of the closest approach to c: the body's initial line of motion.
-double closest_approach(const Body& b, const Centre& c) {
-  const Vec3 d = b.s0.R - c.c;
-  const Vec3& v = b.s0.v;
-  const double v2 = v.squaredNorm();
-  if (!(v2 > 0.0) || d.dot(v) >= 0.0) return d.norm();  // at rest or moving away
-  return d.cross(v).norm() / std::sqrt(v2);
-}
-
 }  // namespace
 
 double state_distance(const State& a, const State& b) {
@@ -320,43 +303,6 @@ ToleranceResult run_to_tolerance(const MethodInfo& method, const Body& body, con
     throw Error("--tol assumes Coulomb's law (its error model and time transformations do); run the thesis code's "
                 "force law with a fixed step --h");
   return Search(method, body, centres, tol, t_end).search();
-}
-
-const MethodInfo& choose_method(const Body& body, const std::vector<Centre>& centres, double tol, std::string* why) {
-  check_tolerance(tol);
-  // The table by tolerance, measured (logh on the close, thesis and two-centres scenes, force
-  // evaluations of the whole search): Yoshida 4 (3 stages) is cheapest down to 1e-5 (thesis 3,648
-  // against 10,944 for Kahan-Li 6), Kahan-Li 6 down to 1e-10 (close 1e-9: 21,690 against 33,218 for
-  // Kahan-Li 8), Kahan-Li 8 below.
-  const char* table = tol >= kLooseTolerance ? "y4" : tol >= kTightTolerance ? "kl6" : "kl8";
-  std::ostringstream os;
-  bool repulsive = true;
-  double potential_at_closest = 0.0;
-  for (const Centre& c : centres) {
-    repulsive = repulsive && c.A < 0.0;
-    potential_at_closest += std::abs(c.A) / std::max(closest_approach(body, c), 1e-300);
-  }
-  const double c = automatic_omega_c(body, centres, 0.0);
-  std::string name;
-  if (body.p.B == 0.0 && centres.size() == 1) {
-    name = "ks";
-    os << "ks: a material point and one centre (exact Kepler/Rutherford flow)";
-  } else if (c > 0.0 && potential_at_closest < kFarFraction * c) {
-    name = std::string("lp-") + table;
-    os << name << ": the body stays far from every centre (sum |A|/r_min ~ " << potential_at_closest
-       << " < c/10 = " << 0.1 * c << ", so a time transformation would hardly change the step)";
-  } else if (repulsive) {
-    name = std::string("logh-") + table;
-    os << name << ": every centre repels (logarithmic Hamiltonian, step ~ distance to the centres)";
-  } else {
-    name = std::string("ttl-") + table;
-    os << name << ": an attracting centre (time-transformed leapfrog, step ~ distance to the centres)";
-  }
-  if (name != "ks")
-    os << "; " << (tol >= kLooseTolerance ? "Yoshida 4 for tol >= 1e-5"
-                   : tol >= kTightTolerance ? "Kahan-Li 6 for 1e-10 <= tol < 1e-5" : "Kahan-Li 8 for tol < 1e-10");
-  if (why) *why = os.str();
-  return method_or_throw(name);
 }
 
 }  // namespace bodypoint::adaptive

@@ -4,6 +4,7 @@
 // Run: build/bin/bench_batch --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 // and compare the items_per_second medians of one run (the ratio is the speed-up per core).
 #include "bodypoint/batch.hpp"
+#include "bodypoint/methods.hpp"
 #include "bodypoint/run.hpp"
 
 #include <benchmark/benchmark.h>

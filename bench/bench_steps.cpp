@@ -4,6 +4,7 @@
 //
 //   build/bin/bench_steps --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include "bodypoint/field.hpp"
+#include "bodypoint/methods.hpp"
 #include "bodypoint/rhs.hpp"
 #include "bodypoint/rk/odeint.hpp"
 #include "bodypoint/run.hpp"

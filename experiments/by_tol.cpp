@@ -11,6 +11,7 @@
 
 #include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/io.hpp"
+#include "bodypoint/methods.hpp"
 #include "bodypoint/reference.hpp"
 #include "bodypoint/run.hpp"
 
@@ -55,7 +56,7 @@ TolRow measure_auto(const NamedScene& ns, const State& ref, double tol, long rep
   row.scene = ns.name;
   row.tol = tol;
   row.is_auto = true;
-  const MethodInfo& m = adaptive::choose_method(body, ns.scene.centres, tol, nullptr);
+  const MethodInfo& m = choose_method(body, ns.scene.centres, tol, nullptr);
   row.method = std::string(m.name);
   std::vector<double> times;
   adaptive::ToleranceResult r;

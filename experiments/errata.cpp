@@ -14,6 +14,7 @@
 
 #include "bodypoint/invariants.hpp"
 #include "bodypoint/io.hpp"
+#include "bodypoint/methods.hpp"
 #include "bodypoint/reference.hpp"
 #include "bodypoint/rhs.hpp"
 #include "bodypoint/run.hpp"

@@ -11,6 +11,7 @@
 #include "orders.hpp"
 
 #include "bodypoint/io.hpp"
+#include "bodypoint/methods.hpp"
 #include "bodypoint/order_fit.hpp"
 #include "bodypoint/reference.hpp"
 #include "bodypoint/run.hpp"

@@ -2,6 +2,7 @@
 #include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/batch.hpp"
 #include "bodypoint/io.hpp"
+#include "bodypoint/methods.hpp"
 #include "bodypoint/reference.hpp"
 #include "bodypoint/run.hpp"
 #include "budget.hpp"
@@ -95,7 +96,7 @@ BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre
     return b;
   }
   // The step search, then the delivered run repeated with invariants or output when they are asked for.
-  b.method = plan.method ? plan.method : &adaptive::choose_method(body, centres, plan.tol, &b.why);
+  b.method = plan.method ? plan.method : &choose_method(body, centres, plan.tol, &b.why);
   b.search = adaptive::run_to_tolerance(*b.method, body, centres, plan.tol, spec.t_end);
   if (spec.track_invariants || sink)
     b.result = run(*b.method, body, centres, adaptive::delivered_spec(*b.method, *b.search, spec.t_end, spec), sink);

@@ -5,6 +5,7 @@
 #include "stress.hpp"
 
 #include "bodypoint/io.hpp"
+#include "bodypoint/methods.hpp"
 #include "budget.hpp"
 
 #include <cmath>

@@ -14,6 +14,7 @@
 //   definite, so it is recorded as skipped instead of integrated. Sets P1.4 and P1.5 are printed
 //   with identical parameters; both are run.
 #include "bodypoint/io.hpp"
+#include "bodypoint/methods.hpp"
 #include "cli.hpp"
 #include "errata.hpp"
 #include "orders.hpp"

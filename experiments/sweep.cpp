@@ -3,6 +3,7 @@
 
 #include "bodypoint/batch.hpp"
 #include "bodypoint/io.hpp"
+#include "bodypoint/methods.hpp"
 #include "cli.hpp"
 #include "mpi_sweep.hpp"
 #include "rows_file.hpp"

@@ -8,6 +8,7 @@
 // the median of several repeats with no invariant tracking and no output inside the timed region, and
 // run once more, untimed, to measure max_rel_dE.
 #include "bodypoint/io.hpp"
+#include "bodypoint/methods.hpp"
 #include "bodypoint/reference.hpp"
 #include "bodypoint/run.hpp"
 #include "bodypoint/scenes.hpp"

@@ -2,9 +2,10 @@
 // logarithmic Hamiltonian, convergence order in the fictitious step, time reversibility, exact end
 // times, stress cases, and the close-encounter targets of issue #4.
 #include "bodypoint/adaptive/ks.hpp"
-#include "bodypoint/adaptive/registry.hpp"
+#include "bodypoint/adaptive/methods.hpp"
 #include "bodypoint/adaptive/time_transformed.hpp"
 #include "bodypoint/invariants.hpp"
+#include "bodypoint/methods.hpp"
 #include "bodypoint/reference.hpp"
 #include "bodypoint/run.hpp"
 #include "bodypoint/scenes.hpp"

@@ -1,6 +1,7 @@
 // No heap allocation inside any step loop: a counting global operator new shows that the number of
 // allocations of a run does not depend on its number of steps, for every method, with and without
 // invariant tracking, with one centre and with several.
+#include "bodypoint/methods.hpp"
 #include "bodypoint/run.hpp"
 #include "bodypoint/scenes.hpp"
 

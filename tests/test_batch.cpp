@@ -1,6 +1,7 @@
 // Batch kernels (issue #14): every lane computes the scalar run's bits, for every batch method and
 // every width this CPU runs; a diverging lane does not touch the others.
 #include "bodypoint/batch.hpp"
+#include "bodypoint/methods.hpp"
 #include "bodypoint/run.hpp"
 
 #include <gtest/gtest.h>

@@ -1,5 +1,6 @@
 // The bodypoint command line: the acceptance run, the JSON and CSV outputs, and one clear
 // line plus a non-zero exit (and no output file) for every kind of bad input.
+#include "bodypoint/methods.hpp"
 #include "bodypoint/reference.hpp"
 #include "cli_helpers.hpp"
 #include "common.hpp"

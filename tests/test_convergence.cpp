@@ -1,6 +1,7 @@
 // Measured convergence orders of every fixed-step method (log-log slope of the final-position error
 // against h), for a body-point (B = 0.7) and a material point (B = 0), against independent references:
 // Boost.Odeint rkf78 in long double for B != 0, the analytic Rutherford hyperbola for B = 0.
+#include "bodypoint/methods.hpp"
 #include "bodypoint/reference.hpp"
 #include "bodypoint/run.hpp"
 #include "bodypoint/scenes.hpp"

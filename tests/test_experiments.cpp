@@ -1,6 +1,7 @@
 // Experiment drivers: sweep rows equal single simulate runs bit for bit, the thread count does not
 // change the output, bad ranges are rejected, and the --quick study recipes run and write their CSVs.
 #include "cli_helpers.hpp"
+#include "bodypoint/methods.hpp"
 #include "common.hpp"
 
 #include <gtest/gtest.h>

@@ -2,6 +2,7 @@
 // bounded energy error without drift, several centres, force-evaluation counts, the round-off floor.
 #include "bodypoint/field.hpp"
 #include "bodypoint/invariants.hpp"
+#include "bodypoint/methods.hpp"
 #include "bodypoint/reference.hpp"
 #include "bodypoint/run.hpp"
 #include "bodypoint/splitting/classic.hpp"

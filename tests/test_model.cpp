@@ -1,6 +1,7 @@
 // Model, initial conditions, equations of motion and input validation.
 #include "bodypoint/field.hpp"
 #include "bodypoint/invariants.hpp"
+#include "bodypoint/methods.hpp"
 #include "bodypoint/rhs.hpp"
 #include "bodypoint/run.hpp"
 #include "bodypoint/scene_file.hpp"

@@ -1,4 +1,5 @@
 // Coefficient tables: consistency, symmetry, published values, force evaluations per step.
+#include "bodypoint/methods.hpp"
 #include "bodypoint/run.hpp"
 #include "bodypoint/splitting/blanes_moan.hpp"
 #include "bodypoint/splitting/classic.hpp"

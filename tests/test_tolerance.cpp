@@ -4,6 +4,7 @@
 // step search was not tuned on as well as on the named ones: several centres of both signs, near
 // head-on encounters, B = 0 and B != 0, an end time long after the encounter.
 #include "bodypoint/adaptive/tolerance.hpp"
+#include "bodypoint/methods.hpp"
 #include "bodypoint/reference.hpp"
 #include "bodypoint/run.hpp"
 #include "bodypoint/scenes.hpp"
@@ -94,7 +95,7 @@ TEST(Tolerance, AutoDeliversTolWithAnHonestEstimate) {
     const State ref = reference_state(b, c.scene.centres, c.t_end, 1e-18L);
     for (double tol : {1e-4, 1e-7, 1e-10}) {
       std::string why;
-      const MethodInfo& m = adaptive::choose_method(b, c.scene.centres, tol, &why);
+      const MethodInfo& m = choose_method(b, c.scene.centres, tol, &why);
       const adaptive::ToleranceResult r = adaptive::run_to_tolerance(m, b, c.scene.centres, tol, c.t_end);
       const double err = adaptive::state_distance(r.result.final, ref);
       EXPECT_LE(err, tol) << c.name << " tol " << tol << " " << why;
@@ -134,7 +135,7 @@ TEST(Tolerance, EveryFamilyAcceptsTol) {
 
 TEST(Tolerance, AutoChoosesByTheScene) {
   auto chosen = [](const Scene& s, double tol) {
-    return std::string(adaptive::choose_method(s.bodies.front(), s.centres, tol, nullptr).name);
+    return std::string(choose_method(s.bodies.front(), s.centres, tol, nullptr).name);
   };
   SceneParams material;
   material.B = 0.0;

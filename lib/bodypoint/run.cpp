@@ -1,4 +1,4 @@
-// bodypoint: method registry and the typed run loops behind `run`.
+// bodypoint: the core layer's methods and the typed run loops behind `run`.
 //
 // The field type (one centre at the origin or a list), the spin (B = 0 or not) and the observer
 // (none, or invariants and samples) are chosen here, once, before the step loop starts; each
@@ -6,7 +6,6 @@
 #include "bodypoint/run.hpp"
 
 #include "bodypoint/run_support.hpp"
-#include "bodypoint/adaptive/registry.hpp"
 
 #include "bodypoint/field.hpp"
 #include "bodypoint/rhs.hpp"
@@ -77,7 +76,7 @@ MethodInfo lie_method(std::string_view name, int order, std::string_view what) {
           static_cast<int>(Seq.kicks_merged()), what, &run_splitting<sp::LiePoissonKernel, Seq>};
 }
 
-std::vector<MethodInfo> make_registry() {
+std::vector<MethodInfo> make_rows() {
   std::vector<MethodInfo> all = {
       {"rk4", Family::Odeint, 4, 4, 4, "classical Runge-Kutta (thesis 2.1; odeint runge_kutta4)",
        &run_odeint_rk4},
@@ -120,26 +119,14 @@ std::vector<MethodInfo> make_registry() {
       lie_method<kl8_ops>("lp-kl8", 8, "exact Lie-Poisson, Kahan-Li 1997 p8 s17"),
       lie_method<ss10_ops>("lp-ss10", 10, "exact Lie-Poisson, Sofroniou-Spaletta 2005 p10 s35"),
   };
-  for (const MethodInfo& m : adaptive::methods()) all.push_back(m);
   return all;
 }
 
 }  // namespace
 
-const std::vector<MethodInfo>& methods() {
-  static const std::vector<MethodInfo> registry = make_registry();
-  return registry;
-}
-
-const MethodInfo* find_method(std::string_view name) {
-  for (const MethodInfo& m : methods())
-    if (m.name == name) return &m;
-  return nullptr;
-}
-
-const MethodInfo& method_or_throw(std::string_view name) {
-  if (const MethodInfo* m = find_method(name)) return *m;
-  throw Error("unknown method '" + std::string(name) + "' (see 'bodypoint methods')");
+const std::vector<MethodInfo>& core_methods() {
+  static const std::vector<MethodInfo> rows = make_rows();
+  return rows;
 }
 
 namespace {

@@ -1,9 +1,12 @@
-// bodypoint: running one method on one body of a scene.
+// bodypoint: running one method on one body of a scene (the core layer's interface to every method).
 //
-// `run` integrates a body for `steps` fixed steps of size h from t0 = 0 (time is t0 + i h, never a
-// running sum) and returns the final state, the force-evaluation count and the wall time of the
-// step loop. Invariants are tracked only when asked for, and states are handed to a sink only
-// when one is given: with neither, the step loop runs with a null observer and stores nothing.
+// A method is a MethodInfo row: its family, order and cost, and the function that runs it. `run`
+// validates the inputs once and calls it. Fixed-step methods take `steps` steps of size h from t0 = 0
+// (time is t0 + i h, never a running sum); step-size-controlled methods run to t_end with --tol;
+// time-transformed methods (adaptive/) take fictitious steps ds = h. Invariants are tracked only when
+// asked for, and states are handed to a sink only when one is given: with neither, the step loop runs
+// with a null observer and stores nothing. This layer lists its own methods (core_methods); the
+// registry of every method is one layer up (bodypoint/methods.hpp).
 #pragma once
 
 #include "bodypoint/invariants.hpp"
@@ -65,14 +68,9 @@ struct MethodInfo {
   RunResult (*run)(const Body&, const std::vector<Centre>&, const RunSpec&, const SampleSink*);
 };
 
-/// Every fixed-step method, in the order `bodypoint methods` lists them.
-const std::vector<MethodInfo>& methods();
-
-/// The method called `name`, or nullptr.
-const MethodInfo* find_method(std::string_view name);
-
-/// Throws Error("unknown method ...") for a name not in methods().
-const MethodInfo& method_or_throw(std::string_view name);
+/// The methods of the core layer, in listing order: Runge-Kutta and Adams-Bashforth (Odeint), the
+/// step-size-controlled peers (Odeint, GSL), the thesis's schemes and the exact Lie-Poisson splittings.
+const std::vector<MethodInfo>& core_methods();
 
 /// True for methods that choose their own steps from a tolerance (spec.tol, spec.t_end apply).
 inline bool is_adaptive(const MethodInfo& m) {

@@ -12,7 +12,7 @@
 // close to 2^p (a converging ladder whose ratio is below 2^p is given its measured rate instead,
 // which makes the estimate larger). See tolerance.cpp for the steps of the search.
 //
-// `choose_method` is `--method auto`: family, order and table from the scene and tol.
+// `--method auto` (which method for a scene and a tol) is one layer up: bodypoint/methods.hpp.
 #pragma once
 
 #include "bodypoint/run.hpp"
@@ -47,15 +47,6 @@ ToleranceResult run_to_tolerance(const MethodInfo& method, const Body& body, con
 /// `base` with the step of `r` filled in (h and steps, or ds and t_end): run() with it repeats the
 /// delivered run, e.g. with invariants tracked or a sink.
 RunSpec delivered_spec(const MethodInfo& method, const ToleranceResult& r, double t_end, RunSpec base);
-
-/// `--method auto`: a one-centre material point: ks; a body far from every centre for the whole run
-/// (straight-line estimate of the closest approach, potential there below the time-step constant c):
-/// Lie-Poisson; only repelling centres: logH; any attracting centre: TTL. The table by measured cost:
-/// Yoshida 4 for tol >= 1e-5, Kahan-Li 6 for 1e-10 <= tol < 1e-5, Kahan-Li 8 below (Blanes-Moan S6,
-/// tried for the loose tolerances, has an error that is rough in ds near the bounded step's spin
-/// angle, and its Richardson estimates were off by up to 60x on the two-centres scene).
-/// `why` receives one line saying what was chosen and why.
-const MethodInfo& choose_method(const Body& body, const std::vector<Centre>& centres, double tol, std::string* why);
 
 /// Relative distance of two final states: max(|dR|/|R_b|, |dv|/|v_b|).
 double state_distance(const State& a, const State& b);

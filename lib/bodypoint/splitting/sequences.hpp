@@ -1,6 +1,7 @@
-// bodypoint: the fixed-step splitting tables flattened to their sub-flow sequences, one name per
-// method of the registry (run.cpp) and of the batch kernels (batch.hpp). Static storage, so that they
-// can be template arguments of the composition engine.
+// bodypoint: the splitting tables flattened to their sub-flow sequences, one name per table, for the
+// fixed-step methods (run.cpp), the time-transformed ones (adaptive/run.cpp) and the batch kernels
+// (batch.hpp). verlet_ops is kick-drift-kick, strang_ops drift-kick-drift. Static storage, so that
+// they can be template arguments of the composition engine.
 #pragma once
 
 #include "bodypoint/splitting/blanes_moan.hpp"

@@ -42,7 +42,7 @@ struct ThesisKernel {
 
   [[nodiscard]] ThesisState initial_state(const State& s0) const { return {s0, Vec3::Zero()}; }
 
-  /// CodeSlip::none unless the scene reproduces the published code (set by the registry).
+  /// CodeSlip::none unless the scene reproduces the published code (set by the core layer's run loop, run.cpp).
   CodeSlip slip = CodeSlip::none;
 
   void begin_step(ThesisState& x) const {

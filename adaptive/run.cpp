@@ -8,17 +8,12 @@
 // takes spec.steps fictitious steps. With a sink and spec.dt_out > 0, states at t = k dt_out are
 // made by side steps from the state before the crossing step (one step of the same table in physical
 // time), without touching the main integration.
-#include "bodypoint/adaptive/registry.hpp"
+#include "bodypoint/adaptive/methods.hpp"
 
 #include "bodypoint/adaptive/ks.hpp"
 #include "bodypoint/adaptive/time_transformed.hpp"
 #include "bodypoint/run_support.hpp"
-#include "bodypoint/splitting/blanes_moan.hpp"
-#include "bodypoint/splitting/classic.hpp"
-#include "bodypoint/splitting/kahan_li.hpp"
-#include "bodypoint/splitting/mclachlan.hpp"
-#include "bodypoint/splitting/sofroniou_spaletta.hpp"
-#include "bodypoint/splitting/yoshida.hpp"
+#include "bodypoint/splitting/sequences.hpp"
 
 #include <cmath>
 #include <limits>
@@ -317,15 +312,7 @@ RunResult run_ks(const Body& body, const std::vector<Centre>& centres, const Run
   return r;
 }
 
-constexpr auto verlet_ops = sp::flatten(sp::strang_dkd_table);
-constexpr auto y4_ops = sp::flatten(sp::yoshida4);
-constexpr auto bm4_ops = sp::flatten(sp::blanes_moan4);
-constexpr auto y6_ops = sp::flatten(sp::yoshida6);
-constexpr auto kl6_ops = sp::flatten(sp::kahan_li6);
-constexpr auto y8_ops = sp::flatten(sp::yoshida8);
-constexpr auto mcl8_ops = sp::flatten(sp::mclachlan8);
-constexpr auto kl8_ops = sp::flatten(sp::kahan_li8);
-constexpr auto ss10_ops = sp::flatten(sp::sofroniou_spaletta10);
+using namespace splitting::ops;
 
 template <const auto& Seq>
 MethodInfo logh(std::string_view name, int order, std::string_view what) {
@@ -342,7 +329,7 @@ MethodInfo ttl(std::string_view name, int order, std::string_view what) {
 
 std::vector<MethodInfo> methods() {
   return {
-      logh<verlet_ops>("logh-verlet", 2, "logarithmic Hamiltonian, leapfrog DKD (repulsive scenes), ds = --h"),
+      logh<strang_ops>("logh-verlet", 2, "logarithmic Hamiltonian, leapfrog DKD (repulsive scenes), ds = --h"),
       logh<y4_ops>("logh-y4", 4, "logarithmic Hamiltonian, Yoshida 4"),
       logh<bm4_ops>("logh-bm4", 4, "logarithmic Hamiltonian, Blanes-Moan S6"),
       logh<y6_ops>("logh-y6", 6, "logarithmic Hamiltonian, Yoshida 6"),
@@ -351,7 +338,7 @@ std::vector<MethodInfo> methods() {
       logh<mcl8_ops>("logh-mcl8", 8, "logarithmic Hamiltonian, McLachlan p8 s15"),
       logh<kl8_ops>("logh-kl8", 8, "logarithmic Hamiltonian, Kahan-Li p8 s17"),
       logh<ss10_ops>("logh-ss10", 10, "logarithmic Hamiltonian, Sofroniou-Spaletta p10 s35"),
-      ttl<verlet_ops>("ttl-verlet", 2, "time-transformed leapfrog (Mikkola-Aarseth), any sign of A, ds = --h"),
+      ttl<strang_ops>("ttl-verlet", 2, "time-transformed leapfrog (Mikkola-Aarseth), any sign of A, ds = --h"),
       ttl<y4_ops>("ttl-y4", 4, "time-transformed leapfrog, Yoshida 4"),
       ttl<bm4_ops>("ttl-bm4", 4, "time-transformed leapfrog, Blanes-Moan S6"),
       ttl<y6_ops>("ttl-y6", 6, "time-transformed leapfrog, Yoshida 6"),

@@ -1,0 +1,40 @@
+// bodypoint: the registry of every method, the top library layer.
+//
+// Layers, each a CMake target that depends only on the ones below it:
+//   bodypoint_core      lib/                model, fields, invariants, tables, composition engine,
+//                                           kernels, fixed-step and peer run loops (core_methods)
+//   bodypoint_adaptive  adaptive/           time-transformed and regularised methods and their run
+//                                           loops (adaptive::methods), the --tol step search
+//   bodypoint           experiments/methods this registry and --method auto
+//   bodypoint_commands  experiments/        the command line
+// Nothing below this header includes it.
+#pragma once
+
+#include "bodypoint/run.hpp"
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace bodypoint {
+
+/// Every method, in the order `bodypoint methods` lists them: the core layer's, then the adaptive
+/// layer's.
+const std::vector<MethodInfo>& methods();
+
+/// The method called `name`, or nullptr.
+const MethodInfo* find_method(std::string_view name);
+
+/// Throws Error("unknown method ...") for a name not in methods().
+const MethodInfo& method_or_throw(std::string_view name);
+
+/// `--method auto`: a one-centre material point: ks; a body far from every centre for the whole run
+/// (straight-line estimate of the closest approach, potential there below the time-step constant c):
+/// Lie-Poisson; only repelling centres: logH; any attracting centre: TTL. The table by measured cost:
+/// Yoshida 4 for tol >= 1e-5, Kahan-Li 6 for 1e-10 <= tol < 1e-5, Kahan-Li 8 below (Blanes-Moan S6,
+/// tried for the loose tolerances, has an error that is rough in ds near the bounded step's spin
+/// angle, and its Richardson estimates were off by up to 60x on the two-centres scene).
+/// `why` receives one line saying what was chosen and why.
+const MethodInfo& choose_method(const Body& body, const std::vector<Centre>& centres, double tol, std::string* why);
+
+}  // namespace bodypoint
