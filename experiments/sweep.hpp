@@ -1,4 +1,5 @@
-// bodypoint: parameter sweeps and timing runs, shared by `sweep`, `timing` and `study`.
+// bodypoint: parameter sweeps and grids (one row per grid point and method), shared by `sweep`, `study`
+// and the sweep under mpirun (mpi_sweep.hpp).
 #pragma once
 
 #include "bodypoint/model.hpp"

@@ -61,11 +61,6 @@ inline void advance_time(TimeState& x, double dt) {
   x.t = s;
 }
 
-/// Kinetic energy from momenta: T = (J |K1|^2 - 2 B K1.K2 + m |K2|^2)/(2 D).
-inline double kinetic_energy(const BodyPoint& p, const Momenta& q) {
-  return (p.J * q.K1.squaredNorm() - 2.0 * p.B * q.K1.dot(q.K2) + p.m * q.K2.squaredNorm()) / (2.0 * p.D());
-}
-
 template <class Field, bool Spin>
 struct LogHKernel {
   using state_type = TimeState;
