@@ -45,6 +45,11 @@ constexpr double kReversibilityTol = 1e-12;
 // A non-exact scheme's energy error on the same encounter is far above rounding (measured 1e-6 for
 // lp-y4 at h = 0.01): the control must exceed the exact-Kepler bound by this factor.
 constexpr double kNotExactFactor = 1e3;
+// logH on a material point runs along the exact orbit with a phase (time) error C ds^p: measured
+// C = 3.5e-3 for logh-verlet and 1.8e-2 for logh-y4 at ds = 1e-3..0.05 (close scene, t = 80);
+// 0.05 leaves room. kl8's error is round-off (4e-15..6e-16), below kKeplerRoundOff.
+constexpr double kPhaseErrorConstant = 0.05;
+constexpr double kKeplerRoundOff = 1e-13;
 // The round trip must pass the closest approach of table 3.1 (near t = 40).
 constexpr double kPastEncounter = 50.0;
 // The material point of the close scene comes to r ~ 2.2 from r = 200: dt/ds = r/|A| spans ~90.
@@ -54,6 +59,9 @@ constexpr double kMinBoundedStepRange = 10.0;
 // logh-kl8 at ds = 0.005 is accurate to ~1e-9 relative on the close scene; a side step to an output
 // time is a step of the same scheme, so an output state must be as good (with margin).
 constexpr double kOutputStateTol = 1e-8;
+// ttl-kl8 on a bound orbit for t = 10 at ds = 0.01: an 8th-order error far below round-off, measured
+// 1.3e-15; 100x for the round-off of other compilers and CPUs.
+constexpr double kBoundOrbitEnergyTol = 1e-13;
 // Issue #3's bound on |K2|^2 at every step, kept under stress.
 constexpr double kStressK2sqTol = 1e-13;
 // Issue #4's targets on the close encounter: final-position error and relative energy error.
@@ -88,7 +96,10 @@ TEST(LogH, MaterialPointFollowsTheExactKeplerOrbitAtAnyStep) {
       EXPECT_LT((L1 - L0).norm() / L0.norm(), kOrbitElementTol) << method << " ds=" << ds;
       EXPECT_LT((lrl(r.final, mu) - lrl(b.s0, mu)).norm() / lrl(b.s0, mu).norm(), kOrbitElementTol)
           << method << " ds=" << ds;
-      EXPECT_EQ(r.t_end, 80.0);
+      // At t_end itself: the exact state there, up to the method's phase error along the orbit.
+      const State exact = kepler_body_state(b, s.centres.front(), 80.0);
+      const double phase = kPhaseErrorConstant * std::pow(ds, method_or_throw(method).order);
+      EXPECT_LT(test::rel_err(r.final.R, exact.R), phase + kKeplerRoundOff) << method << " ds=" << ds;
     }
   }
   // Control: the same encounter with a fixed-step splitting has an energy error that grows with h.
@@ -278,7 +289,7 @@ TEST(TimeTransformed, RefusalsNameAMethodThatWorks) {
   // ttl accepts attraction: a bound orbit run for a while keeps its energy.
   spec.track_invariants = true;
   const RunResult r = run(method_or_throw("ttl-kl8"), s.bodies.front(), s.centres, spec);
-  EXPECT_TRUE(r.final.R.allFinite());
+  EXPECT_LT(r.invariants->max_rel_dE, kBoundOrbitEnergyTol);
 }
 
 TEST(Ks, ReproducesTheRutherfordHyperbolaToRoundOffAtAnyStep) {
@@ -353,31 +364,36 @@ struct StressCase {
   SceneParams sp;
   double t_end, ds;
   std::vector<Centre> extra;  ///< centres added to the scene
+  double max_dE = 0.0;        ///< bound on the relative energy error: 10x the measured value
 };
 
-TEST(TimeTransformed, StressCasesFinishFiniteWithInvariantsReported) {
+TEST(TimeTransformed, StressCasesFinishWithinTheirEnergyBounds) {
   std::vector<StressCase> cases;
   {  // Head-on (d = 0, small Kz), closest approach ~8e-7 of L: weak repulsion A = -2e-3.
     StressCase c{"head-on", "logh-kl8", {}, 80.0, 2e-4, {}};
     c.sp.A = -2e-3;
     c.sp.start.d = 0.0;
     c.sp.start.Kz = 1e-3;
+    c.max_dE = 1e-8;  // measured 1.2e-9
     cases.push_back(c);
   }
   {  // A very slow body (K1 = 1e-3).
     StressCase c{"slow", "logh-y4", {}, 1e4, 1e-2, {}};
     c.sp.start.K1 = 1e-3;
     c.sp.start.Kz = 1e-3;
+    c.max_dE = 1e-12;  // measured 6.0e-14
     cases.push_back(c);
   }
   {  // A very distant start (L = 1e6), through the encounter and out again.
     StressCase c{"distant", "logh-kl8", {}, 4e5, 3e-3, {}};
     c.sp.start.L = 1e6;
+    c.max_dE = 1e-11;  // measured 7.2e-13 after 1.2e7 steps
     cases.push_back(c);
   }
   {  // Between two repelling centres, passing at 0.4 from each.
     StressCase c{"between", "ttl-kl8", {}, 80.0, 1e-3, {{Vec3(0, 0.9, 0), -1.0}}};
     c.sp.start.d = 0.5 + 5.0 / 5.0;  // R_y(0) = d - Kz/K1 = 0.5
+    c.max_dE = 1e-12;  // measured 1.4e-14
     cases.push_back(c);
   }
   for (const StressCase& c : cases) {
@@ -394,7 +410,7 @@ TEST(TimeTransformed, StressCasesFinishFiniteWithInvariantsReported) {
     const RunResult r = run(method_or_throw(c.method), s.bodies.front(), s.centres, spec, &sink);
     EXPECT_TRUE(r.final.R.allFinite() && r.final.v.allFinite() && r.final.w.allFinite()) << c.name;
     ASSERT_TRUE(r.invariants.has_value()) << c.name;
-    EXPECT_TRUE(std::isfinite(r.invariants->max_rel_dE)) << c.name;
+    EXPECT_LT(r.invariants->max_rel_dE, c.max_dE) << c.name;
     EXPECT_LT(r.invariants->max_rel_dK2sq, kStressK2sqTol) << c.name;
     EXPECT_EQ(r.t_end, c.t_end) << c.name;
     std::printf("  %-8s %-9s steps %ld evals %ld min dt %.2e max dt %.2e r_min %.2e max rel dE %.2e\n",
@@ -430,6 +446,7 @@ TEST(CloseEncounter, LogHReachesOneEMinusEightWithFarFewerEvaluations) {
   }
   // Every Boost.Odeint configuration that reaches 1e-8 spends more force evaluations.
   for (const char* m : {"odeint-dopri5", "odeint-rkf78", "odeint-bs"}) {
+    bool reached = false;
     for (double tol = 1e-9; tol >= 1e-15; tol /= 10) {
       RunSpec a;
       a.tol = tol;
@@ -437,9 +454,13 @@ TEST(CloseEncounter, LogHReachesOneEMinusEightWithFarFewerEvaluations) {
       const RunResult r = run(method_or_throw(m), b, ns.scene.centres, a);
       if ((r.final.R - ref.R).norm() <= kCloseTarget) {
         EXPECT_GT(r.force_evals, lh.force_evals) << m << " tol " << tol;
+        reached = true;
         break;
       }
     }
+    // Each reaches it (measured: dopri5 at tol 1e-13, rkf78 at 1e-13, bs at 1e-15), so the
+    // comparison above always runs.
+    EXPECT_TRUE(reached) << m << " did not reach 1e-8 at any tolerance down to 1e-15";
   }
   std::printf("  logh-kl8 ds=0.08: err %.2e, %ld force evaluations, max rel dE %.2e\n", err, lh.force_evals,
               lh.invariants->max_rel_dE);
