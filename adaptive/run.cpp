@@ -1,4 +1,5 @@
-// bodypoint: run loops of the time-transformed (logh-*, ttl-*) and regularised (ks) methods.
+// bodypoint: the time-transformed (logh-*, ttl-*) and regularised (ks) methods, run by one driver
+// (FictitiousLoop) that each of them plugs a Stepper into.
 //
 // A run takes fixed fictitious steps ds = spec.h. With spec.t_end > 0 it stops at exactly t_end:
 // the fictitious step that would pass t_end is undone, and the last step ds' in (0, ds) is solved
@@ -7,7 +8,7 @@
 // which keeps its properties (for logH on a material point: the exact Kepler orbit). Otherwise it
 // takes spec.steps fictitious steps. With a sink and spec.dt_out > 0, states at t = k dt_out are
 // made by side steps from the state before the crossing step (one step of the same table in physical
-// time), without touching the main integration.
+// time; for ks the exact advance), without touching the main integration.
 #include "bodypoint/adaptive/methods.hpp"
 
 #include "bodypoint/adaptive/ks.hpp"
@@ -17,7 +18,10 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
+#include <string_view>
 #include <type_traits>
+#include <utility>
 
 namespace bodypoint::adaptive {
 namespace {
@@ -140,83 +144,160 @@ TimeState step_to_time(K& k, const TimeState& from, double ds, double target, do
   return x;
 }
 
+/// The one driver of every method that takes fixed fictitious steps ds = spec.h: spec.steps of them,
+/// or as many as reach spec.t_end, the last one solved to land on it exactly. A Stepper holds the
+/// kernel and says, for its state type X:
+///   Advance step(X& x, double ds)       one fictitious step; returns the new time and the physical step
+///   double time(const X& x)             the physical time of x
+///   void land(X& x, double t, double t_over)  from x (time < t) to exactly t; t_over is where a whole
+///                                             step would have gone
+///   State at(const X& prev, double t)   the physical state at t in (time(prev), next step's time]
+///   State physical(const X& x)
+///   std::string_view prefix             of its error messages ("" or "ks: ")
+/// Outputs at k dt_out come from at() on the state before the step that crosses them.
+struct Advance {
+  double t;   ///< physical time after the step
+  double dt;  ///< physical step, as the step statistics record it
+};
+
+template <class Stepper, class X>
+class FictitiousLoop {
+ public:
+  FictitiousLoop(Stepper& s, const RunSpec& spec) : s_(s), spec_(spec), next_out_(spec.dt_out) {}
+
+  /// Runs from x; returns the final state and leaves the statistics in stats(). The loop keeps its
+  /// step, end time and statistics in locals (members read through `this` every step cost 3-8%).
+  template <class Obs>
+  X run(X x, Obs& obs) {
+    const bool to_time = spec_.t_end > 0.0;
+    const long cap = to_time ? kMaxFictitiousSteps : spec_.steps;
+    const double h = spec_.h, t_end = to_time ? spec_.t_end : 0.0;
+    StepStats st;
+    double t_over = 0.0;  // the time the step that would pass t_end reaches
+    while (st.steps < cap) {
+      const X prev = x;
+      const Advance a = s_.step(x, h);
+      if (!std::isfinite(a.t) || !s_.physical_finite(x))
+        throw Error(std::string(Stepper::prefix) + "the state became non-finite at t = " +
+                    std::to_string(s_.time(prev)) + "; reduce --h");
+      check_progress(st.steps, s_.time(prev), a.t, t_end, cap);
+      if (to_time && a.t >= t_end) {
+        x = prev;
+        t_over = a.t;
+        break;
+      }
+      st.add(a.dt);
+      if constexpr (Obs::active) {
+        outputs_until(obs, prev, a.t, st.steps);
+        obs.observe(st.steps, a.t, x, !to_time && st.steps == cap);
+      }
+    }
+    if (to_time) finish(x, t_over, cap, obs, st);
+    st_ = st;
+    return x;
+  }
+
+  const StepStats& stats() const { return st_; }
+
+ private:
+  /// The last step, solved to land on t_end, and the outputs up to it.
+  template <class Obs>
+  void finish(X& x, double t_over, long cap, Obs& obs, StepStats& st) {
+    if (st.steps >= cap) throw Error("more than 2e9 fictitious steps before t_end; increase --h");
+    const X prev = x;
+    const double rest = spec_.t_end - s_.time(x);
+    if (rest > 0.0) {
+      s_.land(x, spec_.t_end, t_over);
+      st.add(rest);
+    }
+    s_.set_time(x, spec_.t_end);
+    if constexpr (Obs::active) {
+      outputs_until(obs, prev, spec_.t_end, st.steps);
+      obs.observe(st.steps, spec_.t_end, x, true);
+      if (obs.wants_times() && static_cast<double>(n_out_ - 1) * spec_.dt_out < spec_.t_end)
+        obs.emit(st.steps, spec_.t_end, s_.physical(x));
+    }
+  }
+
+  /// States at the requested output times in (time(prev), t_upto]; output times are n dt_out, not a
+  /// running sum.
+  template <class Obs>
+  void outputs_until(Obs& obs, const X& prev, double t_upto, long steps) {
+    if (!obs.wants_times()) return;
+    while (next_out_ <= t_upto) {
+      obs.emit(steps, next_out_, s_.at(prev, next_out_));
+      next_out_ = static_cast<double>(++n_out_) * spec_.dt_out;
+    }
+  }
+
+  Stepper& s_;
+  const RunSpec& spec_;
+  StepStats st_;
+  long n_out_ = 1;
+  double next_out_;
+};
+
+/// Runs a Stepper through FictitiousLoop with the observer the spec asks for (invariants, samples).
+template <class Stepper, class Field>
+RunResult run_fictitious(Stepper& s, typename Stepper::X x0, const Body& body, const Field& field, const RunSpec& spec,
+                         const SampleSink* sink) {
+  using X = typename Stepper::X;
+  FictitiousLoop<Stepper, X> loop(s, spec);
+  double t_reached = 0.0;
+  auto to_physical = [&s](const X& x) { return s.physical(x); };
+  RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
+    const X x = loop.run(x0, obs);
+    t_reached = s.time(x);
+    return s.physical(x);
+  });
+  loop.stats().record(r, t_reached);
+  return r;
+}
+
+/// logH and TTL kernels as a Stepper: the table's steps in fictitious time, the last one solved for
+/// its length (step_to_time), dense output by one step of the same table in physical time.
+template <class K, const auto& Seq>
+struct TransformedStepper {
+  using X = TimeState;
+  static constexpr std::string_view prefix = "";
+  K& k;
+  double h;
+  Advance step(X& x, double ds) const {
+    const double before = x.time();
+    sp::NullObserver none;
+    sp::integrate<Seq>(k, x, ds, 1, none);
+    return {x.time(), x.time() - before};
+  }
+  static double time(const X& x) { return x.time(); }
+  bool physical_finite(const X& x) const { return x.q.R.allFinite(); }
+  void land(X& x, double t, double t_over) const { x = step_to_time<Seq>(k, x, h, t, t_over); }
+  static void set_time(X& x, double t) {
+    x.t = t;
+    x.t_err = 0.0;
+  }
+  // Dense output: one step of the same table in physical time from prev over the gap, which is at
+  // most the physical step just taken, so its local error is no larger. Solving for the fictitious
+  // step that lands on the output time took 4.1 trial steps per output; this takes one, at the same
+  // accuracy (logh-kl8, close scene, ds = 0.08, dt-out = 1: max error 3.33e-11 both ways against
+  // ds = 0.01; dt-out = 0.1: 19,414 force evaluations instead of 61,455).
+  State at(const X& prev, double t) const {
+    splitting::LieState q = prev.q;
+    sp::NullObserver none;
+    sp::integrate<Seq>(k.lp, q, t - prev.time(), 1, none);
+    return k.lp.to_physical(q);
+  }
+  State physical(const X& x) const { return k.to_physical(x); }
+};
+
 template <template <class, bool> class Kernel, const auto& Seq>
 RunResult run_time_transformed(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
                                const SampleSink* sink) {
   require_time_target(spec);
   return dispatch(body, centres, [&](const auto& field, auto spin) {
-    using Field = std::decay_t<decltype(field)>;
-    using K = Kernel<Field, decltype(spin)::value>;
+    using K = Kernel<std::decay_t<decltype(field)>, decltype(spin)::value>;
     K k(body.p, field, spec.omega_c >= 0.0 ? spec.omega_c : automatic_omega_c(body, centres, spec.h));
-    auto to_physical = [&k](const TimeState& x) { return k.to_physical(x); };
-    const bool to_time = spec.t_end > 0.0;
-    StepStats st;
-    double t_reached = 0.0;
-    RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
-      constexpr bool active = std::decay_t<decltype(obs)>::active;
-      TimeState x = k.initial_state(body.s0);
-      sp::NullObserver none;
-      long n_out = 1;  // output times are n dt_out, not a running sum
-      double next_out = spec.dt_out;
-      // States at requested output times in (prev.time(), t_upto], by side steps from prev.
-      auto outputs_until = [&](const TimeState& prev, double t_upto) {
-        if constexpr (active) {
-          if (!obs.wants_times()) return;
-          while (next_out <= t_upto) {
-            // Dense output: one step of the same table in physical time from prev over the gap, which
-            // is at most the physical step just taken, so its local error is no larger. Solving for
-            // the fictitious step that lands on the output time took 4.1 trial steps per output;
-            // this takes one, at the same accuracy (logh-kl8, close scene, ds = 0.08, dt-out = 1:
-            // max error 3.33e-11 both ways against ds = 0.01; dt-out = 0.1: 19,414 force
-            // evaluations instead of 61,455).
-            splitting::LieState q = prev.q;
-            sp::integrate<Seq>(k.lp, q, next_out - prev.time(), 1, none);
-            obs.emit(st.steps, next_out, k.lp.to_physical(q));
-            next_out = static_cast<double>(++n_out) * spec.dt_out;
-          }
-        }
-      };
-      const long cap = to_time ? kMaxFictitiousSteps : spec.steps;
-      double t_over = 0.0;  // the time the step that would pass t_end reaches
-      while (st.steps < cap) {
-        const TimeState prev = x;
-        sp::integrate<Seq>(k, x, spec.h, 1, none);
-        const double t = x.time();
-        if (!std::isfinite(t) || !x.q.R.allFinite())
-          throw Error("the state became non-finite at t = " + std::to_string(prev.time()) + "; reduce --h");
-        check_progress(st.steps, prev.time(), t, to_time ? spec.t_end : 0.0, cap);
-        if (to_time && t >= spec.t_end) {
-          x = prev;
-          t_over = t;
-          break;
-        }
-        st.add(t - prev.time());
-        if constexpr (active) {
-          outputs_until(prev, t);
-          obs.observe(st.steps, t, x, !to_time && st.steps == cap);
-        }
-      }
-      if (to_time) {
-        if (st.steps >= cap) throw Error("more than 2e9 fictitious steps before t_end; increase --h");
-        const TimeState prev = x;
-        const double rest = spec.t_end - x.time();
-        if (rest > 0.0) {
-          x = step_to_time<Seq>(k, prev, spec.h, spec.t_end, t_over);
-          st.add(rest);
-        }
-        x.t = spec.t_end;
-        x.t_err = 0.0;
-        if constexpr (active) {
-          outputs_until(prev, spec.t_end);
-          obs.observe(st.steps, spec.t_end, x, true);
-          if (obs.wants_times() && static_cast<double>(n_out - 1) * spec.dt_out < spec.t_end)
-            obs.emit(st.steps, spec.t_end, k.to_physical(x));
-        }
-      }
-      t_reached = x.time();
-      return k.to_physical(x);
-    });
-    st.record(r, t_reached);
+    TransformedStepper<K, Seq> stepper{k, spec.h};
+    RunResult r = run_fictitious(stepper, k.initial_state(body.s0), body, field, spec, sink);
     r.force_evals = k.lp.evals;
     return r;
   });
@@ -244,70 +325,36 @@ RunResult run_ttl(const Body& body, const std::vector<Centre>& centres, const Ru
   return run_time_transformed<TtlKernel, Seq>(body, centres, spec, sink);
 }
 
+/// The Kustaanheimo-Stiefel motion as a Stepper: exact in fictitious time, so the last step and the
+/// outputs are exact advances in physical time.
+struct KsStepper {
+  using X = std::pair<KsMotion, double>;  // (motion, t)
+  static constexpr std::string_view prefix = "ks: ";
+  static Advance step(X& x, double ds) {
+    const double dt = x.first.step(ds);
+    x.second = x.second + dt;
+    return {x.second, dt};
+  }
+  static double time(const X& x) { return x.second; }
+  static bool physical_finite(const X& x) { return x.first.state().R.allFinite(); }
+  static void land(X& x, double t, double) { x.first.advance_time(t - x.second); }
+  static void set_time(X& x, double t) { x.second = t; }
+  static State at(const X& prev, double t) {
+    KsMotion side = prev.first;
+    if (t > prev.second) side.advance_time(t - prev.second);
+    return side.state();
+  }
+  static State physical(const X& x) { return x.first.state(); }
+};
+
 RunResult run_ks(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec, const SampleSink* sink) {
   if (body.p.B != 0.0) throw Error("ks regularises a material point: it needs B = 0 (use logh-* or ttl-*)");
   if (centres.size() != 1) throw Error("ks needs exactly one centre (use logh-* or ttl-*)");
   require_time_target(spec);
-  const Centre& c = centres.front();
   CentreList field{centres};  // for the invariants (K2Q about c)
-  StepStats st;
-  double t_reached = 0.0;
-  auto to_physical = [](const std::pair<KsMotion, double>& x) { return x.first.state(); };
-  RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
-    constexpr bool active = std::decay_t<decltype(obs)>::active;
-    std::pair<KsMotion, double> x{KsMotion(body.p, c, body.s0), 0.0};  // (motion, t)
-    long n_out = 1;
-    double next_out = spec.dt_out;
-    auto outputs_until = [&](const std::pair<KsMotion, double>& prev, double t_upto) {
-      if constexpr (active) {
-        if (!obs.wants_times()) return;
-        while (next_out <= t_upto) {
-          KsMotion side = prev.first;
-          if (next_out > prev.second) side.advance_time(next_out - prev.second);
-          obs.emit(st.steps, next_out, side.state());
-          next_out = static_cast<double>(++n_out) * spec.dt_out;
-        }
-      }
-    };
-    const bool to_time = spec.t_end > 0.0;
-    const long cap = to_time ? kMaxFictitiousSteps : spec.steps;
-    while (st.steps < cap) {
-      const auto prev = x;
-      const double dt = x.first.step(spec.h);
-      if (!std::isfinite(dt) || !x.first.state().R.allFinite())
-        throw Error("ks: the state became non-finite at t = " + std::to_string(prev.second) + "; reduce --h");
-      check_progress(st.steps, prev.second, prev.second + dt, to_time ? spec.t_end : 0.0, cap);
-      if (to_time && prev.second + dt >= spec.t_end) {
-        x = prev;
-        break;
-      }
-      x.second += dt;
-      st.add(dt);
-      if constexpr (active) {
-        outputs_until(prev, x.second);
-        obs.observe(st.steps, x.second, x, !to_time && st.steps == cap);
-      }
-    }
-    if (to_time) {
-      if (st.steps >= cap) throw Error("more than 2e9 fictitious steps before t_end; increase --h");
-      const auto prev = x;
-      const double rest = spec.t_end - x.second;
-      if (rest > 0.0) {
-        x.first.advance_time(rest);
-        st.add(rest);
-      }
-      x.second = spec.t_end;
-      if constexpr (active) {
-        outputs_until(prev, spec.t_end);
-        obs.observe(st.steps, spec.t_end, x, true);
-        if (obs.wants_times() && static_cast<double>(n_out - 1) * spec.dt_out < spec.t_end)
-          obs.emit(st.steps, spec.t_end, x.first.state());
-      }
-    }
-    t_reached = x.second;
-    return x.first.state();
-  });
-  st.record(r, t_reached);
+  KsStepper stepper;
+  RunResult r = run_fictitious(stepper, KsStepper::X{KsMotion(body.p, centres.front(), body.s0), 0.0}, body, field,
+                               spec, sink);
   r.force_evals = 0;  // the regularised flow is exact: no force evaluations
   return r;
 }
