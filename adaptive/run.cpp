@@ -160,9 +160,11 @@ struct Advance {
   double dt;  ///< physical step, as the step statistics record it
 };
 
-template <class Stepper, class X>
+template <class Stepper>
 class FictitiousLoop {
  public:
+  using X = typename Stepper::X;
+
   FictitiousLoop(Stepper& s, const RunSpec& spec) : s_(s), spec_(spec), next_out_(spec.dt_out) {}
 
   /// Runs from x; returns the final state and leaves the statistics in stats(). The loop keeps its
@@ -242,7 +244,7 @@ template <class Stepper, class Field>
 RunResult run_fictitious(Stepper& s, typename Stepper::X x0, const Body& body, const Field& field, const RunSpec& spec,
                          const SampleSink* sink) {
   using X = typename Stepper::X;
-  FictitiousLoop<Stepper, X> loop(s, spec);
+  FictitiousLoop<Stepper> loop(s, spec);
   double t_reached = 0.0;
   auto to_physical = [&s](const X& x) { return s.physical(x); };
   RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
