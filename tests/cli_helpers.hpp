@@ -2,6 +2,8 @@
 // started in the background (spawn) to be signalled; and the files a run leaves.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -10,6 +12,7 @@
 #include <spawn.h>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -40,6 +43,17 @@ inline CliResult run_cli(const std::string& args) {
   r.err = ss.str();
   fs::remove(err);
   return r;
+}
+
+/// Runs `bodypoint PREFIX ARGS` for each (ARGS, FRAGMENT): each must fail, say FRAGMENT on stderr and
+/// print nothing on stdout.
+inline void expect_refused(const std::string& prefix, const std::vector<std::pair<std::string, std::string>>& cases) {
+  for (const auto& [args, fragment] : cases) {
+    const CliResult r = run_cli(prefix + args);
+    EXPECT_NE(r.code, 0) << args;
+    EXPECT_NE(r.err.find(fragment), std::string::npos) << args << " -> " << r.err;
+    EXPECT_TRUE(r.out.empty()) << args;
+  }
 }
 
 namespace fs = std::filesystem;
