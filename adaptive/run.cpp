@@ -14,7 +14,7 @@
 #include "bodypoint/adaptive/ks.hpp"
 #include "bodypoint/adaptive/time_transformed.hpp"
 #include "bodypoint/run_support.hpp"
-#include "bodypoint/splitting/sequences.hpp"
+#include "bodypoint/splitting/catalogue.hpp"
 
 #include <cmath>
 #include <limits>
@@ -361,43 +361,41 @@ RunResult run_ks(const Body& body, const std::vector<Centre>& centres, const Run
   return r;
 }
 
-using namespace splitting::ops;
+/// The tables the time-transformed families take: the symmetric drift-first compositions (their drift
+/// carries the time variable, so a step must be symmetric to stay time-reversible); DKD Strang is
+/// their "verlet".
+using LogHTables = sp::List<sp::Use<sp::StrangDkd, "verlet">, sp::Yoshida4, sp::BlanesMoan4, sp::Yoshida6,
+                            sp::KahanLi6, sp::Yoshida8, sp::McLachlan8, sp::KahanLi8, sp::SofroniouSpaletta10>;
+using TtlTables = sp::List<sp::Use<sp::StrangDkd, "verlet">, sp::Yoshida4, sp::BlanesMoan4, sp::Yoshida6,
+                           sp::KahanLi6, sp::McLachlan8, sp::KahanLi8>;
 
-template <const auto& Seq>
-MethodInfo logh(std::string_view name, int order, std::string_view what) {
-  const int s = static_cast<int>(Seq.kicks());
-  return {name, Family::TimeTransformed, order, s, s, what, &run_logh<Seq>};
+template <class E>
+MethodInfo logh_row() {
+  using T = typename E::type;
+  const int s = static_cast<int>(sp::ops_of<T>.kicks());
+  return {"logh-" + std::string(E::tag), Family::TimeTransformed, T::order, s, s,
+          sp::describe<T>("logH (repulsive scenes), ds = --h"),
+          &run_logh<sp::ops_of<T>>};
 }
-template <const auto& Seq>
-MethodInfo ttl(std::string_view name, int order, std::string_view what) {
-  const int s = static_cast<int>(Seq.kicks());
-  return {name, Family::TimeTransformed, order, s, s, what, &run_ttl<Seq>};
+template <class E>
+MethodInfo ttl_row() {
+  using T = typename E::type;
+  const int s = static_cast<int>(sp::ops_of<T>.kicks());
+  return {"ttl-" + std::string(E::tag), Family::TimeTransformed, T::order, s, s,
+          sp::describe<T>("TTL (any sign of A), ds = --h"),
+          &run_ttl<sp::ops_of<T>>};
 }
 
 }  // namespace
 
 std::vector<MethodInfo> methods() {
-  return {
-      logh<strang_ops>("logh-verlet", 2, "logarithmic Hamiltonian, leapfrog DKD (repulsive scenes), ds = --h"),
-      logh<y4_ops>("logh-y4", 4, "logarithmic Hamiltonian, Yoshida 4"),
-      logh<bm4_ops>("logh-bm4", 4, "logarithmic Hamiltonian, Blanes-Moan S6"),
-      logh<y6_ops>("logh-y6", 6, "logarithmic Hamiltonian, Yoshida 6"),
-      logh<kl6_ops>("logh-kl6", 6, "logarithmic Hamiltonian, Kahan-Li p6 s9"),
-      logh<y8_ops>("logh-y8", 8, "logarithmic Hamiltonian, Yoshida 8 (27 stages)"),
-      logh<mcl8_ops>("logh-mcl8", 8, "logarithmic Hamiltonian, McLachlan p8 s15"),
-      logh<kl8_ops>("logh-kl8", 8, "logarithmic Hamiltonian, Kahan-Li p8 s17"),
-      logh<ss10_ops>("logh-ss10", 10, "logarithmic Hamiltonian, Sofroniou-Spaletta p10 s35"),
-      ttl<strang_ops>("ttl-verlet", 2, "time-transformed leapfrog (Mikkola-Aarseth), any sign of A, ds = --h"),
-      ttl<y4_ops>("ttl-y4", 4, "time-transformed leapfrog, Yoshida 4"),
-      ttl<bm4_ops>("ttl-bm4", 4, "time-transformed leapfrog, Blanes-Moan S6"),
-      ttl<y6_ops>("ttl-y6", 6, "time-transformed leapfrog, Yoshida 6"),
-      ttl<kl6_ops>("ttl-kl6", 6, "time-transformed leapfrog, Kahan-Li p6 s9"),
-      ttl<mcl8_ops>("ttl-mcl8", 8, "time-transformed leapfrog, McLachlan p8 s15"),
-      ttl<kl8_ops>("ttl-kl8", 8, "time-transformed leapfrog, Kahan-Li p8 s17"),
-      {"ks", Family::TimeTransformed, 0, 0, 0,
-       "Kustaanheimo-Stiefel regularisation, exact in fictitious time (B = 0, one centre), ds = --h",
-       &run_ks},
-  };
+  std::vector<MethodInfo> all;
+  sp::for_each(LogHTables{}, [&all]<class E>() { all.push_back(logh_row<E>()); });
+  sp::for_each(TtlTables{}, [&all]<class E>() { all.push_back(ttl_row<E>()); });
+  all.push_back({"ks", Family::TimeTransformed, 0, 0, 0,
+                 "Kustaanheimo-Stiefel regularisation, exact in fictitious time (B = 0, one centre), ds = --h",
+                 &run_ks});
+  return all;
 }
 
 }  // namespace bodypoint::adaptive

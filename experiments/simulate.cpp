@@ -324,10 +324,19 @@ int cmd_simulate(int argc, char** argv) {
   return 0;
 }
 
-int cmd_methods(int argc, char** argv) {
-  po::options_description desc("bodypoint methods");
-  po::variables_map vm;
-  if (!parse(argc, argv, desc, vm, "usage: bodypoint methods\nLists every integration method.")) return 0;
+namespace {
+
+/// The README's method table (between its `methods:begin` and `methods:end` markers; ctest
+/// ReadmeMethodTableIsGenerated keeps the two equal).
+void print_markdown_table() {
+  std::cout << "| method | family | order | stages | evals/step | description |\n|---|---|---|---|---|---|\n";
+  for (const MethodInfo& m : methods())
+    std::cout << "| `" << m.name << "` | " << family_name(m.family) << " | " << (m.order ? std::to_string(m.order) : "var")
+              << " | " << (is_adaptive(m) ? "-" : std::to_string(m.stages)) << " | "
+              << (is_adaptive(m) ? "adaptive" : std::to_string(m.evals_per_step)) << " | " << m.description << " |\n";
+}
+
+void print_table() {
   std::cout << std::left << std::setw(16) << "method" << std::setw(8) << "order" << std::setw(8)
             << "stages" << std::setw(14) << "evals/step" << "description\n";
   for (const MethodInfo& m : methods())
@@ -335,6 +344,21 @@ int cmd_methods(int argc, char** argv) {
               << (m.order ? std::to_string(m.order) : "var") << std::setw(8)
               << (is_adaptive(m) ? "-" : std::to_string(m.stages)) << std::setw(14)
               << (is_adaptive(m) ? "adaptive" : std::to_string(m.evals_per_step)) << m.description << "\n";
+}
+
+}  // namespace
+
+int cmd_methods(int argc, char** argv) {
+  po::options_description desc("bodypoint methods");
+  bool markdown = false;
+  desc.add_options()("markdown", po::bool_switch(&markdown), "print the table as Markdown (README's Methods section)");
+  po::variables_map vm;
+  if (!parse(argc, argv, desc, vm, "usage: bodypoint methods [--markdown]\nLists every integration method.")) return 0;
+  if (markdown) {
+    print_markdown_table();
+    return 0;
+  }
+  print_table();
   const Scene probe = thesis_scene(SceneParams{});
   std::string batched;
   for (const MethodInfo& m : methods())

@@ -206,5 +206,24 @@ TEST(Cli, DivergedRunIsAnErrorNotANumber) {
   EXPECT_NE(r.err.find("non-finite"), std::string::npos) << r.err;
 }
 
+// README's table of methods is `bodypoint methods --markdown`, so a table added to the catalogue
+// (or a family's list) cannot be left out of the docs. GSL's peers are rows only in builds with GSL.
+TEST(Cli, ReadmeMethodTableIsGenerated) {
+#ifndef BODYPOINT_HAVE_GSL
+  GTEST_SKIP() << "built without GSL: the README lists gsl-rk8pd and gsl-rkf45";
+#endif
+  std::ifstream in(std::string(BODYPOINT_SOURCE_DIR) + "/README.md");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string readme = ss.str(), begin = "<!-- methods:begin -->\n", end = "<!-- methods:end -->";
+  const std::size_t a = readme.find(begin), b = readme.find(end);
+  ASSERT_NE(a, std::string::npos);
+  ASSERT_NE(b, std::string::npos);
+  const Result r = run_cli("methods --markdown");
+  ASSERT_EQ(r.code, 0);
+  EXPECT_EQ(readme.substr(a + begin.size(), b - a - begin.size()), r.out)
+      << "README's method table is stale: paste `bodypoint methods --markdown` between its markers";
+}
+
 }  // namespace
 }  // namespace bodypoint

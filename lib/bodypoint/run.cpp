@@ -13,16 +13,9 @@
 #ifdef BODYPOINT_HAVE_GSL
 #include "bodypoint/rk/run_gsl.hpp"
 #endif
-#include "bodypoint/splitting/blanes_moan.hpp"
-#include "bodypoint/splitting/classic.hpp"
-#include "bodypoint/splitting/composition.hpp"
-#include "bodypoint/splitting/kahan_li.hpp"
+#include "bodypoint/splitting/catalogue.hpp"
 #include "bodypoint/splitting/lie_poisson.hpp"
-#include "bodypoint/splitting/mclachlan.hpp"
-#include "bodypoint/splitting/sofroniou_spaletta.hpp"
 #include "bodypoint/splitting/thesis.hpp"
-#include "bodypoint/splitting/sequences.hpp"
-#include "bodypoint/splitting/yoshida.hpp"
 
 #include <cmath>
 #include <functional>
@@ -33,7 +26,6 @@ namespace bodypoint {
 namespace {
 
 namespace sp = splitting;
-using namespace splitting::ops;
 using detail::dispatch;
 using detail::observe;
 
@@ -64,16 +56,33 @@ RunResult run_splitting(const Body& body, const std::vector<Centre>& centres, co
   });
 }
 
-template <const auto& Seq, sp::CodeSlip Slip = sp::CodeSlip::none>
-MethodInfo thesis_method(std::string_view name, int order, std::string_view what) {
-  return {name, Family::Thesis, order, static_cast<int>(Seq.kicks()), static_cast<int>(Seq.kicks()),
-          what, &run_splitting<sp::ThesisKernel, Seq, Slip>};
+/// The row of a thesis-family method from its entry in ThesisTables (catalogue.hpp).
+template <class E>
+MethodInfo thesis_row() {
+  using T = typename E::type;
+  constexpr const auto& seq = sp::ops_of<T>;
+  constexpr sp::CodeSlip slip = [] {
+    if constexpr (std::is_same_v<std::remove_cv_t<decltype(E::extra)>, sp::CodeSlip>) {
+      return E::extra;
+    } else {
+      return sp::CodeSlip::none;
+    }
+  }();
+  const int k = static_cast<int>(seq.kicks());
+  return {"thesis-" + std::string(E::tag), Family::Thesis, T::order, k, k,
+          sp::describe<T>("thesis, frozen gyroscopic term"),
+          &run_splitting<sp::ThesisKernel, seq, slip>};
 }
 
-template <const auto& Seq>
-MethodInfo lie_method(std::string_view name, int order, std::string_view what) {
-  return {name, Family::LiePoisson, order, static_cast<int>(Seq.kicks()),
-          static_cast<int>(Seq.kicks_merged()), what, &run_splitting<sp::LiePoissonKernel, Seq>};
+/// The row of an exact Lie-Poisson method from its entry in LiePoissonTables (catalogue.hpp).
+template <class E>
+MethodInfo lie_row() {
+  using T = typename E::type;
+  constexpr const auto& seq = sp::ops_of<T>;
+  return {"lp-" + std::string(E::tag), Family::LiePoisson, T::order, static_cast<int>(seq.kicks()),
+          static_cast<int>(seq.kicks_merged()),
+          sp::describe<T>("exact Lie-Poisson"),
+          &run_splitting<sp::LiePoissonKernel, seq>};
 }
 
 std::vector<MethodInfo> make_rows() {
@@ -98,27 +107,9 @@ std::vector<MethodInfo> make_rows() {
       {"gsl-rkf45", Family::Gsl, 5, 6, 6, "GSL Runge-Kutta-Fehlberg 4(5) with step-size control (gsl_odeiv2_step_rkf45), --tol",
        &run_gsl_rkf45},
 #endif
-      thesis_method<euler_ops>("thesis-euler", 1, "thesis symplectic Euler, frozen gyroscopic term"),
-      thesis_method<verlet_ops>("thesis-verlet", 2, "thesis Verlet (KDK), frozen gyroscopic term"),
-      thesis_method<ruth3_ops, sp::CodeSlip::third_v_z>("thesis-ruth3", 3, "thesis Ruth 3, frozen gyroscopic term"),
-      thesis_method<y4_ops, sp::CodeSlip::third_v_z>("thesis-fr4", 4, "thesis Forest-Ruth 4 (eq. 2.9-2.10), frozen gyroscopic term"),
-      thesis_method<y6_ops, sp::CodeSlip::third_vw_z>("thesis-y6", 6, "thesis Yoshida 6 (table 2.1), frozen gyroscopic term"),
-      lie_method<euler_ops>("lp-euler", 1, "exact Lie-Poisson splitting, Lie-Trotter D K"),
-      lie_method<verlet_ops>("lp-verlet", 2, "exact Lie-Poisson Strang, kick-drift-kick"),
-      lie_method<strang_ops>("lp-verlet-dkd", 2, "exact Lie-Poisson Strang, drift-kick-drift"),
-      lie_method<ruth3_ops>("lp-ruth3", 3, "exact Lie-Poisson, Ruth 1983 third order"),
-      lie_method<y4_ops>("lp-y4", 4, "exact Lie-Poisson, Yoshida/Forest-Ruth 4 (3 stages)"),
-      lie_method<bm4_ops>("lp-bm4", 4, "exact Lie-Poisson, Blanes-Moan 2002 S6 (6 stages)"),
-      lie_method<rkn4_ops>("lp-rkn4", 4, "exact Lie-Poisson, Blanes-Moan 2002 SRKN_6^b (RKN, 6 stages)"),
-      lie_method<rkn6_ops>("lp-rkn6", 6, "exact Lie-Poisson, Blanes-Moan 2002 SRKN_11^b (RKN, 11 stages)"),
-      lie_method<y6_ops>("lp-y6", 6, "exact Lie-Poisson, Yoshida 6 triple jump (thesis table 2.1)"),
-      lie_method<kl6_ops>("lp-kl6", 6, "exact Lie-Poisson, Kahan-Li 1997 p6 s9"),
-      lie_method<y8_ops>("lp-y8", 8, "exact Lie-Poisson, Yoshida 8 triple jump (27 stages)"),
-      lie_method<y8d_ops>("lp-y8d", 8, "exact Lie-Poisson, Yoshida 1990 solution D (15 stages)"),
-      lie_method<mcl8_ops>("lp-mcl8", 8, "exact Lie-Poisson, McLachlan 1995 p8 s15"),
-      lie_method<kl8_ops>("lp-kl8", 8, "exact Lie-Poisson, Kahan-Li 1997 p8 s17"),
-      lie_method<ss10_ops>("lp-ss10", 10, "exact Lie-Poisson, Sofroniou-Spaletta 2005 p10 s35"),
   };
+  sp::for_each(sp::ThesisTables{}, [&all]<class E>() { all.push_back(thesis_row<E>()); });
+  sp::for_each(sp::LiePoissonTables{}, [&all]<class E>() { all.push_back(lie_row<E>()); });
   return all;
 }
 

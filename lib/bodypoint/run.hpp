@@ -58,13 +58,26 @@ struct RunResult {
 /// TimeTransformed: fixed fictitious step ds (--h), variable physical step (logh-*, ttl-*, ks).
 enum class Family { Thesis, LiePoisson, Odeint, OdeintAdaptive, Gsl, TimeTransformed };
 
+/// The family's name as `bodypoint methods --markdown` prints it.
+constexpr std::string_view family_name(Family f) {
+  switch (f) {
+    case Family::Thesis: return "thesis drift/kick";
+    case Family::LiePoisson: return "exact Lie-Poisson";
+    case Family::Odeint: return "Boost.Odeint fixed step";
+    case Family::OdeintAdaptive: return "Boost.Odeint adaptive";
+    case Family::Gsl: return "GSL adaptive";
+    case Family::TimeTransformed: return "time-transformed";
+  }
+  return "?";
+}
+
 struct MethodInfo {
-  std::string_view name;
+  std::string name;
   Family family;
   int order;            ///< nominal order (thesis family: of the underlying table; 0: variable)
   int stages;           ///< sub-steps (kicks) per step as written
   int evals_per_step;   ///< force evaluations per step in a long run without per-step output
-  std::string_view description;
+  std::string description;
   RunResult (*run)(const Body&, const std::vector<Centre>&, const RunSpec&, const SampleSink*);
 };
 

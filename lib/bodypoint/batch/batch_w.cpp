@@ -14,10 +14,11 @@
 #include "bodypoint/batch/lanes.hpp"
 
 #include "bodypoint/batch/abi.hpp"
+#include "bodypoint/splitting/catalogue.hpp"
 #include "bodypoint/splitting/lie_poisson.hpp"
-#include "bodypoint/splitting/sequences.hpp"
 
 #include <limits>
+#include <string_view>
 
 namespace bodypoint::batch::BODYPOINT_BATCH_NS {
 namespace {
@@ -292,8 +293,6 @@ long run_rk4(const Params& p, const Physical& s0, double h, long steps, std::siz
   return 4 * steps;
 }
 
-using namespace sp::ops;
-
 using Runner = long (*)(const Params&, const Physical&, double, long, std::size_t, double*);
 template <const auto& Seq>
 long lie(const Params& p, const Physical& s0, double h, long steps, std::size_t count, double* out) {
@@ -310,23 +309,43 @@ bool same(const char* a, const char* b) {
   return *a == *b;
 }
 
+/// A method's name and batch runner; the name is built at compile time (this unit calls no library code).
+struct Row {
+  char name[32]{};
+  Runner run = nullptr;
+};
+constexpr Row row(std::string_view prefix, std::string_view tag, Runner run) {
+  Row r;
+  r.run = run;
+  std::size_t n = 0;
+  for (char c : prefix) r.name[n++] = c;
+  for (char c : tag) r.name[n++] = c;
+  return r;
+}
+
+/// The rows of a family, generated from its list of tables (splitting/catalogue.hpp).
+template <std::size_t N>
+struct Rows {
+  Row rows[N];
+};
+template <class... E>
+constexpr Rows<sizeof...(E)> thesis_rows(sp::List<E...> /*list*/) {
+  return {{row("thesis-", sp::entry_t<E>::tag, &thesis<sp::ops_of<typename sp::entry_t<E>::type>>)...}};
+}
+template <class... E>
+constexpr Rows<sizeof...(E)> lie_rows(sp::List<E...> /*list*/) {
+  return {{row("lp-", sp::entry_t<E>::tag, &lie<sp::ops_of<typename sp::entry_t<E>::type>>)...}};
+}
+constexpr auto kThesisRows = thesis_rows(sp::ThesisTables{});
+constexpr auto kLieRows = lie_rows(sp::LiePoissonTables{});
+
 /// The batch runner of `method`, or nullptr.
 Runner runner(const char* name) {
-  static const struct {
-    const char* name;
-    Runner run;
-  } table[] = {
-      {"rk4", run_rk4},
-      {"thesis-euler", thesis<euler_ops>},  {"thesis-verlet", thesis<verlet_ops>}, {"thesis-ruth3", thesis<ruth3_ops>},
-      {"thesis-fr4", thesis<y4_ops>},       {"thesis-y6", thesis<y6_ops>},
-      {"lp-euler", lie<euler_ops>},         {"lp-verlet", lie<verlet_ops>},       {"lp-verlet-dkd", lie<strang_ops>},
-      {"lp-ruth3", lie<ruth3_ops>},         {"lp-y4", lie<y4_ops>},               {"lp-bm4", lie<bm4_ops>},
-      {"lp-rkn4", lie<rkn4_ops>},           {"lp-rkn6", lie<rkn6_ops>},           {"lp-y6", lie<y6_ops>},
-      {"lp-kl6", lie<kl6_ops>},             {"lp-y8", lie<y8_ops>},               {"lp-y8d", lie<y8d_ops>},
-      {"lp-mcl8", lie<mcl8_ops>},           {"lp-kl8", lie<kl8_ops>},             {"lp-ss10", lie<ss10_ops>},
-  };
-  for (const auto& row : table)
-    if (same(row.name, name)) return row.run;
+  if (same("rk4", name)) return run_rk4;
+  for (const Row& r : kThesisRows.rows)
+    if (same(r.name, name)) return r.run;
+  for (const Row& r : kLieRows.rows)
+    if (same(r.name, name)) return r.run;
   return nullptr;
 }
 

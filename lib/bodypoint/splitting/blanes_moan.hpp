@@ -71,4 +71,26 @@ inline constexpr Table<12> blanes_moan_rkn6 = [] {
   return t;
 }();
 
+// The table types (catalogue.hpp).
+struct BlanesMoan4 {
+  static constexpr std::string_view tag = "bm4", title = "Blanes-Moan S6",
+                                    citation = "Blanes-Moan 2002, table 2";
+  static constexpr int order = 4, stages = 6;
+  static constexpr const auto& table = blanes_moan4;
+};
+struct BlanesMoanRkn4 {
+  static constexpr std::string_view tag = "rkn4", title = "Blanes-Moan SRKN_6^b (RKN)",
+                                    citation = "Blanes-Moan 2002, table 3";
+  static constexpr int order = 4, stages = 6;
+  static constexpr bool nystrom = true;
+  static constexpr const auto& table = blanes_moan_rkn4;
+};
+struct BlanesMoanRkn6 {
+  static constexpr std::string_view tag = "rkn6", title = "Blanes-Moan SRKN_11^b (RKN)",
+                                    citation = "Blanes-Moan 2002, table 3";
+  static constexpr int order = 6, stages = 11;
+  static constexpr bool nystrom = true;
+  static constexpr const auto& table = blanes_moan_rkn6;
+};
+
 }  // namespace bodypoint::splitting

@@ -25,4 +25,30 @@ inline constexpr auto strang_dkd_table = strang_dkd(std::array<double, 1>{1.0});
 /// 30 (1983) 2669, table with c = (7/24, 3/4, -1/24), d = (2/3, -2/3, 1).
 inline constexpr Table<3> ruth3{{1.0, -2.0 / 3.0, 2.0 / 3.0}, {-1.0 / 24.0, 3.0 / 4.0, 7.0 / 24.0}};
 
+// The table types (catalogue.hpp).
+struct Euler {
+  static constexpr std::string_view tag = "euler", title = "Lie-Trotter D K",
+                                    citation = "thesis sec. 2.5";
+  static constexpr int order = 1, stages = 1;
+  static constexpr const auto& table = euler;
+};
+struct VerletKdk {
+  static constexpr std::string_view tag = "verlet", title = "Strang, kick-drift-kick",
+                                    citation = "thesis sec. 2.5";
+  static constexpr int order = 2, stages = 1;
+  static constexpr const auto& table = verlet_kdk;
+};
+struct StrangDkd {
+  static constexpr std::string_view tag = "verlet-dkd", title = "Strang, drift-kick-drift",
+                                    citation = "Strang 1968";
+  static constexpr int order = 2, stages = 1;
+  static constexpr const auto& table = strang_dkd_table;
+};
+struct Ruth3 {
+  static constexpr std::string_view tag = "ruth3", title = "Ruth third order",
+                                    citation = "Ruth 1983; thesis sec. 2.5";
+  static constexpr int order = 3, stages = 3;
+  static constexpr const auto& table = ruth3;
+};
+
 }  // namespace bodypoint::splitting

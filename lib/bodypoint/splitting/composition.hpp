@@ -22,6 +22,7 @@
 
 #include <array>
 #include <cstddef>
+#include <string_view>
 #include <type_traits>
 
 namespace bodypoint::splitting {

@@ -33,4 +33,18 @@ inline constexpr auto kahan_li8_weights = palindrome(std::array<double, 8>{
 inline constexpr double kahan_li8_middle = -0.60550853383003451170;
 inline constexpr auto kahan_li8 = strang_dkd(kahan_li8_weights);
 
+// The table types (catalogue.hpp).
+struct KahanLi6 {
+  static constexpr std::string_view tag = "kl6", title = "Kahan-Li p6 s9",
+                                    citation = "Kahan-Li 1997; HLW (3.11)";
+  static constexpr int order = 6, stages = 9;
+  static constexpr const auto& table = kahan_li6;
+};
+struct KahanLi8 {
+  static constexpr std::string_view tag = "kl8", title = "Kahan-Li p8 s17",
+                                    citation = "Kahan-Li 1997; HLW (3.12)";
+  static constexpr int order = 8, stages = 17;
+  static constexpr const auto& table = kahan_li8;
+};
+
 }  // namespace bodypoint::splitting

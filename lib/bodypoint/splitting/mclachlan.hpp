@@ -22,4 +22,12 @@ inline constexpr auto mclachlan8_weights = palindrome(std::array<double, 7>{
 inline constexpr double mclachlan8_middle = -0.79688793935291635402;
 inline constexpr auto mclachlan8 = strang_dkd(mclachlan8_weights);
 
+// The table type (catalogue.hpp).
+struct McLachlan8 {
+  static constexpr std::string_view tag = "mcl8", title = "McLachlan p8 s15",
+                                    citation = "McLachlan 1995";
+  static constexpr int order = 8, stages = 15;
+  static constexpr const auto& table = mclachlan8;
+};
+
 }  // namespace bodypoint::splitting

@@ -31,4 +31,12 @@ inline constexpr auto sofroniou_spaletta10_weights = palindrome(std::array<doubl
 inline constexpr double sofroniou_spaletta10_middle = 0.049317735759594537918;
 inline constexpr auto sofroniou_spaletta10 = strang_dkd(sofroniou_spaletta10_weights);
 
+// The table type (catalogue.hpp).
+struct SofroniouSpaletta10 {
+  static constexpr std::string_view tag = "ss10", title = "Sofroniou-Spaletta p10 s35",
+                                    citation = "Sofroniou-Spaletta 2005";
+  static constexpr int order = 10, stages = 35;
+  static constexpr const auto& table = sofroniou_spaletta10;
+};
+
 }  // namespace bodypoint::splitting

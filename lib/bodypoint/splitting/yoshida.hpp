@@ -37,4 +37,30 @@ inline constexpr auto yoshida8d_weights = palindrome(std::array<double, 7>{
     0.102799849391985});  // w1
 inline constexpr auto yoshida8d = strang_dkd(yoshida8d_weights);
 
+// The table types (catalogue.hpp).
+struct Yoshida4 {
+  static constexpr std::string_view tag = "y4", title = "Yoshida/Forest-Ruth 4, triple jump",
+                                    citation = "Yoshida 1990; Forest-Ruth 1990; thesis eq. 2.9-2.10";
+  static constexpr int order = 4, stages = 3;
+  static constexpr const auto& table = yoshida4;
+};
+struct Yoshida6 {
+  static constexpr std::string_view tag = "y6", title = "Yoshida 6, triple jump",
+                                    citation = "Yoshida 1990; thesis table 2.1";
+  static constexpr int order = 6, stages = 9;
+  static constexpr const auto& table = yoshida6;
+};
+struct Yoshida8 {
+  static constexpr std::string_view tag = "y8", title = "Yoshida 8, triple jump",
+                                    citation = "Yoshida 1990; thesis appendix 2";
+  static constexpr int order = 8, stages = 27;
+  static constexpr const auto& table = yoshida8;
+};
+struct Yoshida8D {
+  static constexpr std::string_view tag = "y8d", title = "Yoshida 8, solution D",
+                                    citation = "Yoshida 1990, table 2";
+  static constexpr int order = 8, stages = 15;
+  static constexpr const auto& table = yoshida8d;
+};
+
 }  // namespace bodypoint::splitting
