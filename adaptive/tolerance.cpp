@@ -164,9 +164,9 @@ class Search {
   }
 
  private:
-  /// Order-p methods: pilot pair, predicted step, close pair (file comment).
-  Level ladder() {
-    // 1. The pilot pair, coarse and cheap; a refused step halves h0.
+  /// The pilot pair at h0 and h0/2 (a refused step halves h0); sets the first estimate and returns
+  /// the finer run.
+  Level pilot() {
     double h = initial_step(m_, b_, c_, t_end_);
     Level a, b;
     for (int k = 0;; ++k) {
@@ -180,6 +180,13 @@ class Search {
       }
     }
     estimate_ = pair_estimate(a, b);
+    return b;
+  }
+
+  /// Order-p methods: pilot pair, predicted step, close pair (file comment).
+  Level ladder() {
+    // 1. The pilot pair, coarse and cheap.
+    const Level b = pilot();
     // 2./3. Predict, estimate from a close triple, repeat until the estimate is below kAccept tol.
     Level fine = b;
     double h_next = 0.0, best_bound = std::numeric_limits<double>::infinity();

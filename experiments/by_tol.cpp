@@ -111,88 +111,102 @@ std::string ms(double s) {
   return os.str();
 }
 
-}  // namespace
-
-void run_by_tolerance(const std::vector<NamedScene>& scenes, const std::vector<double>& tols, long repeats,
-                      std::ostream* csv, std::ostream& summary) {
-  std::vector<TolRow> rows;
-  const std::vector<std::string> peers = peer_names();
-  for (const NamedScene& ns : scenes) {
-    const State ref = reference_state(ns.scene.bodies.front(), ns.scene.centres, ns.t_end, 1e-18L);
-    for (double tol : tols) {
-      try {
-        rows.push_back(measure_auto(ns, ref, tol, repeats));
-      } catch (const Error& e) {  // refused (below the round-off floor, over the budget): recorded as such
-        TolRow refused;
-        refused.scene = ns.name;
-        refused.tol = tol;
-        refused.is_auto = true;
-        refused.method = "refused";
-        refused.err = refused.err_estimate = std::numeric_limits<double>::quiet_NaN();
-        rows.push_back(refused);
-        std::cerr << "  " << ns.name << " tol " << sci(tol, 0) << ": auto refused (" << e.what() << ")\n";
-        continue;
-      }
-      std::cerr << "  " << ns.name << " tol " << sci(tol, 0) << ": auto " << rows.back().method << " err "
-                << sci(rows.back().err) << " (estimate " << sci(rows.back().err_estimate) << ") in "
-                << ms(rows.back().wall_s) << " ms\n";
-      for (const std::string& p : peers) {
-        try {
-          rows.push_back(measure_peer(ns, p, ref, tol, repeats));
-        } catch (const Error& e) {
-          std::cerr << "  " << ns.name << " " << p << " tol " << sci(tol, 0) << ": failed (" << e.what() << ")\n";
-        }
-      }
+/// auto at each tolerance, then every peer at the same tolerance; a refusal (below the round-off
+/// floor, over the budget) is recorded as such.
+void measure_at_tolerances(const NamedScene& ns, const State& ref, const std::vector<double>& tols, long repeats,
+                           const std::vector<std::string>& peers, std::vector<TolRow>& rows) {
+  for (double tol : tols) {
+    try {
+      rows.push_back(measure_auto(ns, ref, tol, repeats));
+    } catch (const Error& e) {
+      TolRow refused;
+      refused.scene = ns.name;
+      refused.tol = tol;
+      refused.is_auto = true;
+      refused.method = "refused";
+      refused.err = refused.err_estimate = std::numeric_limits<double>::quiet_NaN();
+      rows.push_back(refused);
+      std::cerr << "  " << ns.name << " tol " << sci(tol, 0) << ": auto refused (" << e.what() << ")\n";
+      continue;
     }
-    // The peers' own ladders, for the oracle comparison: each peer at requested tolerances from 1e-3
-    // down by half decades, as if the user had known which one delivers TOL.
+    std::cerr << "  " << ns.name << " tol " << sci(tol, 0) << ": auto " << rows.back().method << " err "
+              << sci(rows.back().err) << " (estimate " << sci(rows.back().err_estimate) << ") in "
+              << ms(rows.back().wall_s) << " ms\n";
     for (const std::string& p : peers) {
-      for (int k = 6; k <= 30; ++k) {
-        const double t = std::pow(10.0, -0.5 * k);
-        try {
-          TolRow r = measure_peer(ns, p, ref, t, repeats);
-          r.is_ladder = true;
-          rows.push_back(r);
-          if (r.err < kLadderFloor) break;
-        } catch (const Error& e) {
-          break;
-        }
+      try {
+        rows.push_back(measure_peer(ns, p, ref, tol, repeats));
+      } catch (const Error& e) {
+        std::cerr << "  " << ns.name << " " << p << " tol " << sci(tol, 0) << ": failed (" << e.what() << ")\n";
       }
     }
   }
-  if (csv) {
-    *csv << "# bodypoint work-precision --by-tol, revision " << git_revision() << "\n"
-         << "# err = max(|dR|/|R_ref|, |dv|/|v_ref|) against odeint rkf78 in long double at tol 1e-18; met = err <= tol\n"
-         << "# wall_s = median over repeats of the step loops (auto: all runs of its search); h = ds for logh/ttl/ks\n"
-         << "scene,method,kind,tol,h,err_estimate,err,met,runs,force_evals,wall_s\n";
-    for (const TolRow& r : rows)
-      *csv << r.scene << ',' << r.method << ',' << (r.is_auto ? "auto" : r.is_ladder ? "ladder" : "at-tol") << ','
-           << fmt(r.tol) << ','
-           << (r.is_auto ? fmt(r.h) : "") << ',' << (r.is_auto ? fmt(r.err_estimate) : "") << ',' << fmt(r.err)
-           << ',' << (r.met ? "yes" : "no") << ',' << r.runs << ',' << r.force_evals << ',' << fmt(r.wall_s) << '\n';
+}
+
+/// The peers' own ladders, for the oracle comparison: each peer at requested tolerances from 1e-3
+/// down by half decades, as if the user had known which one delivers TOL.
+void measure_peer_ladders(const NamedScene& ns, const State& ref, long repeats, const std::vector<std::string>& peers,
+                          std::vector<TolRow>& rows) {
+  for (const std::string& p : peers) {
+    for (int k = 6; k <= 30; ++k) {
+      const double t = std::pow(10.0, -0.5 * k);
+      try {
+        TolRow r = measure_peer(ns, p, ref, t, repeats);
+        r.is_ladder = true;
+        rows.push_back(r);
+        if (r.err < kLadderFloor) break;
+      } catch (const Error& e) {
+        break;
+      }
+    }
   }
+}
+
+void write_tol_rows(std::ostream& csv, const std::vector<TolRow>& rows) {
+  csv << "# bodypoint work-precision --by-tol, revision " << git_revision() << "\n"
+      << "# err = max(|dR|/|R_ref|, |dv|/|v_ref|) against odeint rkf78 in long double at tol 1e-18; met = err <= tol\n"
+      << "# wall_s = median over repeats of the step loops (auto: all runs of its search); h = ds for logh/ttl/ks\n"
+      << "scene,method,kind,tol,h,err_estimate,err,met,runs,force_evals,wall_s\n";
+  for (const TolRow& r : rows)
+    csv << r.scene << ',' << r.method << ',' << (r.is_auto ? "auto" : r.is_ladder ? "ladder" : "at-tol") << ','
+        << fmt(r.tol) << ',' << (r.is_auto ? fmt(r.h) : "") << ',' << (r.is_auto ? fmt(r.err_estimate) : "") << ','
+        << fmt(r.err) << ',' << (r.met ? "yes" : "no") << ',' << r.runs << ',' << r.force_evals << ','
+        << fmt(r.wall_s) << '\n';
+}
+
+/// The fastest peer run at auto's tolerance that met it, and how many met it.
+std::pair<const TolRow*, int> fastest_meeting(const std::vector<TolRow>& rows, const TolRow& a) {
+  const TolRow* best = nullptr;
+  int meeting = 0;
+  for (const TolRow& r : rows) {
+    if (r.is_auto || r.is_ladder || r.scene != a.scene || r.tol != a.tol || !r.met) continue;
+    ++meeting;
+    if (!best || r.wall_s < best->wall_s) best = &r;
+  }
+  return {best, meeting};
+}
+
+/// Oracle: the fastest ladder configuration delivering TOL whose next finer one delivers it too.
+const TolRow* oracle_for(const std::vector<TolRow>& rows, const TolRow& a) {
+  const TolRow* oracle = nullptr;
+  for (std::size_t i = 0; i + 1 < rows.size(); ++i) {
+    const TolRow& r = rows[i];
+    const TolRow& next = rows[i + 1];
+    if (!r.is_ladder || r.scene != a.scene || !(r.err <= a.tol)) continue;
+    if (!(next.is_ladder && next.method == r.method && next.scene == r.scene && next.err <= a.tol)) continue;
+    if (!oracle || r.wall_s < oracle->wall_s) oracle = &r;
+  }
+  return oracle;
+}
+
+void write_tol_summary(std::ostream& summary, const std::vector<TolRow>& rows, std::size_t peer_count) {
   summary << "| scene | TOL | auto method | ds or h | estimate | delivered | met | time [ms] | fastest peer meeting TOL "
              "| time [ms] | speed-up | peers meeting TOL | fastest peer config delivering TOL | time [ms] | speed-up |\n"
           << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   int met = 0, total = 0, faster3 = 0, compared = 0, oracle3 = 0, oracle_n = 0;
   for (const TolRow& a : rows) {
     if (!a.is_auto) continue;
-    const TolRow* best = nullptr;
-    int meeting = 0;
-    for (const TolRow& r : rows) {
-      if (r.is_auto || r.is_ladder || r.scene != a.scene || r.tol != a.tol || !r.met) continue;
-      ++meeting;
-      if (!best || r.wall_s < best->wall_s) best = &r;
-    }
-    // Oracle: the fastest ladder configuration delivering TOL whose next finer one delivers it too.
-    const TolRow* oracle = nullptr;
-    for (std::size_t i = 0; i + 1 < rows.size(); ++i) {
-      const TolRow& r = rows[i];
-      const TolRow& next = rows[i + 1];
-      if (!r.is_ladder || r.scene != a.scene || !(r.err <= a.tol)) continue;
-      if (!(next.is_ladder && next.method == r.method && next.scene == r.scene && next.err <= a.tol)) continue;
-      if (!oracle || r.wall_s < oracle->wall_s) oracle = &r;
-    }
+    const auto [best, meeting] = fastest_meeting(rows, a);
+    const TolRow* oracle = oracle_for(rows, a);
     ++total;
     met += a.met ? 1 : 0;
     summary << "| " << a.scene << " | " << sci(a.tol, 0) << " | " << a.method << " | " << std::setprecision(3)
@@ -206,7 +220,7 @@ void run_by_tolerance(const std::vector<NamedScene>& scenes, const std::vector<d
     } else {
       summary << "none | - | - | ";
     }
-    summary << meeting << "/" << peers.size() << " | ";
+    summary << meeting << "/" << peer_count << " | ";
     if (oracle) {
       const double ratio = oracle->wall_s / a.wall_s;
       ++oracle_n;
@@ -220,6 +234,21 @@ void run_by_tolerance(const std::vector<NamedScene>& scenes, const std::vector<d
   summary << "\nauto met TOL in " << met << " of " << total << " cases; where a peer met it too, auto was >= 3x "
           << "faster in " << faster3 << " of " << compared << "; against the fastest peer configuration that "
           << "delivers TOL (its tolerance chosen afterwards), >= 3x in " << oracle3 << " of " << oracle_n << ".\n";
+}
+
+}  // namespace
+
+void run_by_tolerance(const std::vector<NamedScene>& scenes, const std::vector<double>& tols, long repeats,
+                      std::ostream* csv, std::ostream& summary) {
+  std::vector<TolRow> rows;
+  const std::vector<std::string> peers = peer_names();
+  for (const NamedScene& ns : scenes) {
+    const State ref = reference_state(ns.scene.bodies.front(), ns.scene.centres, ns.t_end, 1e-18L);
+    measure_at_tolerances(ns, ref, tols, repeats, peers, rows);
+    measure_peer_ladders(ns, ref, repeats, peers, rows);
+  }
+  if (csv) write_tol_rows(*csv, rows);
+  write_tol_summary(summary, rows, peers.size());
 }
 
 }  // namespace bodypoint::cli

@@ -31,16 +31,11 @@ const char* force_law_name(ForceLaw law) {
 
 void add_scene_options(po::options_description& desc, SceneOptions& o) {
   SceneParams& p = o.params;
+  for (const SceneParameter& q : scene_parameters()) {
+    double& field = q.field(p);
+    desc.add_options()(std::string(q.name).c_str(), po::value(&field)->default_value(field), std::string(q.help).c_str());
+  }
   desc.add_options()
-      ("A", po::value(&p.A)->default_value(p.A), "Coulomb constant of the centre at the origin (A < 0 repels)")
-      ("m", po::value(&p.m)->default_value(p.m), "mass")
-      ("B", po::value(&p.B)->default_value(p.B), "coupling inertia (B = 0: material point)")
-      ("J", po::value(&p.J)->default_value(p.J), "rotational inertia")
-      ("K1", po::value(&p.start.K1)->default_value(p.start.K1), "initial linear momentum K1(0) = K1 i")
-      ("Kx", po::value(&p.start.Kx)->default_value(p.start.Kx), "K2(0) = Kx i - Kz k")
-      ("Kz", po::value(&p.start.Kz)->default_value(p.start.Kz), "K2(0) = Kx i - Kz k")
-      ("d", po::value(&p.start.d)->default_value(p.start.d), "impact parameter")
-      ("L", po::value(&p.start.L)->default_value(p.start.L), "initial distance along -x")
       ("force-law", po::value<std::string>()->default_value("coulomb")->notifier([&p](const std::string& v) {
          p.law = parse_force_law(v);
        }),
@@ -51,9 +46,11 @@ void add_scene_options(po::options_description& desc, SceneOptions& o) {
 
 Scene make_scene(const po::variables_map& vm, const SceneOptions& o) {
   if (vm.count("scene")) {
-    for (const char* k : {"A", "m", "B", "J", "K1", "Kx", "Kz", "d", "L", "force-law"})
+    std::vector<std::string> keys{"force-law"};
+    for (const SceneParameter& q : scene_parameters()) keys.emplace_back(q.name);
+    for (const std::string& k : keys)
       if (vm.count(k) && !vm[k].defaulted())
-        throw Error(std::string("--") + k + " cannot be combined with --scene (set it in the scene file)");
+        throw Error("--" + k + " cannot be combined with --scene (set it in the scene file)");
     return read_scene_file(o.scene_file);
   }
   return thesis_scene(o.params);
@@ -81,11 +78,20 @@ void apply_step_options(const po::variables_map& vm, const StepOptions& o, RunSp
 
 std::string describe(const SceneParams& p) {
   std::ostringstream os;
-  os << "A=" << fmt(p.A) << " m=" << fmt(p.m) << " B=" << fmt(p.B) << " J=" << fmt(p.J)
-     << " K1=" << fmt(p.start.K1) << " Kx=" << fmt(p.start.Kx) << " Kz=" << fmt(p.start.Kz)
-     << " d=" << fmt(p.start.d) << " L=" << fmt(p.start.L);
+  SceneParams copy = p;
+  const char* sep = "";
+  for (const SceneParameter& q : scene_parameters()) {
+    os << sep << q.name << '=' << fmt(q.field(copy));
+    sep = " ";
+  }
   if (p.law != ForceLaw::coulomb) os << " force-law=" << force_law_name(p.law);
   return os.str();
+}
+
+std::string join(const std::vector<std::string>& items, const std::string& sep) {
+  std::string out;
+  for (const std::string& item : items) out += (out.empty() ? "" : sep) + item;
+  return out;
 }
 
 std::vector<std::string> split_list(const std::string& s) {

@@ -77,6 +77,8 @@ int cmd_study(int argc, char** argv);
 int cmd_view(int argc, char** argv);
 
 /// "A=.. m=.. B=.. J=.. K1=.. Kx=.. Kz=.. d=.. L=..": the thesis's parameters, for output headers.
+/// items joined by sep.
+std::string join(const std::vector<std::string>& items, const std::string& sep);
 std::string describe(const SceneParams& p);
 
 /// The non-empty items of a comma-separated list.

@@ -3,6 +3,7 @@
 #include "bodypoint/batch.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
+#include "bodypoint/observables.hpp"
 #include "bodypoint/reference.hpp"
 #include "bodypoint/run.hpp"
 #include "budget.hpp"
@@ -14,6 +15,8 @@
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <string>
+#include <vector>
 
 namespace bodypoint::cli {
 namespace {
@@ -130,7 +133,9 @@ std::string search_line(const BodyRun& b) {
 
 }  // namespace
 
-int cmd_simulate(int argc, char** argv) {
+namespace {
+
+struct SimulateOptions {
   SceneOptions so;
   StepOptions st;
   std::string method_name = "lp-y4";
@@ -139,188 +144,224 @@ int cmd_simulate(int argc, char** argv) {
   double tol = 1e-10, dt_out = 0.0, omega_c = -1.0;
   bool json = false, no_invariants = false, with_reference = false, dry_run = false, quiet = false;
   double max_seconds = 3600.0, max_rows = 1e7;
-  po::options_description desc("bodypoint simulate");
-  add_scene_options(desc, so);
-  add_step_options(desc, st);
+  std::vector<std::string> observe;
+};
+
+void add_simulate_options(po::options_description& desc, SimulateOptions& o) {
+  add_scene_options(desc, o.so);
+  add_step_options(desc, o.st);
   desc.add_options()
-      ("method", po::value(&method_name)->default_value(method_name),
+      ("method", po::value(&o.method_name)->default_value(o.method_name),
        "integration method (see 'bodypoint methods'), or auto (the default with --tol)")
-      ("out", po::value(&out), "write the trajectory to this CSV file (atomically)")
-      ("tol", po::value(&tol)->default_value(tol),
+      ("out", po::value(&o.out), "write the trajectory to this CSV file (atomically)")
+      ("observe", po::value(&o.observe)->multitoken(),
+       "with --out: also write these observables (e.g. spin_angle; the list is in observables.cpp)")
+      ("tol", po::value(&o.tol)->default_value(o.tol),
        "odeint-*/gsl-*: error tolerance per step; any other method: the final state's relative error "
        "(R and v) to deliver, the step is chosen for it")
-      ("dt-out", po::value(&dt_out), "with --out, time-transformed methods: write states at t = k dt-out")
-      ("omega-c", po::value(&omega_c), "time-transformed methods: constant c added to the time-step function "
+      ("dt-out", po::value(&o.dt_out), "with --out, time-transformed methods: write states at t = k dt-out")
+      ("omega-c", po::value(&o.omega_c), "time-transformed methods: constant c added to the time-step function "
        "(physical step <= ds/c); default: from the scene's spin-orbit rate")
-      ("every", po::value(&every)->default_value(every), "with --out: write every k-th step (and the last)")
-      ("json", po::bool_switch(&json), "print one JSON object instead of the summary")
-      ("no-invariants", po::bool_switch(&no_invariants), "do not track the invariants (fastest; final state only)")
-      ("dry-run", po::bool_switch(&dry_run), "check every option and the scene, print what would run, run nothing")
-      ("max-seconds", po::value(&max_seconds)->default_value(max_seconds),
+      ("every", po::value(&o.every)->default_value(o.every), "with --out: write every k-th step (and the last)")
+      ("json", po::bool_switch(&o.json), "print one JSON object instead of the summary")
+      ("no-invariants", po::bool_switch(&o.no_invariants), "do not track the invariants (fastest; final state only)")
+      ("dry-run", po::bool_switch(&o.dry_run), "check every option and the scene, print what would run, run nothing")
+      ("max-seconds", po::value(&o.max_seconds)->default_value(o.max_seconds),
        "refuse a run whose calibrated estimate exceeds this many seconds")
-      ("max-rows", po::value(&max_rows)->default_value(max_rows), "with --out: refuse to write more rows than this")
-      ("quiet", po::bool_switch(&quiet), "no estimate and no progress bar on stderr")
-      ("reference", po::bool_switch(&with_reference),
+      ("max-rows", po::value(&o.max_rows)->default_value(o.max_rows), "with --out: refuse to write more rows than this")
+      ("quiet", po::bool_switch(&o.quiet), "no estimate and no progress bar on stderr")
+      ("reference", po::bool_switch(&o.with_reference),
        "also report err_R = |R - R_ref| against Boost.Odeint rkf78 in long double at tolerance 1e-16");
+}
+
+/// The output options of the run specification, checked against the plan and the scene.
+void apply_output_options(const po::variables_map& vm, const SimulateOptions& o, const Scene& scene, RunPlan& plan) {
+  RunSpec& spec = plan.spec;
+  if (plan.search && vm.count("omega-c")) throw Error("--tol uses the automatic time-step constant: drop --omega-c");
+  if (vm.count("dt-out")) {
+    if (plan.method && !is_time_transformed(*plan.method))
+      throw Error("--dt-out is for time-transformed methods (logh-*, ttl-*, ks)");
+    if (!(o.dt_out > 0.0) || !std::isfinite(o.dt_out)) throw Error("--dt-out must be a finite number > 0");
+    if (!vm.count("out")) throw Error("--dt-out needs --out");
+    spec.dt_out = o.dt_out;
+  }
+  if (vm.count("observe") && !vm.count("out")) throw Error("--observe needs --out");
+  spec.every = o.every;
+  spec.omega_c = o.omega_c;
+  if (o.every < 1) throw Error("--every must be >= 1");
+  spec.track_invariants = !o.no_invariants;
+  if (!(o.max_seconds > 0.0)) throw Error("--max-seconds must be > 0");
+  if (!(o.max_rows >= 1.0)) throw Error("--max-rows must be >= 1");
+  if (vm.count("out") && !plan.search) {
+    // Rows the output would get: one per dt-out, or per every-th step (fictitious steps to t_end are
+    // not known in advance: the sink counts them and stops the run at the limit).
+    const double rows = spec.dt_out > 0.0 ? spec.t_end / spec.dt_out
+                        : spec.steps > 0 ? static_cast<double>(spec.steps) / static_cast<double>(spec.every) : 0.0;
+    if (rows * static_cast<double>(scene.bodies.size()) > o.max_rows)
+      throw Error("--out would get about " + fmt(std::ceil(rows)) + " rows per body, more than --max-rows " +
+                  fmt(o.max_rows) + " (raise --every or --dt-out, or --max-rows)");
+  }
+}
+
+void print_dry_run(const RunPlan& plan, const std::string& method_name, const Scene& scene) {
+  const RunSpec& spec = plan.spec;
+  std::cout << "would run " << (plan.search ? method_name + " with --tol " + fmt(plan.tol) : std::string(plan.method->name))
+            << " on " << scene.bodies.size() << " body-point(s) and " << scene.centres.size() << " centre(s): ";
+  if (plan.search) std::cout << "step search to t_end = " << fmt(spec.t_end);
+  else if (is_time_transformed(*plan.method)) std::cout << "ds = " << fmt(spec.h) << (spec.t_end > 0 ? " to t_end = " + fmt(spec.t_end) : " for " + std::to_string(spec.steps) + " fictitious steps");
+  else if (is_adaptive(*plan.method)) std::cout << "tol = " << fmt(spec.tol) << " to t_end = " << fmt(spec.t_end);
+  else std::cout << spec.steps << " steps of h = " << fmt(spec.h);
+  std::cout << "\n";
+}
+
+/// The trajectory file of --out: opened before computing (an unwritable path fails at once), its
+/// columns from the observables' list, committed only after every body ran.
+class TrajectoryFile {
+ public:
+  TrajectoryFile(const std::string& path, const SimulateOptions& o, const po::variables_map& vm, const RunPlan& plan,
+                 const Scene& scene)
+      : file_(path), writer_(file_.stream(), select_observables(scene.centres, o.observe), true), max_rows_(o.max_rows) {
+    std::ostream& os = file_.stream();
+    os << "# bodypoint simulate, revision " << git_revision() << "\n# method=" << o.method_name;
+    if (plan.search) os << " tol=" << fmt(plan.tol) << " t_end=" << fmt(plan.spec.t_end);
+    else os << " h=" << fmt(plan.spec.h) << " steps=" << plan.spec.steps;
+    os << " every=" << plan.spec.every << " " << scene_header(vm, o.so) << "\n";
+    writer_.help();
+    writer_.header();
+  }
+  SampleSink sink(long body, const BodyPoint& p) {
+    return [this, body, &p](const Sample& s) {
+      if (static_cast<double>(++rows_) > max_rows_)
+        throw Error("--out reached --max-rows " + fmt(max_rows_) + " rows; raise --every or --dt-out, or --max-rows; "
+                    "no output written");
+      writer_.row(body, s, p);
+    };
+  }
+  std::ostream& stream() { return file_.stream(); }
+  void commit() { file_.commit(); }
+
+ private:
+  AtomicFile file_;
+  TrajectoryWriter writer_;
+  double max_rows_;
+  long rows_ = 0;
+};
+
+/// One body: budget, run (with the progress bar), health, and the reference error when asked for.
+BodyRun simulate_body(const SimulateOptions& o, const RunPlan& plan, const Body& body, const Scene& scene,
+                      const SampleSink* sink) {
+  std::optional<WorkEstimate> estimate;
+  if (!plan.search) {
+    estimate = estimate_work(*plan.method, body, scene.centres, plan.spec);
+    if (estimate) check_budget(*estimate, o.max_seconds, o.quiet || o.json);
+  }
+  BodyRun br;
+  {
+    const ProgressBar bar(estimate, progress_wanted(o.quiet));
+    br = run_body(plan, body, scene.centres, plan.spec, sink);
+  }
+  const Health health = assess(br.result);
+  if (health.status != "ok")
+    throw Error("body '" + body.name + "' (" + std::string(br.method->name) + "): " + health.why +
+                (health.status == "collision" ? "; a time-transformed method (ttl-*) or a smaller --h can follow it"
+                                              : "; the step is too large for this scene (reduce --h)") +
+                "; no output written");
+  if (o.with_reference) {
+    const State ref = reference_state(body, scene.centres, br.result.t_end);
+    br.err_R = (br.result.final.R - ref.R).norm();
+    br.err_rel = adaptive::state_distance(br.result.final, ref);
+  }
+  return br;
+}
+
+void report_json(const std::vector<BodyRun>& runs, const Scene& scene, const RunPlan& plan) {
+  const BodyRun& r0 = runs.front();
+  const double h0 = r0.search ? r0.search->h : plan.spec.h;
+  std::cout << "{\"method\": \"" << r0.method->name << "\", \"h\": " << json_number(h0)
+            << (is_adaptive(*r0.method) ? ", \"tol\": " + json_number(plan.spec.tol) : std::string())
+            << search_json(r0, plan.tol) << ", \"steps\": " << r0.result.steps
+            << ", \"t_end\": " << json_number(r0.result.t_end) << ", " << json_body(r0.result, r0.err_R, r0.err_rel);
+  if (runs.size() > 1) {
+    std::cout << ", \"bodies\": [";
+    for (std::size_t b = 0; b < runs.size(); ++b)
+      std::cout << (b ? ", " : "") << "{\"name\": \"" << scene.bodies[b].name << "\", \"method\": \""
+                << runs[b].method->name << "\"" << search_json(runs[b], plan.tol) << ", "
+                << json_body(runs[b].result, runs[b].err_R, runs[b].err_rel) << "}";
+    std::cout << "]";
+  }
+  std::cout << "}\n";
+}
+
+void report_body(const BodyRun& run, const std::string& name) {
+  const RunResult& r = run.result;
+  std::cout << "\n[" << name << "]\n";
+  if (!run.why.empty()) std::cout << "  chosen: " << run.why << "\n";
+  if (run.search) std::cout << "  " << search_line(run) << "\n";
+  std::cout << std::setprecision(12) << "  R(t_end) = " << r.final.R.transpose() << "\n"
+            << "  v(t_end) = " << r.final.v.transpose() << "\n"
+            << "  w(t_end) = " << r.final.w.transpose() << "\n";
+  if (r.invariants) {
+    std::cout << std::setprecision(3) << std::scientific
+              << "  max |E - E0|/|E0|          = " << r.invariants->max_rel_dE << "\n"
+              << "  max |K2^2 - K2^2_0|/K2^2_0 = " << r.invariants->max_rel_dK2sq << "\n";
+    if (r.invariants->has_K2Q) std::cout << "  max |K2Q - K2Q_0|          = " << r.invariants->max_abs_dK2Q << "\n";
+    std::cout << std::defaultfloat;
+  }
+  if (run.err_R)
+    std::cout << std::setprecision(3) << std::scientific << "  |R - R_ref| (odeint rkf78, long double) = "
+              << *run.err_R << "\n" << std::defaultfloat;
+  std::cout << "  force evaluations = " << r.force_evals << ", wall time = " << std::setprecision(3) << r.wall_s
+            << " s\n";
+}
+
+void report_text(const std::vector<BodyRun>& runs, const Scene& scene, const RunPlan& plan,
+                 const std::string& method_name, const std::string& header) {
+  const BodyRun& r0 = runs.front();
+  std::cout << "bodypoint simulate  method=" << (plan.search ? method_name : std::string(r0.method->name));
+  if (plan.search) std::cout << "  tol=" << fmt(plan.tol);
+  else std::cout << (is_time_transformed(*r0.method) ? "  ds=" : "  h=") << fmt(plan.spec.h);
+  std::cout << "  steps=" << r0.result.steps << "  t_end=" << fmt(r0.result.t_end) << "\n"
+            << "scene: " << header << "  (" << scene.centres.size() << " centre(s), " << scene.bodies.size()
+            << " body-point(s))\n";
+  for (std::size_t b = 0; b < runs.size(); ++b) report_body(runs[b], scene.bodies[b].name);
+}
+
+}  // namespace
+
+int cmd_simulate(int argc, char** argv) {
+  SimulateOptions o;
+  po::options_description desc("bodypoint simulate");
+  add_simulate_options(desc, o);
   po::variables_map vm;
   if (!parse(argc, argv, desc, vm,
              "usage: bodypoint simulate [options]\n"
              "Integrates the scene (default: thesis table 3.1, h = 1e-4, n = 500000) with one method.\n"
              "With --tol and no --method (or --method auto) the method and its step are chosen to deliver tol."))
     return 0;
-
-  RunPlan plan = plan_run(vm, st, method_name, vm["method"].defaulted(), tol);
-  const MethodInfo* fixed_method = plan.method;
-  const bool search = plan.search;
-  if (plan.automatic) method_name = "auto";
-  if (search && vm.count("omega-c")) throw Error("--tol uses the automatic time-step constant: drop --omega-c");
-  const Scene scene = make_scene(vm, so);
-  RunSpec& spec = plan.spec;
-  if (vm.count("dt-out")) {
-    if (fixed_method && !is_time_transformed(*fixed_method))
-      throw Error("--dt-out is for time-transformed methods (logh-*, ttl-*, ks)");
-    if (!(dt_out > 0.0) || !std::isfinite(dt_out)) throw Error("--dt-out must be a finite number > 0");
-    if (!vm.count("out")) throw Error("--dt-out needs --out");
-    spec.dt_out = dt_out;
-  }
-  spec.every = every;
-  spec.omega_c = omega_c;
-  if (every < 1) throw Error("--every must be >= 1");
-  spec.track_invariants = !no_invariants;
-
-  if (!(max_seconds > 0.0)) throw Error("--max-seconds must be > 0");
-  if (!(max_rows >= 1.0)) throw Error("--max-rows must be >= 1");
-  if (vm.count("out") && !search) {
-    // Rows the output would get: one per dt-out, or per every-th step (fictitious steps to t_end are
-    // not known in advance: the sink counts them and stops the run at the limit).
-    const double rows = spec.dt_out > 0.0 ? spec.t_end / spec.dt_out
-                        : spec.steps > 0 ? static_cast<double>(spec.steps) / static_cast<double>(spec.every) : 0.0;
-    if (rows * static_cast<double>(scene.bodies.size()) > max_rows)
-      throw Error("--out would get about " + fmt(std::ceil(rows)) + " rows per body, more than --max-rows " +
-                  fmt(max_rows) + " (raise --every or --dt-out, or --max-rows)");
-  }
-  if (dry_run) {
-    std::cout << "would run " << (search ? method_name + " with --tol " + fmt(tol) : std::string(fixed_method->name))
-              << " on " << scene.bodies.size() << " body-point(s) and " << scene.centres.size() << " centre(s): ";
-    if (search) std::cout << "step search to t_end = " << fmt(spec.t_end);
-    else if (is_time_transformed(*fixed_method)) std::cout << "ds = " << fmt(spec.h) << (spec.t_end > 0 ? " to t_end = " + fmt(spec.t_end) : " for " + std::to_string(spec.steps) + " fictitious steps");
-    else if (is_adaptive(*fixed_method)) std::cout << "tol = " << fmt(spec.tol) << " to t_end = " << fmt(spec.t_end);
-    else std::cout << spec.steps << " steps of h = " << fmt(spec.h);
-    std::cout << "\n";
+  RunPlan plan = plan_run(vm, o.st, o.method_name, vm["method"].defaulted(), o.tol);
+  if (plan.automatic) o.method_name = "auto";
+  const Scene scene = make_scene(vm, o.so);
+  apply_output_options(vm, o, scene, plan);
+  if (o.dry_run) {
+    print_dry_run(plan, o.method_name, scene);
     return 0;
   }
-  // Open the output before computing, so an unwritable path fails at once.
-  std::unique_ptr<AtomicFile> file;
-  SampleSink sink;
-  if (vm.count("out")) {
-    file = std::make_unique<AtomicFile>(out);
-    std::ostream& os = file->stream();
-    os << "# bodypoint simulate, revision " << git_revision() << "\n"
-       << "# method=" << method_name;
-    if (search) os << " tol=" << fmt(tol) << " t_end=" << fmt(spec.t_end);
-    else os << " h=" << fmt(spec.h) << " steps=" << spec.steps;
-    os << " every=" << spec.every << " " << scene_header(vm, so) << "\n"
-       << "# rel_dE = |E-E0|/|E0|, rel_dK2sq = |K2^2-K2^2_0|/K2^2_0, abs_dK2Q = |K2Q-K2Q_0| "
-          "(absent with several centres)\n";
-    os.precision(17);
-  }
-
+  std::unique_ptr<TrajectoryFile> file;
+  if (vm.count("out")) file = std::make_unique<TrajectoryFile>(o.out, o, vm, plan, scene);
   std::vector<BodyRun> runs;
-  long rows_written = 0;
   for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
     const Body& body = scene.bodies[b];
-    if (file) {
-      std::ostream& os = file->stream();
-      const bool k2q = scene.centres.size() == 1;
-      if (b == 0)
-        os << "body,t,Rx,Ry,Rz,vx,vy,vz,wx,wy,wz,rel_dE,rel_dK2sq" << (k2q ? ",abs_dK2Q" : "") << "\n";
-      sink = [&os, b, k2q, &rows_written, max_rows](const Sample& s) {
-        if (static_cast<double>(++rows_written) > max_rows)
-          throw Error("--out reached --max-rows " + fmt(max_rows) + " rows; raise --every or --dt-out, or --max-rows; "
-                      "no output written");
-        os << b << ',' << s.t << ',' << s.s.R.x() << ',' << s.s.R.y() << ',' << s.s.R.z() << ','
-           << s.s.v.x() << ',' << s.s.v.y() << ',' << s.s.v.z() << ',' << s.s.w.x() << ','
-           << s.s.w.y() << ',' << s.s.w.z() << ',' << s.rel_dE << ',' << s.rel_dK2sq;
-        if (k2q) os << ',' << s.abs_dK2Q;
-        os << '\n';
-      };
-    }
-    std::optional<WorkEstimate> estimate;
-    if (!search) {
-      estimate = estimate_work(*fixed_method, body, scene.centres, spec);
-      if (estimate) check_budget(*estimate, max_seconds, quiet || json);
-    }
-    BodyRun br;
-    {
-      const ProgressBar bar(estimate, progress_wanted(quiet));
-      br = run_body(plan, body, scene.centres, spec, file ? &sink : nullptr);
-    }
-    if (search && file) file->stream() << "# body " << b << ": " << search_line(br) << "\n";
-    const Health health = assess(br.result);
-    if (health.status != "ok")
-      throw Error("body '" + body.name + "' (" + std::string(br.method->name) + "): " + health.why +
-                  (health.status == "collision" ? "; a time-transformed method (ttl-*) or a smaller --h can follow it"
-                                                : "; the step is too large for this scene (reduce --h)") +
-                  "; no output written");
-    if (with_reference) {
-      const State ref = reference_state(body, scene.centres, br.result.t_end);
-      br.err_R = (br.result.final.R - ref.R).norm();
-      br.err_rel = adaptive::state_distance(br.result.final, ref);
-    }
-    runs.push_back(std::move(br));
+    const SampleSink sink = file ? file->sink(static_cast<long>(b), body.p) : SampleSink();
+    runs.push_back(simulate_body(o, plan, body, scene, file ? &sink : nullptr));
+    if (plan.search && file) file->stream() << "# body " << b << ": " << search_line(runs.back()) << "\n";
   }
   if (file) file->commit();
-
-  if (json) {
-    const BodyRun& r0 = runs.front();
-    const double h0 = r0.search ? r0.search->h : spec.h;
-    std::cout << "{\"method\": \"" << r0.method->name << "\", \"h\": " << json_number(h0)
-              << (is_adaptive(*r0.method) ? ", \"tol\": " + json_number(spec.tol) : std::string())
-              << search_json(r0, tol) << ", \"steps\": " << r0.result.steps
-              << ", \"t_end\": " << json_number(r0.result.t_end) << ", " << json_body(r0.result, r0.err_R, r0.err_rel);
-    if (runs.size() > 1) {
-      std::cout << ", \"bodies\": [";
-      for (std::size_t b = 0; b < runs.size(); ++b)
-        std::cout << (b ? ", " : "") << "{\"name\": \"" << scene.bodies[b].name << "\", \"method\": \""
-                  << runs[b].method->name << "\"" << search_json(runs[b], tol) << ", "
-                  << json_body(runs[b].result, runs[b].err_R, runs[b].err_rel) << "}";
-      std::cout << "]";
-    }
-    std::cout << "}\n";
+  if (o.json) {
+    report_json(runs, scene, plan);
     return 0;
   }
-
-  const BodyRun& r0 = runs.front();
-  std::cout << "bodypoint simulate  method=" << (search ? method_name : std::string(r0.method->name));
-  if (search) std::cout << "  tol=" << fmt(tol);
-  else std::cout << (is_time_transformed(*r0.method) ? "  ds=" : "  h=") << fmt(spec.h);
-  std::cout << "  steps=" << r0.result.steps << "  t_end=" << fmt(r0.result.t_end) << "\n"
-            << "scene: " << scene_header(vm, so) << "  (" << scene.centres.size() << " centre(s), "
-            << scene.bodies.size() << " body-point(s))\n";
-  for (std::size_t b = 0; b < runs.size(); ++b) {
-    const RunResult& r = runs[b].result;
-    std::cout << "\n[" << scene.bodies[b].name << "]\n";
-    if (!runs[b].why.empty()) std::cout << "  chosen: " << runs[b].why << "\n";
-    if (runs[b].search) std::cout << "  " << search_line(runs[b]) << "\n";
-    std::cout << std::setprecision(12)
-              << "  R(t_end) = " << r.final.R.transpose() << "\n"
-              << "  v(t_end) = " << r.final.v.transpose() << "\n"
-              << "  w(t_end) = " << r.final.w.transpose() << "\n";
-    if (r.invariants) {
-      std::cout << std::setprecision(3) << std::scientific
-                << "  max |E - E0|/|E0|          = " << r.invariants->max_rel_dE << "\n"
-                << "  max |K2^2 - K2^2_0|/K2^2_0 = " << r.invariants->max_rel_dK2sq << "\n";
-      if (r.invariants->has_K2Q)
-        std::cout << "  max |K2Q - K2Q_0|          = " << r.invariants->max_abs_dK2Q << "\n";
-      std::cout << std::defaultfloat;
-    }
-    if (runs[b].err_R)
-      std::cout << std::setprecision(3) << std::scientific << "  |R - R_ref| (odeint rkf78, long double) = "
-                << *runs[b].err_R << "\n" << std::defaultfloat;
-    std::cout << "  force evaluations = " << r.force_evals << ", wall time = " << std::setprecision(3)
-              << r.wall_s << " s\n";
-  }
-  if (file) std::cout << "\ntrajectory written to " << out << "\n";
+  report_text(runs, scene, plan, o.method_name, scene_header(vm, o.so));
+  if (file) std::cout << "\ntrajectory written to " << o.out << "\n";
   return 0;
 }
 

@@ -15,6 +15,7 @@
 //   with identical parameters; both are run.
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
+#include "bodypoint/observables.hpp"
 #include "cli.hpp"
 #include "errata.hpp"
 #include "orders.hpp"
@@ -212,15 +213,7 @@ void study_appendix(const StudyContext& c) {
     SceneParams p;
     p.A = -0.5;
     p.start.d = 50;
-    for (const auto& [k, v] : set.changes) {
-      if (k == "A") p.A = v;
-      else if (k == "J") p.J = v;
-      else if (k == "L") p.start.L = v;
-      else if (k == "d") p.start.d = v;
-      else if (k == "K1") p.start.K1 = v;
-      else if (k == "Kz") p.start.Kz = v;
-      else if (k == "Kx") p.start.Kx = v;
-    }
+    for (const auto& [k, v] : set.changes) scene_field(p, k) = v;
     ix << set.figure << ',' << fmt(p.A) << ',' << fmt(p.m) << ',' << fmt(p.B) << ',' << fmt(p.J) << ','
        << fmt(p.start.L) << ',' << fmt(p.start.d) << ',' << fmt(p.start.K1) << ',' << fmt(p.start.Kz) << ','
        << fmt(p.start.Kx) << ',';
@@ -234,14 +227,11 @@ void study_appendix(const StudyContext& c) {
     const std::string name = "P1." + std::to_string(set.figure) + ".csv";
     AtomicFile f((dir / name).string());
     std::ostream& os = f.stream();
-    os << "# thesis appendix 1, fig. P1." << set.figure << "; thesis-euler h=1e-4 n=250000\n"
-       << "t,Rx,Ry,Rz,vx,vy,vz,wx,wy,wz,rel_dE,rel_dK2sq,abs_dK2Q\n";
-    SampleSink sink = [&os](const Sample& s) {
-      os << fmt(s.t) << ',' << fmt(s.s.R.x()) << ',' << fmt(s.s.R.y()) << ',' << fmt(s.s.R.z()) << ','
-         << fmt(s.s.v.x()) << ',' << fmt(s.s.v.y()) << ',' << fmt(s.s.v.z()) << ',' << fmt(s.s.w.x()) << ','
-         << fmt(s.s.w.y()) << ',' << fmt(s.s.w.z()) << ',' << fmt(s.rel_dE) << ',' << fmt(s.rel_dK2sq) << ','
-         << fmt(s.abs_dK2Q) << '\n';
-    };
+    os << "# thesis appendix 1, fig. P1." << set.figure << "; thesis-euler h=1e-4 n=250000\n";
+    const TrajectoryWriter writer(os, select_observables(scene.centres), false);
+    writer.header();
+    const BodyPoint& bp = scene.bodies.front().p;
+    SampleSink sink = [&writer, &bp](const Sample& s) { writer.row(0, s, bp); };
     RunSpec rs;
     rs.h = 1e-4;
     rs.steps = steps;

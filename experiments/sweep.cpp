@@ -27,15 +27,7 @@ namespace {
 
 /// A copy of `base` with the swept parameter set; h is handled by the caller.
 SceneParams with_value(SceneParams p, const std::string& param, double v) {
-  if (param == "d") p.start.d = v;
-  else if (param == "L") p.start.L = v;
-  else if (param == "Kx") p.start.Kx = v;
-  else if (param == "Kz") p.start.Kz = v;
-  else if (param == "K1") p.start.K1 = v;
-  else if (param == "A") p.A = v;
-  else if (param == "B") p.B = v;
-  else if (param == "J") p.J = v;
-  else if (param == "m") p.m = v;
+  if (param != "h") scene_field(p, param) = v;
   return p;
 }
 
@@ -356,7 +348,7 @@ Axis parse_axis(const std::string& item) {
   Axis axis{item.substr(0, eq), {}};
   const auto& ps = sweep_parameters();
   if (std::find(ps.begin(), ps.end(), axis.param) == ps.end())
-    throw Error("unknown parameter '" + axis.param + "' (d, L, h, Kx, Kz, K1, A, B, J, m)");
+    throw Error("unknown parameter '" + axis.param + "' (" + join(ps, ", ") + ")");
   std::string spec = item.substr(eq + 1);
   const bool log = spec.rfind("log:", 0) == 0;
   if (log) spec = spec.substr(4);
@@ -434,11 +426,11 @@ std::vector<Axis> parse_axes(const po::variables_map& vm, const std::vector<std:
     }
     return axes;
   }
-  if (!vm.count("param")) throw Error("--param is required (or --grid; parameters: d, L, h, Kx, Kz, K1, A, B, J, m)");
+  if (!vm.count("param")) throw Error("--param is required (or --grid; parameters: " + join(sweep_parameters(), ", ") + ")");
   const std::string param = vm["param"].as<std::string>();
   const auto& ps = sweep_parameters();
   if (std::find(ps.begin(), ps.end(), param) == ps.end())
-    throw Error("unknown parameter '" + param + "' (d, L, h, Kx, Kz, K1, A, B, J, m)");
+    throw Error("unknown parameter '" + param + "' (" + join(ps, ", ") + ")");
   const bool log = vm["log"].as<bool>();
   if (vm.count("values")) {
     if (vm.count("from") || vm.count("to") || vm.count("step") || log) throw Error("give --values or a range, not both");

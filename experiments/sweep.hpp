@@ -11,9 +11,13 @@
 
 namespace bodypoint::cli {
 
-/// The parameters a sweep can vary.
+/// The parameters a sweep can vary: the step h and every scene parameter (model.hpp).
 inline const std::vector<std::string>& sweep_parameters() {
-  static const std::vector<std::string> p{"d", "L", "h", "Kx", "Kz", "K1", "A", "B", "J", "m"};
+  static const std::vector<std::string> p = [] {
+    std::vector<std::string> names{"h"};
+    for (const SceneParameter& q : scene_parameters()) names.emplace_back(q.name);
+    return names;
+  }();
   return p;
 }
 

@@ -221,71 +221,56 @@ RunSpec ending_at(const RunPlan& plan, double t_end) {
   return s;
 }
 
-}  // namespace
-
-int cmd_view(int argc, char** argv) {
+struct ViewOptions {
   SceneOptions so;
   StepOptions st;
   std::string method_name = "lp-y4", compare, out = "bodypoint-view.html";
   double tol = 1e-10, compare_h = 0.0, max_mb = 32.0;
   long frames = 3000;
   bool dry_run = false;
-  po::options_description desc("bodypoint view");
-  add_scene_options(desc, so);
-  add_step_options(desc, st);
+};
+
+void add_view_options(po::options_description& desc, ViewOptions& o) {
+  add_scene_options(desc, o.so);
+  add_step_options(desc, o.st);
   desc.add_options()
-      ("method", po::value(&method_name)->default_value(method_name), "integration method, or auto with --tol")
-      ("tol", po::value(&tol)->default_value(tol), "as for simulate: per-step tolerance of odeint-*/gsl-*, "
+      ("method", po::value(&o.method_name)->default_value(o.method_name), "integration method, or auto with --tol")
+      ("tol", po::value(&o.tol)->default_value(o.tol), "as for simulate: per-step tolerance of odeint-*/gsl-*, "
        "otherwise the final state's relative error to deliver")
-      ("compare", po::value(&compare), "a second method on the same scene, drawn in a second colour")
-      ("compare-h", po::value(&compare_h), "step (or ds) of the --compare method (default: --h)")
-      ("frames", po::value(&frames)->default_value(frames), "states kept per body (equal arc length, closest approach kept)")
-      ("max-mb", po::value(&max_mb)->default_value(max_mb), "refuse to write a page larger than this many MB")
-      ("out", po::value(&out)->default_value(out), "the HTML file to write (atomically)")
-      ("dry-run", po::bool_switch(&dry_run), "check every option and the scene, run nothing, write nothing");
-  po::variables_map vm;
-  if (!parse(argc, argv, desc, vm,
-             "usage: bodypoint view [options]\n"
-             "Writes one self-contained HTML page (three.js inlined, no server or network needed) that animates\n"
-             "the run in 3D: centres, bodies, trails coloured by the physical step, spin and velocity arrows,\n"
-             "the energy error against t. Options as for simulate."))
-    return 0;
+      ("compare", po::value(&o.compare), "a second method on the same scene, drawn in a second colour")
+      ("compare-h", po::value(&o.compare_h), "step (or ds) of the --compare method (default: --h)")
+      ("frames", po::value(&o.frames)->default_value(o.frames), "states kept per body (equal arc length, closest approach kept)")
+      ("max-mb", po::value(&o.max_mb)->default_value(o.max_mb), "refuse to write a page larger than this many MB")
+      ("out", po::value(&o.out)->default_value(o.out), "the HTML file to write (atomically)")
+      ("dry-run", po::bool_switch(&o.dry_run), "check every option and the scene, run nothing, write nothing");
+}
+
+void check_view_options(const po::variables_map& vm, const ViewOptions& o) {
   if (!viewer_bundle())
     throw Error("this binary was built without the viewer's script: run scripts/setup.sh (it needs npm) to "
                 "install experiments/viewer's packages, then rebuild");
-  if (frames < 16 || frames > 10'000'000) throw Error("--frames must be between 16 and 10000000");
-  if (!(std::isfinite(max_mb) && max_mb > 0.0)) throw Error("--max-mb must be a finite number > 0");
+  if (o.frames < 16 || o.frames > 10'000'000) throw Error("--frames must be between 16 and 10000000");
+  if (!(std::isfinite(o.max_mb) && o.max_mb > 0.0)) throw Error("--max-mb must be a finite number > 0");
   if (vm.count("compare-h") && !vm.count("compare")) throw Error("--compare-h needs --compare");
-  if (vm.count("compare-h") && !(std::isfinite(compare_h) && compare_h > 0.0))
+  if (vm.count("compare-h") && !(std::isfinite(o.compare_h) && o.compare_h > 0.0))
     throw Error("--compare-h must be a finite number > 0");
+}
 
-  std::vector<RunPlan> plans{plan_run(vm, st, method_name, vm["method"].defaulted(), tol)};
-  std::vector<std::string> labels{plans[0].automatic ? "auto" : std::string(plans[0].method->name)};
+/// The run and, with --compare, the second one.
+std::vector<RunPlan> view_plans(const po::variables_map& vm, const ViewOptions& o) {
+  std::vector<RunPlan> plans{plan_run(vm, o.st, o.method_name, vm["method"].defaulted(), o.tol)};
   if (vm.count("compare")) {
-    StepOptions st2 = st;
-    if (vm.count("compare-h")) st2.h = compare_h;
-    plans.push_back(plan_run(vm, st2, compare, false, tol));
-    labels.push_back(plans[1].automatic ? "auto" : std::string(plans[1].method->name));
+    StepOptions st2 = o.st;
+    if (vm.count("compare-h")) st2.h = o.compare_h;
+    plans.push_back(plan_run(vm, st2, o.compare, false, o.tol));
   }
-  const Scene scene = make_scene(vm, so);
-  const std::string_view bundle = *viewer_bundle();
-  const double estimate = static_cast<double>(bundle.size()) +
-                          kBytesPerFrame * static_cast<double>(frames + 2) *
-                              static_cast<double>(scene.bodies.size() * plans.size());
-  const double limit = max_mb * 1e6;
-  if (estimate > limit)
-    throw Error("the page would hold about " + fmt(std::round(estimate / 1e5) / 10) + " MB (" + std::to_string(frames) +
-                " frames x " + std::to_string(scene.bodies.size()) + " bodies x " + std::to_string(plans.size()) +
-                " runs), above --max-mb " + fmt(max_mb) + ": lower --frames or raise --max-mb");
-  if (dry_run) {
-    std::cout << "would write " << out << ": " << plans.size() << " run(s) of " << scene.bodies.size()
-              << " body-point(s), about " << std::round(estimate / 1e3) << " kB\n";
-    return 0;
-  }
-    AtomicFile file(out);  // an unwritable path fails before the runs
+  return plans;
+}
 
-  std::string json = "{\"title\": " + json_string("bodypoint view: " + labels[0] + (plans.size() > 1 ? " vs " + labels[1] : "")) +
-                     ", \"scene\": " + json_string(vm.count("scene") ? "scene=" + so.scene_file : describe(so.params)) +
+/// The page's data: the scene, and every run of every body (the second run ends where the first did).
+std::string page_json(const std::string& title, const std::string& scene_line, const Scene& scene,
+                      const std::vector<RunPlan>& plans, const std::vector<std::string>& labels, long frames) {
+  std::string json = "{\"title\": " + json_string(title) + ", \"scene\": " + json_string(scene_line) +
                      ", \"revision\": " + json_string(git_revision()) + ", \"centres\": [";
   for (std::size_t i = 0; i < scene.centres.size(); ++i)
     json += (i ? ", " : "") + std::string("{\"c\": ") + json_vec(scene.centres[i].c) + ", \"A\": " +
@@ -304,9 +289,44 @@ int cmd_view(int argc, char** argv) {
     }
     json += "]}";
   }
-  json += "]}";
+  return json + "]}";
+}
 
+}  // namespace
+
+int cmd_view(int argc, char** argv) {
+  ViewOptions o;
+  po::options_description desc("bodypoint view");
+  add_view_options(desc, o);
+  po::variables_map vm;
+  if (!parse(argc, argv, desc, vm,
+             "usage: bodypoint view [options]\n"
+             "Writes one self-contained HTML page (three.js inlined, no server or network needed) that animates\n"
+             "the run in 3D: centres, bodies, trails coloured by the physical step, spin and velocity arrows,\n"
+             "the energy error against t. Options as for simulate."))
+    return 0;
+  check_view_options(vm, o);
+  const std::vector<RunPlan> plans = view_plans(vm, o);
+  std::vector<std::string> labels;
+  for (const RunPlan& p : plans) labels.push_back(p.automatic ? "auto" : std::string(p.method->name));
+  const Scene scene = make_scene(vm, o.so);
+  const std::string_view bundle = *viewer_bundle();
+  const double estimate = static_cast<double>(bundle.size()) + kBytesPerFrame * static_cast<double>(o.frames + 2) *
+                                                                   static_cast<double>(scene.bodies.size() * plans.size());
+  const double limit = o.max_mb * 1e6;
+  if (estimate > limit)
+    throw Error("the page would hold about " + fmt(std::round(estimate / 1e5) / 10) + " MB (" + std::to_string(o.frames) +
+                " frames x " + std::to_string(scene.bodies.size()) + " bodies x " + std::to_string(plans.size()) +
+                " runs), above --max-mb " + fmt(o.max_mb) + ": lower --frames or raise --max-mb");
+  if (o.dry_run) {
+    std::cout << "would write " << o.out << ": " << plans.size() << " run(s) of " << scene.bodies.size()
+              << " body-point(s), about " << std::round(estimate / 1e3) << " kB\n";
+    return 0;
+  }
+  AtomicFile file(o.out);  // an unwritable path fails before the runs
   const std::string title = "bodypoint view: " + labels[0] + (plans.size() > 1 ? " vs " + labels[1] : "");
+  const std::string json = page_json(title, vm.count("scene") ? "scene=" + o.so.scene_file : describe(o.so.params),
+                                     scene, plans, labels, o.frames);
   std::ostream& os = file.stream();
   os << "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
      << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
@@ -316,11 +336,11 @@ int cmd_view(int argc, char** argv) {
      << "<script>" << bundle << "</script>\n</body></html>\n";
   const double size = static_cast<double>(os.tellp());
   if (size > limit)
-    throw Error("the page holds " + fmt(std::round(size / 1e5) / 10) + " MB, above --max-mb " + fmt(max_mb) +
+    throw Error("the page holds " + fmt(std::round(size / 1e5) / 10) + " MB, above --max-mb " + fmt(o.max_mb) +
                 ": lower --frames or raise --max-mb; nothing written");
   file.commit();
-  std::cout << "wrote " << out << " (" << std::round(size / 1e3) << " kB, " << scene.bodies.size() << " body-point(s), "
-            << plans.size() << " run(s)); open it in a browser\n";
+  std::cout << "wrote " << o.out << " (" << std::round(size / 1e3) << " kB, " << scene.bodies.size()
+            << " body-point(s), " << plans.size() << " run(s)); open it in a browser\n";
   return 0;
 }
 

@@ -89,186 +89,213 @@ Row measure(const NamedScene& ns, const MethodInfo& m, const Body& body, const S
   return row;
 }
 
+struct WorkPrecisionArgs {
+  std::string scenes = "all", methods = "all", out, summary;
+  std::string tols = "1e-4,1e-5,1e-6,1e-7,1e-8,1e-9,1e-10,1e-11,1e-12";
+  bool quick = false, by_tol = false;
+  Options o;
+};
+
+void add_work_precision_options(po::options_description& desc, WorkPrecisionArgs& a) {
+  desc.add_options()
+      ("scenes", po::value(&a.scenes)->default_value(a.scenes), "comma-separated: thesis,close,material,long,two-centres or all")
+      ("methods", po::value(&a.methods)->default_value(a.methods), "comma-separated method names or all")
+      ("repeats", po::value(&a.o.repeats)->default_value(a.o.repeats), "timed repeats per configuration (median reported)")
+      ("max-evals", po::value(&a.o.max_evals)->default_value(a.o.max_evals), "largest run of a ladder, in force evaluations")
+      ("by-tol", po::bool_switch(&a.by_tol), "second view: auto and every step-size-controlled peer with the same "
+       "requested tolerance; delivered error, whether it met TOL, and time")
+      ("tols", po::value(&a.tols)->default_value(a.tols), "with --by-tol: the tolerances")
+      ("quick", po::bool_switch(&a.quick), "coarse: scenes thesis and material, 1 repeat, runs up to 1e6 force evaluations")
+      ("out", po::value(&a.out), "CSV: scene, method, h, tol, err_R, err_rel, max_rel_dE, force_evals, wall_s")
+      ("summary", po::value(&a.summary), "also write the summary table (Markdown) to this file");
+}
+
+/// --quick's defaults and the checks of the numbers.
+void settle(const po::variables_map& vm, WorkPrecisionArgs& a) {
+  if (a.quick) {
+    if (vm["scenes"].defaulted()) a.scenes = "thesis,material";
+    a.o.repeats = 1;
+    a.o.min_timed_s = 0.0;
+    if (vm["max-evals"].defaulted()) a.o.max_evals = 1e6;
+  }
+  if (a.o.repeats < 1) throw Error("--repeats must be >= 1");
+  if (!(a.o.max_evals >= 1)) throw Error("--max-evals must be >= 1");
+}
+
+std::vector<const MethodInfo*> chosen_methods(const std::string& arg) {
+  std::vector<const MethodInfo*> ms;
+  if (arg == "all") {
+    for (const MethodInfo& m : methods()) ms.push_back(&m);
+  } else {
+    for (const std::string& n : split_list(arg)) ms.push_back(&method_or_throw(n));
+  }
+  if (ms.empty()) throw Error("--methods is empty");
+  return ms;
+}
+
+/// The scene's reference state; its estimated error is noted in `refs` (and on stderr).
+State reference_of(const NamedScene& ns, std::ostringstream& refs) {
+  const Body& body = ns.scene.bodies.front();
+  const State ref = reference_state(body, ns.scene.centres, ns.t_end, 1e-18L);
+  const State loose = reference_state(body, ns.scene.centres, ns.t_end, 1e-15L);
+  RunSpec cs;
+  cs.steps = std::lround(ns.t_end / splitting_check_step(ns.name));
+  cs.h = ns.t_end / static_cast<double>(cs.steps);
+  const State split = run(method_or_throw("lp-ss10"), body, ns.scene.centres, cs).final;
+  const double ref_err = std::max((ref.R - loose.R).norm(), (ref.R - split.R).norm());
+  std::ostringstream line;
+  line << "reference " << ns.name << ": odeint rkf78 long double tol 1e-18, t_end " << fmt(ns.t_end)
+       << ", |R_ref| = " << fmt(ref.R.norm()) << ", estimated error " << std::setprecision(2) << std::scientific
+       << ref_err << " (relative " << ref_err / ref.R.norm() << ")" << std::defaultfloat << "\n";
+  refs << line.str();
+  std::cerr << line.str();
+  return ref;
+}
+
+/// One method's ladder on one scene: halving ds (time-transformed) or h, or tolerances divided by 10,
+/// until two runs in a row are below the floor or a run exceeds the budget. A configuration the
+/// method refuses (ks on a body-point, logh with an attracting centre or a fictitious step too
+/// coarse for the encounter) is left out, with a note.
+void run_ladder(const NamedScene& ns, const MethodInfo& m, const State& ref, const Options& o, std::vector<Row>& rows) {
+  const Body& body = ns.scene.bodies.front();
+  auto try_measure = [&](double h, double tol, Row& row) {
+    try {
+      row = measure(ns, m, body, ref, h, tol, o);
+      return true;
+    } catch (const Error& e) {
+      std::cerr << "  " << ns.name << " " << m.name << (tol > 0 ? " tol=" : " h=") << fmt(tol > 0 ? tol : h)
+                << ": skipped (" << e.what() << ")\n";
+      return false;
+    }
+  };
+  int below = 0, failures = 0;
+  auto keep = [&](const Row& r) {  // true: the ladder goes on
+    rows.push_back(r);
+    below = r.err_rel < o.floor ? below + 1 : 0;
+    return below < 2 && static_cast<double>(r.force_evals) <= o.max_evals;
+  };
+  Row r;
+  if (is_time_transformed(m)) {
+    for (double ds = 0.2; ds >= 1e-5; ds /= 2) {
+      if (!try_measure(ds, 0, r)) {
+        if (++failures > 2 || m.name == "ks") break;  // refused outright, or too coarse twice more
+        continue;
+      }
+      if (!keep(r)) break;
+    }
+  } else if (is_adaptive(m)) {
+    for (double tol = 1e-3; tol >= 1e-14; tol /= 10)
+      if (!try_measure(0, tol, r) || !keep(r)) break;  // a tolerance the controller cannot meet
+  } else {
+    for (double h = 0.5; ns.t_end / h * std::max(1, m.evals_per_step) <= o.max_evals; h /= 2) {
+      rows.push_back(measure(ns, m, body, ref, h, 0, o));
+      below = rows.back().err_rel < o.floor ? below + 1 : 0;
+      if (below >= 2) break;
+    }
+  }
+}
+
+void write_rows(std::ostream& os, const std::vector<Row>& rows, const std::string& refs) {
+  os << "# bodypoint work-precision, revision " << git_revision() << "\n"
+     << "# err_R = |R(t_end) - R_ref| against odeint rkf78 in long double at tol 1e-18; err_rel = err_R/|R_ref|\n"
+     << "# wall_s = median over repeats of the step loop alone (no invariants, no output)\n";
+  std::istringstream ref_lines(refs);
+  for (std::string line; std::getline(ref_lines, line);) os << "# " << line << "\n";
+  os << "# h is the fictitious step ds for time-transformed methods (logh-*, ttl-*, ks)\n"
+     << "scene,method,h,tol,err_R,err_rel,max_rel_dE,force_evals,wall_s\n";
+  for (const Row& r : rows)
+    os << r.scene << ',' << r.method << ',' << (r.h > 0 ? fmt(r.h) : "") << ',' << (r.tol > 0 ? fmt(r.tol) : "")
+       << ',' << fmt(r.err_R) << ',' << fmt(r.err_rel) << ',' << fmt(r.max_rel_dE) << ',' << r.force_evals
+       << ',' << fmt(r.wall_s) << '\n';
+}
+
+std::string config_of(const Row& r) {
+  std::ostringstream c;
+  c << std::setprecision(3);
+  if (r.h > 0) c << (is_time_transformed(method_or_throw(r.method)) ? "ds=" : "h=") << r.h;
+  else c << "tol=" << r.tol;
+  return c.str();
+}
+
+/// The cheapest configuration of ours and of the peers reaching `target` on a scene, counting a row
+/// only when the next finer configuration (the next row of its ladder) reaches it too, so that a
+/// lucky cancellation at one step does not count.
+std::pair<const Row*, const Row*> best_at(const std::vector<Row>& rows, const std::string& scene, double target) {
+  const Row* ours = nullptr;
+  const Row* peer = nullptr;
+  for (std::size_t i = 0; i + 1 < rows.size(); ++i) {
+    const Row& r = rows[i];
+    const Row& next = rows[i + 1];
+    if (r.scene != scene || !(r.err_rel <= target)) continue;
+    if (next.scene != r.scene || next.method != r.method || !(next.err_rel <= target)) continue;
+    const Row*& slot = is_peer(method_or_throw(r.method)) ? peer : ours;
+    if (!slot || r.wall_s < slot->wall_s) slot = &r;
+  }
+  return {ours, peer};
+}
+
+std::string summary_table(const std::vector<NamedScene>& scenes, const std::vector<Row>& rows) {
+  std::ostringstream sum;
+  sum << "| scene | target err_rel | best bodypoint method | config | time [ms] | best peer (Boost.Odeint, GSL) | config | time [ms] | speed-up |\n"
+      << "|---|---|---|---|---|---|---|---|---|\n";
+  for (const NamedScene& ns : scenes)
+    for (double target : {1e-4, 1e-7, 1e-10, 1e-13}) {
+      const auto [ours, peer] = best_at(rows, ns.name, target);
+      sum << "| " << ns.name << " | " << std::setprecision(0) << std::scientific << target << std::defaultfloat
+          << std::setprecision(3) << " | ";
+      for (const Row* r : {ours, peer}) {
+        if (r) sum << r->method << " | " << config_of(*r) << " | " << r->wall_s * 1e3 << " | ";
+        else sum << "- | - | - | ";
+      }
+      if (ours && peer) sum << std::setprecision(3) << peer->wall_s / ours->wall_s << "x |\n";
+      else sum << "- |\n";
+    }
+  return sum.str();
+}
+
+/// Prints the summary and writes the files (each only now, so a failed run leaves none).
+void report(const std::string& sum, const std::string& tag, AtomicFile* csv, AtomicFile* md) {
+  std::cout << sum;
+  if (md) {
+    md->stream() << "<!-- bodypoint work-precision" << tag << ", revision " << git_revision() << " -->\n" << sum;
+    md->commit();
+  }
+  if (csv) csv->commit();
+}
+
 }  // namespace
 
 int cmd_work_precision(int argc, char** argv) {
-  std::string scenes_arg = "all", methods_arg = "all", out, summary;
-  Options o;
-  bool quick = false, by_tol = false;
-  std::string tols_arg = "1e-4,1e-5,1e-6,1e-7,1e-8,1e-9,1e-10,1e-11,1e-12";
+  WorkPrecisionArgs a;
   po::options_description desc("bodypoint work-precision");
-  desc.add_options()
-      ("scenes", po::value(&scenes_arg)->default_value(scenes_arg), "comma-separated: thesis,close,material,long,two-centres or all")
-      ("methods", po::value(&methods_arg)->default_value(methods_arg), "comma-separated method names or all")
-      ("repeats", po::value(&o.repeats)->default_value(o.repeats), "timed repeats per configuration (median reported)")
-      ("max-evals", po::value(&o.max_evals)->default_value(o.max_evals), "largest run of a ladder, in force evaluations")
-      ("by-tol", po::bool_switch(&by_tol), "second view: auto and every step-size-controlled peer with the same "
-       "requested tolerance; delivered error, whether it met TOL, and time")
-      ("tols", po::value(&tols_arg)->default_value(tols_arg), "with --by-tol: the tolerances")
-      ("quick", po::bool_switch(&quick), "coarse: scenes thesis and material, 1 repeat, runs up to 1e6 force evaluations")
-      ("out", po::value(&out), "CSV: scene, method, h, tol, err_R, err_rel, max_rel_dE, force_evals, wall_s")
-      ("summary", po::value(&summary), "also write the summary table (Markdown) to this file");
+  add_work_precision_options(desc, a);
   po::variables_map vm;
   if (!parse(argc, argv, desc, vm,
              "usage: bodypoint work-precision [options]\n"
              "Final-position error against run time for every method on named scenes."))
     return 0;
-  if (quick) {
-    if (vm["scenes"].defaulted()) scenes_arg = "thesis,material";
-    o.repeats = 1;
-    o.min_timed_s = 0.0;
-    if (vm["max-evals"].defaulted()) o.max_evals = 1e6;
-  }
-  if (o.repeats < 1) throw Error("--repeats must be >= 1");
-  if (!(o.max_evals >= 1)) throw Error("--max-evals must be >= 1");
-  const std::vector<std::string> scene_names = scenes_arg == "all" ? named_scene_names() : split_list(scenes_arg);
-  std::vector<const MethodInfo*> ms;
-  if (methods_arg == "all") {
-    for (const MethodInfo& m : methods()) ms.push_back(&m);
-  } else {
-    for (const std::string& n : split_list(methods_arg)) ms.push_back(&method_or_throw(n));
-  }
-  if (ms.empty()) throw Error("--methods is empty");
+  settle(vm, a);
+  const std::vector<std::string> scene_names = a.scenes == "all" ? named_scene_names() : split_list(a.scenes);
+  const std::vector<const MethodInfo*> ms = chosen_methods(a.methods);
   std::vector<NamedScene> scenes;
   for (const std::string& n : scene_names) scenes.push_back(named_scene(n));
-
   std::unique_ptr<AtomicFile> csv, md;
-  if (!out.empty()) csv = std::make_unique<AtomicFile>(out);
-  if (!summary.empty()) md = std::make_unique<AtomicFile>(summary);
-  if (by_tol) {
+  if (!a.out.empty()) csv = std::make_unique<AtomicFile>(a.out);
+  if (!a.summary.empty()) md = std::make_unique<AtomicFile>(a.summary);
+  if (a.by_tol) {
     std::ostringstream sum;
-    run_by_tolerance(scenes, parse_numbers(tols_arg, "--tols"), o.repeats, csv ? &csv->stream() : nullptr, sum);
-    std::cout << sum.str();
-    if (md) {
-      md->stream() << "<!-- bodypoint work-precision --by-tol, revision " << git_revision() << " -->\n" << sum.str();
-      md->commit();
-    }
-    if (csv) csv->commit();
+    run_by_tolerance(scenes, parse_numbers(a.tols, "--tols"), a.o.repeats, csv ? &csv->stream() : nullptr, sum);
+    report(sum.str(), " --by-tol", csv.get(), md.get());
     return 0;
   }
-
   std::vector<Row> rows;
   std::ostringstream refs;
   for (const NamedScene& ns : scenes) {
-    const Body& body = ns.scene.bodies.front();
-    const State ref = reference_state(body, ns.scene.centres, ns.t_end, 1e-18L);
-    const State loose = reference_state(body, ns.scene.centres, ns.t_end, 1e-15L);
-    RunSpec cs;
-    cs.steps = std::lround(ns.t_end / splitting_check_step(ns.name));
-    cs.h = ns.t_end / static_cast<double>(cs.steps);
-    const State split = run(method_or_throw("lp-ss10"), body, ns.scene.centres, cs).final;
-    const double ref_err = std::max((ref.R - loose.R).norm(), (ref.R - split.R).norm());
-    refs << "reference " << ns.name << ": odeint rkf78 long double tol 1e-18, t_end " << fmt(ns.t_end)
-         << ", |R_ref| = " << fmt(ref.R.norm()) << ", estimated error " << std::setprecision(2)
-         << std::scientific << ref_err << " (relative " << ref_err / ref.R.norm() << ")" << std::defaultfloat
-         << "\n";
-    std::cerr << refs.str().substr(refs.str().rfind("reference " + ns.name));
-    for (const MethodInfo* m : ms) {
-      // A configuration the method refuses (ks on a body-point, logh with an attracting centre or a
-      // fictitious step too coarse for the encounter) is left out of the table, with a note.
-      auto try_measure = [&](double h, double tol, Row& row) {
-        try {
-          row = measure(ns, *m, body, ref, h, tol, o);
-          return true;
-        } catch (const Error& e) {
-          std::cerr << "  " << ns.name << " " << m->name << (tol > 0 ? " tol=" : " h=") << fmt(tol > 0 ? tol : h)
-                    << ": skipped (" << e.what() << ")\n";
-          return false;
-        }
-      };
-      if (is_time_transformed(*m)) {
-        int failures = 0;
-        int below = 0;
-        for (double ds = 0.2; ds >= 1e-5; ds /= 2) {
-          Row r;
-          if (!try_measure(ds, 0, r)) {
-            if (++failures > 2 || m->name == "ks") break;  // refused outright, or too coarse twice more
-            continue;
-          }
-          rows.push_back(r);
-          below = r.err_rel < o.floor ? below + 1 : 0;
-          if (below >= 2 || static_cast<double>(r.force_evals) > o.max_evals) break;
-        }
-      } else if (is_adaptive(*m)) {
-        int below = 0;
-        for (double tol = 1e-3; tol >= 1e-14; tol /= 10) {
-          Row r;
-          if (!try_measure(0, tol, r)) break;  // a tolerance the controller cannot meet
-          rows.push_back(r);
-          below = r.err_rel < o.floor ? below + 1 : 0;
-          if (below >= 2 || static_cast<double>(r.force_evals) > o.max_evals) break;
-        }
-      } else {
-        int below = 0;
-        for (double h = 0.5;; h /= 2) {
-          const double evals = ns.t_end / h * std::max(1, m->evals_per_step);
-          if (evals > o.max_evals) break;
-          const Row r = measure(ns, *m, body, ref, h, 0, o);
-          rows.push_back(r);
-          below = r.err_rel < o.floor ? below + 1 : 0;
-          if (below >= 2) break;
-        }
-      }
-    }
+    const State ref = reference_of(ns, refs);
+    for (const MethodInfo* m : ms) run_ladder(ns, *m, ref, a.o, rows);
   }
-
-  if (csv) {
-    std::ostream& os = csv->stream();
-    os << "# bodypoint work-precision, revision " << git_revision() << "\n"
-       << "# err_R = |R(t_end) - R_ref| against odeint rkf78 in long double at tol 1e-18; err_rel = err_R/|R_ref|\n"
-       << "# wall_s = median over repeats of the step loop alone (no invariants, no output)\n";
-    std::istringstream ref_lines(refs.str());
-    for (std::string line; std::getline(ref_lines, line);) os << "# " << line << "\n";
-    os << "# h is the fictitious step ds for time-transformed methods (logh-*, ttl-*, ks)\n"
-       << "scene,method,h,tol,err_R,err_rel,max_rel_dE,force_evals,wall_s\n";
-    for (const Row& r : rows)
-      os << r.scene << ',' << r.method << ',' << (r.h > 0 ? fmt(r.h) : "") << ',' << (r.tol > 0 ? fmt(r.tol) : "")
-         << ',' << fmt(r.err_R) << ',' << fmt(r.err_rel) << ',' << fmt(r.max_rel_dE) << ',' << r.force_evals
-         << ',' << fmt(r.wall_s) << '\n';
-  }
-
-  // Summary: cheapest configuration reaching each target relative error whose next finer
-  // configuration (the next row of its ladder) reaches it too, so that a lucky cancellation at one
-  // step does not count.
-  std::ostringstream sum;
-  sum << "| scene | target err_rel | best bodypoint method | config | time [ms] | best peer (Boost.Odeint, GSL) | config | time [ms] | speed-up |\n"
-      << "|---|---|---|---|---|---|---|---|---|\n";
-  auto is_odeint = [](const std::string& name) { return is_peer(method_or_throw(name)); };
-  auto config = [](const Row& r) {
-    std::ostringstream c;
-    c << std::setprecision(3);
-    if (r.h > 0) c << (is_time_transformed(method_or_throw(r.method)) ? "ds=" : "h=") << r.h;
-    else c << "tol=" << r.tol;
-    return c.str();
-  };
-  for (const NamedScene& ns : scenes) {
-    for (double target : {1e-4, 1e-7, 1e-10, 1e-13}) {
-      const Row* best_bp = nullptr;
-      const Row* best_od = nullptr;
-      for (std::size_t i = 0; i + 1 < rows.size(); ++i) {
-        const Row& r = rows[i];
-        const Row& next = rows[i + 1];
-        if (r.scene != ns.name || !(r.err_rel <= target)) continue;
-        if (next.scene != r.scene || next.method != r.method || !(next.err_rel <= target)) continue;
-        const Row*& slot = is_odeint(r.method) ? best_od : best_bp;
-        if (!slot || r.wall_s < slot->wall_s) slot = &r;
-      }
-      sum << "| " << ns.name << " | " << std::setprecision(0) << std::scientific << target << std::defaultfloat
-          << std::setprecision(3) << " | ";
-      if (best_bp) sum << best_bp->method << " | " << config(*best_bp) << " | " << best_bp->wall_s * 1e3 << " | ";
-      else sum << "- | - | - | ";
-      if (best_od) sum << best_od->method << " | " << config(*best_od) << " | " << best_od->wall_s * 1e3 << " | ";
-      else sum << "- | - | - | ";
-      if (best_bp && best_od) sum << std::setprecision(3) << best_od->wall_s / best_bp->wall_s << "x |\n";
-      else sum << "- |\n";
-    }
-  }
-  std::cout << sum.str();
-  if (md) {
-    md->stream() << "<!-- bodypoint work-precision, revision " << git_revision() << " -->\n" << sum.str();
-    md->commit();
-  }
-  if (csv) csv->commit();
+  if (csv) write_rows(csv->stream(), rows, refs.str());
+  report(summary_table(scenes, rows), "", csv.get(), md.get());
   return 0;
 }
 

@@ -225,5 +225,43 @@ TEST(Cli, ReadmeMethodTableIsGenerated) {
       << "README's method table is stale: paste `bodypoint methods --markdown` between its markers";
 }
 
+// The spin angle observable (observables.cpp), asked for with --observe: its column equals the angle
+// between w and K1 = m v + B w recomputed from the same row's w and v (the file's numbers read back
+// to the same doubles, so only the recomputation's rounding separates them).
+constexpr double kRecomputedAngleTol = 1e-13;
+
+TEST(Cli, ObserveAddsTheSpinAngleColumn) {
+  const fs::path out = fs::temp_directory_path() / ("bp_spin_angle_" + std::to_string(::getpid()) + ".csv");
+  const Result r = run_cli("simulate --method lp-y4 --h 0.01 --steps 2000 --every 100 --out " + out.string() +
+                           " --observe spin_angle");
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(out);
+  std::string line, header;
+  while (std::getline(in, line) && line.rfind("#", 0) == 0) {
+  }
+  header = line;
+  ASSERT_EQ(header, "body,t,Rx,Ry,Rz,vx,vy,vz,wx,wy,wz,rel_dE,rel_dK2sq,abs_dK2Q,spin_angle");
+  const double m = 1.0, B = 0.7;  // the default scene (thesis table 3.1)
+  int rows = 0;
+  double lo = 4.0, hi = -1.0;
+  while (std::getline(in, line)) {
+    std::vector<double> x;
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) x.push_back(std::stod(cell));
+    ASSERT_EQ(x.size(), 15u) << line;
+    const Vec3 v(x[5], x[6], x[7]), w(x[8], x[9], x[10]);
+    const Vec3 K1 = m * v + B * w;
+    EXPECT_NEAR(x[14], std::atan2(w.cross(K1).norm(), w.dot(K1)), kRecomputedAngleTol) << line;
+    lo = std::min(lo, x[14]);
+    hi = std::max(hi, x[14]);
+    ++rows;
+  }
+  EXPECT_EQ(rows, 21);
+  EXPECT_GT(hi, lo) << "the spin-orbit coupling turns w against K1";
+  fs::remove(out);
+  test::expect_refused("simulate --method lp-y4 --steps 10 ", {{"--out x.csv --observe nonsense", "unknown observable 'nonsense'"},
+                                                         {"--observe spin_angle", "--observe needs --out"}});
+}
+
 }  // namespace
 }  // namespace bodypoint

@@ -94,4 +94,25 @@ Scene thesis_scene(const SceneParams& sp) {
   return s;
 }
 
+const std::vector<SceneParameter>& scene_parameters() {
+  static const std::vector<SceneParameter> list = {
+      {"A", "Coulomb constant of the centre at the origin (A < 0 repels)", [](SceneParams& p) -> double& { return p.A; }},
+      {"m", "mass", [](SceneParams& p) -> double& { return p.m; }},
+      {"B", "coupling inertia (B = 0: material point)", [](SceneParams& p) -> double& { return p.B; }},
+      {"J", "rotational inertia", [](SceneParams& p) -> double& { return p.J; }},
+      {"K1", "initial linear momentum K1(0) = K1 i", [](SceneParams& p) -> double& { return p.start.K1; }},
+      {"Kx", "K2(0) = Kx i - Kz k", [](SceneParams& p) -> double& { return p.start.Kx; }},
+      {"Kz", "K2(0) = Kx i - Kz k", [](SceneParams& p) -> double& { return p.start.Kz; }},
+      {"d", "impact parameter", [](SceneParams& p) -> double& { return p.start.d; }},
+      {"L", "initial distance along -x", [](SceneParams& p) -> double& { return p.start.L; }},
+  };
+  return list;
+}
+
+double& scene_field(SceneParams& p, std::string_view name) {
+  for (const SceneParameter& q : scene_parameters())
+    if (q.name == name) return q.field(p);
+  throw Error("unknown scene parameter '" + std::string(name) + "'");
+}
+
 }  // namespace bodypoint

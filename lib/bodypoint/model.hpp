@@ -14,6 +14,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace bodypoint {
@@ -125,6 +126,18 @@ struct SceneParams {
   ThesisStart start;
   ForceLaw law = ForceLaw::coulomb;
 };
+
+/// One number of SceneParams, by name: the CLI option, the sweep axis, the appendix recipes' key and
+/// the scene line of every output header read this list (one place for the names and the fields).
+struct SceneParameter {
+  std::string_view name;
+  std::string_view help;
+  double& (*field)(SceneParams& p);
+};
+/// Every scene parameter, in the order options and headers list them.
+const std::vector<SceneParameter>& scene_parameters();
+/// The field of p named `name`; Error for an unknown name.
+double& scene_field(SceneParams& p, std::string_view name);
 
 /// Scene of one body and one centre at the origin from the thesis's parameters.
 Scene thesis_scene(const SceneParams& sp);

@@ -57,6 +57,50 @@ const toml::array* array_of_tables(const toml::table& root, std::string_view key
 /// Largest scene file read (a scene of 10^5 bodies is about 10 MB).
 constexpr std::uintmax_t kMaxSceneFileBytes = 16u << 20;
 
+namespace {
+
+Centre parse_centre(const toml::table& t, const std::string& where, const std::string& origin) {
+  only_keys(t, {"position", "A"}, where, origin);
+  Centre c;
+  c.A = number(t, "A", where, origin);
+  if (t.contains("position")) c.c = vector3(t, "position", where, origin);
+  return c;
+}
+
+/// A body in either form: R, v, w, or the thesis's d, L, K1, Kx, Kz (eq. 1.11-1.13).
+Body parse_body(const toml::table& t, std::size_t i, const std::string& origin) {
+  const std::string where = "body " + std::to_string(i + 1);
+  only_keys(t, {"name", "m", "B", "J", "R", "v", "w", "d", "L", "K1", "Kx", "Kz"}, where, origin);
+  Body b;
+  if (const toml::node* n = t.get("name")) {
+    auto s = n->value<std::string>();
+    if (!s) fail(origin, where + ": 'name' must be a string");
+    b.name = *s;
+  }
+  b.p = BodyPoint{number(t, "m", where, origin), number(t, "B", where, origin), number(t, "J", where, origin)};
+  const bool physical = t.contains("R") || t.contains("v") || t.contains("w");
+  const bool thesis = t.contains("d") || t.contains("L") || t.contains("K1") || t.contains("Kx") || t.contains("Kz");
+  if (physical == thesis)
+    fail(origin, where + ": give either R, v, w or the thesis's d, L, K1, Kx, Kz (exactly one form)");
+  try {
+    validate(b.p, where);
+  } catch (const Error& e) {
+    fail(origin, e.what());
+  }
+  if (physical) {
+    b.s0 = State{vector3(t, "R", where, origin), vector3(t, "v", where, origin), vector3(t, "w", where, origin)};
+  } else {
+    ThesisStart ts{number(t, "d", where, origin), number(t, "L", where, origin), number(t, "K1", where, origin),
+                   number(t, "Kx", where, origin), number(t, "Kz", where, origin)};
+    if (ts.K1 == 0.0) fail(origin, where + ": K1 must be non-zero");
+    b.s0 = to_state(b.p, thesis_momenta(ts));
+  }
+  if (b.name.empty()) b.name = "body" + std::to_string(i + 1);
+  return b;
+}
+
+}  // namespace
+
 Scene parse_scene(const std::string& text, const std::string& origin) {
   toml::table root;
   try {
@@ -66,52 +110,12 @@ Scene parse_scene(const std::string& text, const std::string& origin) {
     fail(origin, "line " + std::to_string(src.begin.line) + ": " + std::string(e.description()));
   }
   only_keys(root, {"centre", "body"}, "top level", origin);
-
   Scene scene;
-  if (const toml::array* cs = array_of_tables(root, "centre", origin)) {
-    for (std::size_t k = 0; k < cs->size(); ++k) {
-      const toml::table& t = *(*cs)[k].as_table();
-      const std::string where = "centre " + std::to_string(k + 1);
-      only_keys(t, {"position", "A"}, where, origin);
-      Centre c;
-      c.A = number(t, "A", where, origin);
-      if (t.contains("position")) c.c = vector3(t, "position", where, origin);
-      scene.centres.push_back(c);
-    }
-  }
-  if (const toml::array* bs = array_of_tables(root, "body", origin)) {
-    for (std::size_t i = 0; i < bs->size(); ++i) {
-      const toml::table& t = *(*bs)[i].as_table();
-      std::string where = "body " + std::to_string(i + 1);
-      only_keys(t, {"name", "m", "B", "J", "R", "v", "w", "d", "L", "K1", "Kx", "Kz"}, where, origin);
-      Body b;
-      if (const toml::node* n = t.get("name")) {
-        auto s = n->value<std::string>();
-        if (!s) fail(origin, where + ": 'name' must be a string");
-        b.name = *s;
-      }
-      b.p = BodyPoint{number(t, "m", where, origin), number(t, "B", where, origin), number(t, "J", where, origin)};
-      const bool physical = t.contains("R") || t.contains("v") || t.contains("w");
-      const bool thesis = t.contains("d") || t.contains("L") || t.contains("K1") || t.contains("Kx") || t.contains("Kz");
-      if (physical == thesis)
-        fail(origin, where + ": give either R, v, w or the thesis's d, L, K1, Kx, Kz (exactly one form)");
-      try {
-        validate(b.p, where);
-      } catch (const Error& e) {
-        fail(origin, e.what());
-      }
-      if (physical) {
-        b.s0 = State{vector3(t, "R", where, origin), vector3(t, "v", where, origin), vector3(t, "w", where, origin)};
-      } else {
-        ThesisStart ts{number(t, "d", where, origin), number(t, "L", where, origin), number(t, "K1", where, origin),
-                       number(t, "Kx", where, origin), number(t, "Kz", where, origin)};
-        if (ts.K1 == 0.0) fail(origin, where + ": K1 must be non-zero");
-        b.s0 = to_state(b.p, thesis_momenta(ts));
-      }
-      if (b.name.empty()) b.name = "body" + std::to_string(i + 1);
-      scene.bodies.push_back(b);
-    }
-  }
+  if (const toml::array* cs = array_of_tables(root, "centre", origin))
+    for (std::size_t k = 0; k < cs->size(); ++k)
+      scene.centres.push_back(parse_centre(*(*cs)[k].as_table(), "centre " + std::to_string(k + 1), origin));
+  if (const toml::array* bs = array_of_tables(root, "body", origin))
+    for (std::size_t i = 0; i < bs->size(); ++i) scene.bodies.push_back(parse_body(*(*bs)[i].as_table(), i, origin));
   try {
     validate(scene);
   } catch (const Error& e) {
