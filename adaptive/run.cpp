@@ -305,26 +305,41 @@ RunResult run_time_transformed(const Body& body, const std::vector<Centre>& cent
   });
 }
 
-RunResult run_logh_checked(RunResult (*f)(const Body&, const std::vector<Centre>&, const RunSpec&, const SampleSink*),
-                           const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
-                           const SampleSink* sink) {
-  if (!all_repulsive(centres))
-    throw Error("logh-* needs every centre repulsive (A < 0) so that Pi > 0; use ttl-* (any sign of A) "
-                "or ks (material point, one centre)");
-  return f(body, centres, spec, sink);
-}
-
 template <const auto& Seq>
 RunResult run_logh(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec, const SampleSink* sink) {
-  return run_logh_checked(&run_time_transformed<LogHKernel, Seq>, body, centres, spec, sink);
+  return run_time_transformed<LogHKernel, Seq>(body, centres, spec, sink);
 }
 
 template <const auto& Seq>
 RunResult run_ttl(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec, const SampleSink* sink) {
+  return run_time_transformed<TtlKernel, Seq>(body, centres, spec, sink);
+}
+
+// What each time-transformed family assumes of a scene (MethodInfo::check).
+std::string coulomb_only(const MethodInfo& m, const std::vector<Centre>& centres) {
+  if (!non_coulomb(centres)) return "";
+  return m.name + " assumes Coulomb's law (its time transformation is built on -A/|R|); the thesis "
+         "code's force law runs with the fixed-step, Runge-Kutta and step-size-controlled methods";
+}
+std::string logh_check(const MethodInfo& m, const Body& /*body*/, const std::vector<Centre>& centres) {
+  if (std::string why = coulomb_only(m, centres); !why.empty()) return why;
+  if (!all_repulsive(centres))
+    return "logh-* needs every centre repulsive (A < 0) so that Pi > 0; use ttl-* (any sign of A) or ks (material "
+           "point, one centre)";
+  return "";
+}
+std::string ttl_check(const MethodInfo& m, const Body& /*body*/, const std::vector<Centre>& centres) {
+  if (std::string why = coulomb_only(m, centres); !why.empty()) return why;
   double total = 0.0;
   for (const Centre& c : centres) total += std::abs(c.A);
-  if (!(total > 0.0)) throw Error("ttl-* needs a centre with A != 0 (its time step function is sum |A|/r)");
-  return run_time_transformed<TtlKernel, Seq>(body, centres, spec, sink);
+  if (!(total > 0.0)) return "ttl-* needs a centre with A != 0 (its time step function is sum |A|/r)";
+  return "";
+}
+std::string ks_check(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres) {
+  if (std::string why = coulomb_only(m, centres); !why.empty()) return why;
+  if (body.p.B != 0.0) return "ks regularises a material point: it needs B = 0 (use logh-* or ttl-*)";
+  if (centres.size() != 1) return "ks needs exactly one centre (use logh-* or ttl-*)";
+  return "";
 }
 
 /// The Kustaanheimo-Stiefel motion as a Stepper: exact in fictitious time, so the last step and the
@@ -350,8 +365,6 @@ struct KsStepper {
 };
 
 RunResult run_ks(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec, const SampleSink* sink) {
-  if (body.p.B != 0.0) throw Error("ks regularises a material point: it needs B = 0 (use logh-* or ttl-*)");
-  if (centres.size() != 1) throw Error("ks needs exactly one centre (use logh-* or ttl-*)");
   require_time_target(spec);
   CentreList field{centres};  // for the invariants (K2Q about c)
   KsStepper stepper;
@@ -375,7 +388,7 @@ MethodInfo logh_row() {
   const int s = static_cast<int>(sp::ops_of<T>.kicks());
   return {"logh-" + std::string(E::tag), Family::TimeTransformed, T::order, s, s,
           sp::describe<T>("logH (repulsive scenes), ds = --h"),
-          &run_logh<sp::ops_of<T>>};
+          &run_logh<sp::ops_of<T>>, &logh_check};
 }
 template <class E>
 MethodInfo ttl_row() {
@@ -383,7 +396,7 @@ MethodInfo ttl_row() {
   const int s = static_cast<int>(sp::ops_of<T>.kicks());
   return {"ttl-" + std::string(E::tag), Family::TimeTransformed, T::order, s, s,
           sp::describe<T>("TTL (any sign of A), ds = --h"),
-          &run_ttl<sp::ops_of<T>>};
+          &run_ttl<sp::ops_of<T>>, &ttl_check};
 }
 
 }  // namespace
@@ -394,7 +407,7 @@ std::vector<MethodInfo> methods() {
   sp::for_each(TtlTables{}, [&all]<class E>() { all.push_back(ttl_row<E>()); });
   all.push_back({"ks", Family::TimeTransformed, 0, 0, 0,
                  "Kustaanheimo-Stiefel regularisation, exact in fictitious time (B = 0, one centre), ds = --h",
-                 &run_ks});
+                 &run_ks, &ks_check});
   return all;
 }
 

@@ -92,7 +92,8 @@ void write_orders(std::ostream& csv) {
   auto cell = [](double x) { return std::isfinite(x) ? fmt(x) : std::string(); };
   for (const MethodInfo& m : methods()) {
     if (is_adaptive(m)) continue;  // no step to refine: a tolerance
-    const bool ks = m.name == "ks";
+    // A method that refuses the spinning body (ks) is measured on the material point.
+    const bool ks = !refusal(m, enc_spin.scene.bodies.front(), enc_spin.scene.centres).empty();
     std::size_t ue = 0, uo = 0;
     const double enc = measured_order(m, ks ? enc_material : enc_spin, &ue);
     const double orb = m.family == Family::Thesis ? std::numeric_limits<double>::quiet_NaN()

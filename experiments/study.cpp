@@ -148,7 +148,7 @@ void study_evals(const StudyContext& c) {
     rs.h = 1e-3;
     rs.steps = 1000;
     rs.t_end = is_adaptive(m) ? 1.0 : 0.0;
-    const Scene& sc = m.name == "ks" ? material_scene : scene;
+    const Scene& sc = refusal(m, scene.bodies.front(), scene.centres).empty() ? scene : material_scene;
     const RunResult r = run(m, sc.bodies.front(), sc.centres, rs);
     os << m.name << ',' << m.order << ',' << m.stages << ',' << m.evals_per_step << ','
        << fmt(static_cast<double>(r.force_evals) / static_cast<double>(r.steps)) << '\n';

@@ -153,11 +153,15 @@ State reference_of(const NamedScene& ns, std::ostringstream& refs) {
 }
 
 /// One method's ladder on one scene: halving ds (time-transformed) or h, or tolerances divided by 10,
-/// until two runs in a row are below the floor or a run exceeds the budget. A configuration the
-/// method refuses (ks on a body-point, logh with an attracting centre or a fictitious step too
-/// coarse for the encounter) is left out, with a note.
+/// until two runs in a row are below the floor or a run exceeds the budget. A method that refuses the
+/// scene (MethodInfo::check: ks on a body-point, logh with an attracting centre) and a configuration
+/// that fails (a fictitious step too coarse for the encounter) are left out, with a note.
 void run_ladder(const NamedScene& ns, const MethodInfo& m, const State& ref, const Options& o, std::vector<Row>& rows) {
   const Body& body = ns.scene.bodies.front();
+  if (const std::string why = refusal(m, body, ns.scene.centres); !why.empty()) {
+    std::cerr << "  " << ns.name << " " << m.name << ": refused (" << why << ")\n";
+    return;
+  }
   auto try_measure = [&](double h, double tol, Row& row) {
     try {
       row = measure(ns, m, body, ref, h, tol, o);
@@ -178,7 +182,7 @@ void run_ladder(const NamedScene& ns, const MethodInfo& m, const State& ref, con
   if (is_time_transformed(m)) {
     for (double ds = 0.2; ds >= 1e-5; ds /= 2) {
       if (!try_measure(ds, 0, r)) {
-        if (++failures > 2 || m.name == "ks") break;  // refused outright, or too coarse twice more
+        if (++failures > 2) break;  // too coarse for the encounter three times
         continue;
       }
       if (!keep(r)) break;

@@ -501,5 +501,40 @@ TEST(Peers, GslRk8pdAgreesWithTheReference) {
 }
 #endif
 
+// Each method says which scenes it refuses (MethodInfo::check), and run() refuses exactly those, with
+// that reason, before any step: the callers that ask (sweeps, work-precision, benchmarks, tests) and
+// run() cannot disagree.
+TEST(Methods, RefusalIsExactlyWhatRunRefuses) {
+  SceneParams attracting, material, code;
+  attracting.A = 2.0;
+  material.B = 0.0;
+  code.law = ForceLaw::thesis_code;
+  const std::vector<Scene> scenes = {thesis_scene(SceneParams{}), thesis_scene(attracting), thesis_scene(material),
+                                     thesis_scene(code), named_scene("two-centres").scene};
+  RunSpec spec;
+  spec.h = 1e-3;
+  spec.steps = 10;
+  int refused = 0, accepted = 0;
+  for (const MethodInfo& m : methods())
+    for (const Scene& s : scenes) {
+      const Body& b = s.bodies.front();
+      const std::string why = refusal(m, b, s.centres);
+      if (why.empty()) {
+        EXPECT_NO_THROW(run(m, b, s.centres, spec)) << m.name;
+        ++accepted;
+        continue;
+      }
+      ++refused;
+      try {
+        run(m, b, s.centres, spec);
+        ADD_FAILURE() << m.name << " ran a scene it refuses: " << why;
+      } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()), why) << m.name;
+      }
+    }
+  EXPECT_GT(refused, 0);  // ks on a spinning body, logh-* with an attracting centre, ... refuse
+  EXPECT_GT(accepted, refused);
+}
+
 }  // namespace
 }  // namespace bodypoint

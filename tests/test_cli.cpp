@@ -2,6 +2,7 @@
 // line plus a non-zero exit (and no output file) for every kind of bad input.
 #include "bodypoint/methods.hpp"
 #include "bodypoint/reference.hpp"
+#include "bodypoint/scenes.hpp"
 #include "cli_helpers.hpp"
 #include "common.hpp"
 
@@ -62,7 +63,8 @@ TEST(Cli, EveryMethodRunsAndReportsItsInvariants) {
     // ks regularises a material point: it runs with B = 0. The thesis's schemes turn the spin-orbit
     // rotation into an explicit Euler step that grows like (1 + (w h)^2)^(n/2), w = B|K1|/D = 6.9:
     // at h = 0.01 that is e^12 by t = 50, so they get the thesis's own step.
-    const std::string extra = m.name == "ks" ? " --B 0" : "";
+    const Scene thesis = thesis_scene(SceneParams{});
+    const std::string extra = refusal(m, thesis.bodies.front(), thesis.centres).empty() ? "" : " --B 0";
     const std::string step = m.family == Family::Thesis ? "1e-4" : "0.01";
     const Result r = run_cli("simulate --json --h " + step + " --t-end 50 --method " + std::string(m.name) + extra);
     ASSERT_EQ(r.code, 0) << m.name << ": " << r.err;
@@ -188,10 +190,11 @@ TEST(Cli, WorkPrecisionQuickWritesRowsForEveryMethodAndASummary) {
   EXPECT_EQ(header, "scene,method,h,tol,err_R,err_rel,max_rel_dE,force_evals,wall_s");
   for (const char* scene : {"thesis", "material"})
     for (const MethodInfo& m : methods()) {
-      if (m.name == "ks" && std::string(scene) == "thesis") continue;  // ks needs B = 0: refused, noted
+      const NamedScene ns = named_scene(scene);
+      if (!refusal(m, ns.scene.bodies.front(), ns.scene.centres).empty()) continue;  // refused, noted
       EXPECT_GT(rows[std::string(scene) + "," + std::string(m.name)], 0) << scene << " " << m.name;
     }
-  EXPECT_NE(r.err.find("thesis ks h=0.2: skipped (ks regularises a material point"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("thesis ks: refused (ks regularises a material point"), std::string::npos) << r.err;
   for (const char* target : {"| thesis | 1e-04 |", "| thesis | 1e-07 |", "| material | 1e-10 |"})
     EXPECT_NE(r.out.find(target), std::string::npos) << r.out;
   EXPECT_NE(r.err.find("reference thesis: odeint rkf78 long double"), std::string::npos) << r.err;

@@ -144,15 +144,17 @@ Health assess(const RunResult& r) {
   return {"diverged", why};
 }
 
+std::string refusal(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres) {
+  return m.check ? m.check(m, body, centres) : std::string();
+}
+
 RunResult run(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
               const RunSpec& spec, const SampleSink* sink) {
   validate(Scene{centres, {body}});
   if (!std::isfinite(spec.h) || spec.h <= 0.0)
     throw Error("step size h must be a finite number > 0, got " + std::to_string(spec.h));
   if (spec.every < 1) throw Error("--every must be >= 1");
-  if (is_time_transformed(method) && non_coulomb(centres))
-    throw Error(std::string(method.name) + " assumes Coulomb's law (its time transformation is built on -A/|R|); the "
-                "thesis code's force law runs with the fixed-step, Runge-Kutta and step-size-controlled methods");
+  if (const std::string why = refusal(method, body, centres); !why.empty()) throw Error(why);
   // Time-transformed methods run to t_end when it is given, otherwise for spec.steps fictitious steps.
   if (is_time_transformed(method)) return method.run(body, centres, spec, sink);
   if (spec.steps < 1) throw Error("number of steps must be >= 1");

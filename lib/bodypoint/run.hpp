@@ -20,6 +20,8 @@
 
 namespace bodypoint {
 
+/// What a run is asked to do; its defaults are the defaults of every command (the thesis's h = 1e-4,
+/// n = 500000 of table 3.1, tol 1e-10).
 struct RunSpec {
   double h = 1e-4;       ///< fixed step; for adaptive methods the first trial step
   long steps = 500000;   ///< fixed-step methods: number of steps (t_end = steps h)
@@ -71,6 +73,11 @@ constexpr std::string_view family_name(Family f) {
   return "?";
 }
 
+/// Why a method cannot run a (valid) scene, in one line; empty when it can. A family's assumptions:
+/// Coulomb's law and the sign of A for the time transformations, B = 0 and one centre for ks.
+struct MethodInfo;
+using SceneCheck = std::string (*)(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres);
+
 struct MethodInfo {
   std::string name;
   Family family;
@@ -79,7 +86,12 @@ struct MethodInfo {
   int evals_per_step;   ///< force evaluations per step in a long run without per-step output
   std::string description;
   RunResult (*run)(const Body&, const std::vector<Centre>&, const RunSpec&, const SampleSink*);
+  SceneCheck check = nullptr;  ///< nullptr: runs every valid scene
 };
+
+/// Why `m` refuses the scene (empty: it accepts it). `run` throws this reason; sweeps, studies,
+/// benchmarks and tests ask it instead of knowing which family assumes what.
+std::string refusal(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres);
 
 /// The methods of the core layer, in listing order: Runge-Kutta and Adams-Bashforth (Odeint), the
 /// step-size-controlled peers (Odeint, GSL), the thesis's schemes and the exact Lie-Poisson splittings.
