@@ -112,6 +112,35 @@ struct StepStats {
   }
 };
 
+/// The one driver of step-size-controlled runs (Boost.Odeint's controlled steppers, GSL's evolve):
+/// from t = 0 with first trial step h0 to exactly t_end. `try_step(x, t, dt)` attempts one step from
+/// t and says whether it was accepted, leaving t and dt as its controller does (it lands on t_end
+/// itself). The driver refuses accepted steps that do not move t (they would repeat forever), caps
+/// the accepted steps and their rate (check_adaptive_rate), stops after 1000 rejections in a row, and
+/// hands every accepted step to the observer. `Says` words the three failures for its stepper
+/// (stalled(t, taken), too_many(t, t_end), collapsed(t)).
+template <class Says, class X, class TryStep, class Observer>
+X controlled_loop(X x, double h0, double t_end, StepStats& st, Observer& obs, TryStep&& try_step) {
+  double t = 0.0, dt = std::min(h0, t_end);
+  long rejected_in_a_row = 0;
+  while (t < t_end) {
+    const double t_before = t;
+    if (!try_step(x, t, dt)) {
+      if (++rejected_in_a_row > 1000 || !(dt > 0.0)) throw Error(Says::collapsed(t));
+      continue;
+    }
+    const double taken = t - t_before;
+    if (!time_advances(t_before, t)) throw Error(Says::stalled(t, taken));
+    if (st.steps >= kMaxAdaptiveSteps) throw Error(Says::too_many(t, t_end));
+    st.add(taken);
+    rejected_in_a_row = 0;
+    check_adaptive_rate(st.steps, t, t_end);
+    if constexpr (Observer::active) obs.observe(st.steps, t, x, t >= t_end);
+    if (!std::isfinite(x[0])) break;
+  }
+  return x;
+}
+
 /// Runs `loop(observer)` with a null observer or a monitor, timing the loop only.
 template <class Field, class ToPhysical, class Loop>
 RunResult observe(const BodyPoint& p, const Field& field, const State& s0, const RunSpec& spec,

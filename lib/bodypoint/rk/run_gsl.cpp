@@ -42,6 +42,15 @@ struct GslDeleter {
   void operator()(gsl_odeiv2_evolve* e) const { gsl_odeiv2_evolve_free(e); }
 };
 
+/// How the controlled-step driver words GSL's failures.
+struct GslSays {
+  static std::string stalled(double t, double /*taken*/) {
+    return "gsl: the step size collapsed at t = " + std::to_string(t) + " (tolerance too tight?)";
+  }
+  static std::string too_many(double /*t*/, double /*t_end*/) { return "gsl: more than 2e8 steps before t_end"; }
+  static std::string collapsed(double t) { return stalled(t, 0.0); }
+};
+
 RunResult run_gsl(const gsl_odeiv2_step_type* type, const Body& body, const std::vector<Centre>& centres,
                   const RunSpec& spec, const SampleSink* sink) {
   gsl_set_error_handler_off();
@@ -59,24 +68,14 @@ RunResult run_gsl(const gsl_odeiv2_step_type* type, const Body& body, const std:
     detail::StepStats st;
     auto to_physical = [](const OdeState<double>& x) { return from_ode(x); };
     RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
-      OdeState<double> x = to_ode(body.s0);
-      double t = 0.0, dt = std::min(spec.h, t_end);
-      while (t < t_end) {
-        const double t_before = t;
+      auto try_step = [&](OdeState<double>& x, double& t, double& dt) {  // evolve retries and lands on t_end
         const int status =
             gsl_odeiv2_evolve_apply(evolve.get(), control.get(), step.get(), &gsys, &t, t_end, &dt, x.data());
         if (status != GSL_SUCCESS)
           throw Error("gsl: step failed at t = " + std::to_string(t) + " (" + gsl_strerror(status) + ")");
-        const double taken = t - t_before;
-        if (!detail::time_advances(t_before, t))
-          throw Error("gsl: the step size collapsed at t = " + std::to_string(t) + " (tolerance too tight?)");
-        if (st.steps >= detail::kMaxAdaptiveSteps) throw Error("gsl: more than 2e8 steps before t_end");
-        st.add(taken);
-        detail::check_adaptive_rate(st.steps, t, t_end);
-        if constexpr (std::decay_t<decltype(obs)>::active) obs.observe(st.steps, t, x, t >= t_end);
-        if (!std::isfinite(x[0])) break;
-      }
-      return from_ode(x);
+        return true;
+      };
+      return from_ode(detail::controlled_loop<GslSays>(to_ode(body.s0), spec.h, t_end, st, obs, try_step));
     });
     r.force_evals = evals;
     st.record(r, t_end);

@@ -62,6 +62,22 @@ RunResult run_odeint(const Body& body, const std::vector<Centre>& centres, const
   });
 }
 
+/// How the controlled-step driver words an odeint stepper's failures.
+struct OdeintSays {
+  static std::string stalled(double t, double taken) {
+    return "the step stopped advancing time at t = " + detail::short_number(t) + " (accepted step " +
+           detail::short_number(taken) + "): the tolerance is below what double precision resolves, "
+           "or the body fell onto a centre";
+  }
+  static std::string too_many(double t, double t_end) {
+    return "more than 2e8 accepted steps before t_end = " + detail::short_number(t_end) + " (reached t = " +
+           detail::short_number(t) + "); loosen --tol or shorten --t-end";
+  }
+  static std::string collapsed(double t) {
+    return "adaptive step size collapsed at t = " + std::to_string(t) + " (tolerance too tight?)";
+  }
+};
+
 /// Step-size-controlled odeint stepper from t = 0 to spec.t_end, hitting t_end exactly (the last
 /// trial step is cut to the remaining time). The observer sees every accepted step.
 template <class Controlled>
@@ -75,35 +91,15 @@ RunResult run_odeint_adaptive(const Body& body, const std::vector<Centre>& centr
     const double t_end = spec.t_end;
     detail::StepStats st;
     RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
-      OdeState<double> x = to_ode(body.s0);
       Controlled stepper = rk::make_controlled<Controlled>(spec.tol);
-      double t = 0.0, dt = std::min(spec.h, t_end);
-      long rejected_in_a_row = 0;
-      while (t < t_end) {
+      auto try_step = [&](OdeState<double>& x, double& t, double& dt) {
         const bool final_step = t + dt >= t_end;
         if (final_step) dt = t_end - t;
-        const double t_before = t;
-        if (stepper.try_step(std::ref(sys), x, t, dt) == boost::numeric::odeint::success) {
-          if (final_step) t = t_end;  // exact end time, not t_before + dt rounded
-          const double taken = t - t_before;
-          // An accepted step that does not move t (dt below the resolution of t) would repeat forever.
-          if (!detail::time_advances(t_before, t))
-            throw Error("the step stopped advancing time at t = " + detail::short_number(t) + " (accepted step " +
-                        detail::short_number(taken) + "): the tolerance is below what double precision resolves, "
-                        "or the body fell onto a centre");
-          if (st.steps >= detail::kMaxAdaptiveSteps)
-            throw Error("more than 2e8 accepted steps before t_end = " + detail::short_number(t_end) +
-                        " (reached t = " + detail::short_number(t) + "); loosen --tol or shorten --t-end");
-          st.add(taken);
-          rejected_in_a_row = 0;
-          detail::check_adaptive_rate(st.steps, t, t_end);
-          if constexpr (std::decay_t<decltype(obs)>::active) obs.observe(st.steps, t, x, t >= t_end);
-          if (!std::isfinite(x[0])) break;
-        } else if (++rejected_in_a_row > 1000 || !(dt > 0.0)) {
-          throw Error("adaptive step size collapsed at t = " + std::to_string(t) + " (tolerance too tight?)");
-        }
-      }
-      return from_ode(x);
+        if (stepper.try_step(std::ref(sys), x, t, dt) != boost::numeric::odeint::success) return false;
+        if (final_step) t = t_end;  // exact end time, not t_before + dt rounded
+        return true;
+      };
+      return from_ode(detail::controlled_loop<OdeintSays>(to_ode(body.s0), spec.h, t_end, st, obs, try_step));
     });
     r.force_evals = evals;
     st.record(r, t_end);
