@@ -29,8 +29,8 @@ Scene make_scene(const po::variables_map& vm, const SceneOptions& o);
 
 /// Step options: --h and --steps or --t-end.
 struct StepOptions {
-  double h = 1e-4;
-  long steps = 500000;
+  double h = RunSpec{}.h;  // the defaults of every run are RunSpec's (run.hpp)
+  long steps = RunSpec{}.steps;
   double t_end = 0.0;
 };
 void add_step_options(po::options_description& desc, StepOptions& o);

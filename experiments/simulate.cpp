@@ -141,7 +141,7 @@ struct SimulateOptions {
   std::string method_name = "lp-y4";
   std::string out;
   long every = 1;
-  double tol = 1e-10, dt_out = 0.0, omega_c = -1.0;
+  double tol = RunSpec{}.tol, dt_out = 0.0, omega_c = RunSpec{}.omega_c;
   bool json = false, no_invariants = false, with_reference = false, dry_run = false, quiet = false;
   double max_seconds = 3600.0, max_rows = 1e7;
   std::vector<std::string> observe;

@@ -463,7 +463,7 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
       ("grid", po::value(&grid)->composing(), "instead of --param: one varied parameter of a grid, NAME=FROM:TO:STEP, "
        "NAME=log:FROM:TO:POINTS or NAME=a,b,c; repeat for each (every combination is run)")
       ("methods", po::value(&methods_arg)->default_value(methods_arg), "comma-separated names, 'fixed' (every fixed-step method) or 'all'")
-      ("tol", po::value(&job.spec.tol)->default_value(1e-10), "adaptive methods: error tolerance")
+      ("tol", po::value(&job.spec.tol)->default_value(job.spec.tol), "adaptive methods: error tolerance")
       ("threads", po::value(&job.threads)->default_value(0), "worker threads (0: all cores)")
       ("out", po::value(&job.out), "CSV file (default: standard output); with --shard, this shard's rows file")
       ("resume", po::bool_switch(&job.resume), "finish an interrupted run of the same sweep and --out from its journal")

@@ -37,10 +37,10 @@ struct SweepSpec {
   std::vector<Axis> axes;
   std::vector<const MethodInfo*> methods;
   SceneParams base;   ///< the fixed scene parameters (table 3.1 unless changed)
-  double h = 1e-4;    ///< fixed step (unless param == "h")
+  double h = RunSpec{}.h;  ///< fixed step (unless param == "h")
   long steps = 0;     ///< fixed number of steps, or 0 when t_end is fixed
   double t_end = 0;   ///< fixed end time (steps = ceil(t_end/h), h = t_end/steps), or 0
-  double tol = 1e-10; ///< adaptive methods
+  double tol = RunSpec{}.tol;  ///< adaptive methods
 };
 
 /// Parses one --grid item: NAME=FROM:TO:STEP (linear), NAME=log:FROM:TO:POINTS or NAME=a,b,c.

@@ -14,8 +14,8 @@ struct TimingSpec {
   std::vector<long> ns;
   std::vector<const MethodInfo*> methods;
   SceneParams base;
-  double h = 1e-4;
-  double tol = 1e-10;
+  double h = RunSpec{}.h;
+  double tol = RunSpec{}.tol;
   long repeats = 5;
   long warmup = 1;
 };

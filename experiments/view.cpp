@@ -225,7 +225,7 @@ struct ViewOptions {
   SceneOptions so;
   StepOptions st;
   std::string method_name = "lp-y4", compare, out = "bodypoint-view.html";
-  double tol = 1e-10, compare_h = 0.0, max_mb = 32.0;
+  double tol = RunSpec{}.tol, compare_h = 0.0, max_mb = 32.0;
   long frames = 3000;
   bool dry_run = false;
 };
