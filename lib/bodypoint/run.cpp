@@ -21,6 +21,7 @@
 #include <functional>
 #include <limits>
 #include <type_traits>
+#include <variant>
 
 namespace bodypoint {
 namespace {
@@ -148,27 +149,37 @@ std::string refusal(const MethodInfo& m, const Body& body, const std::vector<Cen
   return m.check ? m.check(m, body, centres) : std::string();
 }
 
-RunResult run(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
-              const RunSpec& spec, const SampleSink* sink) {
-  validate(Scene{centres, {body}});
+Advance advance_of(const MethodInfo& m, const RunSpec& spec) {
   if (!std::isfinite(spec.h) || spec.h <= 0.0)
     throw Error("step size h must be a finite number > 0, got " + std::to_string(spec.h));
   if (spec.every < 1) throw Error("--every must be >= 1");
-  if (const std::string why = refusal(method, body, centres); !why.empty()) throw Error(why);
-  // Time-transformed methods run to t_end when it is given, otherwise for spec.steps fictitious steps.
-  if (is_time_transformed(method)) return method.run(body, centres, spec, sink);
-  if (spec.steps < 1) throw Error("number of steps must be >= 1");
-  if (is_adaptive(method)) {
-    RunSpec s = spec;
-    if (s.t_end == 0.0) s.t_end = spec.h * static_cast<double>(spec.steps);
-    if (!std::isfinite(s.t_end) || s.t_end <= 0.0) throw Error("end time must be a finite number > 0");
-    if (!std::isfinite(s.tol) || s.tol <= 0.0) throw Error("--tol must be a finite number > 0");
-    if (s.tol < kMinStepTolerance)
-      throw Error("--tol " + detail::short_number(s.tol) + " is below what double precision can deliver (a step's rounding "
-                  "is ~1e-16 relative; the smallest tolerance taken is 1e-15)");
-    return method.run(body, centres, s, sink);
+  if (is_time_transformed(m)) {
+    if (spec.t_end < 0.0 || !std::isfinite(spec.t_end)) throw Error("end time must be a finite number >= 0");
+    if (spec.t_end == 0.0 && spec.steps < 1) throw Error("give a number of fictitious steps or an end time");
+    if (spec.dt_out < 0.0 || !std::isfinite(spec.dt_out)) throw Error("--dt-out must be a finite number >= 0");
+    return FictitiousSteps{spec.h, spec.t_end, spec.t_end == 0.0 ? spec.steps : 0, spec.dt_out};
   }
-  return method.run(body, centres, spec, sink);
+  if (spec.steps < 1) throw Error("number of steps must be >= 1");
+  if (!is_adaptive(m)) return FixedSteps{spec.h, spec.steps};
+  const double t_end = spec.t_end == 0.0 ? spec.h * static_cast<double>(spec.steps) : spec.t_end;
+  if (!std::isfinite(t_end) || t_end <= 0.0) throw Error("end time must be a finite number > 0");
+  if (!std::isfinite(spec.tol) || spec.tol <= 0.0) throw Error("--tol must be a finite number > 0");
+  if (spec.tol < kMinStepTolerance)
+    throw Error("--tol " + detail::short_number(spec.tol) + " is below what double precision can deliver (a step's "
+                "rounding is ~1e-16 relative; the smallest tolerance taken is 1e-15)");
+  return ControlledSteps{spec.h, t_end, spec.tol};
+}
+
+RunResult run(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
+              const RunSpec& spec, const SampleSink* sink) {
+  validate(Scene{centres, {body}});
+  const Advance advance = advance_of(method, spec);
+  if (const std::string why = refusal(method, body, centres); !why.empty()) throw Error(why);
+  // The driver reads the run specification with the end time the advance settled on (a
+  // step-size-controlled run without t_end runs to steps h).
+  RunSpec s = spec;
+  if (const auto* c = std::get_if<ControlledSteps>(&advance)) s.t_end = c->t_end;
+  return method.run(body, centres, s, sink);
 }
 
 }  // namespace bodypoint

@@ -16,6 +16,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <variant>
 #include <vector>
 
 namespace bodypoint {
@@ -124,7 +125,31 @@ constexpr double kDivergedEnergy = 1.0;
 constexpr double kCollisionFraction = 1e-6;
 Health assess(const RunResult& r);
 
-/// Validates the inputs (scene, h > 0 and finite, steps >= 1, every >= 1, tol > 0) and runs.
+/// The three ways of advancing time, one driver each: fixed steps h, time i h (the composition engine
+/// and Odeint's fixed-step loop, under one observer: run_support.hpp); fixed fictitious steps ds to
+/// exactly t_end, or `steps` of them when t_end = 0, with output times dt_out (FictitiousLoop,
+/// adaptive/run.cpp); step-size control to exactly t_end at tolerance tol from a first trial step h0
+/// (controlled_loop, run_support.hpp).
+struct FixedSteps {
+  double h;
+  long steps;
+};
+struct FictitiousSteps {
+  double ds, t_end;
+  long steps;
+  double dt_out;
+};
+struct ControlledSteps {
+  double h0, t_end, tol;
+};
+using Advance = std::variant<FixedSteps, FictitiousSteps, ControlledSteps>;
+
+/// How `m` advances time under `spec`, every number of it checked (h > 0 and finite, every >= 1;
+/// steps >= 1 or an end time; tol in [1e-15, inf)): the one place a run specification is validated.
+Advance advance_of(const MethodInfo& m, const RunSpec& spec);
+
+/// Validates the scene and the run specification (advance_of), asks the method whether it accepts
+/// the scene (refusal), and runs.
 RunResult run(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
               const RunSpec& spec, const SampleSink* sink = nullptr);
 
