@@ -18,8 +18,13 @@ cmake --build build-asan --parallel "$(nproc)"
 # each (order fits over step ladders, the L = 1e6 stress start, every thesis study at once): under ASan
 # they took 3-10 minutes each.
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-skip='ViewerInChromium|StressCasesFinishFiniteWithInvariantsReported|ConvergenceOrderInTheFictitiousStep'
+skip='ViewerInChromium|StressCasesFinishWithinTheirEnergyBounds|ConvergenceOrderInTheFictitiousStep'
 skip+='|Convergence.NominalOrderFor|Study.QuickRecipesWriteEveryCsv'
+# A renamed test would silently leave the list (it happened once): every pattern must name a test.
+for pattern in ${skip//|/ }; do
+  ctest --test-dir build-asan -N -R "$pattern" | grep -q "Test *#" ||
+    { echo "check-sanitizers: skip pattern '$pattern' matches no test (renamed?)" >&2; exit 1; }
+done
 ctest --test-dir build-asan --output-on-failure -j2 -E "$skip"
 
 work="$(mktemp -d)"
