@@ -167,10 +167,10 @@ void write_tol_rows(std::ostream& csv, const std::vector<TolRow>& rows) {
       << "# wall_s = median over repeats of the step loops (auto: all runs of its search); h = ds for logh/ttl/ks\n"
       << "scene,method,kind,tol,h,err_estimate,err,met,runs,force_evals,wall_s\n";
   for (const TolRow& r : rows)
-    csv << r.scene << ',' << r.method << ',' << (r.is_auto ? "auto" : r.is_ladder ? "ladder" : "at-tol") << ','
-        << fmt(r.tol) << ',' << (r.is_auto ? fmt(r.h) : "") << ',' << (r.is_auto ? fmt(r.err_estimate) : "") << ','
-        << fmt(r.err) << ',' << (r.met ? "yes" : "no") << ',' << r.runs << ',' << r.force_evals << ','
-        << fmt(r.wall_s) << '\n';
+    csv << CsvLine().text(r.scene).text(r.method).text(r.is_auto ? "auto" : r.is_ladder ? "ladder" : "at-tol")
+               .num(r.tol).num_if(r.is_auto, r.h).num_if(r.is_auto, r.err_estimate).num(r.err)
+               .text(r.met ? "yes" : "no").count(r.runs).count(r.force_evals).num(r.wall_s).str()
+        << '\n';
 }
 
 /// The fastest peer run at auto's tolerance that met it, and how many met it.

@@ -38,7 +38,7 @@ constexpr double kOdeTol = 1e-12;
 struct Writer {
   std::ostream& os;
   void row(const std::string& key, double value, const std::string& what) {
-    os << key << ',' << fmt(value) << ",\"" << what << "\"\n";
+    os << CsvLine().text(key).num(value).quoted(what).str() << '\n';
   }
 };
 

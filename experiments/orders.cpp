@@ -89,7 +89,6 @@ void write_orders(std::ostream& csv) {
       << "method,nominal,encounter,encounter_points,orbit,orbit_points\n";
   const Probe enc_spin = probe(convergence_encounter(0.7)), enc_material = probe(convergence_encounter(0.0));
   const Probe orb_spin = probe(convergence_orbit(0.7)), orb_material = probe(convergence_orbit(0.0));
-  auto cell = [](double x) { return std::isfinite(x) ? fmt(x) : std::string(); };
   for (const MethodInfo& m : methods()) {
     if (is_adaptive(m)) continue;  // no step to refine: a tolerance
     // A method that refuses the spinning body (ks) is measured on the material point.
@@ -98,7 +97,9 @@ void write_orders(std::ostream& csv) {
     const double enc = measured_order(m, ks ? enc_material : enc_spin, &ue);
     const double orb = m.family == Family::Thesis ? std::numeric_limits<double>::quiet_NaN()
                                                    : measured_order(m, ks ? orb_material : orb_spin, &uo);
-    csv << m.name << ',' << m.order << ',' << cell(enc) << ',' << ue << ',' << cell(orb) << ',' << uo << '\n';
+    csv << CsvLine().text(m.name).count(m.order).num_if(std::isfinite(enc), enc).count(static_cast<long>(ue))
+               .num_if(std::isfinite(orb), orb).count(static_cast<long>(uo)).str()
+        << '\n';
   }
 }
 

@@ -158,10 +158,9 @@ void write_stress(std::ostream& csv, std::ostream& md, const std::vector<StressR
       << "# status: ok | refused (not run, reason) | diverged | collision (flagged, reason); max_rel_dE only for runs\n"
       << "case,method,status,max_rel_dE,steps,wall_s,reason\n";
   for (const StressRow& r : rows) {
-    std::string reason = r.reason;
-    std::replace(reason.begin(), reason.end(), '"', '\'');
-    csv << '"' << r.case_name << "\"," << r.method << ',' << r.status << ',' << fmt(r.max_rel_dE) << ',' << r.steps
-        << ',' << fmt(r.wall_s) << ",\"" << reason << "\"\n";
+    csv << CsvLine().quoted(r.case_name).text(r.method).text(r.status).num(r.max_rel_dE).count(r.steps)
+               .num(r.wall_s).quoted(r.reason).str()
+        << '\n';
   }
   md << "| case | method | outcome | max rel dE | steps | wall [s] |\n|---|---|---|---|---|---|\n";
   for (const StressRow& r : rows) {

@@ -150,8 +150,9 @@ void study_evals(const StudyContext& c) {
     rs.t_end = is_adaptive(m) ? 1.0 : 0.0;
     const Scene& sc = refusal(m, scene.bodies.front(), scene.centres).empty() ? scene : material_scene;
     const RunResult r = run(m, sc.bodies.front(), sc.centres, rs);
-    os << m.name << ',' << m.order << ',' << m.stages << ',' << m.evals_per_step << ','
-       << fmt(static_cast<double>(r.force_evals) / static_cast<double>(r.steps)) << '\n';
+    os << CsvLine().text(m.name).count(m.order).count(m.stages).count(m.evals_per_step)
+              .num(static_cast<double>(r.force_evals) / static_cast<double>(r.steps)).str()
+       << '\n';
   }
   f.commit();
   std::cerr << "wrote " << (c.dir / "force_evals.csv").string() << "\n";
@@ -214,14 +215,14 @@ void study_appendix(const StudyContext& c) {
     p.A = -0.5;
     p.start.d = 50;
     for (const auto& [k, v] : set.changes) scene_field(p, k) = v;
-    ix << set.figure << ',' << fmt(p.A) << ',' << fmt(p.m) << ',' << fmt(p.B) << ',' << fmt(p.J) << ','
-       << fmt(p.start.L) << ',' << fmt(p.start.d) << ',' << fmt(p.start.K1) << ',' << fmt(p.start.Kz) << ','
-       << fmt(p.start.Kx) << ',';
+    CsvLine row;
+    row.count(set.figure);
+    for (const char* k : {"A", "m", "B", "J", "L", "d", "K1", "Kz", "Kx"}) row.num(scene_field(p, k));
     Scene scene;
     try {
       scene = thesis_scene(p);
     } catch (const Error& e) {
-      ix << "\"skipped: " << e.what() << "\",,,\n";
+      ix << row.quoted(std::string("skipped: ") + e.what()).str() << ",,,\n";
       continue;
     }
     const std::string name = "P1." + std::to_string(set.figure) + ".csv";
@@ -239,7 +240,7 @@ void study_appendix(const StudyContext& c) {
     rs.track_invariants = true;
     const RunResult r = run(method_or_throw("thesis-euler"), scene.bodies.front(), scene.centres, rs, &sink);
     f.commit();
-    ix << "ok," << name << ',' << fmt(r.invariants->max_rel_dE) << ',' << fmt(r.invariants->max_rel_dK2sq) << '\n';
+    ix << row.text("ok").text(name).num(r.invariants->max_rel_dE).num(r.invariants->max_rel_dK2sq).str() << '\n';
   }
   index.commit();
   std::cerr << "wrote " << dir.string() << "/ (30 sets)\n";

@@ -119,13 +119,12 @@ std::string format_row(const std::vector<double>& point, const MethodInfo& metho
                        const std::string& status, std::string reason) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const InvariantStats s = result.invariants ? *result.invariants : InvariantStats{nan, nan, nan};
-  std::replace(reason.begin(), reason.end(), '"', '\'');
-  std::ostringstream os;
-  for (double v : point) os << fmt(v) << ',';
-  os << method.name << ',' << fmt(s.max_rel_dE) << ',' << fmt(s.max_rel_dK2sq) << ',' << fmt(s.max_abs_dK2Q) << ','
-     << fmt(result.final.R.x()) << ',' << fmt(result.final.R.y()) << ',' << fmt(result.final.R.z()) << ','
-     << result.force_evals << ',' << fmt(result.wall_s) << ',' << status << ",\"" << reason << '"';
-  return os.str();
+  CsvLine row;
+  for (double v : point) row.num(v);
+  row.text(method.name).num(s.max_rel_dE).num(s.max_rel_dK2sq).num(s.max_abs_dK2Q);
+  row.num(result.final.R.x()).num(result.final.R.y()).num(result.final.R.z());
+  row.count(result.force_evals).num(result.wall_s).text(status).quoted(std::move(reason));
+  return row.str();
 }
 
 }  // namespace

@@ -59,8 +59,9 @@ void write_timing_csv(std::ostream& os, const TimingSpec& spec, const std::vecto
      << " timed repeats of the step loop alone (no invariants, no output), one thread\n"
      << "n,method,median_s,min_s,max_s,repeats,force_evals\n";
   for (const TimingRow& r : rows)
-    os << r.n << ',' << r.method->name << ',' << fmt(r.median_s) << ',' << fmt(r.min_s) << ',' << fmt(r.max_s)
-       << ',' << r.repeats << ',' << r.force_evals << '\n';
+    os << CsvLine().count(r.n).text(r.method->name).num(r.median_s).num(r.min_s).num(r.max_s).count(r.repeats)
+              .count(r.force_evals).str()
+       << '\n';
 }
 
 /// Largest n of one timing run: 1e10 steps are hours of a 100 ns step, repeated.

@@ -208,9 +208,9 @@ void write_rows(std::ostream& os, const std::vector<Row>& rows, const std::strin
   os << "# h is the fictitious step ds for time-transformed methods (logh-*, ttl-*, ks)\n"
      << "scene,method,h,tol,err_R,err_rel,max_rel_dE,force_evals,wall_s\n";
   for (const Row& r : rows)
-    os << r.scene << ',' << r.method << ',' << (r.h > 0 ? fmt(r.h) : "") << ',' << (r.tol > 0 ? fmt(r.tol) : "")
-       << ',' << fmt(r.err_R) << ',' << fmt(r.err_rel) << ',' << fmt(r.max_rel_dE) << ',' << r.force_evals
-       << ',' << fmt(r.wall_s) << '\n';
+    os << CsvLine().text(r.scene).text(r.method).num_if(r.h > 0, r.h).num_if(r.tol > 0, r.tol).num(r.err_R)
+              .num(r.err_rel).num(r.max_rel_dE).count(r.force_evals).num(r.wall_s).str()
+       << '\n';
 }
 
 std::string config_of(const Row& r) {

@@ -1,5 +1,7 @@
 #include "bodypoint/io.hpp"
 
+#include <algorithm>
+
 #include <atomic>
 #include <cerrno>
 #include <charconv>
@@ -191,6 +193,11 @@ std::string fmt(double x) {
   char buf[32];
   const auto res = std::to_chars(buf, buf + sizeof buf, x);
   return std::string(buf, res.ptr);
+}
+
+CsvLine& CsvLine::quoted(std::string s) {
+  std::replace(s.begin(), s.end(), '"', '\'');
+  return add('"' + s + '"');
 }
 
 std::string json_number(double x) { return std::isfinite(x) ? fmt(x) : "null"; }

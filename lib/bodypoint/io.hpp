@@ -63,6 +63,28 @@ class CooperativeInterrupt {
 
 /// x in the shortest form that reads back exactly ("nan"/"inf" spelled as such).
 std::string fmt(double x);
+/// One CSV line, the one row format of every CSV the tool writes: cells separated by commas, numbers
+/// by fmt, counts and names as they are, free text quoted (its own quotes turned into apostrophes).
+class CsvLine {
+ public:
+  CsvLine& num(double x) { return add(fmt(x)); }
+  /// fmt(x), or an empty cell when `present` is false (a column that does not apply to the row).
+  CsvLine& num_if(bool present, double x) { return add(present ? fmt(x) : std::string()); }
+  CsvLine& count(long n) { return add(std::to_string(n)); }
+  CsvLine& text(std::string_view s) { return add(std::string(s)); }
+  CsvLine& quoted(std::string s);
+  [[nodiscard]] const std::string& str() const { return line_; }
+
+ private:
+  CsvLine& add(const std::string& cell) {
+    if (cells_++) line_ += ',';
+    line_ += cell;
+    return *this;
+  }
+  std::string line_;
+  long cells_ = 0;
+};
+
 /// JSON number, or null for a non-finite value.
 std::string json_number(double x);
 /// "[x, y, z]" as JSON.

@@ -84,14 +84,10 @@ void TrajectoryWriter::header() const {
 }
 
 void TrajectoryWriter::row(long body, const Sample& s, const BodyPoint& p) const {
-  bool first = !body_column_;
-  if (body_column_) os_ << body;
-  for (const Observable* o : columns_) {
-    if (!first) os_ << ',';
-    os_ << fmt(o->value(s, p));
-    first = false;
-  }
-  os_ << '\n';
+  CsvLine line;
+  if (body_column_) line.count(body);
+  for (const Observable* o : columns_) line.num(o->value(s, p));
+  os_ << line.str() << '\n';
 }
 
 }  // namespace bodypoint
