@@ -118,9 +118,12 @@ struct StepStats {
 /// itself). The driver refuses accepted steps that do not move t (they would repeat forever), caps
 /// the accepted steps and their rate (check_adaptive_rate), stops after 1000 rejections in a row, and
 /// hands every accepted step to the observer. `Says` words the three failures for its stepper
-/// (stalled(t, taken), too_many(t, t_end), collapsed(t)).
+/// (stalled(t, taken), too_many(t, t_end), collapsed(t)). Inlined into its caller, with the caller's
+/// try_step inlined into it, as the two loops it replaces were written: out of line, odeint-dopri5 on
+/// the material point took 252 ns per step against 190 (bench_steps, BM_Step).
 template <class Says, class X, class TryStep, class Observer>
-X controlled_loop(X x, double h0, double t_end, StepStats& st, Observer& obs, TryStep&& try_step) {
+[[gnu::always_inline]] inline X controlled_loop(X x, double h0, double t_end, StepStats& st, Observer& obs,
+                                                TryStep&& try_step) {
   double t = 0.0, dt = std::min(h0, t_end);
   long rejected_in_a_row = 0;
   while (t < t_end) {

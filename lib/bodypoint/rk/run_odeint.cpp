@@ -92,7 +92,7 @@ RunResult run_odeint_adaptive(const Body& body, const std::vector<Centre>& centr
     detail::StepStats st;
     RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
       Controlled stepper = rk::make_controlled<Controlled>(spec.tol);
-      auto try_step = [&](OdeState<double>& x, double& t, double& dt) {
+      auto try_step = [&](OdeState<double>& x, double& t, double& dt) __attribute__((always_inline)) {
         const bool final_step = t + dt >= t_end;
         if (final_step) dt = t_end - t;
         if (stepper.try_step(std::ref(sys), x, t, dt) != boost::numeric::odeint::success) return false;
