@@ -298,16 +298,6 @@ RunResult run_time_transformed(const Body& body, const std::vector<Centre>& cent
   });
 }
 
-template <const auto& Seq>
-RunResult run_logh(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec, const SampleSink* sink) {
-  return run_time_transformed<LogHKernel, Seq>(body, centres, spec, sink);
-}
-
-template <const auto& Seq>
-RunResult run_ttl(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec, const SampleSink* sink) {
-  return run_time_transformed<TtlKernel, Seq>(body, centres, spec, sink);
-}
-
 // What each time-transformed family assumes of a scene (MethodInfo::check).
 std::string coulomb_only(const MethodInfo& m, const std::vector<Centre>& centres) {
   if (!non_coulomb(centres)) return "";
@@ -374,29 +364,25 @@ using LogHTables = sp::List<sp::Use<sp::StrangDkd, "verlet">, sp::Yoshida4, sp::
 using TtlTables = sp::List<sp::Use<sp::StrangDkd, "verlet">, sp::Yoshida4, sp::BlanesMoan4, sp::Yoshida6,
                            sp::KahanLi6, sp::McLachlan8, sp::KahanLi8>;
 
-template <class E>
-MethodInfo logh_row() {
+/// The row of a time-transformed method: kernel family K (logH or TTL) times the entry's table.
+template <template <class, bool> class K, class E>
+MethodInfo transformed_row(std::string_view prefix, std::string_view family, SceneCheck check) {
   using T = typename E::type;
   const int s = static_cast<int>(sp::ops_of<T>.kicks());
-  return {"logh-" + std::string(E::tag), Family::TimeTransformed, T::order, s, s,
-          sp::describe<T>("logH (repulsive scenes), ds = --h"),
-          &run_logh<sp::ops_of<T>>, &logh_check};
-}
-template <class E>
-MethodInfo ttl_row() {
-  using T = typename E::type;
-  const int s = static_cast<int>(sp::ops_of<T>.kicks());
-  return {"ttl-" + std::string(E::tag), Family::TimeTransformed, T::order, s, s,
-          sp::describe<T>("TTL (any sign of A), ds = --h"),
-          &run_ttl<sp::ops_of<T>>, &ttl_check};
+  return {std::string(prefix) + std::string(E::tag), Family::TimeTransformed, T::order, s, s, sp::describe<T>(family),
+          &run_time_transformed<K, sp::ops_of<T>>, check};
 }
 
 }  // namespace
 
 std::vector<MethodInfo> methods() {
   std::vector<MethodInfo> all;
-  sp::for_each(LogHTables{}, [&all]<class E>() { all.push_back(logh_row<E>()); });
-  sp::for_each(TtlTables{}, [&all]<class E>() { all.push_back(ttl_row<E>()); });
+  sp::for_each(LogHTables{}, [&all]<class E>() {
+    all.push_back(transformed_row<LogHKernel, E>("logh-", "logH (repulsive scenes), ds = --h", &logh_check));
+  });
+  sp::for_each(TtlTables{}, [&all]<class E>() {
+    all.push_back(transformed_row<TtlKernel, E>("ttl-", "TTL (any sign of A), ds = --h", &ttl_check));
+  });
   all.push_back({"ks", Family::TimeTransformed, 0, 0, 0,
                  "Kustaanheimo-Stiefel regularisation, exact in fictitious time (B = 0, one centre), ds = --h",
                  &run_ks, &ks_check});
