@@ -13,7 +13,7 @@
 
 #include "bodypoint/adaptive/ks.hpp"
 #include "bodypoint/adaptive/time_transformed.hpp"
-#include "bodypoint/run_support.hpp"
+#include "bodypoint/detail/run_support.hpp"
 #include "bodypoint/splitting/catalogue.hpp"
 
 #include <cmath>
@@ -141,7 +141,7 @@ TimeState step_to_time(K& k, const TimeState& from, double ds, double target, do
 /// The one driver of every method that takes fixed fictitious steps ds = spec.h: spec.steps of them,
 /// or as many as reach spec.t_end, the last one solved to land on it exactly. A Stepper holds the
 /// kernel and says, for its state type X:
-///   Advance step(X& x, double ds)       one fictitious step; returns the new time and the physical step
+///   StepAdvance step(X& x, double ds)       one fictitious step; returns the new time and the physical step
 ///   double time(const X& x)             the physical time of x
 ///   void land(X& x, double t, double t_over)  from x (time < t) to exactly t; t_over is where a whole
 ///                                             step would have gone
@@ -149,7 +149,7 @@ TimeState step_to_time(K& k, const TimeState& from, double ds, double target, do
 ///   State physical(const X& x)
 ///   std::string_view prefix             of its error messages ("" or "ks: ")
 /// Outputs at k dt_out come from at() on the state before the step that crosses them.
-struct Advance {
+struct StepAdvance {
   double t;   ///< physical time after the step
   double dt;  ///< physical step, as the step statistics record it
 };
@@ -172,7 +172,7 @@ class FictitiousLoop {
     double t_over = 0.0;  // the time the step that would pass t_end reaches
     while (st.steps < cap) {
       const X prev = x;
-      const Advance a = s_.step(x, h);
+      const StepAdvance a = s_.step(x, h);
       if (!std::isfinite(a.t) || !s_.physical_finite(x))
         throw Error(std::string(Stepper::prefix) + "the state became non-finite at t = " +
                     std::to_string(s_.time(prev)) + "; reduce --h");
@@ -258,7 +258,7 @@ struct TransformedStepper {
   static constexpr std::string_view prefix = "";
   K& k;
   double h;
-  Advance step(X& x, double ds) const {
+  StepAdvance step(X& x, double ds) const {
     const double before = x.time();
     sp::NullObserver none;
     sp::integrate<Seq>(k, x, ds, 1, none);
@@ -330,7 +330,7 @@ std::string ks_check(const MethodInfo& m, const Body& body, const std::vector<Ce
 struct KsStepper {
   using X = std::pair<KsMotion, double>;  // (motion, t)
   static constexpr std::string_view prefix = "ks: ";
-  static Advance step(X& x, double ds) {
+  static StepAdvance step(X& x, double ds) {
     const double dt = x.first.step(ds);
     x.second = x.second + dt;
     return {x.second, dt};

@@ -59,6 +59,12 @@ constexpr int kMaxLevels = 48;
 /// Differences at or below this relative size are at the round-off level of a run of 1e3..1e6 steps.
 constexpr double kRoundOff = 1e-13;
 
+/// A limit of the search itself (its budget, the smallest step it takes): final, unlike a method's
+/// refusal of one step, which only halves the pilot's step.
+struct SearchLimit : Error {
+  using Error::Error;
+};
+
 struct Level {
   double h = 0.0;
   long steps = 0;
@@ -97,7 +103,7 @@ RunSpec step_spec(const MethodInfo& m, double h, double t_end, RunSpec s) {
     return s;
   }
   const double n = std::ceil(t_end / h * (1.0 - 1e-12));
-  if (!(n <= 1e12)) throw Error("--tol: the step the search needs (" + std::to_string(h) + ") is too small");
+  if (!(n <= 1e12)) throw SearchLimit("--tol: the step the search needs (" + std::to_string(h) + ") is too small");
   s.steps = std::max(1L, static_cast<long>(n));
   s.h = t_end / static_cast<double>(s.steps);
   s.t_end = 0.0;
@@ -133,7 +139,7 @@ class Search {
     s.omega_c = automatic_omega_c(b_, c_, h_c);
     const double expected = expected_evals(s);
     if (spent_evals_ + expected > kMaxEvals)
-      throw Error("--tol " + fmt_tol() + " is out of reach of " + std::string(m_.name) +
+      throw SearchLimit("--tol " + fmt_tol() + " is out of reach of " + std::string(m_.name) +
                   " within 2e9 force evaluations (last estimate " + fmt_number(last_estimate_) + ")");
     const RunResult r = run(m_, b_, c_, s);
     if (!(r.final.R.allFinite() && r.final.v.allFinite())) throw Error("the state became non-finite");
@@ -174,8 +180,10 @@ class Search {
         a = run_at(h, h);
         b = run_at(0.5 * a.h, h);
         break;
-      } catch (const Error& e) {
-        if (std::string(e.what()).find("--tol") == 0 || k >= kMaxLevels) throw;
+      } catch (const SearchLimit&) {
+        throw;
+      } catch (const Error&) {
+        if (k >= kMaxLevels) throw;
         h *= 0.5;
       }
     }
@@ -300,7 +308,7 @@ ToleranceResult run_to_tolerance(const MethodInfo& method, const Body& body, con
                                  double tol, double t_end) {
   check_tolerance(tol);
   if (!(std::isfinite(t_end) && t_end > 0.0)) throw Error("--tol needs a finite end time > 0");
-  if (is_adaptive(method))
+  if (is_step_controlled(method))
     throw Error(std::string(method.name) + " controls its own step: give it --tol without the search (this is "
                 "for fixed-step and time-transformed methods)");
   if (method.order == 0 && method.name != "ks")

@@ -38,7 +38,7 @@ std::string duration(double s) {
 
 std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
                                           const RunSpec& spec) {
-  if (is_adaptive(m)) return std::nullopt;
+  if (is_step_controlled(m)) return std::nullopt;
   // A calibration without an end time can run away (ks's physical step grows with r): no estimate
   // then; the run's own checks still bound it.
   auto calibrate = [&](long steps) -> std::optional<RunResult> {

@@ -46,7 +46,7 @@ double median_of(std::vector<double> v) {
 std::vector<std::string> peer_names() {
   std::vector<std::string> out;
   for (const MethodInfo& m : methods())
-    if (is_adaptive(m)) out.emplace_back(m.name);
+    if (is_step_controlled(m)) out.emplace_back(m.name);
   return out;
 }
 

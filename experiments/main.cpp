@@ -10,6 +10,11 @@
 #include <iostream>
 #include <string>
 
+#ifdef BODYPOINT_MPI_PROGRAM
+#include <climits>
+#include <unistd.h>
+#endif
+
 namespace {
 
 constexpr const char* usage =
@@ -25,9 +30,25 @@ constexpr const char* usage =
     "  view       write a self-contained HTML page that animates a run in 3D (three.js)\n"
     "Run 'bodypoint <command> --help' for the options of a command.";
 
+#ifdef BODYPOINT_MPI_PROGRAM
+/// Started by an MPI launcher: hand this process over to the build of the same program with MPI
+/// (experiments/CMakeLists.txt), which sits beside this one. Returns only when it is not there.
+void exec_mpi_program(char** argv) {
+  char self[PATH_MAX];
+  const ssize_t n = ::readlink("/proc/self/exe", self, sizeof self - 1);
+  if (n <= 0) return;
+  std::string path(self, static_cast<std::size_t>(n));
+  path = path.substr(0, path.rfind('/') + 1) + BODYPOINT_MPI_PROGRAM;
+  ::execv(path.c_str(), argv);
+}
+#endif
+
 }  // namespace
 
 int main(int argc, char** argv) {
+#ifdef BODYPOINT_MPI_PROGRAM
+  if (bodypoint::cli::launched_by_mpi()) exec_mpi_program(argv);
+#endif
   if (argc < 2 || std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0) {
     std::cout << usage << "\n";
     return argc < 2 ? 2 : 0;

@@ -90,7 +90,7 @@ void write_orders(std::ostream& csv) {
   const Probe enc_spin = probe(convergence_encounter(0.7)), enc_material = probe(convergence_encounter(0.0));
   const Probe orb_spin = probe(convergence_orbit(0.7)), orb_material = probe(convergence_orbit(0.0));
   for (const MethodInfo& m : methods()) {
-    if (is_adaptive(m)) continue;  // no step to refine: a tolerance
+    if (is_step_controlled(m)) continue;  // no step to refine: a tolerance
     // A method that refuses the spinning body (ks) is measured on the material point.
     const bool ks = !refusal(m, enc_spin.scene.bodies.front(), enc_spin.scene.centres).empty();
     std::size_t ue = 0, uo = 0;

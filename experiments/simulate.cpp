@@ -54,7 +54,7 @@ RunPlan plan_run(const po::variables_map& vm, const StepOptions& st, const std::
   plan.automatic = method_name == "auto" || (tol_given && method_defaulted);
   if (plan.automatic && !tol_given) throw Error("--method auto needs --tol (the accuracy to deliver)");
   plan.method = plan.automatic ? nullptr : &method_or_throw(method_name);
-  plan.search = plan.automatic || (tol_given && !is_adaptive(*plan.method));
+  plan.search = plan.automatic || (tol_given && !is_step_controlled(*plan.method));
   plan.tol = tol;
   RunSpec& spec = plan.spec;
   spec.tol = tol;
@@ -75,7 +75,7 @@ RunPlan plan_run(const po::variables_map& vm, const StepOptions& st, const std::
     spec.h = st.h;
     spec.t_end = vm.count("t-end") ? st.t_end : 0.0;
     spec.steps = vm.count("t-end") ? 0 : st.steps;
-  } else if (is_adaptive(*plan.method)) {
+  } else if (is_step_controlled(*plan.method)) {
     // The method chooses its steps: --h is only the first trial step, --t-end (or h steps) the end.
     if (!std::isfinite(st.h) || st.h <= 0.0) throw Error("--h must be a finite number > 0");
     if (vm.count("t-end") && !vm["steps"].defaulted()) throw Error("give --steps or --t-end, not both");
@@ -209,7 +209,7 @@ void print_dry_run(const RunPlan& plan, const std::string& method_name, const Sc
             << " on " << scene.bodies.size() << " body-point(s) and " << scene.centres.size() << " centre(s): ";
   if (plan.search) std::cout << "step search to t_end = " << fmt(spec.t_end);
   else if (is_time_transformed(*plan.method)) std::cout << "ds = " << fmt(spec.h) << (spec.t_end > 0 ? " to t_end = " + fmt(spec.t_end) : " for " + std::to_string(spec.steps) + " fictitious steps");
-  else if (is_adaptive(*plan.method)) std::cout << "tol = " << fmt(spec.tol) << " to t_end = " << fmt(spec.t_end);
+  else if (is_step_controlled(*plan.method)) std::cout << "tol = " << fmt(spec.tol) << " to t_end = " << fmt(spec.t_end);
   else std::cout << spec.steps << " steps of h = " << fmt(spec.h);
   std::cout << "\n";
 }
@@ -278,7 +278,7 @@ void report_json(const std::vector<BodyRun>& runs, const Scene& scene, const Run
   const BodyRun& r0 = runs.front();
   const double h0 = r0.search ? r0.search->h : plan.spec.h;
   std::cout << "{\"method\": \"" << r0.method->name << "\", \"h\": " << json_number(h0)
-            << (is_adaptive(*r0.method) ? ", \"tol\": " + json_number(plan.spec.tol) : std::string())
+            << (is_step_controlled(*r0.method) ? ", \"tol\": " + json_number(plan.spec.tol) : std::string())
             << search_json(r0, plan.tol) << ", \"steps\": " << r0.result.steps
             << ", \"t_end\": " << json_number(r0.result.t_end) << ", " << json_body(r0.result, r0.err_R, r0.err_rel);
   if (runs.size() > 1) {
@@ -373,8 +373,8 @@ void print_markdown_table() {
   std::cout << "| method | family | order | stages | evals/step | description |\n|---|---|---|---|---|---|\n";
   for (const MethodInfo& m : methods())
     std::cout << "| `" << m.name << "` | " << family_name(m.family) << " | " << (m.order ? std::to_string(m.order) : "var")
-              << " | " << (is_adaptive(m) ? "-" : std::to_string(m.stages)) << " | "
-              << (is_adaptive(m) ? "adaptive" : std::to_string(m.evals_per_step)) << " | " << m.description << " |\n";
+              << " | " << (is_step_controlled(m) ? "-" : std::to_string(m.stages)) << " | "
+              << (is_step_controlled(m) ? "adaptive" : std::to_string(m.evals_per_step)) << " | " << m.description << " |\n";
 }
 
 void print_table() {
@@ -383,8 +383,8 @@ void print_table() {
   for (const MethodInfo& m : methods())
     std::cout << std::left << std::setw(16) << m.name << std::setw(8)
               << (m.order ? std::to_string(m.order) : "var") << std::setw(8)
-              << (is_adaptive(m) ? "-" : std::to_string(m.stages)) << std::setw(14)
-              << (is_adaptive(m) ? "adaptive" : std::to_string(m.evals_per_step)) << m.description << "\n";
+              << (is_step_controlled(m) ? "-" : std::to_string(m.stages)) << std::setw(14)
+              << (is_step_controlled(m) ? "adaptive" : std::to_string(m.evals_per_step)) << m.description << "\n";
 }
 
 }  // namespace

@@ -114,7 +114,7 @@ StressRow run_case(const StressCase& c, const MethodInfo& m, double max_seconds)
     RunSpec spec;
     spec.track_invariants = true;
     spec.tol = 1e-10;
-    if (is_adaptive(m)) {
+    if (is_step_controlled(m)) {
       spec.h = c.h;
       spec.steps = 1;
       spec.t_end = c.t_end;

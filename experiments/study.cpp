@@ -147,7 +147,7 @@ void study_evals(const StudyContext& c) {
     RunSpec rs;
     rs.h = 1e-3;
     rs.steps = 1000;
-    rs.t_end = is_adaptive(m) ? 1.0 : 0.0;
+    rs.t_end = is_step_controlled(m) ? 1.0 : 0.0;
     const Scene& sc = refusal(m, scene.bodies.front(), scene.centres).empty() ? scene : material_scene;
     const RunResult r = run(m, sc.bodies.front(), sc.centres, rs);
     os << CsvLine().text(m.name).count(m.order).count(m.stages).count(m.evals_per_step)

@@ -72,10 +72,9 @@ RunSpec resolve_steps(double h, long steps, double t_end, double tol) {
   spec.h = h;
   spec.steps = steps;
   if (t_end > 0.0) {
-    const double n = std::ceil(t_end / h * (1.0 - 1e-12));
-    if (n > 1e13) throw Error("--t-end / --h asks for more than 1e13 steps");
-    spec.steps = static_cast<long>(n);
-    spec.h = t_end / static_cast<double>(spec.steps);
+    const FixedSteps f = fixed_steps_to(t_end, h);
+    spec.h = f.h;
+    spec.steps = f.steps;
   }
   if (spec.steps < 1) throw Error("--steps must be >= 1");
   spec.t_end = spec.h * static_cast<double>(spec.steps);

@@ -203,7 +203,7 @@ TrackJson body_json(const Body& body, const std::vector<Centre>& centres, const 
 /// The step the run used, as the header shows it.
 std::string step_label(const RunPlan& plan) {
   if (plan.search) return "tol=" + fmt(plan.tol);
-  if (is_adaptive(*plan.method)) return "tol=" + fmt(plan.spec.tol);
+  if (is_step_controlled(*plan.method)) return "tol=" + fmt(plan.spec.tol);
   if (is_time_transformed(*plan.method)) return "ds=" + fmt(plan.spec.h);
   return "h=" + fmt(plan.spec.h) + " steps=" + std::to_string(plan.spec.steps);
 }

@@ -56,7 +56,7 @@ Row measure(const NamedScene& ns, const MethodInfo& m, const Body& body, const S
   if (is_time_transformed(m)) {
     spec.h = h;  // the fictitious step ds
     spec.steps = 0;
-  } else if (is_adaptive(m)) {
+  } else if (is_step_controlled(m)) {
     spec.tol = tol;
     spec.h = 1e-3;
     spec.steps = 1;
@@ -78,8 +78,8 @@ Row measure(const NamedScene& ns, const MethodInfo& m, const Body& body, const S
   Row row;
   row.scene = ns.name;
   row.method = std::string(m.name);
-  row.h = is_adaptive(m) ? 0.0 : spec.h;  // for time-transformed methods: ds
-  row.tol = is_adaptive(m) ? tol : 0.0;
+  row.h = is_step_controlled(m) ? 0.0 : spec.h;  // for time-transformed methods: ds
+  row.tol = is_step_controlled(m) ? tol : 0.0;
   row.err_R = (r.final.R - ref.R).norm();
   if (!std::isfinite(row.err_R)) row.err_R = std::numeric_limits<double>::infinity();
   row.err_rel = row.err_R / ref.R.norm();
@@ -187,7 +187,7 @@ void run_ladder(const NamedScene& ns, const MethodInfo& m, const State& ref, con
       }
       if (!keep(r)) break;
     }
-  } else if (is_adaptive(m)) {
+  } else if (is_step_controlled(m)) {
     for (double tol = 1e-3; tol >= 1e-14; tol /= 10)
       if (!try_measure(0, tol, r) || !keep(r)) break;  // a tolerance the controller cannot meet
   } else {

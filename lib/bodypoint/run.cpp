@@ -5,7 +5,7 @@
 // combination is its own instantiation of the generic loop.
 #include "bodypoint/run.hpp"
 
-#include "bodypoint/run_support.hpp"
+#include "bodypoint/detail/run_support.hpp"
 
 #include "bodypoint/field.hpp"
 #include "bodypoint/rhs.hpp"
@@ -17,6 +17,7 @@
 #include "bodypoint/splitting/lie_poisson.hpp"
 #include "bodypoint/splitting/thesis.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -160,7 +161,7 @@ Advance advance_of(const MethodInfo& m, const RunSpec& spec) {
     return FictitiousSteps{spec.h, spec.t_end, spec.t_end == 0.0 ? spec.steps : 0, spec.dt_out};
   }
   if (spec.steps < 1) throw Error("number of steps must be >= 1");
-  if (!is_adaptive(m)) return FixedSteps{spec.h, spec.steps};
+  if (!is_step_controlled(m)) return FixedSteps{spec.h, spec.steps};
   const double t_end = spec.t_end == 0.0 ? spec.h * static_cast<double>(spec.steps) : spec.t_end;
   if (!std::isfinite(t_end) || t_end <= 0.0) throw Error("end time must be a finite number > 0");
   if (!std::isfinite(spec.tol) || spec.tol <= 0.0) throw Error("--tol must be a finite number > 0");
@@ -168,6 +169,15 @@ Advance advance_of(const MethodInfo& m, const RunSpec& spec) {
     throw Error("--tol " + detail::short_number(spec.tol) + " is below what double precision can deliver (a step's "
                 "rounding is ~1e-16 relative; the smallest tolerance taken is 1e-15)");
   return ControlledSteps{spec.h, t_end, spec.tol};
+}
+
+FixedSteps fixed_steps_to(double t_end, double h_max) {
+  if (!(std::isfinite(h_max) && h_max > 0.0)) throw Error("step size h must be a finite number > 0");
+  if (!(std::isfinite(t_end) && t_end > 0.0)) throw Error("end time must be a finite number > 0");
+  const double n = std::ceil(t_end / h_max * (1.0 - 1e-12));
+  if (!(n <= 1e13)) throw Error("end time / step size asks for more than 1e13 steps");
+  const long steps = std::max(1L, static_cast<long>(n));
+  return {t_end / static_cast<double>(steps), steps};
 }
 
 RunResult run(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,

@@ -98,8 +98,9 @@ std::string refusal(const MethodInfo& m, const Body& body, const std::vector<Cen
 /// step-size-controlled peers (Odeint, GSL), the thesis's schemes and the exact Lie-Poisson splittings.
 const std::vector<MethodInfo>& core_methods();
 
-/// True for methods that choose their own steps from a tolerance (spec.tol, spec.t_end apply).
-inline bool is_adaptive(const MethodInfo& m) {
+/// True for methods that choose their own steps from a tolerance per step (spec.tol, spec.t_end
+/// apply): Boost.Odeint's and GSL's controlled steppers.
+inline bool is_step_controlled(const MethodInfo& m) {
   return m.family == Family::OdeintAdaptive || m.family == Family::Gsl;
 }
 /// True for the general-purpose peers (Boost.Odeint, GSL) that bodypoint's own methods compete with.
@@ -109,8 +110,8 @@ inline bool is_peer(const MethodInfo& m) {
 /// True for methods with a fixed fictitious step: spec.h is ds; with spec.t_end > 0 they run to
 /// exactly t_end, otherwise spec.steps fictitious steps.
 inline bool is_time_transformed(const MethodInfo& m) { return m.family == Family::TimeTransformed; }
-/// True for every method whose physical step varies (adaptive or time-transformed).
-inline bool has_variable_step(const MethodInfo& m) { return is_adaptive(m) || is_time_transformed(m); }
+/// True for every method whose physical step varies (step-size-controlled or time-transformed).
+inline bool has_variable_step(const MethodInfo& m) { return is_step_controlled(m) || is_time_transformed(m); }
 
 /// Whether a run stayed in the regime its numbers mean something in: "ok"; "diverged" (a non-finite
 /// state or invariant, or a relative energy error above kDivergedEnergy); "collision" (diverged after
@@ -142,9 +143,18 @@ struct FictitiousSteps {
 struct ControlledSteps {
   double h0, t_end, tol;
 };
-using Advance = std::variant<FixedSteps, FictitiousSteps, ControlledSteps>;
+/// The accuracy mode: the final state's relative error max(|dR|/|R|, |dv|/|v|) at t_end is to be at
+/// most tol; the step (h, or ds) is searched with a Richardson error estimate (adaptive/tolerance.hpp).
+struct Accuracy {
+  double tol, t_end;
+};
+using Advance = std::variant<FixedSteps, FictitiousSteps, ControlledSteps, Accuracy>;
 
-/// How `m` advances time under `spec`, every number of it checked (h > 0 and finite, every >= 1;
+/// Fixed steps that land exactly on t_end: n = ceil(t_end / h_max) steps of t_end / n (a quotient
+/// within 1e-12 of a whole number counts as that number). Throws Error beyond 1e13 steps.
+FixedSteps fixed_steps_to(double t_end, double h_max);
+
+/// How `m` advances time under `spec` (never Accuracy, which chooses its own spec), every number of it checked (h > 0 and finite, every >= 1;
 /// steps >= 1 or an end time; tol in [1e-15, inf)): the one place a run specification is validated.
 Advance advance_of(const MethodInfo& m, const RunSpec& spec);
 

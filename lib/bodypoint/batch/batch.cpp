@@ -1,8 +1,8 @@
 // bodypoint: picks the batch width the CPU runs and converts between the program's types and the
-// per-width units' plain arrays (batch/abi.hpp).
+// per-width units' plain arrays (detail/batch_abi.hpp).
 #include "bodypoint/batch.hpp"
 
-#include "bodypoint/batch/abi.hpp"
+#include "bodypoint/detail/batch_abi.hpp"
 #include "bodypoint/splitting/lie_poisson.hpp"
 
 #include <chrono>

@@ -10,10 +10,10 @@
 // This unit is compiled with wider instruction sets than the rest of the program, so it calls no
 // inline function of a header (Eigen, the standard library, splitting's scalar code): the linker
 // could keep its wide copy for every caller. Everything it runs is its own (internal linkage) or
-// constexpr data; it exchanges plain arrays (batch/abi.hpp) with batch.cpp, built for the baseline.
+// constexpr data; it exchanges plain arrays (detail/batch_abi.hpp) with batch.cpp, built for the baseline.
 #include "bodypoint/batch/lanes.hpp"
 
-#include "bodypoint/batch/abi.hpp"
+#include "bodypoint/detail/batch_abi.hpp"
 #include "bodypoint/splitting/catalogue.hpp"
 #include "bodypoint/splitting/lie_poisson.hpp"
 

@@ -8,7 +8,7 @@
 #include "bodypoint/rk/run_gsl.hpp"
 
 #include "bodypoint/rhs.hpp"
-#include "bodypoint/run_support.hpp"
+#include "bodypoint/detail/run_support.hpp"
 
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_odeiv2.h>

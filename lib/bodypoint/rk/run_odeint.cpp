@@ -3,7 +3,7 @@
 
 #include "bodypoint/rhs.hpp"
 #include "bodypoint/rk/odeint.hpp"
-#include "bodypoint/run_support.hpp"
+#include "bodypoint/detail/run_support.hpp"
 
 #include <cmath>
 #include <functional>

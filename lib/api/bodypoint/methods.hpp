@@ -1,12 +1,12 @@
-// bodypoint: the registry of every method, the top library layer.
+// bodypoint: the catalogue of every method, part of the public API (bodypoint.hpp).
 //
 // Layers, each a CMake target that depends only on the ones below it:
-//   bodypoint_core      lib/                model, fields, invariants, tables, composition engine,
-//                                           kernels, fixed-step and peer run loops (core_methods)
-//   bodypoint_adaptive  adaptive/           time-transformed and regularised methods and their run
-//                                           loops (adaptive::methods), the --tol step search
-//   bodypoint           experiments/methods this registry and --method auto
-//   bodypoint_commands  experiments/        the command line
+//   bodypoint_core      lib/bodypoint/   model, fields, invariants, tables, composition engine,
+//                                        kernels, fixed-step and peer drivers (core_methods)
+//   bodypoint_adaptive  adaptive/        time-transformed and regularised methods and their driver
+//                                        (adaptive::methods), the accuracy mode's step search
+//   bodypoint           lib/api/         this catalogue, --method auto, integrate() and Stepper
+//   bodypoint_commands  experiments/     the command line
 // Nothing below this header includes it.
 #pragma once
 

@@ -1,0 +1,147 @@
+// bodypoint: the public API. One header for a program that integrates body-points:
+//
+//   #include <bodypoint/bodypoint.hpp>
+//   bodypoint::Scene scene = bodypoint::thesis_scene({});                 // table 3.1 of the thesis
+//   bodypoint::Result r = bodypoint::integrate(scene, "lp-y4", bodypoint::FixedSteps{1e-3, 50000});
+//   if (r.outcome == bodypoint::Outcome::ok) use(r.bodies[0].run.final);    // R, v, w at t = 50
+//
+// What it holds, from the ground up:
+//   - the model (model.hpp): a Scene is fixed Coulomb centres and independent body-points, each with
+//     its parameters m, B, J and initial state (R, v, w); thesis_scene() builds the thesis's set-up;
+//     read_scene_file() reads a TOML scene (scene_file.hpp). The physics and the meaning of every
+//     parameter are in docs/physics.md.
+//   - the catalogue (methods.hpp): every method, each a MethodInfo row with its family, order and
+//     cost; methods(), find_method(), and choose_method() for `auto`.
+//   - a way of advancing time, as a value (Advance): FixedSteps, FictitiousSteps (time-transformed
+//     and regularised methods), ControlledSteps (step-size-controlled peers) or Accuracy (a relative
+//     error of the final state to deliver; the step is searched).
+//   - integrate(): every body of a scene with one method and one Advance; a Result per body with a
+//     typed Outcome (ok, diverged, collision, refused, failed) and its one-line reason.
+//   - Stepper: one body advanced segment by segment (advance_to), queried and continued.
+//
+// Invalid input (a scene that breaks a rule of validate(), a step that is not a finite number > 0, an
+// unknown method name) throws bodypoint::Error with a one-line reason naming the quantity; anything
+// that happens to a valid request is reported in the Result, never thrown.
+#pragma once
+
+#include "bodypoint/methods.hpp"
+#include "bodypoint/model.hpp"
+#include "bodypoint/run.hpp"
+#include "bodypoint/scene_file.hpp"
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+namespace bodypoint {
+
+/// What a run asks for besides the way of advancing time. By default the invariants are tracked
+/// and nothing else is kept: the step loop stores no trajectory.
+struct Options {
+  bool track_invariants = true;
+  /// Receives the observed states (the first, every `every`-th and the last; for FictitiousSteps with
+  /// dt_out > 0 the states at t = k dt_out). nullptr: no samples.
+  const SampleSink* sink = nullptr;
+  long every = 1;
+  /// Time-transformed methods: the constant c of the time-step function (physical step <= ds/c);
+  /// < 0: chosen from the scene (the spin-orbit rate).
+  double omega_c = -1.0;
+};
+
+/// How one body's run ended.
+enum class Outcome {
+  ok,         ///< the run reached its end in the regime its numbers mean something in
+  diverged,   ///< a non-finite state or invariant, or an energy error above kDivergedEnergy
+  collision,  ///< diverged after falling onto an attracting centre
+  refused,    ///< the method does not apply to this scene (not run; reason says why)
+  failed,     ///< started but stopped: a budget, a time transformation that broke down, an accuracy out of reach
+};
+std::string_view outcome_name(Outcome o);
+
+/// What the accuracy mode did to deliver its tolerance (Accuracy).
+struct AccuracyReport {
+  double tol = 0.0;
+  double err_estimate = 0.0;  ///< estimated relative error of the final state
+  double step = 0.0;          ///< the step chosen: h, or the fictitious step ds of time-transformed methods
+  double omega_c = 0.0;       ///< time-transformed methods: the time-step constant c used
+  int runs = 0;               ///< integrations made by the search
+  long force_evals = 0;       ///< over all of them
+  double wall_s = 0.0;        ///< their step loops
+};
+
+/// One body's run.
+struct BodyResult {
+  const MethodInfo* method = nullptr;  ///< the method that ran (Accuracy with no method: chosen per body)
+  std::string chosen;                  ///< what was chosen and why (automatic choice only)
+  Outcome outcome = Outcome::ok;
+  std::string reason;                  ///< one line; empty when ok
+  RunResult run;                       ///< final state, steps, cost, invariants (unless refused or failed)
+  std::optional<AccuracyReport> accuracy;
+  /// The force evaluations this body cost in all: the run, and the search of the accuracy mode.
+  [[nodiscard]] long total_force_evals() const;
+};
+
+/// Every body's run, in the scene's order.
+struct Result {
+  std::vector<BodyResult> bodies;
+  Outcome outcome = Outcome::ok;  ///< ok when every body is ok, else the first body's that is not
+  std::string reason;             ///< "<body name>: <reason>" of that body
+  long force_evals = 0;           ///< all bodies, searches included
+  double wall_s = 0.0;            ///< all bodies' step loops, searches included
+};
+
+/// The run specification of `method` under `how` (its step, end time, tolerance and outputs), checked:
+/// the one place where a way of advancing time meets a method. Throws Error for a number out of range
+/// or an Advance the method cannot take (FixedSteps for a step-size-controlled method, ...). Not for
+/// Accuracy, which chooses the step itself.
+RunSpec run_spec(const MethodInfo& method, const Advance& how, const Options& options = {});
+
+/// Integrates one body of a scene (the scene's centres act on it) with `method`; with Accuracy,
+/// `method` may be nullptr: chosen by choose_method.
+BodyResult integrate_body(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
+                          const Advance& how, const Options& options = {});
+
+/// Integrates every body of the scene. With Accuracy `method` may be nullptr (chosen per body).
+Result integrate(const Scene& scene, const MethodInfo* method, const Advance& how, const Options& options = {});
+/// The same with the method by name; "auto" with Accuracy chooses per body.
+Result integrate(const Scene& scene, std::string_view method, const Advance& how, const Options& options = {});
+
+/// One body advanced in segments: advance_to(t) integrates from the current time to t and may be
+/// called again to continue. Each segment starts from the state the previous one ended in, as a run
+/// from that state would (a one-step method continues exactly as one long run of the same steps,
+/// up to round-off in the merged sub-steps; ab4 restarts its history with RK4).
+///   step: fixed-step methods: the largest step <= step that lands on t; time-transformed methods: the
+///         fictitious step ds; step-size-controlled methods: the tolerance per step, and the first
+///         trial step is min(1e-3, t - time()).
+class Stepper {
+ public:
+  Stepper(const MethodInfo& method, Body body, std::vector<Centre> centres, double step, Options options = {});
+  Stepper(std::string_view method, Body body, std::vector<Centre> centres, double step, Options options = {});
+
+  /// Integrates to time t > time(); returns the outcome of the segment (refused or failed leave the
+  /// stepper where it was). Samples handed to options.sink carry absolute times.
+  Outcome advance_to(double t);
+
+  [[nodiscard]] double time() const { return t_; }
+  [[nodiscard]] const State& state() const { return body_.s0; }
+  [[nodiscard]] Momenta momenta() const { return to_momenta(body_.p, body_.s0); }
+  [[nodiscard]] const BodyPoint& body_point() const { return body_.p; }
+  [[nodiscard]] const MethodInfo& method() const { return *method_; }
+  [[nodiscard]] long force_evals() const { return force_evals_; }
+  [[nodiscard]] long steps() const { return steps_; }
+  [[nodiscard]] const std::string& reason() const { return reason_; }  ///< of the last segment that was not ok
+
+ private:
+  const MethodInfo* method_;
+  Body body_;  // body_.s0 is the current state
+  std::vector<Centre> centres_;
+  double step_;
+  Options options_;
+  double t_ = 0.0;
+  long force_evals_ = 0, steps_ = 0;
+  std::string reason_;
+};
+
+}  // namespace bodypoint
