@@ -42,13 +42,13 @@ constexpr long kProgressCheck = 1L << 20;
 void check_progress(long steps, double t_prev, double t, double t_end, long cap) {
   if (!(t > t_prev))
     throw Error("physical time stopped advancing at t = " + detail::short_number(t_prev) + " (step dt = " +
-                detail::short_number(t - t_prev) + "): the time transformation broke down; reduce --h or check D = m J - B^2");
+                detail::short_number(t - t_prev) + "): the time transformation broke down; reduce the fictitious step ds or check D = m J - B^2");
   if (t_end > 0.0 && steps > 0 && steps % kProgressCheck == 0) {
     const double needed = static_cast<double>(steps) * t_end / t;
     if (needed > static_cast<double>(cap))
       throw Error("at its rate so far (t = " + detail::short_number(t) + " after " + std::to_string(steps) +
                   " fictitious steps) the run needs about " + detail::short_number(needed) +
-                  " steps to reach t_end, more than the budget of 2e9; increase --h");
+                  " steps to reach t_end, more than the budget of 2e9; increase the fictitious step ds");
   }
 }
 
@@ -175,7 +175,7 @@ class FictitiousLoop {
       const StepAdvance a = s_.step(x, h);
       if (!std::isfinite(a.t) || !s_.physical_finite(x))
         throw Error(std::string(Stepper::prefix) + "the state became non-finite at t = " +
-                    std::to_string(s_.time(prev)) + "; reduce --h");
+                    std::to_string(s_.time(prev)) + "; reduce the fictitious step ds");
       check_progress(st.steps, s_.time(prev), a.t, t_end, cap);
       if (to_time && a.t >= t_end) {
         x = prev;
@@ -199,7 +199,7 @@ class FictitiousLoop {
   /// The last step, solved to land on t_end, and the outputs up to it.
   template <class Obs>
   void finish(X& x, double t_over, long cap, Obs& obs, StepStats& st) {
-    if (st.steps >= cap) throw Error("more than 2e9 fictitious steps before t_end; increase --h");
+    if (st.steps >= cap) throw Error("more than 2e9 fictitious steps before t_end; increase the fictitious step ds");
     const X prev = x;
     const double rest = spec_.t_end - s_.time(x);
     if (rest > 0.0) {

@@ -103,7 +103,7 @@ RunSpec step_spec(const MethodInfo& m, double h, double t_end, RunSpec s) {
     return s;
   }
   const double n = std::ceil(t_end / h * (1.0 - 1e-12));
-  if (!(n <= 1e12)) throw SearchLimit("--tol: the step the search needs (" + std::to_string(h) + ") is too small");
+  if (!(n <= 1e12)) throw SearchLimit("tol: the step the search needs (" + std::to_string(h) + ") is too small");
   s.steps = std::max(1L, static_cast<long>(n));
   s.h = t_end / static_cast<double>(s.steps);
   s.t_end = 0.0;
@@ -139,7 +139,7 @@ class Search {
     s.omega_c = automatic_omega_c(b_, c_, h_c);
     const double expected = expected_evals(s);
     if (spent_evals_ + expected > kMaxEvals)
-      throw SearchLimit("--tol " + fmt_tol() + " is out of reach of " + std::string(m_.name) +
+      throw SearchLimit("tol " + fmt_tol() + " is out of reach of " + std::string(m_.name) +
                   " within 2e9 force evaluations (last estimate " + fmt_number(last_estimate_) + ")");
     const RunResult r = run(m_, b_, c_, s);
     if (!(r.final.R.allFinite() && r.final.v.allFinite())) throw Error("the state became non-finite");
@@ -220,7 +220,7 @@ class Search {
       const double bound = std::max(e_fine, e_mid);
       const bool smooth = bound <= kSmoothBand * std::min(e_fine, e_mid) || q_obs >= p_;
       if (state_distance(coarse.final, fine.final) <= kRoundOff && bound > kAccept * tol_)
-        throw Error("--tol " + fmt_tol() + " is below the round-off floor of " + std::string(m_.name) +
+        throw Error("tol " + fmt_tol() + " is below the round-off floor of " + std::string(m_.name) +
                     " on this scene (estimate " + fmt_number(estimate_) + ")");
       if (bound <= kAccept * tol_ && (smooth || bound <= kRoundOff)) return fine;
       // Not accurate enough: predict again; not smooth in h (a resonance of the far-field step with the
@@ -232,11 +232,11 @@ class Search {
         best_bound = bound;
         stalled = 0;
       } else if (++stalled >= kMaxStalls) {
-        throw Error("--tol " + fmt_tol() + " is out of reach of " + std::string(m_.name) +
+        throw Error("tol " + fmt_tol() + " is out of reach of " + std::string(m_.name) +
                     " on this scene: the error estimate stalls at " + fmt_number(best_bound));
       }
     }
-    throw Error("--tol " + fmt_tol() + ": " + std::string(m_.name) + " did not reach it in " +
+    throw Error("tol " + fmt_tol() + ": " + std::string(m_.name) + " did not reach it in " +
                 std::to_string(kMaxLevels) + " refinements");
   }
 
@@ -253,7 +253,7 @@ class Search {
     const Level b = run_at(h / kMinRefinement, h);
     estimate_ = std::max(state_distance(a.final, b.final), std::numeric_limits<double>::epsilon());
     if (estimate_ > kAccept * tol_)
-      throw Error("--tol " + fmt_tol() + " is below what " + std::string(m_.name) + " delivers on this scene (" +
+      throw Error("tol " + fmt_tol() + " is below what " + std::string(m_.name) + " delivers on this scene (" +
                   fmt_number(estimate_) + ")");
     return a;
   }
@@ -292,11 +292,11 @@ double state_distance(const State& a, const State& b) {
 }
 
 void check_tolerance(double tol) {
-  if (!std::isfinite(tol) || !(tol > 0.0)) throw Error("--tol must be a finite number > 0");
+  if (!std::isfinite(tol) || !(tol > 0.0)) throw Error("tol must be a finite number > 0");
   if (tol < kMinTolerance)
-    throw Error("--tol below 1e-13 cannot be delivered in double precision (the round-off of a run is "
+    throw Error("tol below 1e-13 cannot be delivered in double precision (the round-off of a run is "
                 "1e-15..1e-13 relative)");
-  if (!(tol < 1.0)) throw Error("--tol must be below 1 (it is a relative error of the final state)");
+  if (!(tol < 1.0)) throw Error("tol must be below 1 (it is a relative error of the final state)");
 }
 
 RunSpec delivered_spec(const MethodInfo& method, const ToleranceResult& r, double t_end, RunSpec base) {
@@ -307,16 +307,16 @@ RunSpec delivered_spec(const MethodInfo& method, const ToleranceResult& r, doubl
 ToleranceResult run_to_tolerance(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
                                  double tol, double t_end) {
   check_tolerance(tol);
-  if (!(std::isfinite(t_end) && t_end > 0.0)) throw Error("--tol needs a finite end time > 0");
+  if (!(std::isfinite(t_end) && t_end > 0.0)) throw Error("the accuracy mode needs an end time t_end that is a finite number > 0");
   if (is_step_controlled(method))
-    throw Error(std::string(method.name) + " controls its own step: give it --tol without the search (this is "
-                "for fixed-step and time-transformed methods)");
+    throw Error(std::string(method.name) + " controls its own step: give it a tolerance per step, not the accuracy mode's "
+                "search (which is for fixed-step and time-transformed methods)");
   if (method.order == 0 && method.name != "ks")
     throw Error(std::string(method.name) + " has no fixed order for the error estimate");
   validate(Scene{centres, {body}});
   if (non_coulomb(centres))
-    throw Error("--tol assumes Coulomb's law (its error model and time transformations do); run the thesis code's "
-                "force law with a fixed step --h");
+    throw Error("the accuracy mode (tol) assumes Coulomb's law (its error model and time transformations do); run "
+                "the thesis code's force law with a fixed step h");
   return Search(method, body, centres, tol, t_end).search();
 }
 

@@ -147,7 +147,7 @@ TEST(Cli, BadInputGivesOneLineErrorNonZeroExitAndNoOutputFile) {
       {"--h abc", "invalid"},
       {"--force-law newton", "unknown --force-law 'newton'"},
       {"--force-law thesis-code --method logh-y4 --h 0.1", "assumes Coulomb's law"},
-      {"--force-law thesis-code --tol 1e-6 --t-end 5", "--tol assumes Coulomb's law"},
+      {"--force-law thesis-code --tol 1e-6 --t-end 5", "the accuracy mode (tol) assumes Coulomb's law"},
       {"--scene " + bad_scene.string() + " --force-law thesis-code", "cannot be combined with --scene"},
   };
   const fs::path out = dir / "out.csv";

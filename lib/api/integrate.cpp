@@ -169,12 +169,17 @@ Outcome Stepper::advance_to(double t) {
   if (is_time_transformed(*method_)) how = FictitiousSteps{step_, span, 0, 0.0};
   else if (is_step_controlled(*method_)) how = ControlledSteps{std::min(1e-3, span), span, step_};
   else how = fixed_steps_to(span, step_);
-  // Samples carry absolute times: the segment's run starts at 0.
+  // Samples carry absolute times (the segment's run starts at 0); a later segment's first sample is
+  // the state the previous one ended with, already handed on.
   const double t0 = t_;
+  const bool first = steps_ == 0;
   SampleSink shifted;
   Options opt = options_;
   if (options_.sink) {
-    shifted = [this, t0](const Sample& s) { (*options_.sink)(Sample{s.step, t0 + s.t, s.s, s.rel_dE, s.rel_dK2sq, s.abs_dK2Q}); };
+    shifted = [this, t0, first](const Sample& s) {
+      if (s.step == 0 && !first) return;
+      (*options_.sink)(Sample{s.step, t0 + s.t, s.s, s.rel_dE, s.rel_dK2sq, s.abs_dK2Q});
+    };
     opt.sink = &shifted;
   }
   const BodyResult r = integrate_body(body_, centres_, method_, how, opt);

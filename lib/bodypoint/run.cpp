@@ -153,20 +153,20 @@ std::string refusal(const MethodInfo& m, const Body& body, const std::vector<Cen
 Advance advance_of(const MethodInfo& m, const RunSpec& spec) {
   if (!std::isfinite(spec.h) || spec.h <= 0.0)
     throw Error("step size h must be a finite number > 0, got " + std::to_string(spec.h));
-  if (spec.every < 1) throw Error("--every must be >= 1");
+  if (spec.every < 1) throw Error("every must be >= 1");
   if (is_time_transformed(m)) {
     if (spec.t_end < 0.0 || !std::isfinite(spec.t_end)) throw Error("end time must be a finite number >= 0");
     if (spec.t_end == 0.0 && spec.steps < 1) throw Error("give a number of fictitious steps or an end time");
-    if (spec.dt_out < 0.0 || !std::isfinite(spec.dt_out)) throw Error("--dt-out must be a finite number >= 0");
+    if (spec.dt_out < 0.0 || !std::isfinite(spec.dt_out)) throw Error("dt_out must be a finite number >= 0");
     return FictitiousSteps{spec.h, spec.t_end, spec.t_end == 0.0 ? spec.steps : 0, spec.dt_out};
   }
   if (spec.steps < 1) throw Error("number of steps must be >= 1");
   if (!is_step_controlled(m)) return FixedSteps{spec.h, spec.steps};
   const double t_end = spec.t_end == 0.0 ? spec.h * static_cast<double>(spec.steps) : spec.t_end;
   if (!std::isfinite(t_end) || t_end <= 0.0) throw Error("end time must be a finite number > 0");
-  if (!std::isfinite(spec.tol) || spec.tol <= 0.0) throw Error("--tol must be a finite number > 0");
+  if (!std::isfinite(spec.tol) || spec.tol <= 0.0) throw Error("the tolerance tol must be a finite number > 0");
   if (spec.tol < kMinStepTolerance)
-    throw Error("--tol " + detail::short_number(spec.tol) + " is below what double precision can deliver (a step's "
+    throw Error("tol " + detail::short_number(spec.tol) + " is below what double precision can deliver (a step's "
                 "rounding is ~1e-16 relative; the smallest tolerance taken is 1e-15)");
   return ControlledSteps{spec.h, t_end, spec.tol};
 }

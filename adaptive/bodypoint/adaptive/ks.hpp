@@ -163,7 +163,7 @@ class KsMotion {
   }
   [[nodiscard]] int substeps(double ds) const {
     const double n = std::ceil(std::abs(ds) / max_substep());
-    if (!(n <= 1e9)) throw Error("ks: the fictitious step needs more than 1e9 sub-steps; reduce --h");
+    if (!(n <= 1e9)) throw Error("ks: the fictitious step needs more than 1e9 sub-steps; reduce the fictitious step ds");
     return std::max(1, static_cast<int>(n));
   }
 

@@ -83,7 +83,7 @@ struct LogHKernel {
     const double gc = x.g + c;
     if (!(gc > 0.0))
       throw Error("logh: E - T + c = " + std::to_string(gc) + " <= 0 at t = " + std::to_string(x.time()) +
-                  " (the fictitious step is too large for this encounter; reduce --h)");
+                  " (the fictitious step is too large for this encounter; reduce the fictitious step ds)");
     const double dt = ds / gc;
     lp.drift(x.q, dt);
     advance_time(x, dt);

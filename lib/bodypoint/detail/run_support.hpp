@@ -41,7 +41,7 @@ inline void check_adaptive_rate(long steps, double t, double t_end) {
   if (needed > static_cast<double>(kMaxAdaptiveSteps))
     throw Error("at its rate so far (t = " + short_number(t) + " after " + std::to_string(steps) +
                 " accepted steps) the run needs about " + short_number(needed) + " steps to reach t_end = " +
-                short_number(t_end) + ", more than the budget of 2e8; loosen --tol or shorten --t-end");
+                short_number(t_end) + ", more than the budget of 2e8; loosen the tolerance tol or shorten t_end");
 }
 
 /// False when a step from t_before to t did not move time by more than a few of its last bits: such

@@ -71,7 +71,7 @@ struct OdeintSays {
   }
   static std::string too_many(double t, double t_end) {
     return "more than 2e8 accepted steps before t_end = " + detail::short_number(t_end) + " (reached t = " +
-           detail::short_number(t) + "); loosen --tol or shorten --t-end";
+           detail::short_number(t) + "); loosen the tolerance tol or shorten t_end";
   }
   static std::string collapsed(double t) {
     return "adaptive step size collapsed at t = " + std::to_string(t) + " (tolerance too tight?)";

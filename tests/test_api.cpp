@@ -1,0 +1,210 @@
+// The public API (bodypoint.hpp) through the library: integrate() is run() for every way of advancing
+// time, outcomes are typed, run_spec() is where an Advance meets a method, and a Stepper continues a
+// run as one run of the same steps would.
+#include "bodypoint/adaptive/tolerance.hpp"
+#include "bodypoint/bodypoint.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <vector>
+
+namespace bodypoint {
+namespace {
+
+/// Continuing a one-step method in segments repeats the same steps from the same states; the state
+/// crosses each segment boundary through (R, v, w) and back to the method's variables (R, K1, K2),
+/// which rounds it once more: a few ulp per boundary, over 10 boundaries.
+constexpr double kSegmentRoundOff = 1e-12;
+
+Scene thesis() { return thesis_scene(SceneParams{}); }
+
+double rel(const Vec3& a, const Vec3& b) { return (a - b).norm() / b.norm(); }
+
+TEST(Api, IntegrateIsRunForEveryWayOfAdvancingTime) {
+  const Scene s = thesis();
+  const Body& b = s.bodies.front();
+  struct Case {
+    const char* method;
+    Advance how;
+  };
+  const std::vector<Case> cases = {
+      {"lp-y4", FixedSteps{1e-2, 500}},
+      {"rk4", FixedSteps{1e-2, 500}},
+      {"logh-kl6", FictitiousSteps{0.05, 5.0, 0, 0.0}},
+      {"odeint-dopri5", ControlledSteps{1e-3, 5.0, 1e-9}},
+  };
+  for (const Case& c : cases) {
+    const MethodInfo& m = method_or_throw(c.method);
+    const Result r = integrate(s, c.method, c.how);
+    ASSERT_EQ(r.outcome, Outcome::ok) << c.method << ": " << r.reason;
+    const RunResult direct = run(m, b, s.centres, run_spec(m, c.how));
+    EXPECT_EQ(r.bodies.front().run.final.R, direct.final.R) << c.method;
+    EXPECT_EQ(r.bodies.front().run.final.v, direct.final.v) << c.method;
+    EXPECT_EQ(r.bodies.front().run.force_evals, direct.force_evals) << c.method;
+    ASSERT_TRUE(r.bodies.front().run.invariants.has_value()) << c.method;
+    EXPECT_EQ(r.force_evals, direct.force_evals) << c.method;
+  }
+}
+
+TEST(Api, AccuracyModeDeliversTheSearchedRunWithItsReport) {
+  SceneParams p;
+  p.start.Kz = 0.1;
+  p.start.d = 0.05;
+  const Scene s = thesis_scene(p);
+  const Body& b = s.bodies.front();
+  const double tol = 1e-8, t_end = 80.0;
+  Options quiet;
+  quiet.track_invariants = false;
+  const Result r = integrate(s, "auto", Accuracy{tol, t_end}, quiet);
+  ASSERT_EQ(r.outcome, Outcome::ok) << r.reason;
+  const BodyResult& br = r.bodies.front();
+  ASSERT_TRUE(br.accuracy.has_value());
+  EXPECT_FALSE(br.chosen.empty());
+  const adaptive::ToleranceResult t = adaptive::run_to_tolerance(*br.method, b, s.centres, tol, t_end);
+  EXPECT_EQ(br.run.final.R, t.result.final.R);
+  EXPECT_LE(br.accuracy->err_estimate, tol);
+  EXPECT_EQ(br.accuracy->force_evals, t.total_force_evals);
+  // The total counts the search: it is what the user's request cost.
+  EXPECT_EQ(r.force_evals, br.run.force_evals + t.total_force_evals);
+  // With invariants asked for, the delivered run carries them and ends in the same state.
+  const Result with = integrate(s, br.method, Accuracy{tol, t_end});
+  ASSERT_TRUE(with.bodies.front().run.invariants.has_value());
+  EXPECT_EQ(with.bodies.front().run.final.R, br.run.final.R);
+}
+
+TEST(Api, OutcomesAreTyped) {
+  // refused: ks is for a material point; the reason is the method's own.
+  const Scene s = thesis();
+  const Result refused = integrate(s, "ks", FictitiousSteps{0.1, 1.0, 0, 0.0});
+  EXPECT_EQ(refused.outcome, Outcome::refused);
+  EXPECT_EQ(refused.bodies.front().reason, refusal(method_or_throw("ks"), s.bodies.front(), s.centres));
+  EXPECT_NE(refused.reason.find(refused.bodies.front().reason), std::string::npos);
+  // diverged: a step far too large for the encounter of a close pass.
+  SceneParams close;
+  close.start.Kz = 0.1;
+  close.start.d = 0.05;
+  close.start.L = 20.0;
+  const Result diverged = integrate(thesis_scene(close), "thesis-euler", FixedSteps{0.5, 200});
+  EXPECT_EQ(diverged.outcome, Outcome::diverged) << outcome_name(diverged.outcome);
+  EXPECT_FALSE(diverged.reason.empty());
+  // failed: an accuracy a method cannot reach on the scene (the thesis's Euler is first order for
+  // B != 0: 1e-12 would take more than the search's budget of force evaluations).
+  const Result failed = integrate(s, "thesis-euler", Accuracy{1e-12, 50.0});
+  EXPECT_EQ(failed.outcome, Outcome::failed);
+  EXPECT_FALSE(failed.reason.empty());
+  EXPECT_EQ(outcome_name(Outcome::collision), "collision");
+}
+
+TEST(Api, InvalidRequestsThrowWithTheQuantityNamed) {
+  const Scene s = thesis();
+  EXPECT_THROW(integrate(s, "no-such-method", FixedSteps{1e-2, 10}), Error);
+  EXPECT_THROW(integrate(s, "auto", FixedSteps{1e-2, 10}), Error);
+  EXPECT_THROW(integrate(s, nullptr, FixedSteps{1e-2, 10}), Error);
+  EXPECT_THROW(integrate(s, "lp-y4", FixedSteps{-1.0, 10}), Error);
+  EXPECT_THROW(integrate(s, "lp-y4", FixedSteps{std::nan(""), 10}), Error);
+  EXPECT_THROW(integrate(s, "lp-y4", Accuracy{0.0, 10.0}), Error);
+  EXPECT_THROW(integrate(s, "lp-y4", Accuracy{1e-6, -1.0}), Error);
+  // An Advance the method does not take.
+  EXPECT_THROW(run_spec(method_or_throw("lp-y4"), ControlledSteps{1e-3, 1.0, 1e-8}), Error);
+  EXPECT_THROW(run_spec(method_or_throw("odeint-dopri5"), FixedSteps{1e-3, 10}), Error);
+  EXPECT_THROW(run_spec(method_or_throw("logh-y4"), FixedSteps{1e-3, 10}), Error);
+  EXPECT_THROW(run_spec(method_or_throw("lp-y4"), FictitiousSteps{0.1, 1.0, 0, 0.0}), Error);
+  // A scene that breaks a rule: D = m J - B^2 <= 0.
+  SceneParams singular;
+  singular.B = 1.0;
+  EXPECT_THROW(integrate(thesis_scene(singular), "lp-y4", FixedSteps{1e-2, 10}), Error);
+  // The library's reasons name quantities (h, tol, every), never a command-line flag.
+  Options every0;
+  every0.every = 0;
+  const std::vector<std::function<void()>> bad = {
+      [&] { integrate(s, "lp-y4", FixedSteps{0.0, 10}); },
+      [&] { integrate(s, "lp-y4", FixedSteps{1e-2, 10}, every0); },
+      [&] { integrate(s, "odeint-dopri5", ControlledSteps{1e-3, 1.0, 1e-20}); },
+      [&] { integrate(s, "lp-y4", Accuracy{1e-20, 1.0}); },
+      [&] { integrate(s, "lp-y4", Accuracy{2.0, 1.0}); },
+      [&] { integrate(s, "logh-y4", FictitiousSteps{0.1, 1.0, 0, -1.0}); },
+  };
+  for (std::size_t i = 0; i < bad.size(); ++i) {
+    try {
+      bad[i]();
+      ADD_FAILURE() << "request " << i << " accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()).find("--"), std::string::npos) << "a library error names a flag: " << e.what();
+    }
+  }
+  const Result unreachable = integrate(s, "thesis-euler", Accuracy{1e-12, 50.0});
+  EXPECT_EQ(unreachable.reason.find("--"), std::string::npos) << unreachable.reason;
+}
+
+TEST(Api, FixedStepsLandOnTheEndTime) {
+  const FixedSteps f = fixed_steps_to(1.0, 0.3);
+  EXPECT_EQ(f.steps, 4);
+  EXPECT_DOUBLE_EQ(f.h * static_cast<double>(f.steps), 1.0);
+  EXPECT_EQ(fixed_steps_to(1.0, 0.1).steps, 10);  // 1/0.1 rounds to 10.000000000000002: still 10
+  EXPECT_THROW(fixed_steps_to(1.0, 0.0), Error);
+  EXPECT_THROW(fixed_steps_to(1e20, 1e-10), Error);
+}
+
+TEST(Api, AStepperContinuesAsOneRunOfTheSameSteps) {
+  const Scene s = thesis();
+  const Body& b = s.bodies.front();
+  const double h = 1e-2;
+  Stepper stepper("lp-y4", b, s.centres, h);
+  for (int k = 1; k <= 10; ++k) ASSERT_EQ(stepper.advance_to(k), Outcome::ok) << stepper.reason();
+  EXPECT_EQ(stepper.time(), 10.0);
+  EXPECT_EQ(stepper.steps(), 1000);
+  const Result one = integrate(s, "lp-y4", FixedSteps{h, 1000});
+  const State& whole = one.bodies.front().run.final;
+  EXPECT_LT(rel(stepper.state().R, whole.R), kSegmentRoundOff);
+  EXPECT_LT(rel(stepper.state().v, whole.v), kSegmentRoundOff);
+  EXPECT_LT(rel(stepper.state().w, whole.w), kSegmentRoundOff);
+  // The same steps: the same work.
+  EXPECT_EQ(stepper.force_evals(), one.bodies.front().run.force_evals);
+}
+
+TEST(Api, AStepperHandsOnSamplesWithAbsoluteTimes) {
+  const Scene s = thesis();
+  std::vector<double> times;
+  const SampleSink sink = [&times](const Sample& x) { times.push_back(x.t); };
+  Options o;
+  o.sink = &sink;
+  o.every = 50;
+  Stepper stepper("lp-y4", s.bodies.front(), s.centres, 1e-2, o);
+  ASSERT_EQ(stepper.advance_to(1.0), Outcome::ok);
+  ASSERT_EQ(stepper.advance_to(2.0), Outcome::ok);
+  // 0, 0.5, 1 from the first segment; 1.5, 2 from the second (its start is the first's end).
+  ASSERT_EQ(times.size(), 5u);
+  for (std::size_t i = 0; i < times.size(); ++i) EXPECT_NEAR(times[i], 0.5 * static_cast<double>(i), 1e-12);
+}
+
+TEST(Api, AStepperRefusesTimeThatDoesNotAdvanceAndKeepsItsState) {
+  const Scene s = thesis();
+  Stepper stepper("logh-y4", s.bodies.front(), s.centres, 0.05);
+  ASSERT_EQ(stepper.advance_to(1.0), Outcome::ok);
+  const State before = stepper.state();
+  EXPECT_THROW(stepper.advance_to(1.0), Error);
+  EXPECT_THROW(stepper.advance_to(std::nan("")), Error);
+  EXPECT_EQ(stepper.state().R, before.R);
+  // A method that refuses the scene leaves the stepper where it was.
+  Stepper ks("ks", s.bodies.front(), s.centres, 0.05);
+  EXPECT_EQ(ks.advance_to(1.0), Outcome::refused);
+  EXPECT_EQ(ks.time(), 0.0);
+  EXPECT_FALSE(ks.reason().empty());
+}
+
+TEST(Api, MultiBodyTotalsAreTheSumOfTheBodies) {
+  Scene s = thesis();
+  Body second = s.bodies.front();
+  second.name = "second";
+  second.s0.R.y() += 3.0;
+  s.bodies.push_back(second);
+  const Result r = integrate(s, "lp-y6", FixedSteps{1e-2, 300});
+  ASSERT_EQ(r.bodies.size(), 2u);
+  EXPECT_EQ(r.force_evals, r.bodies[0].run.force_evals + r.bodies[1].run.force_evals);
+  EXPECT_NE(r.bodies[0].run.final.R, r.bodies[1].run.final.R);
+}
+
+}  // namespace
+}  // namespace bodypoint
