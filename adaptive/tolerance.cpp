@@ -315,8 +315,7 @@ ToleranceResult run_to_tolerance(const MethodInfo& method, const Body& body, con
     throw Error(std::string(method.name) + " has no fixed order for the error estimate");
   validate(Scene{centres, {body}});
   if (non_coulomb(centres))
-    throw Error("the accuracy mode (tol) assumes Coulomb's law (its error model and time transformations do); run "
-                "the thesis code's force law with a fixed step h");
+    throw Error(std::string(kNeedsCoulomb));
   return Search(method, body, centres, tol, t_end).search();
 }
 

@@ -1,7 +1,7 @@
 // bodypoint command line: options shared by the subcommands.
 #pragma once
 
-#include "bodypoint/adaptive/tolerance.hpp"
+#include "bodypoint/bodypoint.hpp"
 #include "bodypoint/model.hpp"
 #include "bodypoint/run.hpp"
 
@@ -56,10 +56,14 @@ struct BodyRun {
   RunResult result;
   std::optional<double> err_R;
   std::optional<double> err_rel;  ///< max(|dR|/|R_ref|, |dv|/|v_ref|), the measure --tol bounds
-  std::optional<adaptive::ToleranceResult> search;
+  std::optional<AccuracyReport> search;
   std::string why;  ///< --method auto: what was chosen and why
+  Outcome outcome = Outcome::ok;
+  std::string reason;  ///< of an outcome other than ok
 };
-/// Runs one body as planned (spec may add invariants, output steps and a sink to plan.spec).
+/// Runs one body as planned through the library (integrate_body; spec may add invariants, output
+/// steps and a sink to plan.spec). A method that refuses the scene or a run that fails throws Error
+/// with the library's reason; diverged and collision are left to the caller (outcome, reason).
 BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
                  const SampleSink* sink);
 

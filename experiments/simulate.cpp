@@ -92,19 +92,21 @@ RunPlan plan_run(const po::variables_map& vm, const StepOptions& st, const std::
 
 BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
                  const SampleSink* sink) {
+  Options options;
+  options.track_invariants = spec.track_invariants;
+  options.sink = sink;
+  options.every = spec.every;
+  options.omega_c = spec.omega_c;
+  const Advance how = plan.search ? Advance(Accuracy{plan.tol, spec.t_end, spec.dt_out}) : advance_of(*plan.method, spec);
+  BodyResult r = integrate_body(body, centres, plan.method, how, options);
+  if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) throw Error(r.reason);
   BodyRun b;
-  if (!plan.search) {
-    b.method = plan.method;
-    b.result = run(*plan.method, body, centres, spec, sink);
-    return b;
-  }
-  // The step search, then the delivered run repeated with invariants or output when they are asked for.
-  b.method = plan.method ? plan.method : &choose_method(body, centres, plan.tol, &b.why);
-  b.search = adaptive::run_to_tolerance(*b.method, body, centres, plan.tol, spec.t_end);
-  if (spec.track_invariants || sink)
-    b.result = run(*b.method, body, centres, adaptive::delivered_spec(*b.method, *b.search, spec.t_end, spec), sink);
-  else
-    b.result = b.search->result;
+  b.method = r.method;
+  b.result = std::move(r.run);
+  b.search = r.accuracy;
+  b.why = std::move(r.chosen);
+  b.outcome = r.outcome;
+  b.reason = std::move(r.reason);
   return b;
 }
 
@@ -114,9 +116,9 @@ std::string search_json(const BodyRun& b, double tol) {
   if (!b.search) return "";
   std::ostringstream os;
   os << ", \"tol\": " << json_number(tol) << ", \"err_estimate\": " << json_number(b.search->err_estimate)
-     << ", \"h_chosen\": " << json_number(b.search->h) << ", \"search_runs\": " << b.search->runs
-     << ", \"search_force_evals\": " << b.search->total_force_evals
-     << ", \"search_wall_s\": " << json_number(b.search->total_wall_s);
+     << ", \"h_chosen\": " << json_number(b.search->step) << ", \"search_runs\": " << b.search->runs
+     << ", \"search_force_evals\": " << b.search->force_evals
+     << ", \"search_wall_s\": " << json_number(b.search->wall_s);
   if (!b.why.empty()) os << ", \"chosen\": \"" << b.why << "\"";
   return os.str();
 }
@@ -125,9 +127,9 @@ std::string search_line(const BodyRun& b) {
   std::ostringstream os;
   os << "method=" << b.method->name;
   if (b.search)
-    os << (is_time_transformed(*b.method) ? " ds=" : " h=") << fmt(b.search->h)
+    os << (is_time_transformed(*b.method) ? " ds=" : " h=") << fmt(b.search->step)
        << " err_estimate=" << fmt(b.search->err_estimate) << " search: " << b.search->runs << " runs, "
-       << b.search->total_force_evals << " force evaluations";
+       << b.search->force_evals << " force evaluations";
   return os.str();
 }
 
@@ -260,11 +262,10 @@ BodyRun simulate_body(const SimulateOptions& o, const RunPlan& plan, const Body&
     const ProgressBar bar(estimate, progress_wanted(o.quiet));
     br = run_body(plan, body, scene.centres, plan.spec, sink);
   }
-  const Health health = assess(br.result);
-  if (health.status != "ok")
-    throw Error("body '" + body.name + "' (" + std::string(br.method->name) + "): " + health.why +
-                (health.status == "collision" ? "; a time-transformed method (ttl-*) or a smaller --h can follow it"
-                                              : "; the step is too large for this scene (reduce --h)") +
+  if (br.outcome != Outcome::ok)
+    throw Error("body '" + body.name + "' (" + std::string(br.method->name) + "): " + br.reason +
+                (br.outcome == Outcome::collision ? "; a time-transformed method (ttl-*) or a smaller --h can follow it"
+                                                  : "; the step is too large for this scene (reduce --h)") +
                 "; no output written");
   if (o.with_reference) {
     const State ref = reference_state(body, scene.centres, br.result.t_end);
@@ -276,7 +277,7 @@ BodyRun simulate_body(const SimulateOptions& o, const RunPlan& plan, const Body&
 
 void report_json(const std::vector<BodyRun>& runs, const Scene& scene, const RunPlan& plan) {
   const BodyRun& r0 = runs.front();
-  const double h0 = r0.search ? r0.search->h : plan.spec.h;
+  const double h0 = r0.search ? r0.search->step : plan.spec.h;
   std::cout << "{\"method\": \"" << r0.method->name << "\", \"h\": " << json_number(h0)
             << (is_step_controlled(*r0.method) ? ", \"tol\": " + json_number(plan.spec.tol) : std::string())
             << search_json(r0, plan.tol) << ", \"steps\": " << r0.result.steps

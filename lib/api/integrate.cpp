@@ -85,6 +85,7 @@ void run_accurately(BodyResult& r, const Body& body, const std::vector<Centre>& 
   RunSpec base;
   base.track_invariants = options.track_invariants;
   base.every = options.every;
+  base.dt_out = a.dt_out;
   r.run = run(*r.method, body, centres, adaptive::delivered_spec(*r.method, t, a.t_end, base), options.sink);
 }
 
@@ -100,6 +101,12 @@ BodyResult integrate_body(const Body& body, const std::vector<Centre>& centres, 
     if (!(std::isfinite(accuracy->t_end) && accuracy->t_end > 0.0))
       throw Error("the accuracy mode needs an end time t_end that is a finite number > 0");
     if (options.every < 1) throw Error("every must be >= 1");
+    if (non_coulomb(centres)) {
+      r.method = method;
+      r.outcome = Outcome::refused;
+      r.reason = adaptive::kNeedsCoulomb;
+      return r;
+    }
     r.method = method ? method : &choose_method(body, centres, accuracy->tol, &r.chosen);
   } else {
     if (!method) throw Error("only the accuracy mode chooses a method by itself; name one");

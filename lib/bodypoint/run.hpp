@@ -147,6 +147,7 @@ struct ControlledSteps {
 /// most tol; the step (h, or ds) is searched with a Richardson error estimate (adaptive/tolerance.hpp).
 struct Accuracy {
   double tol, t_end;
+  double dt_out = 0.0;  ///< with a sink, when the method chosen is time-transformed: samples at t = k dt_out
 };
 using Advance = std::variant<FixedSteps, FictitiousSteps, ControlledSteps, Accuracy>;
 

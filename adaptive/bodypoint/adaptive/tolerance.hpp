@@ -18,6 +18,7 @@
 #include "bodypoint/run.hpp"
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace bodypoint::adaptive {
@@ -26,6 +27,11 @@ namespace bodypoint::adaptive {
 /// floor of 1e-15..1e-13 relative (README, round-off floor test), so a smaller error cannot be
 /// delivered, nor estimated, in double precision.
 inline constexpr double kMinTolerance = 1e-13;
+
+/// Why the accuracy mode refuses a scene with a centre that does not follow Coulomb's law.
+inline constexpr std::string_view kNeedsCoulomb =
+    "the accuracy mode (tol) assumes Coulomb's law (its error model and time transformations do); run the thesis "
+    "code's force law with a fixed step h";
 
 struct ToleranceResult {
   RunResult result;        ///< the delivered run (no invariants, no samples: see delivered_spec)

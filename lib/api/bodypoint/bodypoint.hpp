@@ -73,7 +73,9 @@ struct AccuracyReport {
 
 /// One body's run.
 struct BodyResult {
-  const MethodInfo* method = nullptr;  ///< the method that ran (Accuracy with no method: chosen per body)
+  /// The method that ran (Accuracy with no method: chosen per body); nullptr only when the accuracy
+  /// mode refused the scene before a method was chosen.
+  const MethodInfo* method = nullptr;
   std::string chosen;                  ///< what was chosen and why (automatic choice only)
   Outcome outcome = Outcome::ok;
   std::string reason;                  ///< one line; empty when ok
