@@ -119,7 +119,7 @@ std::string search_json(const BodyRun& b, double tol) {
      << ", \"h_chosen\": " << json_number(b.search->step) << ", \"search_runs\": " << b.search->runs
      << ", \"search_force_evals\": " << b.search->force_evals
      << ", \"search_wall_s\": " << json_number(b.search->wall_s);
-  if (!b.why.empty()) os << ", \"chosen\": \"" << b.why << "\"";
+  if (!b.why.empty()) os << ", \"chosen\": " << json_string(b.why);
   return os.str();
 }
 
@@ -278,15 +278,15 @@ BodyRun simulate_body(const SimulateOptions& o, const RunPlan& plan, const Body&
 void report_json(const std::vector<BodyRun>& runs, const Scene& scene, const RunPlan& plan) {
   const BodyRun& r0 = runs.front();
   const double h0 = r0.search ? r0.search->step : plan.spec.h;
-  std::cout << "{\"method\": \"" << r0.method->name << "\", \"h\": " << json_number(h0)
+  std::cout << "{\"method\": " << json_string(r0.method->name) << ", \"h\": " << json_number(h0)
             << (is_step_controlled(*r0.method) ? ", \"tol\": " + json_number(plan.spec.tol) : std::string())
             << search_json(r0, plan.tol) << ", \"steps\": " << r0.result.steps
             << ", \"t_end\": " << json_number(r0.result.t_end) << ", " << json_body(r0.result, r0.err_R, r0.err_rel);
   if (runs.size() > 1) {
     std::cout << ", \"bodies\": [";
     for (std::size_t b = 0; b < runs.size(); ++b)
-      std::cout << (b ? ", " : "") << "{\"name\": \"" << scene.bodies[b].name << "\", \"method\": \""
-                << runs[b].method->name << "\"" << search_json(runs[b], plan.tol) << ", "
+      std::cout << (b ? ", " : "") << "{\"name\": " << json_string(scene.bodies[b].name) << ", \"method\": "
+                << json_string(runs[b].method->name) << search_json(runs[b], plan.tol) << ", "
                 << json_body(runs[b].result, runs[b].err_R, runs[b].err_rel) << "}";
     std::cout << "]";
   }

@@ -108,20 +108,6 @@ class Decimator {
 };
 
 /// A JSON string literal that is also safe inside an HTML <script> element.
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (const unsigned char c : s) {
-    char buf[8];
-    if (c == '"' || c == '\\' || c < 0x20 || c == '<' || c == '>' || c == '&') {
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else {
-      out += static_cast<char>(c);
-    }
-  }
-  return out + "\"";
-}
-
 /// x with `digits` significant digits (JSON: non-finite values never reach here, Decimator refuses them).
 void put(std::string& out, double x, int digits) {
   char buf[32];
@@ -174,7 +160,7 @@ TrackJson body_json(const Body& body, const std::vector<Centre>& centres, const 
   if (d.seen() < 2) throw Error(who + ": the run produced no trajectory (fewer than two states); no page written");
   if (const Health h = assess(br.result); h.status != "ok") throw Error(who + ": " + h.why + "; no page written");
   const std::vector<Frame> f = d.frames(frames);
-  std::string out = "{\"name\": " + json_string(body.name) + ", \"steps\": " + std::to_string(br.result.steps) +
+  std::string out = "{\"name\": " + json_string(body.name, true) + ", \"steps\": " + std::to_string(br.result.steps) +
                     ", \"force_evals\": " + std::to_string(br.result.force_evals) + ", \"invariants\": {";
   if (br.result.invariants) {
     const InvariantStats& inv = *br.result.invariants;
@@ -270,16 +256,16 @@ std::vector<RunPlan> view_plans(const po::variables_map& vm, const ViewOptions& 
 /// The page's data: the scene, and every run of every body (the second run ends where the first did).
 std::string page_json(const std::string& title, const std::string& scene_line, const Scene& scene,
                       const std::vector<RunPlan>& plans, const std::vector<std::string>& labels, long frames) {
-  std::string json = "{\"title\": " + json_string(title) + ", \"scene\": " + json_string(scene_line) +
-                     ", \"revision\": " + json_string(git_revision()) + ", \"centres\": [";
+  std::string json = "{\"title\": " + json_string(title, true) + ", \"scene\": " + json_string(scene_line, true) +
+                     ", \"revision\": " + json_string(git_revision(), true) + ", \"centres\": [";
   for (std::size_t i = 0; i < scene.centres.size(); ++i)
     json += (i ? ", " : "") + std::string("{\"c\": ") + json_vec(scene.centres[i].c) + ", \"A\": " +
             json_number(scene.centres[i].A) + "}";
   json += "], \"runs\": [";
   std::vector<double> t_end(scene.bodies.size(), 0.0);
   for (std::size_t k = 0; k < plans.size(); ++k) {
-    json += (k ? ", " : "") + std::string("{\"method\": ") + json_string(labels[k]) +
-            ", \"step\": " + json_string(step_label(plans[k])) + ", \"bodies\": [";
+    json += (k ? ", " : "") + std::string("{\"method\": ") + json_string(labels[k], true) +
+            ", \"step\": " + json_string(step_label(plans[k]), true) + ", \"bodies\": [";
     for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
       const RunSpec spec = k == 0 ? plans[k].spec : ending_at(plans[k], t_end[b]);
       const TrackJson tr = body_json(scene.bodies[b], scene.centres, plans[k], spec,

@@ -208,6 +208,20 @@ std::string json_vec(const Vec3& v) {
   return os.str();
 }
 
+std::string json_string(std::string_view s, bool html_safe) {
+  std::string out = "\"";
+  for (const unsigned char c : s) {
+    if (c == '"' || c == '\\' || c < 0x20 || (html_safe && (c == '<' || c == '>' || c == '&'))) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      out += buf;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out + "\"";
+}
+
 const char* git_revision() { return BODYPOINT_GIT_REVISION; }
 
 }  // namespace bodypoint

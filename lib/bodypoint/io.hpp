@@ -13,6 +13,7 @@
 
 #include <fstream>
 #include <string>
+#include <string_view>
 
 namespace bodypoint {
 
@@ -89,6 +90,9 @@ class CsvLine {
 std::string json_number(double x);
 /// "[x, y, z]" as JSON.
 std::string json_vec(const Vec3& v);
+/// s as a JSON string: quotes, backslashes and control characters escaped (\u00XX). With html_safe,
+/// also <, > and &, so that the text can stand inside an HTML <script> element.
+std::string json_string(std::string_view s, bool html_safe = false);
 
 /// The git revision this binary was built from.
 const char* git_revision();
