@@ -1,5 +1,5 @@
 // bodypoint study orders: for every fixed-step and time-transformed method, a ladder of steps h0/sqrt(2)^k
-// on the two scenes of tests/test_convergence.cpp, the final position against a long-double reference,
+// on the two scenes of tests/lib/test_convergence.cpp, the final position against a long-double reference,
 // and the slope fitted above round-off (bodypoint/order_fit.hpp):
 //   encounter  table 3.1 moved close (L = 20, d = 1), stopped at t = 3 next to the closest approach;
 //   orbit      a bound eccentric orbit (A = 1, e ~ 0.44) for two periods (t = 30): a longer run widens
@@ -84,7 +84,7 @@ double measured_order(const MethodInfo& m, const Probe& p, std::size_t* used) {
 void write_orders(std::ostream& csv) {
   csv << "# bodypoint study orders: slope of the final-position error against the step, fitted above\n"
       << "# round-off (lib/bodypoint/order_fit.hpp), on the encounter (L = 20, d = 1, t = 3) and the bound\n"
-      << "# orbit (A = 1, t = 30) of tests/test_convergence.cpp, B = 0.7 (ks: B = 0); time-transformed\n"
+      << "# orbit (A = 1, t = 30) of tests/lib/test_convergence.cpp, B = 0.7 (ks: B = 0); time-transformed\n"
       << "# methods with c = 0; empty: the method does not run there; revision " << git_revision() << "\n"
       << "method,nominal,encounter,encounter_points,orbit,orbit_points\n";
   const Probe enc_spin = probe(convergence_encounter(0.7)), enc_material = probe(convergence_encounter(0.0));

@@ -3,7 +3,7 @@
 // For sweeps whose members share the method, the step and the number of steps: the fixed-step
 // Lie-Poisson and thesis families and RK4, one Coulomb centre at the origin (every thesis scene),
 // B != 0 (the spin kernels). Each lane computes exactly the bits of the scalar `run` with
-// invariants tracked (tests/test_batch.cpp asserts equality), so a batch is a faster way to the same
+// invariants tracked (tests/lib/test_batch.cpp asserts equality), so a batch is a faster way to the same
 // numbers, not an approximation. The width is the widest the CPU runs among those the compiler
 // built: 8 (AVX-512), 4 (AVX2), 2 (SSE2); BODYPOINT_SIMD=2|4|8 narrows it (for measurements).
 // A lane that diverges computes NaN in its own lane only; all lanes take the same number of steps.

@@ -1,5 +1,5 @@
 // bodypoint: the measured order of a method from a ladder of steps (log-log slope above round-off).
-// Shared by the convergence tests (tests/test_convergence.cpp) and `bodypoint study --name orders`.
+// Shared by the convergence tests (tests/lib/test_convergence.cpp) and `bodypoint study --name orders`.
 #pragma once
 
 #include <algorithm>

@@ -5,7 +5,7 @@
 //   D dw/dt = -B F(R) + m B (w x v)
 //   dR/dt   = v
 // with F = -A (R - c)/|R - c|^3 summed over centres. Erratum 1: the thesis prints the second line
-// with both signs flipped, which breaks dK1/dt = F; tests/test_model.cpp checks the identity.
+// with both signs flipped, which breaks dK1/dt = F; tests/lib/test_model.cpp checks the identity.
 //
 // Odeint state layout: x = (R, v, w), nine scalars.
 #pragma once

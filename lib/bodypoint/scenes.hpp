@@ -6,7 +6,7 @@
 //   material     table 3.1 with B = 0 (a material point), t_end = 50
 //   long         table 3.1 run to t_end = 1e4
 //   two-centres  table 3.1 plus a second repelling centre (A = -1) at (40, 6, 0), t_end = 60
-// and the two scenes on which orders are measured (tests/test_convergence.cpp, `study --name orders`).
+// and the two scenes on which orders are measured (tests/lib/test_convergence.cpp, `study --name orders`).
 #pragma once
 
 #include "bodypoint/model.hpp"

@@ -4,7 +4,7 @@
 // ordinary differential equations", Math. Comp. 66 (1997) 1089-1099; the weights as tabulated in
 // E. Hairer, C. Lubich, G. Wanner, Geometric Numerical Integration, 2nd ed. (2006), sec. V.3.2,
 // eq. (3.11) (p6 s9) and (3.12) (p8 s17). Outermost weight first; the middle weight is derived
-// from sum g = 1 (tests/test_tables.cpp checks it against the published middle weight).
+// from sum g = 1 (tests/lib/test_tables.cpp checks it against the published middle weight).
 #pragma once
 
 #include "bodypoint/splitting/composition.hpp"

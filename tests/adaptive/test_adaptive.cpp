@@ -33,7 +33,7 @@ constexpr double kOrbitElementTol = 2e-12;
 // KS is an exact flow: the final state is the analytic hyperbola to the rounding accumulated over its
 // steps (measured 1.4e-12 relative after ~3000 steps at ds = 1e-3, 2e-13 at ds >= 1e-2).
 constexpr double kKsTol = 5e-12;
-// Same slope tolerance as for the fixed-step methods (tests/test_convergence.cpp).
+// Same slope tolerance as for the fixed-step methods (tests/lib/test_convergence.cpp).
 constexpr double kSlopeTol = 0.15;
 // Eighth-order tables in time-transformed form on the trap: the h^10 term still contributes in the
 // window above the round-off plateau, most for McLachlan's and Kahan-Li's weights, which make the h^8
