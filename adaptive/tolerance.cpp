@@ -141,7 +141,10 @@ class Search {
     if (spent_evals_ + expected > kMaxEvals)
       throw SearchLimit("tol " + fmt_tol() + " is out of reach of " + std::string(m_.name) +
                   " within 2e9 force evaluations (last estimate " + fmt_number(last_estimate_) + ")");
-    const RunResult r = run(m_, b_, c_, s);
+    // The scene and the method's acceptance of it were checked once (run_to_tolerance); each run's
+    // specification is checked here, and the method runs without run()'s checks of the scene.
+    (void)advance_of(m_, s);
+    const RunResult r = m_.run(b_, c_, s, nullptr);
     if (!(r.final.R.allFinite() && r.final.v.allFinite())) throw Error("the state became non-finite");
     Level l{s.h, s.steps, r.final, std::max(r.force_evals, r.steps), r.wall_s, s.omega_c};
     spent_evals_ += static_cast<double>(l.evals);
@@ -316,6 +319,7 @@ ToleranceResult run_to_tolerance(const MethodInfo& method, const Body& body, con
   validate(Scene{centres, {body}});
   if (non_coulomb(centres))
     throw Error(std::string(kNeedsCoulomb));
+  if (const std::string why = refusal(method, body, centres); !why.empty()) throw Error(why);
   return Search(method, body, centres, tol, t_end).search();
 }
 
