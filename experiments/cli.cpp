@@ -149,4 +149,20 @@ bool parse(int argc, char** argv, const po::options_description& desc, po::varia
   return true;
 }
 
+std::vector<const MethodInfo*> parse_methods(const std::string& list) {
+  std::vector<const MethodInfo*> ms;
+  if (list == "all") {
+    for (const MethodInfo& m : methods()) ms.push_back(&m);
+    return ms;
+  }
+  if (list == "fixed") {
+    for (const MethodInfo& m : methods())
+      if (!has_variable_step(m)) ms.push_back(&m);
+    return ms;
+  }
+  for (const std::string& n : split_list(list)) ms.push_back(&method_or_throw(n));
+  if (ms.empty()) throw Error("--methods is empty");
+  return ms;
+}
+
 }  // namespace bodypoint::cli

@@ -46,7 +46,7 @@ struct RunPlan {
   double tol = 0.0;
   RunSpec spec;
 };
-/// Validates the step options against the method; throws Error with the reason.
+/// Validates the step options against the method; throws Error with the reason (plan.cpp).
 RunPlan plan_run(const po::variables_map& vm, const StepOptions& st, const std::string& method_name,
                  bool method_defaulted, double tol);
 
@@ -61,7 +61,7 @@ struct BodyRun {
   Outcome outcome = Outcome::ok;
   std::string reason;  ///< of an outcome other than ok
 };
-/// Runs one body as planned through the library (integrate_body; spec may add invariants, output
+/// Runs one body as planned through the library (plan.cpp; integrate_body; spec may add invariants, output
 /// steps and a sink to plan.spec). A method that refuses the scene or a run that fails throws Error
 /// with the library's reason; diverged and collision are left to the caller (outcome, reason).
 BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,

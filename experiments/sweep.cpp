@@ -25,12 +25,6 @@
 namespace bodypoint::cli {
 namespace {
 
-/// A copy of `base` with the swept parameter set; h is handled by the caller.
-SceneParams with_value(SceneParams p, const std::string& param, double v) {
-  if (param != "h") scene_field(p, param) = v;
-  return p;
-}
-
 void progress_bar(std::size_t done, std::size_t total) {
   const int width = 40;
   const int filled = static_cast<int>(width * done / std::max<std::size_t>(total, 1));
@@ -89,153 +83,28 @@ unsigned thread_count(long requested) {
   return std::max(1u, std::thread::hardware_concurrency());
 }
 
-namespace {
-
-/// The scene parameters at grid point p.
-SceneParams point_params(const SweepSpec& spec, const std::vector<double>& point) {
-  SceneParams p = spec.base;
-  for (std::size_t a = 0; a < spec.axes.size(); ++a) p = with_value(p, spec.axes[a].param, point[a]);
-  return p;
-}
-
-double point_h(const SweepSpec& spec, const std::vector<double>& point) {
-  for (std::size_t a = 0; a < spec.axes.size(); ++a)
-    if (spec.axes[a].param == "h") return point[a];
-  return spec.h;
-}
-
-std::string point_label(const SweepSpec& spec, const std::vector<double>& point) {
-  std::string s;
-  for (std::size_t a = 0; a < spec.axes.size(); ++a) {
-    if (a) s += ", ";
-    s.append(spec.axes[a].param).append(" = ").append(fmt(point[a]));
-  }
-  return s;
-}
-
-/// One CSV row (the columns of sweep_header).
-std::string format_row(const std::vector<double>& point, const MethodInfo& method, const RunResult& result,
-                       const std::string& status, std::string reason) {
+std::string format_row(const SweepRow& r) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  const InvariantStats s = result.invariants ? *result.invariants : InvariantStats{nan, nan, nan};
+  const InvariantStats s = r.result.invariants ? *r.result.invariants : InvariantStats{nan, nan, nan};
+  // A run that stopped reads "refused" as one that was not run: neither has a state.
+  const std::string_view status = r.outcome == Outcome::failed ? "refused" : outcome_name(r.outcome);
   CsvLine row;
-  for (double v : point) row.num(v);
-  row.text(method.name).num(s.max_rel_dE).num(s.max_rel_dK2sq).num(s.max_abs_dK2Q);
-  row.num(result.final.R.x()).num(result.final.R.y()).num(result.final.R.z());
-  row.count(result.force_evals).num(result.wall_s).text(status).quoted(std::move(reason));
+  for (double v : r.point) row.num(v);
+  row.text(r.method->name).num(s.max_rel_dE).num(s.max_rel_dK2sq).num(s.max_abs_dK2Q);
+  row.num(r.result.final.R.x()).num(r.result.final.R.y()).num(r.result.final.R.z());
+  row.count(r.result.force_evals).num(r.result.wall_s).text(std::string(status)).quoted(r.reason);
   return row.str();
 }
 
-}  // namespace
-
-std::string run_sweep_task(const SweepSpec& spec, std::size_t i) { return run_sweep_unit(spec, {i}).front(); }
-
-namespace {
-
-/// A task's row when its run threw (a budget or the method refused it).
-std::string refused_row(const std::vector<double>& point, const MethodInfo& method, const std::string& why) {
-  RunResult result;
-  const Vec3 nan = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
-  result.final = State{nan, nan, nan};
-  return format_row(point, method, result, "refused", why);
-}
-
-std::string ok_row(const std::vector<double>& point, const MethodInfo& method, const RunResult& result) {
-  const Health h = assess(result);
-  return format_row(point, method, result, h.status, h.why);
-}
-
-}  // namespace
-
 std::vector<std::string> run_sweep_unit(const SweepSpec& spec, const std::vector<std::size_t>& unit) {
-  const std::size_t M = spec.methods.size();
-  const MethodInfo& method = *spec.methods[unit.front() % M];
-  std::vector<std::vector<double>> points;
-  std::vector<batch::Member> members;
-  for (std::size_t i : unit) {
-    points.push_back(grid_point(spec, i / M));
-    const Scene scene = thesis_scene(point_params(spec, points.back()));
-    members.push_back({scene.bodies.front().p, scene.bodies.front().s0, scene.centres.front().A});
-  }
   std::vector<std::string> rows;
-  if (unit.size() > 1) {  // a batch: one method, one step (plan_units), lanes that accept it
-    const RunSpec rs = resolve_steps(point_h(spec, points.front()), spec.steps, spec.t_end, spec.tol);
-    const auto results = batch::run(method, members, rs);
-    for (std::size_t k = 0; k < unit.size(); ++k) rows.push_back(ok_row(points[k], method, results[k]));
-    return rows;
-  }
-  try {
-    const Scene scene = thesis_scene(point_params(spec, points.front()));
-    const RunSpec rs = resolve_steps(point_h(spec, points.front()), spec.steps, spec.t_end, spec.tol);
-    rows.push_back(ok_row(points.front(), method, run(method, scene.bodies.front(), scene.centres, rs)));
-  } catch (const std::exception& e) {
-    rows.push_back(refused_row(points.front(), method, e.what()));
-  }
+  for (const SweepRow& r : run_sweep_unit_rows(spec, unit)) rows.push_back(format_row(r));
   return rows;
 }
 
-std::vector<std::vector<std::size_t>> plan_units(const SweepSpec& spec, const std::vector<std::size_t>& todo, bool simd) {
-  std::vector<std::vector<std::size_t>> units;
-  const std::size_t M = spec.methods.size(), lanes = simd ? batch::width() : 1;
-  std::map<std::pair<std::size_t, double>, std::vector<std::size_t>> open;  // (method, h) -> a filling batch
-  for (std::size_t i : todo) {
-    const MethodInfo& method = *spec.methods[i % M];
-    const std::vector<double> point = grid_point(spec, i / M);
-    const Scene scene = thesis_scene(point_params(spec, point));
-    if (lanes < 2 || !batch::accepts(method, scene.bodies.front(), scene.centres)) {
-      units.push_back({i});
-      continue;
-    }
-    auto& filling = open[{i % M, point_h(spec, point)}];
-    filling.push_back(i);
-    if (filling.size() == lanes) units.push_back(std::exchange(filling, {}));
-  }
-  for (auto& [key, rest] : open)
-    if (!rest.empty()) units.push_back(rest);
-  return units;
-}
-
-void validate_sweep(const SweepSpec& spec) {
-  if (spec.methods.empty()) throw Error("the method list is empty");
-  if (spec.axes.empty()) throw Error("the sweep has no varied parameter");
-  for (const Axis& a : spec.axes)
-    if (a.values.empty()) throw Error("the sweep has no values of " + a.param);
-  const std::size_t points = task_count(spec) / spec.methods.size();
-  for (std::size_t p = 0; p < points; ++p) {
-    const std::vector<double> point = grid_point(spec, p);
-    try {
-      thesis_scene(point_params(spec, point));
-    } catch (const Error& e) {
-      throw Error(point_label(spec, point) + ": " + e.what());
-    }
-    resolve_steps(point_h(spec, point), spec.steps, spec.t_end, spec.tol);
-  }
-}
-
-std::size_t task_count(const SweepSpec& spec) {
-  double n = static_cast<double>(spec.methods.size());
-  for (const Axis& a : spec.axes) n *= static_cast<double>(a.values.size());
-  if (n > 1e9) throw Error("the sweep has more than 1e9 (grid point, method) runs");
-  return static_cast<std::size_t>(n);
-}
-
-std::vector<double> grid_point(const SweepSpec& spec, std::size_t p) {
-  std::vector<double> point(spec.axes.size());
-  for (std::size_t a = spec.axes.size(); a-- > 0;) {
-    const std::size_t n = spec.axes[a].values.size();
-    point[a] = spec.axes[a].values[p % n];
-    p /= n;
-  }
-  return point;
-}
-
-std::size_t shard_of(const SweepSpec& spec, std::size_t task, std::size_t shards) {
-  const std::size_t M = spec.methods.size();
-  return (task / M + task % M) % std::max<std::size_t>(shards, 1);
-}
+std::string run_sweep_task(const SweepSpec& spec, std::size_t i) { return run_sweep_unit(spec, {i}).front(); }
 
 std::vector<std::string> run_sweep(const SweepSpec& spec, const SweepControl& control) {
-  validate_sweep(spec);
   const std::size_t n = task_count(spec);
   std::vector<std::string> rows(n);
   std::vector<std::size_t> todo;
@@ -245,33 +114,19 @@ std::vector<std::string> run_sweep(const SweepSpec& spec, const SweepControl& co
     if (done && done->count(i)) rows[i] = done->at(i);
     else todo.push_back(i);
   }
-  const auto units = plan_units(spec, todo, control.simd);
-  std::atomic<std::size_t> next{0}, finished{0};
-  std::mutex mutex;  // the progress bar, the journal and the first error
-  std::exception_ptr error;
-  const CooperativeInterrupt stop_at_row_boundary;  // a signal stops the sweep between units
-  auto worker = [&] {
-    for (std::size_t k; !interrupted() && (k = next++) < units.size();) {
-      const auto unit_rows = run_sweep_unit(spec, units[k]);
-      std::lock_guard<std::mutex> lock(mutex);
-      try {
-        for (std::size_t j = 0; j < units[k].size(); ++j) {
-          rows[units[k][j]] = unit_rows[j];
-          if (control.journal) control.journal->append(units[k][j], unit_rows[j]);
-        }
-      } catch (...) {  // the journal cannot be written: stop handing out units, report after the join
-        if (!error) error = std::current_exception();
-        next = units.size();
-      }
-      finished += units[k].size();
-      if (control.progress) progress_bar(finished, todo.size());
-    }
+  std::size_t finished = 0;
+  SweepRunner runner;
+  runner.threads = control.threads;
+  runner.simd = control.simd;
+  runner.stop = [] { return interrupted(); };
+  runner.on_row = [&](SweepRow&& r) {  // one call at a time: the rows, the journal, the progress bar
+    rows[r.task] = format_row(r);
+    if (control.journal) control.journal->append(r.task, rows[r.task]);
+    ++finished;
+    if (control.progress) progress_bar(finished, todo.size());
   };
-  std::vector<std::thread> pool;
-  for (unsigned k = 1; k < std::min<std::size_t>(control.threads, units.size()); ++k) pool.emplace_back(worker);
-  worker();
-  for (std::thread& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
+  const CooperativeInterrupt stop_at_row_boundary;  // a signal stops the sweep between units
+  run_sweep_tasks(spec, todo, runner);
   CooperativeInterrupt::check();
   return rows;
 }
@@ -321,22 +176,6 @@ void write_sweep_csv(std::ostream& os, const SweepSpec& spec, const std::vector<
                      const std::string& command) {
   for (const std::string& line : sweep_header(spec, command)) os << line << "\n";
   for (const std::string& row : rows) os << row << "\n";
-}
-
-std::vector<const MethodInfo*> parse_methods(const std::string& list) {
-  std::vector<const MethodInfo*> ms;
-  if (list == "all") {
-    for (const MethodInfo& m : methods()) ms.push_back(&m);
-    return ms;
-  }
-  if (list == "fixed") {
-    for (const MethodInfo& m : methods())
-      if (!has_variable_step(m)) ms.push_back(&m);
-    return ms;
-  }
-  for (const std::string& n : split_list(list)) ms.push_back(&method_or_throw(n));
-  if (ms.empty()) throw Error("--methods is empty");
-  return ms;
 }
 
 Axis parse_axis(const std::string& item) {

@@ -1,9 +1,11 @@
-// bodypoint: parameter sweeps and grids (one row per grid point and method), shared by `sweep`, `study`
-// and the sweep under mpirun (mpi_sweep.hpp).
+// bodypoint: the command line's side of sweeps and grids (the engine is the library's,
+// bodypoint/sweep.hpp): ranges and --grid items from text, CSV rows, header and key, threads, shards,
+// the journal, shared by `sweep`, `study` and the sweep under mpirun (mpi_sweep.hpp).
 #pragma once
 
 #include "bodypoint/model.hpp"
 #include "bodypoint/run.hpp"
+#include "bodypoint/sweep.hpp"
 
 #include <ostream>
 #include <string>
@@ -11,61 +13,19 @@
 
 namespace bodypoint::cli {
 
-/// The parameters a sweep can vary: the step h and every scene parameter (model.hpp).
-inline const std::vector<std::string>& sweep_parameters() {
-  static const std::vector<std::string> p = [] {
-    std::vector<std::string> names{"h"};
-    for (const SceneParameter& q : scene_parameters()) names.emplace_back(q.name);
-    return names;
-  }();
-  return p;
-}
-
 /// Values from --from/--to/--step (linear, computed as from + k step), --log with --points, or a list.
 std::vector<double> linear_range(double from, double to, double step);
 std::vector<double> log_range(double from, double to, long points);
 
-/// One varied parameter and its values.
-struct Axis {
-  std::string param;
-  std::vector<double> values;
-};
-
-/// One sweep: the varied parameters (one, or a grid: every combination, the last axis fastest),
-/// methods, and everything else fixed.
-struct SweepSpec {
-  std::vector<Axis> axes;
-  std::vector<const MethodInfo*> methods;
-  SceneParams base;   ///< the fixed scene parameters (table 3.1 unless changed)
-  double h = RunSpec{}.h;  ///< fixed step (unless param == "h")
-  long steps = 0;     ///< fixed number of steps, or 0 when t_end is fixed
-  double t_end = 0;   ///< fixed end time (steps = ceil(t_end/h), h = t_end/steps), or 0
-  double tol = RunSpec{}.tol;  ///< adaptive methods
-};
-
 /// Parses one --grid item: NAME=FROM:TO:STEP (linear), NAME=log:FROM:TO:POINTS or NAME=a,b,c.
 Axis parse_axis(const std::string& item);
 
-/// Number of (grid point, method) tasks; task i is point i / methods, method i % methods.
-std::size_t task_count(const SweepSpec& spec);
-/// The values of the varied parameters at grid point p (in axis order).
-std::vector<double> grid_point(const SweepSpec& spec, std::size_t p);
-
 /// Runs task i (grid point i / methods, method i % methods) and returns its CSV row.
 std::string run_sweep_task(const SweepSpec& spec, std::size_t i);
-/// Runs a unit of plan_units (one task, or a batch) and returns its rows in the unit's order.
+/// Runs a unit of plan_units (one task, or a batch) and returns its CSV rows in the unit's order.
 std::vector<std::string> run_sweep_unit(const SweepSpec& spec, const std::vector<std::size_t>& unit);
-/// The tasks in units: batches of up to batch::width() tasks of one method and step whose scenes
-/// a batch kernel accepts (with simd), single tasks otherwise.
-std::vector<std::vector<std::size_t>> plan_units(const SweepSpec& spec, const std::vector<std::size_t>& todo, bool simd);
-
-/// Throws Error for an empty sweep or a grid point whose scene or step is invalid.
-void validate_sweep(const SweepSpec& spec);
-
-/// The shard (0 .. shards-1) that runs task i = point * M + method: (point + method) % shards, so that
-/// every shard gets every method on an equal share of the points (a method's cost varies far more
-/// than a point's, and interleaving whole tasks would give one shard all of a method when M is even).
-std::size_t shard_of(const SweepSpec& spec, std::size_t task, std::size_t shards);
+/// One CSV row (the columns of sweep_header) of a task's result.
+std::string format_row(const SweepRow& row);
 
 /// How a sweep runs: threads, which tasks (shard K of N takes the tasks with shard_of == K), and a
 /// journal that keeps finished rows durably and supplies those of an interrupted run (rows_file.hpp).

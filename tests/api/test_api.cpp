@@ -3,6 +3,7 @@
 // run as one run of the same steps would.
 #include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/bodypoint.hpp"
+#include "bodypoint/sweep.hpp"
 
 #include <gtest/gtest.h>
 
@@ -204,6 +205,66 @@ TEST(Api, MultiBodyTotalsAreTheSumOfTheBodies) {
   ASSERT_EQ(r.bodies.size(), 2u);
   EXPECT_EQ(r.force_evals, r.bodies[0].run.force_evals + r.bodies[1].run.force_evals);
   EXPECT_NE(r.bodies[0].run.final.R, r.bodies[1].run.final.R);
+}
+
+}  // namespace
+}  // namespace bodypoint
+
+namespace bodypoint {
+namespace {
+
+TEST(ApiSweep, RowsAreTypedAndEqualSingleRuns) {
+  SweepSpec s;
+  s.axes = {{"d", {5.0, 10.0, 20.0}}, {"B", {0.0, 0.7}}};
+  s.methods = {&method_or_throw("lp-y4"), &method_or_throw("ks"), &method_or_throw("logh-y4")};
+  s.h = 0.05;
+  s.t_end = 5.0;
+  const std::vector<SweepRow> rows = run_sweep_rows(s, 1);
+  ASSERT_EQ(rows.size(), 18u);
+  for (const SweepRow& r : rows) {
+    ASSERT_NE(r.method, nullptr);
+    const SceneParams p = point_params(s, r.point);
+    const Scene scene = thesis_scene(p);
+    const std::string why = refusal(*r.method, scene.bodies.front(), scene.centres);
+    if (!why.empty()) {  // ks at B = 0.7
+      EXPECT_EQ(r.outcome, Outcome::refused) << r.method->name;
+      EXPECT_EQ(r.reason, why);
+      EXPECT_TRUE(std::isnan(r.result.final.R.x()));
+      continue;
+    }
+    EXPECT_EQ(r.outcome, Outcome::ok) << r.method->name << " " << point_label(s, r.point) << ": " << r.reason;
+    const RunResult one = run(*r.method, scene.bodies.front(), scene.centres, point_spec(s, r.point));
+    EXPECT_EQ(r.result.final.R, one.final.R) << r.method->name << " " << point_label(s, r.point);
+    EXPECT_EQ(r.result.force_evals, one.force_evals);
+  }
+  EXPECT_EQ(rows[1].method->name, "ks");  // task i: point i / M, method i % M
+  EXPECT_EQ(rows[3].point, (std::vector<double>{5.0, 0.7}));
+  // Threads hand out units in another order; the rows are the same.
+  const std::vector<SweepRow> two = run_sweep_rows(s, 2);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    EXPECT_EQ(two[i].task, i);
+    EXPECT_EQ(two[i].outcome, rows[i].outcome);
+    if (rows[i].outcome == Outcome::ok) {
+      EXPECT_EQ(two[i].result.final.R, rows[i].result.final.R);
+    }
+  }
+}
+
+TEST(ApiSweep, AnInvalidPointIsNamed) {
+  SweepSpec s;
+  s.axes = {{"B", {0.5, 1.5}}};
+  s.methods = {&method_or_throw("lp-y4")};
+  s.steps = 10;
+  try {
+    run_sweep_rows(s);
+    FAIL() << "D <= 0 accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("B = 1.5: ", 0), 0u) << e.what();
+  }
+  s.axes = {{"h", {0.1, -1.0}}};
+  EXPECT_THROW(run_sweep_rows(s), Error);
+  s.axes.clear();
+  EXPECT_THROW(run_sweep_rows(s), Error);
 }
 
 }  // namespace

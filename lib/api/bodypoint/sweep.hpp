@@ -1,0 +1,108 @@
+// bodypoint: sweeps and grids of the thesis's scene, part of the public API.
+//
+// A sweep varies the step h and scene parameters (scene_parameters(): A, m, B, J, d, L, K1, Kx, Kz)
+// over given values, one axis or a grid of several (every combination, the last axis fastest), for a
+// list of methods. Task i is grid point i / M with method i % M (M methods). Every task is one run of
+// the thesis's scene (thesis_scene) at that point, with fixed steps h (or fictitious steps ds = h, or
+// a first trial step h for step-size-controlled methods, with tol) to the end time, invariants
+// tracked; its result is a typed SweepRow. Tasks of one method and step that a batch kernel accepts
+// run in the lanes of one vector register, bit for bit as they would alone (batch.hpp).
+//
+//   bodypoint::SweepSpec s;
+//   s.axes = {{"d", {5, 10, 20}}};
+//   s.methods = {&bodypoint::method_or_throw("lp-y4")};
+//   s.steps = 100000;
+//   for (const bodypoint::SweepRow& r : bodypoint::run_sweep_rows(s, 2)) use(r.point, r.result.final);
+#pragma once
+
+#include "bodypoint/bodypoint.hpp"
+
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace bodypoint {
+
+/// The parameters a sweep can vary: the step h and every scene parameter (model.hpp).
+inline const std::vector<std::string>& sweep_parameters() {
+  static const std::vector<std::string> p = [] {
+    std::vector<std::string> names{"h"};
+    for (const SceneParameter& q : scene_parameters()) names.emplace_back(q.name);
+    return names;
+  }();
+  return p;
+}
+
+/// One varied parameter and its values.
+struct Axis {
+  std::string param;
+  std::vector<double> values;
+};
+
+/// One sweep: the varied parameters (one, or a grid: every combination, the last axis fastest),
+/// methods, and everything else fixed.
+struct SweepSpec {
+  std::vector<Axis> axes;
+  std::vector<const MethodInfo*> methods;
+  SceneParams base;         ///< the fixed scene parameters (table 3.1 unless changed)
+  double h = RunSpec{}.h;   ///< fixed step (unless an axis varies h)
+  long steps = 0;           ///< fixed number of steps, or 0 when t_end is fixed
+  double t_end = 0;         ///< fixed end time (steps = ceil(t_end/h), h = t_end/steps), or 0
+  double tol = RunSpec{}.tol;  ///< step-size-controlled methods: tolerance per step
+};
+
+/// Number of (grid point, method) tasks; Error above 1e9.
+std::size_t task_count(const SweepSpec& spec);
+/// The values of the varied parameters at grid point p (in axis order).
+std::vector<double> grid_point(const SweepSpec& spec, std::size_t p);
+/// The scene parameters at a grid point.
+SceneParams point_params(const SweepSpec& spec, const std::vector<double>& point);
+/// The run specification at a grid point: h (or t_end/n landing on t_end), steps, tol, invariants.
+RunSpec point_spec(const SweepSpec& spec, const std::vector<double>& point);
+/// "d = 5, L = 100": a grid point for messages.
+std::string point_label(const SweepSpec& spec, const std::vector<double>& point);
+
+/// Throws Error for an empty sweep, or a grid point whose scene or step is invalid (the point named).
+void validate_sweep(const SweepSpec& spec);
+
+/// One task's result.
+struct SweepRow {
+  std::size_t task = 0;
+  std::vector<double> point;
+  const MethodInfo* method = nullptr;
+  /// ok, diverged or collision (assess()), refused (the method does not take the scene) or failed
+  /// (the run stopped: a budget, a broken time transformation).
+  Outcome outcome = Outcome::ok;
+  std::string reason;  ///< one line; empty when ok
+  RunResult result;    ///< final state NaN when refused or failed
+};
+
+/// The tasks of `todo` in units: batches of up to batch::width() tasks of one method and step whose
+/// scenes a batch kernel accepts (with simd), single tasks otherwise.
+std::vector<std::vector<std::size_t>> plan_units(const SweepSpec& spec, const std::vector<std::size_t>& todo, bool simd);
+/// Runs one unit; its rows in the unit's order.
+std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vector<std::size_t>& unit);
+
+/// The shard (0 .. shards-1) that runs task i = point * M + method: (point + method) % shards, so that
+/// every shard gets every method on an equal share of the points.
+std::size_t shard_of(const SweepSpec& spec, std::size_t task, std::size_t shards);
+
+/// How run_sweep_tasks runs.
+struct SweepRunner {
+  unsigned threads = 1;
+  bool simd = true;  ///< batches of vector lanes where a kernel accepts them (false: every task alone)
+  /// Receives each finished row, one call at a time, in completion order. An exception from it stops
+  /// the handing out of units and is rethrown after the running ones finish.
+  std::function<void(SweepRow&&)> on_row;
+  /// Asked before each unit: true stops the handing out of units (the running ones finish).
+  std::function<bool()> stop;
+};
+
+/// Validates the sweep, then runs the tasks of `todo` on runner.threads threads.
+void run_sweep_tasks(const SweepSpec& spec, const std::vector<std::size_t>& todo, const SweepRunner& runner);
+
+/// Every task of the sweep, by task index, on `threads` threads.
+std::vector<SweepRow> run_sweep_rows(const SweepSpec& spec, unsigned threads = 1);
+
+}  // namespace bodypoint

@@ -1,0 +1,204 @@
+// bodypoint: sweeps and grids (sweep.hpp).
+#include "bodypoint/sweep.hpp"
+
+#include "bodypoint/batch.hpp"
+#include "bodypoint/io.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <thread>
+#include <utility>
+
+namespace bodypoint {
+namespace {
+
+double point_h(const SweepSpec& spec, const std::vector<double>& point) {
+  for (std::size_t a = 0; a < spec.axes.size(); ++a)
+    if (spec.axes[a].param == "h") return point[a];
+  return spec.h;
+}
+
+/// A row whose run did not happen (refused) or stopped (failed): no state, no invariants.
+SweepRow unrun_row(SweepRow row, Outcome outcome, std::string why) {
+  const Vec3 nan = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+  row.result = RunResult{};
+  row.result.final = State{nan, nan, nan};
+  row.outcome = outcome;
+  row.reason = std::move(why);
+  return row;
+}
+
+/// The row of a finished run, judged by assess().
+SweepRow run_row(SweepRow row, RunResult result) {
+  const Health h = assess(result);
+  row.result = std::move(result);
+  row.outcome = h.status == "ok" ? Outcome::ok : h.status == "collision" ? Outcome::collision : Outcome::diverged;
+  row.reason = h.why;
+  return row;
+}
+
+}  // namespace
+
+std::size_t task_count(const SweepSpec& spec) {
+  double n = static_cast<double>(spec.methods.size());
+  for (const Axis& a : spec.axes) n *= static_cast<double>(a.values.size());
+  if (n > 1e9) throw Error("the sweep has more than 1e9 (grid point, method) runs");
+  return static_cast<std::size_t>(n);
+}
+
+std::vector<double> grid_point(const SweepSpec& spec, std::size_t p) {
+  std::vector<double> point(spec.axes.size());
+  for (std::size_t a = spec.axes.size(); a-- > 0;) {
+    const std::size_t n = spec.axes[a].values.size();
+    point[a] = spec.axes[a].values[p % n];
+    p /= n;
+  }
+  return point;
+}
+
+SceneParams point_params(const SweepSpec& spec, const std::vector<double>& point) {
+  SceneParams p = spec.base;
+  for (std::size_t a = 0; a < spec.axes.size(); ++a)
+    if (spec.axes[a].param != "h") scene_field(p, spec.axes[a].param) = point[a];
+  return p;
+}
+
+RunSpec point_spec(const SweepSpec& spec, const std::vector<double>& point) {
+  const double h = point_h(spec, point);
+  if (!(std::isfinite(h) && h > 0.0)) throw Error("step size h must be a finite number > 0, got " + fmt(h));
+  RunSpec rs;
+  rs.h = h;
+  rs.steps = spec.steps;
+  if (spec.t_end > 0.0) {
+    const FixedSteps f = fixed_steps_to(spec.t_end, h);
+    rs.h = f.h;
+    rs.steps = f.steps;
+  }
+  if (rs.steps < 1) throw Error("the number of steps must be >= 1");
+  rs.t_end = rs.h * static_cast<double>(rs.steps);
+  rs.tol = spec.tol;
+  rs.track_invariants = true;
+  return rs;
+}
+
+std::string point_label(const SweepSpec& spec, const std::vector<double>& point) {
+  std::string s;
+  for (std::size_t a = 0; a < spec.axes.size(); ++a) {
+    if (a) s += ", ";
+    s.append(spec.axes[a].param).append(" = ").append(fmt(point[a]));
+  }
+  return s;
+}
+
+void validate_sweep(const SweepSpec& spec) {
+  if (spec.methods.empty()) throw Error("the method list is empty");
+  if (spec.axes.empty()) throw Error("the sweep has no varied parameter");
+  for (const Axis& a : spec.axes)
+    if (a.values.empty()) throw Error("the sweep has no values of " + a.param);
+  const std::size_t points = task_count(spec) / spec.methods.size();
+  for (std::size_t p = 0; p < points; ++p) {
+    const std::vector<double> point = grid_point(spec, p);
+    try {
+      thesis_scene(point_params(spec, point));
+      point_spec(spec, point);
+    } catch (const Error& e) {
+      throw Error(point_label(spec, point) + ": " + e.what());
+    }
+  }
+}
+
+std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vector<std::size_t>& unit) {
+  const std::size_t M = spec.methods.size();
+  const MethodInfo& method = *spec.methods[unit.front() % M];
+  std::vector<SweepRow> rows;
+  std::vector<batch::Member> members;
+  for (std::size_t i : unit) {
+    rows.push_back(SweepRow{i, grid_point(spec, i / M), &method, Outcome::ok, {}, {}});
+    const Scene scene = thesis_scene(point_params(spec, rows.back().point));
+    members.push_back({scene.bodies.front().p, scene.bodies.front().s0, scene.centres.front().A});
+  }
+  if (unit.size() > 1) {  // a batch: one method, one step (plan_units), lanes that accept it
+    auto results = batch::run(method, members, point_spec(spec, rows.front().point));
+    for (std::size_t k = 0; k < unit.size(); ++k) rows[k] = run_row(std::move(rows[k]), std::move(results[k]));
+    return rows;
+  }
+  SweepRow& row = rows.front();
+  const Scene scene = thesis_scene(point_params(spec, row.point));
+  try {
+    row = run_row(std::move(row), run(method, scene.bodies.front(), scene.centres, point_spec(spec, row.point)));
+  } catch (const std::exception& e) {  // run() throws the method's refusal, or why the run stopped
+    const bool refused = !refusal(method, scene.bodies.front(), scene.centres).empty();
+    row = unrun_row(std::move(row), refused ? Outcome::refused : Outcome::failed, e.what());
+  }
+  return rows;
+}
+
+std::vector<std::vector<std::size_t>> plan_units(const SweepSpec& spec, const std::vector<std::size_t>& todo, bool simd) {
+  std::vector<std::vector<std::size_t>> units;
+  const std::size_t M = spec.methods.size(), lanes = simd ? batch::width() : 1;
+  std::map<std::pair<std::size_t, double>, std::vector<std::size_t>> open;  // (method, h) -> a filling batch
+  for (std::size_t i : todo) {
+    const MethodInfo& method = *spec.methods[i % M];
+    const std::vector<double> point = grid_point(spec, i / M);
+    const Scene scene = thesis_scene(point_params(spec, point));
+    if (lanes < 2 || !batch::accepts(method, scene.bodies.front(), scene.centres)) {
+      units.push_back({i});
+      continue;
+    }
+    auto& filling = open[{i % M, point_h(spec, point)}];
+    filling.push_back(i);
+    if (filling.size() == lanes) units.push_back(std::exchange(filling, {}));
+  }
+  for (auto& [key, rest] : open)
+    if (!rest.empty()) units.push_back(rest);
+  return units;
+}
+
+std::size_t shard_of(const SweepSpec& spec, std::size_t task, std::size_t shards) {
+  const std::size_t M = spec.methods.size();
+  return (task / M + task % M) % std::max<std::size_t>(shards, 1);
+}
+
+void run_sweep_tasks(const SweepSpec& spec, const std::vector<std::size_t>& todo, const SweepRunner& runner) {
+  validate_sweep(spec);
+  const auto units = plan_units(spec, todo, runner.simd);
+  std::atomic<std::size_t> next{0};
+  std::mutex mutex;  // on_row and the first error
+  std::exception_ptr error;
+  auto worker = [&] {
+    for (std::size_t k; !(runner.stop && runner.stop()) && (k = next++) < units.size();) {
+      std::vector<SweepRow> rows = run_sweep_unit_rows(spec, units[k]);
+      std::lock_guard<std::mutex> lock(mutex);
+      try {
+        if (runner.on_row)
+          for (SweepRow& row : rows) runner.on_row(std::move(row));
+      } catch (...) {  // e.g. the caller's journal cannot be written: stop handing out units
+        if (!error) error = std::current_exception();
+        next = units.size();
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned k = 1; k < std::min<std::size_t>(runner.threads, units.size()); ++k) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
+}
+
+std::vector<SweepRow> run_sweep_rows(const SweepSpec& spec, unsigned threads) {
+  std::vector<std::size_t> all(task_count(spec));
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+  std::vector<SweepRow> rows(all.size());
+  SweepRunner runner;
+  runner.threads = std::max(1u, threads);
+  runner.on_row = [&rows](SweepRow&& r) { rows[r.task] = std::move(r); };
+  run_sweep_tasks(spec, all, runner);
+  return rows;
+}
+
+}  // namespace bodypoint
