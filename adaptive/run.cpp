@@ -67,7 +67,7 @@ constexpr double kMaxSpinAngle = 2.0;
 // Omega with an additive constant: both stay separable, symplectic and time-symmetric in the extended
 // phase space for any fixed c >= 0, and the physical step is bounded by ds/c. The scene has two time
 // scales: the encounter, where dt = ds r/|A| advances the orbit by the angle v dt/r = ds v/|A| per
-// step, and the spin-orbit precession of K2 about K1 at Omega_so = |B| |K1|/D (PHYSICS.md), which
+// step, and the spin-orbit precession of K2 about K1 at Omega_so = |B| |K1|/D (docs/physics.md), which
 // does not slow down far away while the step set by Pi alone grows like r. Far from every centre
 // the spin angle per step is Omega_so ds/c; c = sum|A| Omega_so/(k v0) makes it k times the orbital
 // angle per step in the encounter. k = 16 was measured (logh-kl8 on the close and thesis scenes,

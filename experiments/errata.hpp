@@ -1,5 +1,5 @@
 // bodypoint study errata: one runnable demonstration per erratum of the thesis and of its published
-// code, each measured (shared/PHYSICS.md "Errata"; paper/bodypoint.tex, section "Errata").
+// code, each measured (docs/physics.md "Errata"; paper/bodypoint.tex, section "Errata").
 #pragma once
 
 #include <ostream>

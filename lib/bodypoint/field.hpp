@@ -1,6 +1,6 @@
 // bodypoint: Coulomb fields.
 //
-// F(R) = -A (R - c)/|R - c|^3,  Pi(R) = -A/|R - c|  (shared/PHYSICS.md "Model"; thesis eq. 1.2).
+// F(R) = -A (R - c)/|R - c|^3,  Pi(R) = -A/|R - c|  (docs/physics.md "Model"; thesis eq. 1.2).
 // Forces and potentials of several centres add. Two field types let a step loop pay only for
 // what the scene holds: `OriginCentre` (one centre at the origin, no centre loop, the total
 // angular momentum K2Q about it is conserved) and `CentreList` (any number, anywhere).

@@ -1,4 +1,4 @@
-// bodypoint: first integrals and their deviation along a run (shared/PHYSICS.md "First integrals").
+// bodypoint: first integrals and their deviation along a run (docs/physics.md "First integrals").
 //
 //   E    = 1/2 m v.v + B v.w + 1/2 J w.w + Pi(R)   (thesis eq. 4.1 with Erratum 2: B v.w, not B/2 v.w)
 //   K2Q  = (R - c) x K1 + K2                       (eq. 1.6; a vector, only for a single centre c)

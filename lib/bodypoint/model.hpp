@@ -2,7 +2,7 @@
 //
 // A body-point is a particle with translational and rotational degrees of freedom and spherical
 // inertia tensors, kinetic energy T = 1/2 m v.v + B v.w + 1/2 J w.w (thesis eq. 1.3,
-// shared/PHYSICS.md "Model"). Symbols follow the physics:
+// docs/physics.md "Model"). Symbols follow the physics:
 //   m  mass, B  coupling, J  rotational inertia, D = m J - B^2 (> 0 for positive-definite T),
 //   R  position, v  translational velocity, w  angular velocity,
 //   K1 = m v + B w  linear momentum (eq. 1.4), K2 = B v + J w  proper angular momentum (eq. 1.5),
@@ -79,7 +79,7 @@ inline Momenta to_momenta(const BodyPoint& p, const State& s) {
   return {s.R, p.m * s.v + p.B * s.w, p.B * s.v + p.J * s.w};
 }
 
-/// (R, K1, K2) -> (R, v, w): v = (J K1 - B K2)/D, w = (m K2 - B K1)/D (PHYSICS.md "Model").
+/// (R, K1, K2) -> (R, v, w): v = (J K1 - B K2)/D, w = (m K2 - B K1)/D (docs/physics.md "Model").
 inline State to_state(const BodyPoint& p, const Momenta& q) {
   const double inv_D = 1.0 / p.D();
   return {q.R, (p.J * q.K1 - p.B * q.K2) * inv_D, (p.m * q.K2 - p.B * q.K1) * inv_D};

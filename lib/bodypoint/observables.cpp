@@ -13,7 +13,7 @@ bool one_centre(const std::vector<Centre>& centres) { return centres.size() == 1
 
 /// The angle between the spin w and the linear momentum K1 = m v + B w, in radians (0 when either
 /// vanishes): how far the spin leans out of the direction of motion, which the spin-orbit coupling B
-/// turns (PHYSICS.md).
+/// turns (docs/physics.md).
 double spin_angle(const Sample& s, const BodyPoint& p) {
   const Vec3 K1 = p.m * s.s.v + p.B * s.s.w;
   return std::atan2(s.s.w.cross(K1).norm(), s.s.w.dot(K1));

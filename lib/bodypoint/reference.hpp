@@ -1,4 +1,4 @@
-// bodypoint: independent references a run is checked against (shared/PHYSICS.md "What to check a
+// bodypoint: independent references a run is checked against (docs/physics.md "What to check a
 // run against").
 //
 // - `reference_state`: Boost.Odeint's runge_kutta_fehlberg78 with step-size control, in long
@@ -8,7 +8,7 @@
 //   (J. M. A. Danby, Fundamentals of Celestial Mechanics, 2nd ed. 1988, sec. 6.9; Stumpff
 //   functions), valid for attraction and repulsion alike (mu = A/m of either sign).
 // - `helix_state`: the exact free motion (A = 0): K1 constant, K2 rotating about K1 at rate
-//   -(B/D)|K1|, R from the conservation of R x K1 + K2 (PHYSICS.md, kinetic drift).
+//   -(B/D)|K1|, R from the conservation of R x K1 + K2 (docs/physics.md, kinetic drift).
 #pragma once
 
 #include "bodypoint/model.hpp"
@@ -173,7 +173,7 @@ inline State kepler_body_state(const Body& body, const Centre& centre, double t)
 
 /// The exact free motion (A = 0) at time t, written independently of the splitting kernel:
 /// Rodrigues rotation of K2 about k = K1/|K1| by theta = -(B/D)|K1| t, and
-/// R = R0 + t (J|K1| - B K2.k)/D k + K1 x (K2_0 - K2_t)/|K1|^2 (PHYSICS.md, kinetic drift).
+/// R = R0 + t (J|K1| - B K2.k)/D k + K1 x (K2_0 - K2_t)/|K1|^2 (docs/physics.md, kinetic drift).
 inline State helix_state(const BodyPoint& p, const State& s0, double t) {
   const Momenta q0 = to_momenta(p, s0);
   const double k1 = q0.K1.norm();

@@ -1,6 +1,6 @@
 // bodypoint: right-hand side of the equations of motion, usable as a Boost.Odeint system.
 //
-// shared/PHYSICS.md "Equations of motion" (the thesis's eq. 1.9 and the corrected eq. 1.10):
+// docs/physics.md "Equations of motion" (the thesis's eq. 1.9 and the corrected eq. 1.10):
 //   D dv/dt = J F(R) - B^2 (w x v)
 //   D dw/dt = -B F(R) + m B (w x v)
 //   dR/dt   = v

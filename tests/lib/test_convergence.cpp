@@ -18,7 +18,7 @@
 namespace bodypoint {
 namespace {
 
-// Slope within 0.15 of the order: the tolerance STYLE.md and issue #3 ask for; the ladders below are
+// Slope within 0.15 of the order: the tolerance issue #3 asks for; the ladders below are
 // chosen in the asymptotic range, above the round-off plateau.
 constexpr double kSlopeTol = 0.15;
 // The two independent references (odeint rkf78 in long double, Kepler's equation) agree this well.
@@ -138,7 +138,7 @@ TEST(Convergence, NominalOrderForMaterialPoint) {
 TEST(Convergence, ThesisFamilyIsFirstOrderForBodyPoint) {
   // The gyroscopic term w x v is frozen at the start of each step (thesis eq. 2.12): an explicit
   // Euler step of the spin-orbit rotation, so every scheme of the family is first order for B != 0
-  // whatever its table (shared/PHYSICS.md). Measured, not assumed: the slope is asserted to be 1.
+  // whatever its table (docs/physics.md). Measured, not assumed: the slope is asserted to be 1.
   for (const MethodInfo& m : methods()) {
     if (m.family != Family::Thesis) continue;
     EXPECT_NEAR(measured_slope({m.name, 1, 0.01}, 0.7), 1.0, kSlopeTol) << m.name;

@@ -9,7 +9,7 @@
 //   time-transformed Hamiltonians", Celest. Mech. Dyn. Astron. 74 (1999) 287; M. Preto, S. Tremaine,
 //   "A class of symplectic integrators with adaptive time step for separable Hamiltonian systems",
 //   Astron. J. 118 (1999) 2532). In extended phase space with p_t = -E,
-//     H~ = ln(Pi(R)) - ln(-(T + p_t))                                 (shared/PHYSICS.md)
+//     H~ = ln(Pi(R)) - ln(-(T + p_t))                                 (docs/physics.md)
 //   is separable; its flows are
 //     drift for ds: dt = ds/(E - T) (T is constant along the exact kinetic drift), then the exact
 //                   kinetic drift for dt;

@@ -1,6 +1,6 @@
 // bodypoint: the exact Lie-Poisson sub-flows of H = T(K1, K2) + Pi(R).
 //
-// shared/PHYSICS.md "Exact Lie-Poisson splitting". With Omega = -(B/D) K1 (constant during a drift):
+// docs/physics.md "Exact Lie-Poisson splitting". With Omega = -(B/D) K1 (constant during a drift):
 //
 //   kinetic drift for tau:  K1 const,  dK2/dt = Omega x K2  (K2 precesses about K1),
 //     K2(tau) = K2 + tau S1(phi) u + tau^2 C1(phi) W,                u = Omega x K2, W = Omega x u,

@@ -1,13 +1,13 @@
 // bodypoint: the thesis's drift/kick kernel with the gyroscopic term frozen at the step start.
 //
 // Thesis eq. 2.2 and 2.12 (sec. 2.3, 2.5), with the corrected equations of motion
-// (shared/PHYSICS.md, Erratum 1):
+// (docs/physics.md, Erratum 1):
 //   drift:  R += c h v
 //   kick:   v += d h (J F(R) - B^2 g)/D,   w += d h (-B F(R) + m B g)/D,   g = w_{i-1} x v_{i-1}
 // where g is evaluated once at the start of each step and held fixed through its stages.
 // For B != 0 this is not an exact splitting of any Hamiltonian: the frozen term makes every
 // scheme of this family first-order accurate in the gyroscopic coupling and not symplectic
-// (PHYSICS.md "The thesis's integrators"). It is kept, faithfully, as the thesis's baseline.
+// (docs/physics.md "The thesis's integrators"). It is kept, faithfully, as the thesis's baseline.
 #pragma once
 
 #include "bodypoint/model.hpp"
