@@ -383,7 +383,7 @@ std::vector<MethodInfo> methods() {
   sp::for_each(TtlTables{}, [&all]<class E>() {
     all.push_back(transformed_row<TtlKernel, E>("ttl-", "TTL (any sign of A), ds = --h", &ttl_check));
   });
-  all.push_back({"ks", Family::TimeTransformed, 0, 0, 0,
+  all.push_back({"ks", Family::Regularised, 0, 0, 0,
                  "Kustaanheimo-Stiefel regularisation, exact in fictitious time (B = 0, one centre), ds = --h",
                  &run_ks, &ks_check});
   return all;

@@ -112,7 +112,7 @@ RunSpec step_spec(const MethodInfo& m, double h, double t_end, RunSpec s) {
 
 /// The first, coarse step of the ladder.
 double initial_step(const MethodInfo& m, const Body& b, const std::vector<Centre>& centres, double t_end) {
-  if (m.name == "ks") {
+  if (m.family == Family::Regularised) {
     // KS fictitious time: one sub-step of the exact flow (sqrt(2 |h|) ds = 1, ks.hpp).
     const double mu = centres.front().A / b.p.m;
     const double h = 0.5 * b.s0.v.squaredNorm() - mu / (b.s0.R - centres.front().c).norm();
@@ -314,7 +314,7 @@ ToleranceResult run_to_tolerance(const MethodInfo& method, const Body& body, con
   if (is_step_controlled(method))
     throw Error(std::string(method.name) + " controls its own step: give it a tolerance per step, not the accuracy mode's "
                 "search (which is for fixed-step and time-transformed methods)");
-  if (method.order == 0 && method.name != "ks")
+  if (method.order == 0 && method.family != Family::Regularised)
     throw Error(std::string(method.name) + " has no fixed order for the error estimate");
   validate(Scene{centres, {body}});
   if (non_coulomb(centres))

@@ -311,6 +311,18 @@ void print_markdown_table() {
               << (is_step_controlled(m) ? "adaptive" : std::to_string(m.evals_per_step)) << " | " << m.description << " |\n";
 }
 
+/// One row per method for scripts (paper/ reads the families from it): method, family (family_key),
+/// order (0: variable), stages, force evaluations per step, and how it advances time.
+void print_csv() {
+  std::cout << "method,family,order,stages,evals_per_step,advance\n";
+  for (const MethodInfo& m : methods()) {
+    CsvLine row;
+    row.text(m.name).text(std::string(family_key(m.family))).count(m.order).count(m.stages).count(m.evals_per_step);
+    row.text(is_step_controlled(m) ? "controlled" : is_time_transformed(m) ? "fictitious" : "fixed");
+    std::cout << row.str() << "\n";
+  }
+}
+
 void print_table() {
   std::cout << std::left << std::setw(16) << "method" << std::setw(8) << "order" << std::setw(8)
             << "stages" << std::setw(14) << "evals/step" << "description\n";
@@ -325,12 +337,18 @@ void print_table() {
 
 int cmd_methods(int argc, char** argv) {
   po::options_description desc("bodypoint methods");
-  bool markdown = false;
-  desc.add_options()("markdown", po::bool_switch(&markdown), "print the table as Markdown (README's Methods section)");
+  bool markdown = false, csv = false;
+  desc.add_options()("markdown", po::bool_switch(&markdown), "print the table as Markdown (README's Methods section)")(
+      "csv", po::bool_switch(&csv), "print one CSV row per method (method, family, order, stages, evals_per_step, advance)");
   po::variables_map vm;
-  if (!parse(argc, argv, desc, vm, "usage: bodypoint methods [--markdown]\nLists every integration method.")) return 0;
+  if (!parse(argc, argv, desc, vm, "usage: bodypoint methods [--markdown | --csv]\nLists every integration method.")) return 0;
+  if (markdown && csv) throw Error("give --markdown or --csv, not both");
   if (markdown) {
     print_markdown_table();
+    return 0;
+  }
+  if (csv) {
+    print_csv();
     return 0;
   }
   print_table();

@@ -74,6 +74,10 @@ scale=()
 scripts/ensemble-scaling.sh "${scale[@]}" --build "${BODYPOINT_BUILD_DIR:-build}" --csv "$results/scaling.csv" \
   > "$results/scaling.md"
 
+# The catalogue: the scripts group methods by the families it gives (paper/catalogue.py).
+"$bin" methods --csv > "$results/methods.csv.tmp"
+mv "$results/methods.csv.tmp" "$results/methods.csv"
+
 out=paper/build
 mkdir -p "$out"
 "$py" paper/make_figures.py "$results" "$out/figures"

@@ -14,6 +14,8 @@ import math
 import os
 import sys
 
+from catalogue import family, load as load_catalogue
+
 import matplotlib
 
 matplotlib.use("Agg")
@@ -33,20 +35,6 @@ DIVERGED = 1e2
 WIDE = 6.3
 
 
-def family(method):
-    if method in THESIS_SEVEN:
-        return "thesis's seven"
-    if method.startswith("lp-"):
-        return "Lie-Poisson"
-    if method.startswith(("logh-", "ttl-")):
-        return "time-transformed"
-    if method == "ks":
-        return "KS"
-    if method.startswith("odeint-"):
-        return "Boost.Odeint"
-    if method.startswith("gsl-"):
-        return "GSL"
-    return None
 
 
 def read_csv(path):
@@ -271,6 +259,7 @@ def main():
     if len(sys.argv) != 3:
         sys.exit("usage: make_figures.py RESULTS_DIR FIGURES_DIR")
     res, figs = sys.argv[1], sys.argv[2]
+    load_catalogue(res)
     os.makedirs(figs, exist_ok=True)
     listing = []
     sweep_figures(res, figs, listing)

@@ -15,6 +15,8 @@ import re
 import statistics
 import sys
 
+from catalogue import family, has_fictitious_step, load as load_catalogue
+
 THESIS_SEVEN = ["thesis-euler", "thesis-verlet", "thesis-ruth3", "thesis-fr4", "thesis-y6", "rk4", "ab4"]
 DIGITS = ["Zero", "One", "Two", "Three", "Four", "Five", "Six", "Seven", "Eight", "Nine"]
 # A fit of the energy error's slope against h uses deviations inside this window: above it the run is
@@ -272,14 +274,6 @@ def speedup_table(res, out, M):
     M.add("NumSpeedupRows", count(len(body)))
 
 
-def family(method):
-    if method in THESIS_SEVEN:
-        return "thesis's seven"
-    for prefix, name in [("lp-", "Lie-Poisson"), ("logh-", "time-transformed"), ("ttl-", "time-transformed"),
-                         ("odeint-", "Boost.Odeint"), ("gsl-", "GSL")]:
-        if method.startswith(prefix):
-            return name
-    return "KS" if method == "ks" else None
 
 
 def close_table(res, out, M):
@@ -309,8 +303,6 @@ def close_table(res, out, M):
                 f.write("\\midrule\n")
 
 
-def has_fictitious_step(method):
-    return method.startswith(("logh-", "ttl-")) or method == "ks"
 
 
 def by_tol(res, out, M):
@@ -463,6 +455,7 @@ def main():
     if len(sys.argv) != 4:
         sys.exit("usage: make_macros.py RESULTS_DIR OUT_DIR MODE")
     res, out, mode = sys.argv[1:]
+    load_catalogue(res)
     os.makedirs(out, exist_ok=True)
     M = Macros()
     _, header = read_csv(os.path.join(res, "d_sweep.csv"))

@@ -58,8 +58,9 @@ struct RunResult {
 /// Thesis: the thesis's drift/kick schemes; LiePoisson: exact splittings; Odeint: fixed-step
 /// odeint steppers (rk4, ab4); OdeintAdaptive: step-size-controlled odeint steppers (--tol);
 /// Gsl: GSL's step-size-controlled steppers (--tol; peers, present when built with GSL);
-/// TimeTransformed: fixed fictitious step ds (--h), variable physical step (logh-*, ttl-*, ks).
-enum class Family { Thesis, LiePoisson, Odeint, OdeintAdaptive, Gsl, TimeTransformed };
+/// TimeTransformed: fixed fictitious step ds, variable physical step (logh-*, ttl-*);
+/// Regularised: the Kustaanheimo-Stiefel flow, exact in its fictitious time (ks).
+enum class Family { Thesis, LiePoisson, Odeint, OdeintAdaptive, Gsl, TimeTransformed, Regularised };
 
 /// The family's name as `bodypoint methods --markdown` prints it.
 constexpr std::string_view family_name(Family f) {
@@ -70,6 +71,21 @@ constexpr std::string_view family_name(Family f) {
     case Family::OdeintAdaptive: return "Boost.Odeint adaptive";
     case Family::Gsl: return "GSL adaptive";
     case Family::TimeTransformed: return "time-transformed";
+    case Family::Regularised: return "regularised";
+  }
+  return "?";
+}
+
+/// The family as one word, for machine-read tables (`bodypoint methods --csv`, the paper's scripts).
+constexpr std::string_view family_key(Family f) {
+  switch (f) {
+    case Family::Thesis: return "thesis";
+    case Family::LiePoisson: return "lie-poisson";
+    case Family::Odeint: return "odeint";
+    case Family::OdeintAdaptive: return "odeint-adaptive";
+    case Family::Gsl: return "gsl";
+    case Family::TimeTransformed: return "time-transformed";
+    case Family::Regularised: return "regularised";
   }
   return "?";
 }
@@ -107,9 +123,11 @@ inline bool is_step_controlled(const MethodInfo& m) {
 inline bool is_peer(const MethodInfo& m) {
   return m.family == Family::Odeint || m.family == Family::OdeintAdaptive || m.family == Family::Gsl;
 }
-/// True for methods with a fixed fictitious step: spec.h is ds; with spec.t_end > 0 they run to
-/// exactly t_end, otherwise spec.steps fictitious steps.
-inline bool is_time_transformed(const MethodInfo& m) { return m.family == Family::TimeTransformed; }
+/// True for methods with a fixed fictitious step (time-transformed and regularised): spec.h is ds;
+/// with spec.t_end > 0 they run to exactly t_end, otherwise spec.steps fictitious steps.
+inline bool is_time_transformed(const MethodInfo& m) {
+  return m.family == Family::TimeTransformed || m.family == Family::Regularised;
+}
 /// True for every method whose physical step varies (step-size-controlled or time-transformed).
 inline bool has_variable_step(const MethodInfo& m) { return is_step_controlled(m) || is_time_transformed(m); }
 

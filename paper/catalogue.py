@@ -1,0 +1,42 @@
+"""The catalogue of methods as `bodypoint methods --csv` lists it (paper/build.sh writes it to
+RESULTS_DIR/methods.csv): the paper's scripts group methods by the family the catalogue gives each,
+never by the prefix of a name, so a method or a family added to the catalogue is drawn and counted
+without touching them."""
+import csv
+import os
+
+# The paper's grouping of the catalogue's families (bodypoint's family_key, run.hpp): the thesis's
+# seven are its five drift/kick schemes and Boost.Odeint's RK4 and AB4.
+PAPER_FAMILY = {
+    "thesis": "thesis's seven",
+    "odeint": "thesis's seven",
+    "lie-poisson": "Lie-Poisson",
+    "time-transformed": "time-transformed",
+    "regularised": "KS",
+    "odeint-adaptive": "Boost.Odeint",
+    "gsl": "GSL",
+}
+
+_rows = {}
+
+
+def load(results):
+    """Reads RESULTS_DIR/methods.csv; every other function here needs it."""
+    with open(os.path.join(results, "methods.csv"), newline="") as f:
+        for row in csv.DictReader(f):
+            _rows[row["method"]] = row
+    unknown = {r["family"] for r in _rows.values()} - PAPER_FAMILY.keys()
+    if unknown:
+        raise SystemExit(f"catalogue.py: give the paper's name of the families {sorted(unknown)} in PAPER_FAMILY")
+
+
+def family(method):
+    """The paper's family of a method, or None for a method not in the catalogue."""
+    row = _rows.get(method)
+    return PAPER_FAMILY[row["family"]] if row else None
+
+
+def has_fictitious_step(method):
+    """True for the time-transformed and regularised methods (their step is the fictitious ds)."""
+    row = _rows.get(method)
+    return bool(row) and row["advance"] == "fictitious"
