@@ -16,6 +16,7 @@
 #include "bodypoint/splitting/composition.hpp"
 #include "bodypoint/splitting/kahan_li.hpp"
 #include "bodypoint/splitting/mclachlan.hpp"
+#include "bodypoint/splitting/omelyan.hpp"
 #include "bodypoint/splitting/sofroniou_spaletta.hpp"
 #include "bodypoint/splitting/suzuki.hpp"
 #include "bodypoint/splitting/yoshida.hpp"
@@ -103,7 +104,7 @@ constexpr void for_each(List<E...> /*list*/, F&& f) {
 /// Every table, in listing order.
 using AllTables = List<Euler, VerletKdk, StrangDkd, Ruth3, Yoshida4, BlanesMoan4, BlanesMoanRkn4, BlanesMoanRkn6,
                        Yoshida6, KahanLi6, Yoshida8, Yoshida8D, McLachlan8, KahanLi8, SofroniouSpaletta10,
-                       Suzuki4>;
+                       Suzuki4, Pefrl4>;
 
 /// The exact Lie-Poisson splitting (lp-*) takes every table.
 using LiePoissonTables = AllTables;
