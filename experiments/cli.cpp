@@ -140,7 +140,14 @@ bool parse(int argc, char** argv, const po::options_description& desc, po::varia
   all.add_options()("help", "show this help");
   // Whole option names only: with boost's default prefix guessing, "--ou x" would mean "--out x".
   const int style = po::command_line_style::default_style & ~po::command_line_style::allow_guessing;
-  po::store(po::command_line_parser(argc, argv).options(all).positional({}).style(style).run(), vm);
+  try {
+    po::store(po::command_line_parser(argc, argv).options(all).positional({}).style(style).run(), vm);
+  } catch (const po::unknown_option& e) {
+    std::vector<std::string> names;
+    for (const auto& o : all.options()) names.push_back("--" + o->long_name());
+    const std::string near = closest_word(e.get_option_name(), names, 2);
+    throw Error(std::string(e.what()) + (near.empty() ? "" : " (did you mean " + near + "?)"));
+  }
   if (vm.count("help")) {
     std::cout << usage << "\n\n" << all << "\n";
     return false;

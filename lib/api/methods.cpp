@@ -2,6 +2,10 @@
 #include "bodypoint/methods.hpp"
 
 #include "bodypoint/adaptive/methods.hpp"
+#include "bodypoint/io.hpp"
+
+#include <string>
+#include <vector>
 
 namespace bodypoint {
 
@@ -20,9 +24,22 @@ const MethodInfo* find_method(std::string_view name) {
   return nullptr;
 }
 
+namespace {
+/// A name closer to a typo than this many edits is suggested (lp-y5 -> lp-y4, RK4 -> rk4).
+constexpr std::size_t kSuggestDistance = 2;
+}  // namespace
+
+std::string closest_method(std::string_view name) {
+  std::vector<std::string> names;
+  for (const MethodInfo& m : methods()) names.push_back(m.name);
+  return closest_word(name, names, kSuggestDistance);
+}
+
 const MethodInfo& method_or_throw(std::string_view name) {
   if (const MethodInfo* m = find_method(name)) return *m;
-  throw Error("unknown method '" + std::string(name) + "' (see 'bodypoint methods')");
+  const std::string near = closest_method(name);
+  throw Error("unknown method '" + std::string(name) + "'" + (near.empty() ? "" : " (did you mean " + near + "?)") +
+              " (see 'bodypoint methods')");
 }
 
 }  // namespace bodypoint

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -17,6 +18,7 @@
 #include <signal.h>
 #include <sstream>
 #include <unistd.h>
+#include <vector>
 
 #ifndef BODYPOINT_GIT_REVISION
 #define BODYPOINT_GIT_REVISION "unknown"
@@ -220,6 +222,36 @@ std::string json_string(std::string_view s, bool html_safe) {
     }
   }
   return out + "\"";
+}
+
+namespace {
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const bool same =
+          std::tolower(static_cast<unsigned char>(a[i - 1])) == std::tolower(static_cast<unsigned char>(b[j - 1]));
+      const std::size_t next = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (same ? 0 : 1)});
+      diagonal = row[j];
+      row[j] = next;
+    }
+  }
+  return row[b.size()];
+}
+}  // namespace
+
+std::string closest_word(std::string_view word, const std::vector<std::string>& candidates, std::size_t max_edits) {
+  std::string best;
+  std::size_t best_d = max_edits + 1;
+  for (const std::string& c : candidates)
+    if (const std::size_t d = edit_distance(word, c); d < best_d) {
+      best_d = d;
+      best = c;
+    }
+  return best;
 }
 
 const char* git_revision() { return BODYPOINT_GIT_REVISION; }

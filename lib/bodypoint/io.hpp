@@ -14,6 +14,7 @@
 #include <fstream>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace bodypoint {
 
@@ -93,6 +94,11 @@ std::string json_vec(const Vec3& v);
 /// s as a JSON string: quotes, backslashes and control characters escaped (\u00XX). With html_safe,
 /// also <, > and &, so that the text can stand inside an HTML <script> element.
 std::string json_string(std::string_view s, bool html_safe = false);
+
+/// The candidate within max_edits edits (insertions, deletions, substitutions; letters compared
+/// without case) of word, the closest first in the candidates' order; empty when none is. For "did
+/// you mean" in messages.
+std::string closest_word(std::string_view word, const std::vector<std::string>& candidates, std::size_t max_edits);
 
 /// The git revision this binary was built from.
 const char* git_revision();

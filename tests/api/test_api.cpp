@@ -269,3 +269,22 @@ TEST(ApiSweep, AnInvalidPointIsNamed) {
 
 }  // namespace
 }  // namespace bodypoint
+
+namespace bodypoint {
+namespace {
+
+TEST(ApiCatalogue, AnUnknownMethodSuggestsTheClosestName) {
+  EXPECT_EQ(closest_method("RK4"), "rk4");
+  EXPECT_EQ(closest_method("lp-y5"), "lp-y4");
+  EXPECT_EQ(closest_method("logh-kl7"), "logh-kl6");
+  EXPECT_EQ(closest_method("runge-kutta"), "");
+  try {
+    method_or_throw("lp-pefr");
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("did you mean lp-pefrl?"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace bodypoint

@@ -139,6 +139,8 @@ TEST(Cli, BadInputGivesOneLineErrorNonZeroExitAndNoOutputFile) {
       {"--L 0 --d 1", "starts on centre"},
       {"--method rk5", "unknown method 'rk5'"},
       {"--bogus 3", "unrecognised option"},
+      {"--metod lp-y4", "unrecognised option '--metod' (did you mean --method?)"},
+      {"--method RK4", "unknown method 'RK4' (did you mean rk4?)"},
       {"--steps 10 --t-end 5", "not both"},
       {"--steps 0", "--steps must be >= 1"},
       {"--scene " + bad_scene.string(), "bad.toml: line"},

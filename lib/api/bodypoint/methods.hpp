@@ -25,7 +25,11 @@ const std::vector<MethodInfo>& methods();
 /// The method called `name`, or nullptr.
 const MethodInfo* find_method(std::string_view name);
 
-/// Throws Error("unknown method ...") for a name not in methods().
+/// The method whose name is within two edits of `name` (letters compared without case), the closest
+/// first in listing order; empty when none is.
+std::string closest_method(std::string_view name);
+
+/// Throws Error("unknown method ...") for a name not in methods(), suggesting closest_method.
 const MethodInfo& method_or_throw(std::string_view name);
 
 /// `--method auto`: a one-centre material point: ks; a body far from every centre for the whole run
