@@ -130,7 +130,9 @@ std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vect
   SweepRow& row = rows.front();
   const Scene scene = thesis_scene(point_params(spec, row.point));
   try {
-    row = run_row(std::move(row), run(method, scene.bodies.front(), scene.centres, point_spec(spec, row.point)));
+    // The run first: an argument list that also moved `row` may move it before reading row.point.
+    RunResult result = run(method, scene.bodies.front(), scene.centres, point_spec(spec, row.point));
+    row = run_row(std::move(row), std::move(result));
   } catch (const std::exception& e) {  // run() throws the method's refusal, or why the run stopped
     const bool refused = !refusal(method, scene.bodies.front(), scene.centres).empty();
     row = unrun_row(std::move(row), refused ? Outcome::refused : Outcome::failed, e.what());
