@@ -110,8 +110,11 @@ void take_lock(const std::string& lock, const std::string& target) {
     if (process_alive(pid))
       throw Error("another run (pid " + std::to_string(pid) + ") is writing '" + target + "' (lock file " + lock +
                   "); wait for it or choose another path");
-    ::unlink(lock.c_str());  // stale: its writer is gone (kill -9, power loss): so are its temporaries
+    // Stale: its writer is gone (kill -9, power loss), so are its temporaries. They go first: killed
+    // between the two, this run leaves the lock that names them for the next run to clean up (the
+    // other order orphaned a temporary that no lock names; ASan's slow start made that window real).
     remove_temporaries(target, pid);
+    ::unlink(lock.c_str());
   }
   throw Error("cannot take the lock file " + lock + " of '" + target + "'");
 }
