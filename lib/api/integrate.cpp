@@ -92,11 +92,9 @@ void run_accurately(BodyResult& r, const Body& body, const std::vector<Centre>& 
   r.run = r.method->run(body, centres, spec, options.sink);
 }
 
-}  // namespace
-
-BodyResult integrate_body(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
-                          const Advance& how, const Options& options) {
-  validate(Scene{centres, {body}});
+/// integrate_body for a body and centres already validated.
+BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
+                                const Advance& how, const Options& options) {
   BodyResult r;
   const auto* accuracy = std::get_if<Accuracy>(&how);
   if (accuracy) {
@@ -133,11 +131,19 @@ BodyResult integrate_body(const Body& body, const std::vector<Centre>& centres, 
   return r;
 }
 
+}  // namespace
+
+BodyResult integrate_body(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
+                          const Advance& how, const Options& options) {
+  validate(Scene{centres, {body}});
+  return integrate_valid_body(body, centres, method, how, options);
+}
+
 Result integrate(const Scene& scene, const MethodInfo* method, const Advance& how, const Options& options) {
   validate(scene);
   Result all;
   for (const Body& body : scene.bodies) {
-    BodyResult b = integrate_body(body, scene.centres, method, how, options);
+    BodyResult b = integrate_valid_body(body, scene.centres, method, how, options);
     all.force_evals += b.total_force_evals();
     all.wall_s += b.run.wall_s + (b.accuracy ? b.accuracy->wall_s : 0.0);
     if (all.outcome == Outcome::ok && b.outcome != Outcome::ok) {
