@@ -21,6 +21,22 @@ extern char** environ;
 
 namespace bodypoint::test {
 
+/// A path for a test's files in this process's own folder under the system's temporary directory
+/// (removed at exit): two suites running at once (a developer's and CI's) never share a file.
+inline std::filesystem::path temp_path(const std::string& name) {
+  struct Root {
+    std::filesystem::path path =
+        std::filesystem::temp_directory_path() / ("bodypoint-tests." + std::to_string(::getpid()));
+    Root() { std::filesystem::create_directories(path); }
+    ~Root() {
+      std::error_code ec;
+      std::filesystem::remove_all(path, ec);
+    }
+  };
+  static const Root root;
+  return root.path / name;
+}
+
 struct CliResult {
   int code;
   std::string out, err;

@@ -86,7 +86,7 @@ TEST(Cli, ADivergedRunIsRefusedNotReported) {
 }
 
 TEST(Cli, TrajectoryCsvHasHeaderAndEveryKthRow) {
-  const fs::path out = fs::temp_directory_path() / "bp_traj.csv";
+  const fs::path out = test::temp_path("bp_traj.csv");
   fs::remove(out);
   const Result r = run_cli("simulate --method lp-y4 --h 0.01 --steps 1000 --every 100 --out " + out.string());
   ASSERT_EQ(r.code, 0) << r.err;
@@ -122,7 +122,7 @@ struct BadInput {
 };
 
 TEST(Cli, BadInputGivesOneLineErrorNonZeroExitAndNoOutputFile) {
-  const fs::path dir = fs::temp_directory_path() / "bp_bad";
+  const fs::path dir = test::temp_path("bp_bad");
   fs::create_directories(dir);
   const fs::path bad_scene = dir / "bad.toml";
   std::ofstream(bad_scene) << "[[centre]]\nA = -1\n[[body]\nm = 1\n";
@@ -174,7 +174,7 @@ TEST(Cli, BadInputGivesOneLineErrorNonZeroExitAndNoOutputFile) {
 }
 
 TEST(Cli, WorkPrecisionQuickWritesRowsForEveryMethodAndASummary) {
-  const fs::path out = fs::temp_directory_path() / "bp_wp.csv";
+  const fs::path out = test::temp_path("bp_wp.csv");
   fs::remove(out);
   const Result r = run_cli("work-precision --quick --out " + out.string());
   ASSERT_EQ(r.code, 0) << r.err;

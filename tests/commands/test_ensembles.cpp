@@ -66,7 +66,7 @@ std::vector<std::string> data_rows(const std::vector<std::string>& lines) {
 
 struct TempDir {
   fs::path path;
-  explicit TempDir(const std::string& name) : path(fs::temp_directory_path() / name) {
+  explicit TempDir(const std::string& name) : path(test::temp_path(name)) {
     fs::remove_all(path);
     fs::create_directories(path);
   }

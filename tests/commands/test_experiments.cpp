@@ -133,7 +133,7 @@ std::map<std::string, double> key_values(const fs::path& path) {
 }
 
 TEST(Study, QuickRecipesWriteEveryCsv) {
-  const fs::path dir = fs::temp_directory_path() / "bp_study";
+  const fs::path dir = test::temp_path("bp_study");
   fs::remove_all(dir);
   const Result r = run_cli("study --quick --results " + dir.string());
   ASSERT_EQ(r.code, 0) << r.err;

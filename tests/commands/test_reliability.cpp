@@ -86,7 +86,7 @@ TEST(Reliability, SubnormalValuesAreNumbersAndSweepRowsCarryAStatus) {
 }
 
 TEST(Reliability, DryRunChecksEverythingAndRunsNothing) {
-  const fs::path out = fs::temp_directory_path() / "bp_rel_dry.csv";
+  const fs::path out = test::temp_path("bp_rel_dry.csv");
   fs::remove(out);
   const auto r = run_cli("simulate --dry-run --steps 1000000000000 --every 1000000 --out " + out.string());
   EXPECT_EQ(r.code, 0) << r.err;
@@ -95,7 +95,7 @@ TEST(Reliability, DryRunChecksEverythingAndRunsNothing) {
 }
 
 TEST(Reliability, ASignalRemovesTemporaryAndLockFiles) {
-  const fs::path dir = fs::temp_directory_path() / "bp_rel_sig";
+  const fs::path dir = test::temp_path("bp_rel_sig");
   fs::remove_all(dir);
   fs::create_directories(dir);
   // 2e8 steps take ~30 s: the signal arrives while the trajectory is being written.
@@ -113,7 +113,7 @@ TEST(Reliability, ASignalRemovesTemporaryAndLockFiles) {
 }
 
 TEST(Reliability, ASweepStopsAtARowBoundaryOnSignal) {
-  const fs::path dir = fs::temp_directory_path() / "bp_rel_sweep";
+  const fs::path dir = test::temp_path("bp_rel_sweep");
   fs::remove_all(dir);
   fs::create_directories(dir);
   const pid_t pid = spawn({"sweep", "--param", "d", "--from", "5", "--to", "200", "--step", "5", "--methods",
@@ -134,7 +134,7 @@ TEST(Reliability, ASweepStopsAtARowBoundaryOnSignal) {
 }
 
 TEST(Reliability, OutputsCollideWithNothing) {
-  const fs::path dir = fs::temp_directory_path() / "bp_rel_out";
+  const fs::path dir = test::temp_path("bp_rel_out");
   fs::remove_all(dir);
   fs::create_directories(dir);
   // Two outputs of one run on one path.
@@ -189,7 +189,7 @@ std::vector<std::string> csv_fields(const std::string& line) {
 constexpr double kOkEnergyBound = 1.0;
 
 TEST(Reliability, StressStudyEndsEveryRunWithAMeaningfulOutcome) {
-  const fs::path dir = fs::temp_directory_path() / "bp_rel_stress";
+  const fs::path dir = test::temp_path("bp_rel_stress");
   fs::remove_all(dir);
   const auto r = run_cli("study --name stress --quick --results " + dir.string());
   ASSERT_EQ(r.code, 0) << r.err;

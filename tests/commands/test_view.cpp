@@ -49,7 +49,7 @@ constexpr double kMaxPageBytes = 3e6;
 
 TEST(View, MillionStepRunMakesASmallPageWithTheClosestApproachKept) {
   if (!have_viewer()) GTEST_SKIP() << "built without the viewer's script";
-  const fs::path out = fs::temp_directory_path() / "bp_view_1e6.html";
+  const fs::path out = test::temp_path("bp_view_1e6.html");
   fs::remove(out);
   // The close encounter (d = 0.05) at h = 8e-5: 10^6 steps.
   const auto r = run_cli("view --Kz 0.1 --d 0.05 --h 8e-5 --steps 1000000 --out " + out.string());
@@ -80,7 +80,7 @@ TEST(View, MillionStepRunMakesASmallPageWithTheClosestApproachKept) {
 
 TEST(View, CompareAndSeveralBodiesEmbedEveryTrack) {
   if (!have_viewer()) GTEST_SKIP() << "built without the viewer's script";
-  const fs::path out = fs::temp_directory_path() / "bp_view_cmp.html";
+  const fs::path out = test::temp_path("bp_view_cmp.html");
   const auto r = run_cli("view --scene " + std::string(BODYPOINT_SOURCE_DIR) +
                          "/scenes/two-centres.toml --method lp-verlet --h 0.01 --t-end 60 --compare logh-y4 "
                          "--compare-h 0.05 --frames 200 --out " + out.string());
@@ -100,7 +100,7 @@ TEST(View, CompareAndSeveralBodiesEmbedEveryTrack) {
 
 TEST(View, BadInputIsRefusedWithoutAPage) {
   if (!have_viewer()) GTEST_SKIP() << "built without the viewer's script";
-  const fs::path dir = fs::temp_directory_path() / "bp_view_bad";
+  const fs::path dir = test::temp_path("bp_view_bad");
   fs::create_directories(dir);
   const fs::path out = dir / "v.html";
   const std::vector<std::pair<std::string, std::string>> cases = {
