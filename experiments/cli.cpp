@@ -146,7 +146,10 @@ bool parse(int argc, char** argv, const po::options_description& desc, po::varia
     std::vector<std::string> names;
     for (const auto& o : all.options()) names.push_back("--" + o->long_name());
     const std::string near = closest_word(e.get_option_name(), names, 2);
-    throw Error(std::string(e.what()) + (near.empty() ? "" : " (did you mean " + near + "?)"));
+    // The message is built here: boost's what() substitutes placeholders into the option's own text,
+    // which loops without end when that text holds a placeholder ('--x%option%', fuzz_cli's find).
+    throw Error("unrecognised option '" + e.get_option_name() + "'" +
+                (near.empty() ? "" : " (did you mean " + near + "?)"));
   }
   if (vm.count("help")) {
     std::cout << usage << "\n\n" << all << "\n";
