@@ -18,6 +18,8 @@ namespace {
 /// crosses each segment boundary through (R, v, w) and back to the method's variables (R, K1, K2),
 /// which rounds it once more: a few ulp per boundary, over 10 boundaries.
 constexpr double kSegmentRoundOff = 1e-12;
+/// Sample times are t0 + i h with h = 0.01: a few ulp of times of order 1.
+constexpr double kTimeRoundOff = 1e-12;
 
 Scene thesis() { return thesis_scene(SceneParams{}); }
 
@@ -177,7 +179,7 @@ TEST(Api, AStepperHandsOnSamplesWithAbsoluteTimes) {
   ASSERT_EQ(stepper.advance_to(2.0), Outcome::ok);
   // 0, 0.5, 1 from the first segment; 1.5, 2 from the second (its start is the first's end).
   ASSERT_EQ(times.size(), 5u);
-  for (std::size_t i = 0; i < times.size(); ++i) EXPECT_NEAR(times[i], 0.5 * static_cast<double>(i), 1e-12);
+  for (std::size_t i = 0; i < times.size(); ++i) EXPECT_NEAR(times[i], 0.5 * static_cast<double>(i), kTimeRoundOff);
 }
 
 TEST(Api, AStepperRefusesTimeThatDoesNotAdvanceAndKeepsItsState) {
