@@ -1,7 +1,6 @@
 // `bodypoint sweep`: one scene or run parameter varied over a range, for a list of methods.
 #include "sweep.hpp"
 
-#include "bodypoint/batch.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
 #include "cli.hpp"
@@ -9,14 +8,10 @@
 #include "rows_file.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <exception>
 #include <iostream>
-#include <map>
 #include <limits>
 #include <memory>
-#include <mutex>
 #include <sstream>
 #include <thread>
 #include <utility>
@@ -61,20 +56,10 @@ std::vector<double> log_range(double from, double to, long points) {
 }
 
 RunSpec resolve_steps(double h, long steps, double t_end, double tol) {
+  // The command's words for the two ways a step option can be wrong; the rest is the library's.
   if (!std::isfinite(h) || h <= 0.0) throw Error("--h must be a finite number > 0, got " + fmt(h));
-  RunSpec spec;
-  spec.h = h;
-  spec.steps = steps;
-  if (t_end > 0.0) {
-    const FixedSteps f = fixed_steps_to(t_end, h);
-    spec.h = f.h;
-    spec.steps = f.steps;
-  }
-  if (spec.steps < 1) throw Error("--steps must be >= 1");
-  spec.t_end = spec.h * static_cast<double>(spec.steps);
-  spec.tol = tol;
-  spec.track_invariants = true;
-  return spec;
+  if (!(t_end > 0.0) && steps < 1) throw Error("--steps must be >= 1");
+  return fixed_run_spec(h, steps, t_end, tol);
 }
 
 unsigned thread_count(long requested) {

@@ -68,22 +68,25 @@ SceneParams point_params(const SweepSpec& spec, const std::vector<double>& point
   return p;
 }
 
-RunSpec point_spec(const SweepSpec& spec, const std::vector<double>& point) {
-  const double h = point_h(spec, point);
+RunSpec fixed_run_spec(double h, long steps, double t_end, double tol) {
   if (!(std::isfinite(h) && h > 0.0)) throw Error("step size h must be a finite number > 0, got " + fmt(h));
   RunSpec rs;
   rs.h = h;
-  rs.steps = spec.steps;
-  if (spec.t_end > 0.0) {
-    const FixedSteps f = fixed_steps_to(spec.t_end, h);
+  rs.steps = steps;
+  if (t_end > 0.0) {
+    const FixedSteps f = fixed_steps_to(t_end, h);
     rs.h = f.h;
     rs.steps = f.steps;
   }
   if (rs.steps < 1) throw Error("the number of steps must be >= 1");
   rs.t_end = rs.h * static_cast<double>(rs.steps);
-  rs.tol = spec.tol;
+  rs.tol = tol;
   rs.track_invariants = true;
   return rs;
+}
+
+RunSpec point_spec(const SweepSpec& spec, const std::vector<double>& point) {
+  return fixed_run_spec(point_h(spec, point), spec.steps, spec.t_end, spec.tol);
 }
 
 std::string point_label(const SweepSpec& spec, const std::vector<double>& point) {
