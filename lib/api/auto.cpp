@@ -19,13 +19,20 @@ constexpr double kTightTolerance = 1e-10;
 /// fraction of the time-step constant c: the time transformation would then change the step by < 10%.
 constexpr double kFarFraction = 0.1;
 
-/// Straight-line estimate of the closest approach to c: the body's initial line of motion.
+/// Straight-line estimate of the closest approach to c. A spinning body does not travel along v,
+/// which precesses about K1: far from the centres it follows a helix whose axis passes through the
+/// guiding centre R + K1 x K2/|K1|^2 along K1, at the speed (J |K1| - B K2.K1/|K1|)/D (the kinetic
+/// drift, docs/physics.md). For B = 0 that is the line along v.
 double closest_approach(const Body& b, const Centre& c) {
-  const Vec3 d = b.s0.R - c.c;
-  const Vec3& v = b.s0.v;
-  const double v2 = v.squaredNorm();
-  if (!(v2 > 0.0) || d.dot(v) >= 0.0) return d.norm();  // at rest or moving away
-  return d.cross(v).norm() / std::sqrt(v2);
+  const Momenta q = to_momenta(b.p, b.s0);
+  const double k2 = q.K1.squaredNorm();
+  if (!(k2 > 0.0)) return (b.s0.R - c.c).norm();  // no drift
+  const Vec3 axis = q.K1 / std::sqrt(k2);
+  const double speed = (b.p.J * std::sqrt(k2) - b.p.B * q.K2.dot(axis)) / b.p.D();
+  const Vec3 d = b.s0.R + q.K1.cross(q.K2) / k2 - c.c;
+  const Vec3 u = speed >= 0.0 ? axis : Vec3(-axis);
+  if (d.dot(u) >= 0.0 || speed == 0.0) return d.norm();  // moving away, or at rest
+  return d.cross(u).norm();
 }
 
 }  // namespace
