@@ -1,18 +1,22 @@
 // bodypoint: the step search behind --tol (tolerance.hpp).
 //
-// The search, for a method of order p:
-// 1. Two runs at a coarse h0 (a fictitious step that advances the orbit by about one radian per step
-//    at closest approach, or a fixed step of one spin-orbit period) and h0/2. A run the method
-//    refuses (logH's E - T + c <= 0, a non-finite state) only halves the step.
-// 2. The pair's Richardson estimate est = |x_a - x_b|/((h_a/h_b)^p - 1) predicts the step h* that
-//    would give kTarget tol (at least kMinRefinement finer than the pilot).
-// 3. Runs at r^2 h*, r h* and h* (r = kCloseRatio, all with the time-step constant c of r^2 h*) give
-//    two estimates of the error of x(h*): from the pair (r h*, h*), and from (r^2 h*, r h*) scaled by
-//    r^-p. If they agree within kSmoothBand (the error is smooth in h there) and the larger is at most
-//    kAccept tol, x(h*) is delivered with the first as its estimate. Otherwise step 2 predicts again
-//    (or, when the two disagree, h* is refined by kMinRefinement).
-// Differences that stop shrinking far below 1 are round-off: the finest run is delivered when they are
-// below kAccept tol, otherwise the search reports the floor it met.
+// The search, for a method of order p, in as few integrations as the scene allows. Runs that share
+// one time-step constant c (time-transformed methods; a pair compared by Richardson must be one
+// method) form a ladder, coarse to fine; each new run's error is estimated from the run before it,
+// est = |x_a - x_b|/((h_a/h_b)^p - 1), and the estimate is trusted when the error behaves like C h^p
+// there: the three last runs fit an order of at least p - kOrderSlack, or (a ladder of two) the
+// estimate is what the coarser runs predicted for it, within kAgree.
+// 1. Pilot pair: runs at a coarse step h0 (a fictitious step that advances the orbit by about one
+//    radian per step at closest approach, or a fixed step of one spin-orbit period) and h0/2, with the
+//    c of h0. A run the method refuses (logH's E - T + c <= 0, a non-finite state) halves h0.
+// 2. The latest estimate predicts the step h* that gives kTarget tol. When h*'s own c is well below
+//    the ladder's (far from the centres a run costs ~c/ds steps per unit time), a new ladder starts:
+//    the answer at h* and its companion at kCompanionRatio h* (half the cost of the answer). Otherwise
+//    the answer at h* joins the ladder, whose finest run is its companion: one run.
+// 3. A trusted estimate at most kAccept tol delivers the answer; otherwise back to 2.
+// The delivered run is the one that carries the observers (invariants, samples): samples go to a buffer
+// handed to the caller's sink only when its run is delivered, so nothing is integrated twice.
+// Differences that stop shrinking far below 1 are round-off: the search reports the floor it met.
 #include "bodypoint/adaptive/tolerance.hpp"
 
 #include "bodypoint/adaptive/methods.hpp"
@@ -23,35 +27,38 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 namespace bodypoint::adaptive {
 namespace {
 
-/// The predicted step aims at this fraction of tol, so that the estimate, itself uncertain by a
-/// factor of a few before the asymptotic regime is deep, still lands below tol.
-constexpr double kTarget = 0.2;
+/// The predicted step aims at this fraction of tol: the error of a step predicted from a coarser
+/// pair is uncertain by a factor of a few (the local order differs from p before the asymptotic
+/// range), and a prediction that misses costs one more run.
+constexpr double kTarget = 0.3;
 /// A run is delivered when its estimated error is at most this fraction of tol.
-constexpr double kAccept = 0.5;
-/// The error of the delivered run is estimated from a second run at a step this much coarser. A ratio
-/// close to 1 makes the estimate insensitive to the local order q of the error, which differs from the
-/// nominal p before the asymptotic range (optimised 8th-order tables fall like h^13..h^25 there):
-/// d = err (r^q - 1), and the estimate d/(r^p - 1) is off by (r^q - 1)/(r^p - 1), 2.8x for q = 2p,
-/// 0.7x for q = 3p/4 at r = 1.1, where a ratio of 2 would be off by 250x for p = 8, q = 16.
-constexpr double kCloseRatio = 1.1;
+constexpr double kAccept = 0.8;
+/// The answer's companion runs at this multiple of its step: it costs 1/kCompanionRatio of the
+/// answer. A larger ratio costs less but makes the estimate depend more on the local order q of the
+/// error (it is off by (r^q - 1)/(r^p - 1): 4x for q = p + 2 at r = 2).
+constexpr double kCompanionRatio = 2.0;
+/// A triple whose observed order is this much below p is not smooth in h there.
+constexpr double kOrderSlack = 1.0;
+/// Orders above this are not told apart (the fit's bracket).
+constexpr double kMaxOrder = 40.0;
+/// A new run's estimate agrees with the one the coarser runs predicted for it within this factor.
+constexpr double kAgree = 10.0;
+/// A new ladder (answer and companion, 1 + 1/kCompanionRatio runs) is started for a predicted step
+/// whose own constant c is below this fraction of the ladder's: far from the centres a run costs
+/// about c/ds steps per unit time, so the new ladder's answer costs at most this fraction of a run
+/// at that step on the old ladder, and the pair less than that one run.
+constexpr double kNewConstantGain = 0.5;
 /// A repeated prediction is at least this much finer than the run it failed with.
-constexpr double kMinRefinement = 1.5;
-/// The delivered run's error is estimated twice, from the pairs (r^2 h, r h) and (r h, h) with the
-/// first scaled by r^-p; an error that is smooth in h gives two estimates within this factor. Rough
-/// errors were measured on long runs where the far-field step meets spin-orbit resonances (scene
-/// long, logh-kl8: 9.8e-8 at ds = 0.082, 1.8e-7 at 0.075, 3.0e-9 at 0.068): there a single pair
-/// underestimated the error 50x.
-constexpr double kSmoothBand = 3.0;
+constexpr double kMinRefinement = 1.25;
 /// The search gives up after this many refinements in a row that did not lower its error estimate
 /// by kStallFactor (scene long at tol 1e-12 spent 2e9 force evaluations, about 100 s, before).
 constexpr int kMaxStalls = 3;
 constexpr double kStallFactor = 2.0;
-/// The observed order of a triple is trusted up to this multiple of the nominal order.
-constexpr double kMaxOrderFactor = 2.0;
 /// Budget of force evaluations (or KS steps) over all runs of one search.
 constexpr double kMaxEvals = 2e9;
 /// Refinements before the search gives up.
@@ -65,13 +72,20 @@ struct SearchLimit : Error {
   using Error::Error;
 };
 
+/// A sample kept until its run is known to be the delivered one.
+struct KeptSample {
+  long step;
+  double t;
+  State s;
+  double rel_dE, rel_dK2sq, abs_dK2Q;
+};
+
 struct Level {
   double h = 0.0;
   long steps = 0;
-  State final;
-  long evals = 0;
-  double wall = 0.0;
   double omega_c = 0.0;
+  RunResult run;
+  std::vector<KeptSample> samples;
 };
 
 int effective_order(const MethodInfo& m, const Body& b) {
@@ -128,61 +142,72 @@ double initial_step(const MethodInfo& m, const Body& b, const std::vector<Centre
 
 class Search {
  public:
-  Search(const MethodInfo& m, const Body& b, const std::vector<Centre>& c, double tol, double t_end)
-      : m_(m), b_(b), c_(c), tol_(tol), t_end_(t_end), p_(effective_order(m, b)) {}
-
-  /// Runs the method at step h (ds for time-transformed methods; a fixed step is rounded to t_end/n).
-  /// Runs at step h with the time-step constant that the step h_c calls for (time-transformed
-  /// methods; a pair of runs compared by Richardson must share it to be one method).
-  Level run_at(double h, double h_c) {
-    RunSpec s = step_spec(m_, h, t_end_, RunSpec{});
-    s.omega_c = automatic_omega_c(b_, c_, h_c);
-    const double expected = expected_evals(s);
-    if (spent_evals_ + expected > kMaxEvals)
-      throw SearchLimit("tol " + fmt_tol() + " is out of reach of " + std::string(m_.name) +
-                  " within 2e9 force evaluations (last estimate " + fmt_number(last_estimate_) + ")");
-    // The scene and the method's acceptance of it were checked once (run_to_tolerance); each run's
-    // specification is checked here, and the method runs without run()'s checks of the scene.
-    (void)advance_of(m_, s);
-    const RunResult r = m_.run(b_, c_, s, nullptr);
-    if (!(r.final.R.allFinite() && r.final.v.allFinite())) throw Error("the state became non-finite");
-    Level l{s.h, s.steps, r.final, std::max(r.force_evals, r.steps), r.wall_s, s.omega_c};
-    spent_evals_ += static_cast<double>(l.evals);
-    total_wall_ += r.wall_s;
-    total_evals_ += r.force_evals;
-    ++runs_;
-    return l;
-  }
+  Search(const MethodInfo& m, const Body& b, const std::vector<Centre>& c, double tol, double t_end,
+         const Delivery& delivery)
+      : m_(m), b_(b), c_(c), tol_(tol), t_end_(t_end), p_(effective_order(m, b)), delivery_(delivery) {}
 
   ToleranceResult search() {
-    const Level best = p_ > 0 ? ladder() : exact_flow();
+    Level best = p_ > 0 ? ladder() : exact_flow();
     ToleranceResult out;
     out.h = best.h;
     out.steps = best.steps;
     out.omega_c = best.omega_c;
     out.err_estimate = estimate_;
-    out.result.final = best.final;
-    out.result.steps = best.steps;
-    out.result.t_end = t_end_;
-    out.result.force_evals = best.evals;
-    out.result.wall_s = best.wall;
+    out.result = std::move(best.run);
     out.runs = runs_;
     out.total_force_evals = total_evals_;
     out.total_wall_s = total_wall_;
+    if (delivery_.sink)
+      for (const KeptSample& k : best.samples) (*delivery_.sink)(Sample{k.step, k.t, k.s, k.rel_dE, k.rel_dK2sq, k.abs_dK2Q});
     return out;
   }
 
  private:
+  /// Runs the method at step h (ds for time-transformed methods; a fixed step is rounded to t_end/n)
+  /// with the time-step constant that the step h_c calls for (time-transformed methods; a pair of
+  /// runs compared by Richardson must share it to be one method). A run that may be delivered
+  /// carries the observers the caller asked for, its samples kept aside.
+  Level run_at(double h, double h_c, bool may_deliver) {
+    RunSpec s = step_spec(m_, h, t_end_, RunSpec{});
+    s.omega_c = automatic_omega_c(b_, c_, h_c);
+    Level l;
+    SampleSink keep;
+    if (may_deliver) {
+      s.track_invariants = delivery_.track_invariants;
+      s.every = delivery_.every;
+      s.dt_out = delivery_.sink ? delivery_.dt_out : 0.0;
+      if (delivery_.sink)
+        keep = [&l](const Sample& x) { l.samples.push_back({x.step, x.t, x.s, x.rel_dE, x.rel_dK2sq, x.abs_dK2Q}); };
+    }
+    const double expected = expected_evals(s);
+    if (spent_evals_ + expected > kMaxEvals)
+      throw SearchLimit("tol " + fmt_tol() + " is out of reach of " + std::string(m_.name) +
+                        " within 2e9 force evaluations (last estimate " + fmt_number(last_estimate_) + ")");
+    // The scene and the method's acceptance of it were checked once (run_to_tolerance); each run's
+    // specification is checked here, and the method runs without run()'s checks of the scene.
+    (void)advance_of(m_, s);
+    l.run = m_.run(b_, c_, s, keep ? &keep : nullptr);
+    if (!(l.run.final.R.allFinite() && l.run.final.v.allFinite())) throw Error("the state became non-finite");
+    l.h = s.h;
+    l.steps = s.steps;
+    l.omega_c = s.omega_c;
+    spent_evals_ += static_cast<double>(std::max(l.run.force_evals, l.run.steps));
+    total_wall_ += l.run.wall_s;
+    total_evals_ += l.run.force_evals;
+    ++runs_;
+    return l;
+  }
+
   /// The pilot pair at h0 and h0/2 (a refused step halves h0); sets the first estimate and returns
-  /// the finer run.
-  Level pilot() {
+  /// the finer run, which may be delivered.
+  Level pilot(Level& coarse) {
     double h = initial_step(m_, b_, c_, t_end_);
-    Level a, b;
     for (int k = 0;; ++k) {
       try {
-        a = run_at(h, h);
-        b = run_at(0.5 * a.h, h);
-        break;
+        coarse = run_at(h, h, false);
+        Level fine = run_at(0.5 * coarse.h, h, false);
+        estimate_ = pair_estimate(coarse, fine);
+        return fine;
       } catch (const SearchLimit&) {
         throw;
       } catch (const Error&) {
@@ -190,49 +215,52 @@ class Search {
         h *= 0.5;
       }
     }
-    estimate_ = pair_estimate(a, b);
-    return b;
   }
 
-  /// Order-p methods: pilot pair, predicted step, close pair (file comment).
+  /// Order-p methods (file comment): runs that share one time-step constant c form a ladder; each new
+  /// run is estimated from the run before it (Richardson, order p) and checked by the run before that.
   Level ladder() {
-    // 1. The pilot pair, coarse and cheap.
-    const Level b = pilot();
-    // 2./3. Predict, estimate from a close triple, repeat until the estimate is below kAccept tol.
-    Level fine = b;
-    double h_next = 0.0, best_bound = std::numeric_limits<double>::infinity();
+    std::vector<Level> rungs;  // runs sharing the constant c of step h_c, coarse to fine
+    Level coarse;
+    Level fine = pilot(coarse);
+    double h_c = coarse.h;
+    rungs.push_back(std::move(coarse));
+    rungs.push_back(std::move(fine));
+    double best_bound = std::numeric_limits<double>::infinity();
     int stalled = 0;
     for (int k = 0; k < kMaxLevels; ++k) {
-      const double predicted = fine.h * std::pow(kTarget * tol_ / std::max(estimate_, kRoundOff), 1.0 / p_);
-      const double h_star = k == 0 || h_next == 0.0 ? std::min(predicted, fine.h / kMinRefinement) : h_next;
-      const double r = kCloseRatio, h_c = h_star * r * r;  // the triple shares the constant c of its coarsest step
-      const Level coarsest = run_at(h_c, h_c);
-      const Level coarse = run_at(h_star * r, h_c);
-      fine = run_at(h_star, h_c);
-      const double e_fine = pair_estimate(coarse, fine);
-      const double e_mid = pair_estimate(coarsest, coarse) * std::pow(fine.h / coarse.h, p_);
-      // Where the error falls faster than h^p (before the asymptotic range), the observed order q of
-      // the triple, d(r^2 h, r h)/d(r h, h) = r^q, gives the better estimate (Roache's generalised
-      // Richardson extrapolation); it is used only up to kMaxOrderFactor p, and never below p.
-      const double d_mid = state_distance(coarsest.final, coarse.final);
-      const double d_fine = state_distance(coarse.final, fine.final);
-      const double q_obs = d_fine > 0.0 ? std::log(d_mid / d_fine) / std::log(coarse.h / fine.h) : p_;
-      const double q = std::clamp(std::isfinite(q_obs) ? q_obs : p_, double(p_), kMaxOrderFactor * p_);
-      estimate_ = d_fine / (std::pow(coarse.h / fine.h, q) - 1.0);
+      const double predicted = rungs.back().h * std::pow(kTarget * tol_ / std::max(estimate_, kRoundOff), 1.0 / p_);
+      double expected = kTarget * tol_;  // what the model C h^p says the new run's error is
+      if (automatic_omega_c(b_, c_, kCompanionRatio * predicted) < kNewConstantGain * rungs.back().omega_c) {
+        // Far finer than the ladder so far: a new ladder whose constant c is that of the companion's
+        // step, so that the answer does not pay for the coarse runs' larger c in the far field.
+        h_c = kCompanionRatio * predicted;
+        rungs.clear();
+        rungs.push_back(run_at(h_c, h_c, false));
+        rungs.push_back(run_at(predicted, h_c, true));
+      } else {
+        const double h = std::min(predicted, rungs.back().h / kMinRefinement);
+        expected = estimate_ * std::pow(h / rungs.back().h, p_);
+        rungs.push_back(run_at(h, h_c, true));
+      }
+      const Level& a = rungs[rungs.size() - 2];
+      const Level& b = rungs.back();
+      estimate_ = pair_estimate(a, b);
       last_estimate_ = estimate_;
-      const double bound = std::max(e_fine, e_mid);
-      const bool smooth = bound <= kSmoothBand * std::min(e_fine, e_mid) || q_obs >= p_;
-      if (state_distance(coarse.final, fine.final) <= kRoundOff && bound > kAccept * tol_)
+      const double d = state_distance(a.run.final, b.run.final);
+      if (d <= kRoundOff && estimate_ > kAccept * tol_)
         throw Error("tol " + fmt_tol() + " is below the round-off floor of " + std::string(m_.name) +
                     " on this scene (estimate " + fmt_number(estimate_) + ")");
-      if (bound <= kAccept * tol_ && (smooth || bound <= kRoundOff)) return fine;
-      // Not accurate enough: predict again; not smooth in h (a resonance of the far-field step with the
-      // spin-orbit precession): refine by kMinRefinement, which also lowers the spin angle per step.
-      h_next = smooth ? 0.0 : fine.h / kMinRefinement;
+      // The estimate is trusted when the error behaves like C h^p: the three last runs of the ladder
+      // show an order of at least p - kOrderSlack, or (two runs) the estimate is what the model
+      // carried over from the coarser runs predicted, within kAgree.
+      bool smooth = estimate_ <= kAgree * expected && estimate_ >= expected / kAgree;
+      if (rungs.size() >= 3) smooth = observed_order(rungs[rungs.size() - 3], a, b) >= p_ - kOrderSlack;
+      if (estimate_ <= kAccept * tol_ && (smooth || d <= kRoundOff)) return std::move(rungs.back());
       // A search whose estimates stop falling (round-off, or resonances that refinement does not
       // remove) says so instead of spending its whole budget.
-      if (bound < best_bound / kStallFactor) {
-        best_bound = bound;
+      if (estimate_ < best_bound / kStallFactor) {
+        best_bound = estimate_;
         stalled = 0;
       } else if (++stalled >= kMaxStalls) {
         throw Error("tol " + fmt_tol() + " is out of reach of " + std::string(m_.name) +
@@ -243,18 +271,38 @@ class Search {
                 std::to_string(kMaxLevels) + " refinements");
   }
 
+  /// The order q with which x(h) = x* + C h^q fits three runs at steps h1 > h2 > h3: the root of
+  /// (h1^q - h2^q)/(h2^q - h3^q) = d12/d23 (increasing in q), by bisection on [0, kMaxOrder].
+  static double observed_order(const Level& l1, const Level& l2, const Level& l3) {
+    const double d12 = state_distance(l1.run.final, l2.run.final), d23 = state_distance(l2.run.final, l3.run.final);
+    if (!(d23 > 0.0)) return kMaxOrder;
+    const double target = d12 / d23;
+    auto ratio = [&](double q) {
+      const double a = std::pow(l1.h / l3.h, q), b = std::pow(l2.h / l3.h, q);
+      return (a - b) / (b - 1.0);
+    };
+    double lo = 1e-3, hi = kMaxOrder;
+    if (ratio(lo) >= target) return 0.0;
+    if (ratio(hi) <= target) return kMaxOrder;
+    for (int it = 0; it < 60; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (ratio(mid) < target ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+  }
+
   /// Richardson's estimate of the finer run's error from a pair at steps h_c > h_f, order p.
   [[nodiscard]] double pair_estimate(const Level& c, const Level& f) const {
-    return state_distance(c.final, f.final) / (std::pow(c.h / f.h, p_) - 1.0);
+    return state_distance(c.run.final, f.run.final) / (std::pow(c.h / f.h, p_) - 1.0);
   }
 
   /// ks: exact in fictitious time, only rounding and the time equation err; two runs at different
   /// fictitious steps bound that.
   Level exact_flow() {
     const double h = initial_step(m_, b_, c_, t_end_);
-    const Level a = run_at(h, h);
-    const Level b = run_at(h / kMinRefinement, h);
-    estimate_ = std::max(state_distance(a.final, b.final), std::numeric_limits<double>::epsilon());
+    Level a = run_at(h, h, true);
+    const Level b = run_at(h / kMinRefinement, h, false);
+    estimate_ = std::max(state_distance(a.run.final, b.run.final), std::numeric_limits<double>::epsilon());
     if (estimate_ > kAccept * tol_)
       throw Error("tol " + fmt_tol() + " is below what " + std::string(m_.name) + " delivers on this scene (" +
                   fmt_number(estimate_) + ")");
@@ -278,6 +326,7 @@ class Search {
   const std::vector<Centre>& c_;
   double tol_, t_end_;
   int p_;
+  Delivery delivery_;
   double estimate_ = 0.0, last_estimate_ = std::numeric_limits<double>::quiet_NaN();
   double spent_evals_ = 0.0, total_wall_ = 0.0;
   long total_evals_ = 0;
@@ -302,13 +351,8 @@ void check_tolerance(double tol) {
   if (!(tol < 1.0)) throw Error("tol must be below 1 (it is a relative error of the final state)");
 }
 
-RunSpec delivered_spec(const MethodInfo& method, const ToleranceResult& r, double t_end, RunSpec base) {
-  base.omega_c = r.omega_c;
-  return step_spec(method, r.h, t_end, base);
-}
-
 ToleranceResult run_to_tolerance(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
-                                 double tol, double t_end) {
+                                 double tol, double t_end, const Delivery& delivery) {
   check_tolerance(tol);
   if (!(std::isfinite(t_end) && t_end > 0.0)) throw Error("the accuracy mode needs an end time t_end that is a finite number > 0");
   if (is_step_controlled(method))
@@ -320,7 +364,8 @@ ToleranceResult run_to_tolerance(const MethodInfo& method, const Body& body, con
   if (non_coulomb(centres))
     throw Error(std::string(kNeedsCoulomb));
   if (const std::string why = refusal(method, body, centres); !why.empty()) throw Error(why);
-  return Search(method, body, centres, tol, t_end).search();
+  if (delivery.every < 1) throw Error("every must be >= 1");
+  return Search(method, body, centres, tol, t_end, delivery).search();
 }
 
 }  // namespace bodypoint::adaptive

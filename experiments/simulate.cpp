@@ -61,7 +61,7 @@ std::string search_line(const BodyRun& b) {
   os << "method=" << b.method->name;
   if (b.search)
     os << (is_time_transformed(*b.method) ? " ds=" : " h=") << fmt(b.search->step)
-       << " err_estimate=" << fmt(b.search->err_estimate) << " search: " << b.search->runs << " runs, "
+       << " err_estimate=" << fmt(b.search->err_estimate) << " search: " << b.search->runs << " runs (the delivered one included), "
        << b.search->force_evals << " force evaluations";
   return os.str();
 }

@@ -23,7 +23,7 @@ std::string_view outcome_name(Outcome o) {
 }
 
 long BodyResult::total_force_evals() const {
-  return run.force_evals + (accuracy ? accuracy->force_evals : 0);
+  return accuracy ? accuracy->force_evals : run.force_evals;
 }
 
 RunSpec run_spec(const MethodInfo& method, const Advance& how, const Options& options) {
@@ -72,24 +72,17 @@ void judge(BodyResult& r) {
   r.reason = h.why;
 }
 
-/// The accuracy mode: the step search, then the delivered run repeated when invariants or samples
-/// are asked for (the search's runs take neither).
+/// The accuracy mode: the step search, whose delivered run carries the observers.
 void run_accurately(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Accuracy& a,
                     const Options& options) {
-  const adaptive::ToleranceResult t = adaptive::run_to_tolerance(*r.method, body, centres, a.tol, a.t_end);
+  adaptive::Delivery delivery;
+  delivery.track_invariants = options.track_invariants;
+  delivery.every = options.every;
+  delivery.dt_out = a.dt_out;
+  delivery.sink = options.sink;
+  adaptive::ToleranceResult t = adaptive::run_to_tolerance(*r.method, body, centres, a.tol, a.t_end, delivery);
   r.accuracy = AccuracyReport{a.tol, t.err_estimate, t.h, t.omega_c, t.runs, t.total_force_evals, t.total_wall_s};
-  if (!options.track_invariants && !options.sink) {
-    r.run = t.result;
-    return;
-  }
-  RunSpec base;
-  base.track_invariants = options.track_invariants;
-  base.every = options.every;
-  base.dt_out = a.dt_out;
-  // The scene was validated and accepted by integrate_body: only the delivered spec is checked.
-  const RunSpec spec = adaptive::delivered_spec(*r.method, t, a.t_end, base);
-  (void)advance_of(*r.method, spec);
-  r.run = r.method->run(body, centres, spec, options.sink);
+  r.run = std::move(t.result);
 }
 
 /// integrate_body for a body and centres already validated.
@@ -145,7 +138,7 @@ Result integrate(const Scene& scene, const MethodInfo* method, const Advance& ho
   for (const Body& body : scene.bodies) {
     BodyResult b = integrate_valid_body(body, scene.centres, method, how, options);
     all.force_evals += b.total_force_evals();
-    all.wall_s += b.run.wall_s + (b.accuracy ? b.accuracy->wall_s : 0.0);
+    all.wall_s += (b.accuracy ? b.accuracy->wall_s : b.run.wall_s);
     if (all.outcome == Outcome::ok && b.outcome != Outcome::ok) {
       all.outcome = b.outcome;
       all.reason = (body.name.empty() ? std::string("body") : body.name) + ": " + b.reason;

@@ -22,18 +22,18 @@
 namespace bodypoint {
 namespace {
 
-// The search delivers a run whose estimate is at most half of TOL and whose estimate tracks its true
-// error; the requirement is that the estimate is within this factor of the true error.
-constexpr double kEstimateFactor = 10.0;
-// An underestimate beyond kEstimateFactor would be a broken promise and is never allowed. An
-// overestimate beyond it happens where the delivered step sits in a dip of the error curve (both-signs,
-// ttl-kl8 at ds = 0.1016: error 3.0e-10 while its neighbours at 1.1 and 1.21 times that step follow
-// C h^8 from 5e-9, so every estimate from them says 4e-9); at most this fraction of the grid may.
-constexpr double kMaxOverestimatedFraction = 0.1;
+// The estimate is an estimate of the delivered run's error: within this factor of it both ways (the
+// accuracy issue's requirement), where the error is measurable.
+constexpr double kEstimateFactor = 3.0;
 // Below this the "true" error is the reference's own error and the round-off of the run
 // (reference rkf78 long double tol 1e-18: 1e-15..1e-14 relative; runs: 1e-15..1e-13), so the
 // estimate is compared with the error only above it.
 constexpr double kComparableError = 1e-13;
+// The whole accuracy mode (pilots, companions, the delivered run) costs at most this many times the
+// delivered run in force evaluations. The pilot pair at the coarse step takes a spin-limited far field
+// (about 1.5 delivered runs), the answer's companion half of one, a refinement one more: 2.2..3.3 on
+// this grid. (The search of the previous revision cost 4..6, plus a repeated run for invariants.)
+constexpr double kMaxCostRatio = 3.5;
 
 struct Case {
   std::string name;
@@ -84,12 +84,9 @@ std::vector<Case> cases() {
   return out;
 }
 
-// The grid stops at 1e-10. At 1e-12 auto also delivered on seven of these eight scenes, but on
-// close-long (t = 400, ~1e5 steps of logh-kl8) it delivered 1.8e-12 with an estimate of 2.2e-13: the
-// round-off of that many steps is not systematic in h, so Richardson estimates do not see it (README,
-// "Limits").
 TEST(Tolerance, AutoDeliversTolWithAnHonestEstimate) {
-  int runs = 0, overestimated = 0;
+  int runs = 0, within_decade = 0;
+  double worst_cost = 0.0;
   for (const Case& c : cases()) {
     const Body& b = c.scene.bodies.front();
     const State ref = reference_state(b, c.scene.centres, c.t_end, 1e-18L);
@@ -99,19 +96,25 @@ TEST(Tolerance, AutoDeliversTolWithAnHonestEstimate) {
       const adaptive::ToleranceResult r = adaptive::run_to_tolerance(m, b, c.scene.centres, tol, c.t_end);
       const double err = adaptive::state_distance(r.result.final, ref);
       EXPECT_LE(err, tol) << c.name << " tol " << tol << " " << why;
-      EXPECT_LE(r.err_estimate, 0.5 * tol) << c.name << " tol " << tol;
-      // The estimate is an estimate of err: within kEstimateFactor of it, where err is measurable.
-      ++runs;
-      if (r.err_estimate > kEstimateFactor * std::max(err, kComparableError)) ++overestimated;
+      EXPECT_LE(r.err_estimate, tol) << c.name << " tol " << tol;
       if (err > kComparableError) {
+        EXPECT_LE(r.err_estimate, kEstimateFactor * err) << c.name << " tol " << tol;
         EXPECT_GE(r.err_estimate, err / kEstimateFactor) << c.name << " tol " << tol;
       }
-      std::printf("  %-22s tol %.0e  %-9s h %-10.4g est %.2e err %.2e  (%d runs)\n", c.name.c_str(), tol,
-                  std::string(m.name).c_str(), r.h, r.err_estimate, err, r.runs);
+      // ks counts no force evaluations (its runs are alike: two of them).
+      const double cost = r.result.force_evals > 0
+                              ? static_cast<double>(r.total_force_evals) / static_cast<double>(r.result.force_evals)
+                              : static_cast<double>(r.runs);
+      EXPECT_LE(cost, kMaxCostRatio) << c.name << " tol " << tol;
+      worst_cost = std::max(worst_cost, cost);
+      ++runs;
+      within_decade += err >= 0.1 * tol ? 1 : 0;
+      std::printf("  %-22s tol %.0e  %-9s h %-10.4g est %.2e err %.2e  (%d runs, %.2fx the delivered run)\n",
+                  c.name.c_str(), tol, std::string(m.name).c_str(), r.h, r.err_estimate, err, r.runs, cost);
     }
   }
-  EXPECT_LE(overestimated, kMaxOverestimatedFraction * runs) << overestimated << " of " << runs;
-  std::printf("  estimates more than %.0fx above the error: %d of %d\n", kEstimateFactor, overestimated, runs);
+  std::printf("  delivered error within [tol/10, tol]: %d of %d; largest cost %.2fx the delivered run\n",
+              within_decade, runs, worst_cost);
 }
 
 TEST(Tolerance, EveryFamilyAcceptsTol) {
@@ -124,13 +127,6 @@ TEST(Tolerance, EveryFamilyAcceptsTol) {
         adaptive::run_to_tolerance(method_or_throw(name), b, ns.scene.centres, tol, ns.t_end);
     EXPECT_LE(adaptive::state_distance(r.result.final, ref), tol) << name;
   }
-  // The delivered run repeats exactly from its spec (with invariants tracked).
-  const MethodInfo& m = method_or_throw("logh-bm4");
-  const adaptive::ToleranceResult r = adaptive::run_to_tolerance(m, b, ns.scene.centres, tol, ns.t_end);
-  RunSpec spec;
-  spec.track_invariants = true;
-  const RunResult again = run(m, b, ns.scene.centres, adaptive::delivered_spec(m, r, ns.t_end, spec));
-  EXPECT_LE(adaptive::state_distance(again.final, r.result.final), kComparableError);
 }
 
 TEST(Tolerance, AutoChoosesByTheScene) {
@@ -152,6 +148,15 @@ TEST(Tolerance, AutoChoosesByTheScene) {
   far.A = -1e-3;
   far.start.d = 1e4;
   EXPECT_EQ(chosen(thesis_scene(far), 1e-11), "lp-kl8");
+  // A spinning body drifts along K1, not along v (which precesses about K1): from far starts aimed at
+  // the centre (d = 0.5) the encounter is close, whatever L. Predicted along v, L >= 500 read as
+  // "stays far" and chose lp-kl6, 20x the force evaluations of logh-kl6 at L = 1000.
+  for (double L : {200.0, 1e3, 1e4}) {
+    SceneParams aimed;
+    aimed.start.L = L;
+    aimed.start.d = 0.5;
+    EXPECT_EQ(chosen(thesis_scene(aimed), 1e-9), "logh-kl6") << L;
+  }
 }
 
 TEST(Tolerance, UnreachableOrInvalidTolIsRefused) {

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <vector>
@@ -69,12 +70,31 @@ TEST(Api, AccuracyModeDeliversTheSearchedRunWithItsReport) {
   EXPECT_EQ(br.run.final.R, t.result.final.R);
   EXPECT_LE(br.accuracy->err_estimate, tol);
   EXPECT_EQ(br.accuracy->force_evals, t.total_force_evals);
-  // The total counts the search: it is what the user's request cost.
-  EXPECT_EQ(r.force_evals, br.run.force_evals + t.total_force_evals);
-  // With invariants asked for, the delivered run carries them and ends in the same state.
-  const Result with = integrate(s, br.method, Accuracy{tol, t_end});
-  ASSERT_TRUE(with.bodies.front().run.invariants.has_value());
-  EXPECT_EQ(with.bodies.front().run.final.R, br.run.final.R);
+  // The total counts every run of the accuracy mode, the delivered one among them.
+  EXPECT_EQ(r.force_evals, t.total_force_evals);
+  EXPECT_LT(br.run.force_evals, r.force_evals);
+  // One pass: with invariants and samples asked for, the delivered run carries them; nothing is
+  // integrated again (the same runs and force evaluations), and the sink sees that run only, from
+  // t = 0 to t_end, ending in its final state.
+  std::vector<double> times;
+  State last;
+  const SampleSink sink = [&](const Sample& x) {
+    times.push_back(x.t);
+    last = x.s;
+  };
+  Options observed;
+  observed.sink = &sink;
+  const Result with = integrate(s, br.method, Accuracy{tol, t_end}, observed);
+  ASSERT_EQ(with.outcome, Outcome::ok) << with.reason;
+  const BodyResult& wb = with.bodies.front();
+  ASSERT_TRUE(wb.run.invariants.has_value());
+  EXPECT_EQ(wb.run.final.R, br.run.final.R);
+  EXPECT_EQ(wb.accuracy->runs, br.accuracy->runs);
+  EXPECT_EQ(with.force_evals, r.force_evals);
+  ASSERT_EQ(static_cast<long>(times.size()), wb.run.steps + 1);
+  EXPECT_TRUE(std::is_sorted(times.begin(), times.end()));
+  EXPECT_EQ(times.front(), 0.0);
+  EXPECT_EQ(last.R, wb.run.final.R);
 }
 
 TEST(Api, OutcomesAreTyped) {

@@ -7,10 +7,9 @@
 // method at different steps (E. Hairer, S. P. Norsett, G. Wanner, Solving Ordinary Differential
 // Equations I, 2nd ed., Springer 1993, sec. II.4, "Richardson extrapolation" and its use for global
 // error estimation): in the asymptotic regime err(h) = C h^p, so two runs at h and h/r differ by
-// C h^p (1 - r^-p) and the finer one's error is their difference over r^p - 1. The estimate is only
-// trusted where the ladder shows the asymptotic regime: the ratio of successive differences must be
-// close to 2^p (a converging ladder whose ratio is below 2^p is given its measured rate instead,
-// which makes the estimate larger). See tolerance.cpp for the steps of the search.
+// C h^p (1 - r^-p) and the finer one's error is their difference over r^p - 1. The run delivered is
+// the run reported: it carries the observers (Delivery), nothing is integrated again. See
+// tolerance.cpp for the steps of the search.
 //
 // `--method auto` (which method for a scene and a tol) is one layer up: bodypoint/methods.hpp.
 #pragma once
@@ -33,13 +32,22 @@ inline constexpr std::string_view kNeedsCoulomb =
     "the accuracy mode (tol) assumes Coulomb's law (its error model and time transformations do); run the thesis "
     "code's force law with a fixed step h";
 
+/// What the delivered run carries: invariants, samples (handed to the sink only for the delivered run,
+/// after the search), every k-th step or states at t = k dt_out.
+struct Delivery {
+  bool track_invariants = false;
+  long every = 1;
+  double dt_out = 0.0;
+  const SampleSink* sink = nullptr;
+};
+
 struct ToleranceResult {
-  RunResult result;        ///< the delivered run (no invariants, no samples: see delivered_spec)
+  RunResult result;        ///< the delivered run, with the invariants Delivery asked for
   double h = 0.0;          ///< the step used: h, or ds for time-transformed methods
   long steps = 0;          ///< fixed-step methods: number of steps (time-transformed: 0)
   double omega_c = 0.0;    ///< time-transformed methods: the time-step constant c of the run
   double err_estimate = 0.0;  ///< estimated relative error of the final state
-  int runs = 0;            ///< integrations made to choose the step and estimate the error
+  int runs = 0;            ///< integrations made in all (the delivered run included)
   long total_force_evals = 0;  ///< over all those runs
   double total_wall_s = 0.0;   ///< step loops of all those runs (what a user waits for)
 };
@@ -48,11 +56,7 @@ struct ToleranceResult {
 /// a known order, or ks), then searches the step for a run from t = 0 to t_end. Throws Error with a
 /// one-line reason when tol cannot be met (round-off floor, a budget of force evaluations exceeded).
 ToleranceResult run_to_tolerance(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
-                                 double tol, double t_end);
-
-/// `base` with the step of `r` filled in (h and steps, or ds and t_end): run() with it repeats the
-/// delivered run, e.g. with invariants tracked or a sink.
-RunSpec delivered_spec(const MethodInfo& method, const ToleranceResult& r, double t_end, RunSpec base);
+                                 double tol, double t_end, const Delivery& delivery = {});
 
 /// Relative distance of two final states: max(|dR|/|R_b|, |dv|/|v_b|).
 double state_distance(const State& a, const State& b);

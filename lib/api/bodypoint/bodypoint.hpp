@@ -66,7 +66,7 @@ struct AccuracyReport {
   double err_estimate = 0.0;  ///< estimated relative error of the final state
   double step = 0.0;          ///< the step chosen: h, or the fictitious step ds of time-transformed methods
   double omega_c = 0.0;       ///< time-transformed methods: the time-step constant c used
-  int runs = 0;               ///< integrations made by the search
+  int runs = 0;               ///< integrations made in all, the delivered run (BodyResult::run) included
   long force_evals = 0;       ///< over all of them
   double wall_s = 0.0;        ///< their step loops
 };
