@@ -60,12 +60,18 @@ struct BodyRun {
   std::string why;  ///< --method auto: what was chosen and why
   Outcome outcome = Outcome::ok;
   std::string reason;  ///< of an outcome other than ok
+  std::vector<EventHit> events;  ///< the events asked for, located
+  long event_force_evals = 0;
 };
 /// Runs one body as planned through the library (plan.cpp; integrate_body; spec may add invariants, output
 /// steps and a sink to plan.spec). A method that refuses the scene or a run that fails throws Error
 /// with the library's reason; diverged and collision are left to the caller (outcome, reason).
 BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
-                 const SampleSink* sink);
+                 const SampleSink* sink, const std::vector<Event>& events = {});
+
+/// An event from its command-line form: closest, closest:K (centre K), r=V, r:K=V, x=V, y=V, z=V or
+/// plane=nx,ny,nz,V (normal.R = V); Error naming the forms otherwise.
+Event parse_event(const std::string& text);
 
 /// Parses argv into vm, rejecting unknown options and positional words; returns false after
 /// printing help when --help is given.

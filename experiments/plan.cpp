@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
+#include <string>
 #include <utility>
 
 namespace bodypoint::cli {
@@ -54,8 +56,9 @@ RunPlan plan_run(const po::variables_map& vm, const StepOptions& st, const std::
 }
 
 BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
-                 const SampleSink* sink) {
+                 const SampleSink* sink, const std::vector<Event>& events) {
   Options options;
+  options.events = events;
   options.track_invariants = spec.track_invariants;
   options.sink = sink;
   options.every = spec.every;
@@ -70,7 +73,75 @@ BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre
   b.why = std::move(r.chosen);
   b.outcome = r.outcome;
   b.reason = std::move(r.reason);
+  b.events = std::move(r.events);
+  b.event_force_evals = r.event_force_evals;
   return b;
+}
+
+namespace {
+
+double event_number(const std::string& text, const std::string& value) {
+  std::size_t used = 0;
+  double x = 0.0;
+  try {
+    x = std::stod(value, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != value.size() || !std::isfinite(x))
+    throw Error("--event " + text + ": '" + value + "' is not a finite number");
+  return x;
+}
+
+std::size_t event_centre(const std::string& text, const std::string& index) {
+  if (index.empty() || index.find_first_not_of("0123456789") != std::string::npos || index.size() > 6)
+    throw Error("--event " + text + ": the centre must be an index 0, 1, ...");
+  return static_cast<std::size_t>(std::stoul(index));
+}
+
+}  // namespace
+
+Event parse_event(const std::string& text) {
+  Event e;
+  const std::size_t eq = text.find('=');
+  const std::string key = text.substr(0, eq), value = eq == std::string::npos ? "" : text.substr(eq + 1);
+  const std::string name = key.substr(0, key.find(':'));
+  const std::string index = key.find(':') == std::string::npos ? "0" : key.substr(key.find(':') + 1);
+  if (name == "closest" && eq == std::string::npos) {
+    e.kind = Event::Kind::closest_approach;
+    e.centre = event_centre(text, index);
+    return e;
+  }
+  if (name == "r" && eq != std::string::npos) {
+    e.kind = Event::Kind::radius;
+    e.centre = event_centre(text, index);
+    e.value = event_number(text, value);
+    if (!(e.value > 0.0)) throw Error("--event " + text + ": the radius must be > 0");
+    return e;
+  }
+  if ((key == "x" || key == "y" || key == "z") && eq != std::string::npos) {
+    e.kind = Event::Kind::plane;
+    e.normal = key == "x" ? Vec3::UnitX() : key == "y" ? Vec3::UnitY() : Vec3::UnitZ();
+    e.value = event_number(text, value);
+    return e;
+  }
+  if (key == "plane" && eq != std::string::npos) {
+    double n[4];
+    std::size_t from = 0;
+    for (int i = 0; i < 4; ++i) {
+      const std::size_t comma = i < 3 ? value.find(',', from) : value.size();
+      if (comma == std::string::npos) throw Error("--event " + text + ": give plane=nx,ny,nz,offset");
+      n[i] = event_number(text, value.substr(from, comma - from));
+      from = comma + 1;
+    }
+    e.kind = Event::Kind::plane;
+    e.normal = Vec3(n[0], n[1], n[2]);
+    e.value = n[3];
+    if (!(e.normal.norm() > 0.0)) throw Error("--event " + text + ": the plane's normal must not be zero");
+    return e;
+  }
+  throw Error("unknown --event '" + text + "': give closest, closest:K, r=RADIUS, r:K=RADIUS, x=X, y=Y, z=Z or "
+              "plane=nx,ny,nz,offset");
 }
 
 }  // namespace bodypoint::cli

@@ -66,6 +66,73 @@ std::string search_line(const BodyRun& b) {
   return os.str();
 }
 
+/// The encounter's observables of one body (--scattering): scattering.hpp, and the closest approach
+/// among the located closest-approach events.
+struct Encounter {
+  Scattering sc;
+  std::optional<EventHit> closest;
+};
+
+Encounter encounter(const Body& body, const std::vector<Centre>& centres, const std::vector<Event>& events,
+                    const BodyRun& run) {
+  Encounter e{scattering(body.p, centres, body.s0, run.result.final), std::nullopt};
+  for (const EventHit& h : run.events)
+    if (events[h.event].kind == Event::Kind::closest_approach && (!e.closest || h.distance < e.closest->distance))
+      e.closest = h;
+  return e;
+}
+
+std::string events_json(const std::vector<Event>& events, const BodyRun& run) {
+  if (events.empty()) return "";
+  std::ostringstream os;
+  os << ", \"events\": [";
+  for (std::size_t i = 0; i < run.events.size(); ++i) {
+    const EventHit& h = run.events[i];
+    os << (i ? ", " : "") << "{\"event\": " << json_string(events[h.event].label()) << ", \"t\": " << json_number(h.t)
+       << ", \"r\": " << json_number(h.distance) << ", \"R\": " << json_vec(h.s.R) << ", \"v\": " << json_vec(h.s.v)
+       << ", \"w\": " << json_vec(h.s.w) << "}";
+  }
+  os << "], \"event_force_evals\": " << run.event_force_evals;
+  return os.str();
+}
+
+std::string json_or_null(double x) { return std::isfinite(x) ? json_number(x) : "null"; }
+
+std::string scattering_json(const std::optional<Encounter>& e) {
+  if (!e) return "";
+  const Scattering& sc = e->sc;
+  std::ostringstream os;
+  os << ", \"scattering\": {\"asymptotes\": " << json_string(sc.asymptotes)
+     << ", \"deflection\": " << json_or_null(sc.deflection) << ", \"out_of_plane\": " << json_or_null(sc.out_of_plane)
+     << ", \"b\": " << json_or_null(sc.b) << ", \"v_inf\": " << json_or_null(sc.v_inf);
+  if (sc.in) os << ", \"direction_in\": " << json_vec(sc.in->direction) << ", \"direction_out\": " << json_vec(sc.out->direction);
+  os << ", \"r_min\": " << (e->closest ? json_number(e->closest->distance) : "null")
+     << ", \"t_min\": " << (e->closest ? json_number(e->closest->t) : "null")
+     << ", \"K1_turn\": " << json_number(sc.K1_turn) << ", \"spin_turn\": " << json_number(sc.spin_turn)
+     << ", \"K1_start\": " << json_vec(sc.K1_start) << ", \"K1_end\": " << json_vec(sc.K1_end)
+     << ", \"K2_start\": " << json_vec(sc.K2_start) << ", \"K2_end\": " << json_vec(sc.K2_end)
+     << ", \"E_start\": " << json_number(sc.E_start) << ", \"E_end\": " << json_number(sc.E_end);
+  if (sc.has_K2Q) os << ", \"K2Q_start\": " << json_vec(sc.K2Q_start) << ", \"K2Q_end\": " << json_vec(sc.K2Q_end);
+  os << "}";
+  return os.str();
+}
+
+void print_encounter(const std::vector<Event>& events, const BodyRun& run, const std::optional<Encounter>& e) {
+  for (const EventHit& h : run.events)
+    std::cout << "  event " << events[h.event].label() << ": t = " << fmt(h.t) << ", r = " << fmt(h.distance)
+              << ", R = " << json_vec(h.s.R) << "\n";
+  if (!e) return;
+  const Scattering& sc = e->sc;
+  std::cout << "  scattering (asymptotes: " << sc.asymptotes << ")\n";
+  if (sc.in)
+    std::cout << "    deflection = " << fmt(sc.deflection) << " rad (out of the incoming plane: " << fmt(sc.out_of_plane)
+              << "), impact parameter b = " << fmt(sc.b) << ", v_inf = " << fmt(sc.v_inf) << "\n";
+  if (e->closest) std::cout << "    closest approach r_min = " << fmt(e->closest->distance) << " at t_min = " << fmt(e->closest->t) << "\n";
+  else std::cout << "    no closest approach within the run (the distance has no minimum between its ends)\n";
+  std::cout << "    K1 turned " << fmt(sc.K1_turn) << " rad, the spin K2 " << fmt(sc.spin_turn) << " rad; K1: "
+            << json_vec(sc.K1_start) << " -> " << json_vec(sc.K1_end) << "\n";
+}
+
 }  // namespace
 
 namespace {
@@ -77,7 +144,9 @@ struct SimulateOptions {
   std::string out;
   long every = 1;
   double tol = RunSpec{}.tol, dt_out = 0.0, omega_c = RunSpec{}.omega_c;
-  bool json = false, no_invariants = false, with_reference = false, dry_run = false, quiet = false;
+  bool json = false, no_invariants = false, with_reference = false, dry_run = false, quiet = false, scattering = false;
+  std::vector<std::string> event_text;
+  std::vector<Event> events;  ///< parsed from event_text, and the closest approaches --scattering adds
   double max_seconds = 3600.0, max_rows = 1e7;
   std::vector<std::string> observe;
 };
@@ -98,6 +167,12 @@ void add_simulate_options(po::options_description& desc, SimulateOptions& o) {
       ("omega-c", po::value(&o.omega_c), "time-transformed methods: constant c added to the time-step function "
        "(physical step <= ds/c); default: from the scene's spin-orbit rate")
       ("every", po::value(&o.every)->default_value(o.every), "with --out: write every k-th step (and the last)")
+      ("event", po::value(&o.event_text)->multitoken()->composing(),
+       "locate events on the method's own steps and report them: closest (a closest approach; closest:K to "
+       "centre K), r=RADIUS (r:K=RADIUS), x=X, y=Y, z=Z or plane=nx,ny,nz,offset")
+      ("scattering", po::bool_switch(&o.scattering),
+       "report the encounter: asymptotes, deflection, impact parameter, closest approach, K1 and spin turn "
+       "(docs/physics.md, Scattering)")
       ("json", po::bool_switch(&o.json), "print one JSON object instead of the summary")
       ("no-invariants", po::bool_switch(&o.no_invariants), "do not track the invariants (fastest; final state only)")
       ("dry-run", po::bool_switch(&o.dry_run), "check every option and the scene, print what would run, run nothing")
@@ -193,7 +268,7 @@ BodyRun simulate_body(const SimulateOptions& o, const RunPlan& plan, const Body&
   BodyRun br;
   {
     const ProgressBar bar(estimate, progress_wanted(o.quiet));
-    br = run_body(plan, body, scene.centres, plan.spec, sink);
+    br = run_body(plan, body, scene.centres, plan.spec, sink, o.events);
   }
   if (br.outcome != Outcome::ok)
     throw Error("body '" + body.name + "' (" + std::string(br.method->name) + "): " + br.reason +
@@ -208,19 +283,22 @@ BodyRun simulate_body(const SimulateOptions& o, const RunPlan& plan, const Body&
   return br;
 }
 
-void report_json(const std::vector<BodyRun>& runs, const Scene& scene, const RunPlan& plan) {
+void report_json(const std::vector<BodyRun>& runs, const Scene& scene, const RunPlan& plan, const SimulateOptions& o,
+                 const std::vector<std::optional<Encounter>>& enc) {
   const BodyRun& r0 = runs.front();
   const double h0 = r0.search ? r0.search->step : plan.spec.h;
   std::cout << "{\"method\": " << json_string(r0.method->name) << ", \"h\": " << json_number(h0)
             << (is_step_controlled(*r0.method) ? ", \"tol\": " + json_number(plan.spec.tol) : std::string())
             << search_json(r0, plan.tol) << ", \"steps\": " << r0.result.steps
-            << ", \"t_end\": " << json_number(r0.result.t_end) << ", " << json_body(r0.result, r0.err_R, r0.err_rel);
+            << ", \"t_end\": " << json_number(r0.result.t_end) << ", " << json_body(r0.result, r0.err_R, r0.err_rel)
+            << events_json(o.events, r0) << scattering_json(enc.front());
   if (runs.size() > 1) {
     std::cout << ", \"bodies\": [";
     for (std::size_t b = 0; b < runs.size(); ++b)
       std::cout << (b ? ", " : "") << "{\"name\": " << json_string(scene.bodies[b].name) << ", \"method\": "
                 << json_string(runs[b].method->name) << search_json(runs[b], plan.tol) << ", "
-                << json_body(runs[b].result, runs[b].err_R, runs[b].err_rel) << "}";
+                << json_body(runs[b].result, runs[b].err_R, runs[b].err_rel) << events_json(o.events, runs[b])
+                << scattering_json(enc[b]) << "}";
     std::cout << "]";
   }
   std::cout << "}\n";
@@ -248,8 +326,9 @@ void report_body(const BodyRun& run, const std::string& name) {
             << " s\n";
 }
 
-void report_text(const std::vector<BodyRun>& runs, const Scene& scene, const RunPlan& plan,
-                 const std::string& method_name, const std::string& header) {
+void report_text(const std::vector<BodyRun>& runs, const Scene& scene, const RunPlan& plan, const SimulateOptions& o,
+                 const std::vector<std::optional<Encounter>>& enc, const std::string& header) {
+  const std::string& method_name = o.method_name;
   const BodyRun& r0 = runs.front();
   std::cout << "bodypoint simulate  method=" << (plan.search ? method_name : std::string(r0.method->name));
   if (plan.search) std::cout << "  tol=" << fmt(plan.tol);
@@ -257,7 +336,10 @@ void report_text(const std::vector<BodyRun>& runs, const Scene& scene, const Run
   std::cout << "  steps=" << r0.result.steps << "  t_end=" << fmt(r0.result.t_end) << "\n"
             << "scene: " << header << "  (" << scene.centres.size() << " centre(s), " << scene.bodies.size()
             << " body-point(s))\n";
-  for (std::size_t b = 0; b < runs.size(); ++b) report_body(runs[b], scene.bodies[b].name);
+  for (std::size_t b = 0; b < runs.size(); ++b) {
+    report_body(runs[b], scene.bodies[b].name);
+    print_encounter(o.events, runs[b], enc[b]);
+  }
 }
 
 }  // namespace
@@ -276,6 +358,9 @@ int cmd_simulate(int argc, char** argv) {
   if (plan.automatic) o.method_name = "auto";
   const Scene scene = make_scene(vm, o.so);
   apply_output_options(vm, o, scene, plan);
+  for (const std::string& text : o.event_text) o.events.push_back(parse_event(text));
+  if (o.scattering)
+    for (std::size_t c = 0; c < scene.centres.size(); ++c) o.events.push_back(Event{Event::Kind::closest_approach, c, 0.0, Vec3::UnitX()});
   if (o.dry_run) {
     print_dry_run(plan, o.method_name, scene);
     return 0;
@@ -290,11 +375,14 @@ int cmd_simulate(int argc, char** argv) {
     if (plan.search && file) file->stream() << "# body " << b << ": " << search_line(runs.back()) << "\n";
   }
   if (file) file->commit();
+  std::vector<std::optional<Encounter>> enc(runs.size());
+  if (o.scattering)
+    for (std::size_t b = 0; b < runs.size(); ++b) enc[b] = encounter(scene.bodies[b], scene.centres, o.events, runs[b]);
   if (o.json) {
-    report_json(runs, scene, plan);
+    report_json(runs, scene, plan, o, enc);
     return 0;
   }
-  report_text(runs, scene, plan, o.method_name, scene_header(vm, o.so));
+  report_text(runs, scene, plan, o, enc, scene_header(vm, o.so));
   if (file) std::cout << "\ntrajectory written to " << o.out << "\n";
   return 0;
 }

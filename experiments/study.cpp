@@ -20,6 +20,7 @@
 #include "errata.hpp"
 #include "orders.hpp"
 #include "rows_file.hpp"
+#include "scattering_study.hpp"
 #include "stress.hpp"
 #include "sweep.hpp"
 #include "timing.hpp"
@@ -261,11 +262,14 @@ void study_stress(const StudyContext& c) {
             << " ok, " << refused << " refused with a reason, " << flagged << " diverged or collided (flagged)\n";
 }
 
+void study_scattering(const StudyContext& c) { write_scattering_study(c.dir, c.quick, c.threads); }
+
 const std::vector<std::pair<std::string, void (*)(const StudyContext&)>>& recipes() {
   static const std::vector<std::pair<std::string, void (*)(const StudyContext&)>> r = {
       {"d", study_d},         {"L", study_L},          {"h", study_h},         {"Kx", study_Kx},
       {"timing", study_timing}, {"evals", study_evals}, {"appendix", study_appendix}, {"errata", study_errata}, {"orders", study_orders},
-      {"published", study_published}, {"stress", study_stress}, {"dL-map", study_dL_map}};
+      {"published", study_published}, {"stress", study_stress}, {"dL-map", study_dL_map},
+      {"scattering", study_scattering}};
   return r;
 }
 
@@ -279,7 +283,8 @@ int cmd_study(int argc, char** argv) {
   po::options_description desc("bodypoint study");
   desc.add_options()
       ("name", po::value(&which)->default_value(which), "recipe: d, L, h, Kx, timing, evals, appendix, errata, orders, published (chapter 4 with the thesis code's force "
-       "law), all (these), stress (hostile scenes, issue #12) or dL-map (the (d, L) stability map, issue #14)")
+       "law), all (these), stress (hostile scenes, issue #12), dL-map (the (d, L) stability map, issue #14) or scattering "
+       "(the deflection function theta(b) against Rutherford's, spinning bodies, cross-sections)")
       ("results", po::value(&results)->default_value(results), "folder for the CSVs (created if missing)")
       ("quick", po::bool_switch(&quick), "coarser grids, same recipes (under two minutes on 2 cores)")
       ("threads", po::value(&threads)->default_value(0), "worker threads for the sweeps (0: all cores)")
@@ -287,7 +292,7 @@ int cmd_study(int argc, char** argv) {
       ("no-simd", po::bool_switch(&c.no_simd), "sweeps run every trajectory alone, not in batches of vector lanes (same numbers, slower)");
   po::variables_map vm;
   if (!parse(argc, argv, desc, vm,
-             "usage: bodypoint study [--name d|L|h|Kx|timing|evals|appendix|errata|orders|published|all|stress|dL-map] [--results DIR] [--quick]\n"
+             "usage: bodypoint study [--name d|L|h|Kx|timing|evals|appendix|errata|orders|published|all|stress|dL-map|scattering] [--results DIR] [--quick]\n"
              "Regenerates the thesis's studies for its methods and ours side by side."))
     return 0;
   c.dir = results;
@@ -296,12 +301,12 @@ int cmd_study(int argc, char** argv) {
   c.progress = ::isatty(2) == 1;
   bool found = false;
   for (const auto& [name, fn] : recipes()) found = found || name == which;
-  if (!found && which != "all") throw Error("unknown study '" + which + "' (d, L, h, Kx, timing, evals, appendix, errata, orders, published, all, stress, dL-map)");
+  if (!found && which != "all") throw Error("unknown study '" + which + "' (d, L, h, Kx, timing, evals, appendix, errata, orders, published, all, stress, dL-map, scattering)");
   std::error_code ec;
   fs::create_directories(c.dir, ec);
   if (ec || !fs::is_directory(c.dir)) throw Error("cannot create results folder '" + results + "'");
   for (const auto& [name, fn] : recipes())
-    if ((which == "all" && name != "stress" && name != "dL-map") || which == name) fn(c);
+    if ((which == "all" && name != "stress" && name != "dL-map" && name != "scattering") || which == name) fn(c);
   return 0;
 }
 

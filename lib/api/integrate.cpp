@@ -3,6 +3,7 @@
 
 #include "bodypoint/adaptive/methods.hpp"
 #include "bodypoint/adaptive/tolerance.hpp"
+#include "events.hpp"
 
 #include <cmath>
 #include <limits>
@@ -23,7 +24,7 @@ std::string_view outcome_name(Outcome o) {
 }
 
 long BodyResult::total_force_evals() const {
-  return accuracy ? accuracy->force_evals : run.force_evals;
+  return (accuracy ? accuracy->force_evals : run.force_evals) + event_force_evals;
 }
 
 RunSpec run_spec(const MethodInfo& method, const Advance& how, const Options& options) {
@@ -85,9 +86,102 @@ void run_accurately(BodyResult& r, const Body& body, const std::vector<Centre>& 
   r.run = std::move(t.result);
 }
 
+BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
+                                const Advance& how, const Options& options);
+
+/// The sink of a run with events: every observed state goes to the watch; the caller's sink gets the
+/// states it asked for (every `every`-th step and the last; with dt_out all of them).
+class WatchingSink {
+ public:
+  WatchingSink(detail::EventWatch& watch, const Options& options, bool every_state)
+      : watch_(watch), user_(options.sink), every_(every_state ? 1 : options.every) {}
+  void operator()(const Sample& s) {
+    watch_.observe(s.t, s.s);
+    if (!user_) return;
+    if (s.step % every_ == 0) {
+      (*user_)(s);
+      pending_.reset();
+    } else {
+      pending_ = Pending{s.step, s.t, s.s, s.rel_dE, s.rel_dK2sq, s.abs_dK2Q};
+    }
+  }
+  /// The last state, when the every-th rule skipped it.
+  void finish() {
+    if (user_ && pending_) (*user_)(Sample{pending_->step, pending_->t, pending_->s, pending_->dE, pending_->dK2, pending_->dK2Q});
+  }
+
+ private:
+  struct Pending {
+    long step;
+    double t;
+    State s;
+    double dE, dK2, dK2Q;
+  };
+  detail::EventWatch& watch_;
+  const SampleSink* user_;
+  long every_;
+  std::optional<Pending> pending_;
+};
+
+/// The run's configuration for a time tau from a state: what locates its events (events.hpp).
+detail::Advancer advancer(const BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Advance& how,
+                          const Options& options) {
+  const MethodInfo& m = *r.method;
+  double step = 0.0, tol = 0.0, c = options.omega_c;
+  if (r.accuracy) {
+    step = r.accuracy->step;
+    c = r.accuracy->omega_c;
+  } else if (const auto* fixed = std::get_if<FixedSteps>(&how)) {
+    step = fixed->h;
+  } else if (const auto* fictitious = std::get_if<FictitiousSteps>(&how)) {
+    step = fictitious->ds;
+    if (c < 0.0) c = adaptive::automatic_omega_c(body, centres, step);
+  } else if (const auto* controlled = std::get_if<ControlledSteps>(&how)) {
+    step = controlled->h0;
+    tol = controlled->tol;
+  }
+  return [&m, body, &centres, step, tol, c](const State& s, double tau, long& evals) {
+    Body from = body;
+    from.s0 = s;
+    Options sub;
+    sub.track_invariants = false;
+    sub.omega_c = c;
+    Advance a;
+    if (is_time_transformed(m)) a = FictitiousSteps{step, tau, 0, 0.0};
+    else if (is_step_controlled(m)) a = ControlledSteps{std::min(step, tau), tau, tol};
+    else a = FixedSteps{tau, 1};
+    const BodyResult x = integrate_valid_body(from, centres, &m, a, sub);
+    evals += x.run.force_evals;
+    if (x.outcome == Outcome::refused || x.outcome == Outcome::failed) {
+      constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+      return State{Vec3::Constant(nan), Vec3::Constant(nan), Vec3::Constant(nan)};
+    }
+    return x.run.final;
+  };
+}
+
 /// integrate_body for a body and centres already validated.
 BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
                                 const Advance& how, const Options& options) {
+  if (!options.events.empty()) {
+    // Every observed state goes through the watch; the run itself is the one asked for.
+    const double dt_out = std::holds_alternative<FictitiousSteps>(how) ? std::get<FictitiousSteps>(how).dt_out
+                          : std::holds_alternative<Accuracy>(how)       ? std::get<Accuracy>(how).dt_out
+                                                                        : 0.0;
+    detail::EventWatch watch(options.events, centres);
+    WatchingSink watching(watch, options, dt_out > 0.0);
+    const SampleSink sink = [&watching](const Sample& s) { watching(s); };
+    Options inner = options;
+    inner.events.clear();
+    inner.sink = &sink;
+    inner.every = 1;
+    BodyResult r = integrate_valid_body(body, centres, method, how, inner);
+    if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return r;
+    watching.finish();
+    r.events = detail::locate(watch, options.events, centres, advancer(r, body, centres, how, options),
+                              r.event_force_evals);
+    return r;
+  }
   BodyResult r;
   const auto* accuracy = std::get_if<Accuracy>(&how);
   if (accuracy) {
@@ -129,11 +223,13 @@ BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& cen
 BodyResult integrate_body(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
                           const Advance& how, const Options& options) {
   validate(Scene{centres, {body}});
+  detail::validate_events(options.events, centres);
   return integrate_valid_body(body, centres, method, how, options);
 }
 
 Result integrate(const Scene& scene, const MethodInfo* method, const Advance& how, const Options& options) {
   validate(scene);
+  detail::validate_events(options.events, scene.centres);
   Result all;
   for (const Body& body : scene.bodies) {
     BodyResult b = integrate_valid_body(body, scene.centres, method, how, options);
@@ -195,6 +291,10 @@ Outcome Stepper::advance_to(double t) {
   if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) {
     reason_ = r.reason;
     return r.outcome;
+  }
+  for (EventHit h : r.events) {
+    h.t += t0;
+    events_.push_back(h);
   }
   body_.s0 = r.run.final;
   t_ = t;

@@ -39,6 +39,14 @@ const std::vector<Observable>& observables() {
       {"abs_dK2Q", "|K2Q - K2Q_0| (one centre only)", true, one_centre,
        [](const Sample& s, const BodyPoint&) { return s.abs_dK2Q; }},
       {"spin_angle", "angle between w and K1 = m v + B w, radians", false, always, spin_angle},
+      {"K1x", "linear momentum K1 = m v + B w = (K1x, K1y, K1z)", false, always,
+       [](const Sample& s, const BodyPoint& p) { return (p.m * s.s.v + p.B * s.s.w).x(); }},
+      {"K1y", "", false, always, [](const Sample& s, const BodyPoint& p) { return (p.m * s.s.v + p.B * s.s.w).y(); }},
+      {"K1z", "", false, always, [](const Sample& s, const BodyPoint& p) { return (p.m * s.s.v + p.B * s.s.w).z(); }},
+      {"K2x", "proper angular momentum K2 = B v + J w = (K2x, K2y, K2z)", false, always,
+       [](const Sample& s, const BodyPoint& p) { return (p.B * s.s.v + p.J * s.s.w).x(); }},
+      {"K2y", "", false, always, [](const Sample& s, const BodyPoint& p) { return (p.B * s.s.v + p.J * s.s.w).y(); }},
+      {"K2z", "", false, always, [](const Sample& s, const BodyPoint& p) { return (p.B * s.s.v + p.J * s.s.w).z(); }},
   };
   return list;
 }

@@ -35,16 +35,16 @@ inline State reference_state(const Body& body, const std::vector<Centre>& centre
   S x;
   const OdeState<double> x0 = to_ode(body.s0);
   for (int i = 0; i < 9; ++i) x[i] = x0[i];
-  using Stepper = odeint::runge_kutta_fehlberg78<S, long double>;
-  using Checker = odeint::default_error_checker<long double, typename Stepper::algebra_type,
-                                                typename Stepper::operations_type>;
+  using Rkf78 = odeint::runge_kutta_fehlberg78<S, long double>;
+  using Checker = odeint::default_error_checker<long double, typename Rkf78::algebra_type,
+                                                typename Rkf78::operations_type>;
 #pragma GCC diagnostic push
   // GCC 12 reports odeint's default-constructed stepper members as maybe-uninitialized when the
   // controller copies them (a false positive inside Boost; the members are arrays it fills first).
 #ifndef __clang__  // a GCC-only warning group
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
-  odeint::controlled_runge_kutta<Stepper> stepper{Checker(tol, tol)};
+  odeint::controlled_runge_kutta<Rkf78> stepper{Checker(tol, tol)};
   odeint::integrate_adaptive(stepper, std::cref(sys), x, 0.0L, static_cast<long double>(t_end), 1e-3L);
 #pragma GCC diagnostic pop
   OdeState<double> out;

@@ -19,6 +19,7 @@ install(FILES
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/invariants.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/model.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/run.hpp
+          ${PROJECT_SOURCE_DIR}/lib/bodypoint/scattering.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/scene_file.hpp
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bodypoint)
 

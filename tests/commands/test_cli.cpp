@@ -1,5 +1,6 @@
 // The bodypoint command line: the acceptance run, the JSON and CSV outputs, and one clear
 // line plus a non-zero exit (and no output file) for every kind of bad input.
+#include "bodypoint/bodypoint.hpp"
 #include "bodypoint/methods.hpp"
 #include "bodypoint/reference.hpp"
 #include "bodypoint/scenes.hpp"
@@ -266,6 +267,32 @@ TEST(Cli, ObserveAddsTheSpinAngleColumn) {
   fs::remove(out);
   test::expect_refused("simulate --method lp-y4 --steps 10 ", {{"--out x.csv --observe nonsense", "unknown observable 'nonsense'"},
                                                          {"--observe spin_angle", "--observe needs --out"}});
+}
+
+TEST(Cli, ScatteringAndEventsAreTheLibrarysToTheLastBit) {
+  const Result r = run_cli("simulate --method lp-y8 --h 2e-3 --steps 4000 --B 0 --d 2 --L 20 --scattering --event r=5 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  SceneParams p;
+  p.B = 0.0;
+  p.start.d = 2.0;
+  p.start.L = 20.0;
+  const Scene s = thesis_scene(p);
+  const Body& b = s.bodies.front();
+  Options o;
+  o.events = {Event{Event::Kind::radius, 0, 5.0, Vec3::UnitX()}, Event{}};
+  const bodypoint::Result lib = integrate(s, "lp-y8", FixedSteps{2e-3, 4000}, o);
+  ASSERT_EQ(lib.outcome, Outcome::ok);
+  const Scattering sc = scattering(b.p, s.centres, b.s0, lib.bodies.front().run.final);
+  EXPECT_EQ(json_num(r.out, "deflection"), sc.deflection);
+  EXPECT_EQ(json_num(r.out, "b"), sc.b);
+  EXPECT_EQ(json_num(r.out, "r_min"), lib.bodies.front().events[1].distance);
+  EXPECT_EQ(json_num(r.out, "t_min"), lib.bodies.front().events[1].t);
+  EXPECT_NE(r.out.find("\"asymptotes\": \"kepler\""), std::string::npos);
+  EXPECT_NE(r.out.find("\"event\": \"r=5\""), std::string::npos);
+  test::expect_refused("simulate --steps 10 ", {{"--event nearest", "unknown --event 'nearest'"},
+                                                {"--event r=abc", "is not a finite number"},
+                                                {"--event r:4=5", "the scene has 1 centre(s)"},
+                                                {"--event plane=0,0,0,1", "normal must not be zero"}});
 }
 
 }  // namespace

@@ -179,5 +179,36 @@ TEST(Study, QuickRecipesWriteEveryCsv) {
   fs::remove_all(dir);
 }
 
+/// Issue #22: the material point's deflection agrees with Rutherford's to 1e-10 over b = 1e-3 .. 1e3.
+constexpr double kRutherfordRel = 1e-10;
+
+TEST(Study, ScatteringAgreesWithRutherfordAndReportsEverySeries) {
+  const fs::path dir = test::temp_path("bp_scattering");
+  fs::remove_all(dir);
+  const Result r = run_cli("study --quick --name scattering --results " + dir.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream f(dir / "scattering_summary.csv");
+  std::stringstream ss;
+  ss << f.rdbuf();
+  const auto rows = csv_rows(ss.str());
+  ASSERT_EQ(rows.size(), 8u);  // B = 0 twice (auto, lp-kl8), B = 0.2 .. 0.9, two other spins
+  int material = 0;
+  for (const auto& row : rows) {
+    // series, B, Kx, Kz, points, failed, max_rel_diff_rutherford, theta_at_smallest_b, ...
+    if (std::stod(row[1]) != 0.0) {
+      // a spinning body with the thesis's spin is deflected less than a material point head-on
+      if (row[3] == "5" && row[2] == "2") {
+        EXPECT_LT(std::stod(row[7]), std::stod(row[8])) << row[0];
+      }
+      continue;
+    }
+    ++material;
+    EXPECT_EQ(row[5], "0") << row[0];
+    EXPECT_LT(std::stod(row[6]), kRutherfordRel) << row[0];
+  }
+  EXPECT_EQ(material, 2);
+  EXPECT_TRUE(fs::exists(dir / "scattering.csv"));
+}
+
 }  // namespace
 }  // namespace bodypoint

@@ -17,6 +17,9 @@
 //     error of the final state to deliver; the step is searched).
 //   - integrate(): every body of a scene with one method and one Advance; a Result per body with a
 //     typed Outcome (ok, diverged, collision, refused, failed) and its one-line reason.
+//   - events (Event): closest approaches, radii and planes crossed, located to round-off on the
+//     method's own steps; scattering.hpp turns a run into an encounter's observables (deflection,
+//     asymptotes, impact parameter, spin turn).
 //   - Stepper: one body advanced segment by segment (advance_to), queried and continued.
 //
 // Invalid input (a scene that breaks a rule of validate(), a step that is not a finite number > 0, an
@@ -27,8 +30,10 @@
 #include "bodypoint/methods.hpp"
 #include "bodypoint/model.hpp"
 #include "bodypoint/run.hpp"
+#include "bodypoint/scattering.hpp"
 #include "bodypoint/scene_file.hpp"
 
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -36,6 +41,33 @@
 #include <vector>
 
 namespace bodypoint {
+
+/// Something to locate along a run: where a function g of the state changes sign. It is found on the
+/// method's own steps: the step that brackets the change is taken again from its start with shorter
+/// steps tau of the same method (the same time-step constant, tolerance or fictitious step), and tau
+/// is solved for g = 0 to round-off (Illinois regula falsi). So every family, fixed-step,
+/// time-transformed, regularised and step-size-controlled, serves as its own dense output.
+struct Event {
+  enum class Kind {
+    closest_approach,  ///< a local minimum of |R - c| (g = (R - c).v turns from < 0 to >= 0)
+    radius,            ///< |R - c| crosses `value`, either way
+    plane,             ///< normal.R crosses `value`, either way
+  };
+  Kind kind = Kind::closest_approach;
+  std::size_t centre = 0;  ///< closest_approach, radius: which of the scene's centres
+  double value = 0.0;      ///< radius: the distance; plane: the offset
+  Vec3 normal = Vec3::UnitX();
+  /// "closest", "r=5", "plane(1,0,0)=0": for outputs and messages.
+  [[nodiscard]] std::string label() const;
+};
+
+/// One located event.
+struct EventHit {
+  std::size_t event = 0;  ///< index into Options::events
+  double t = 0.0;
+  State s;
+  double distance = 0.0;  ///< |R - c| to the event's centre (plane: to the scene's first centre)
+};
 
 /// What a run asks for besides the way of advancing time. By default the invariants are tracked
 /// and nothing else is kept: the step loop stores no trajectory.
@@ -48,6 +80,8 @@ struct Options {
   /// Time-transformed methods: the constant c of the time-step function (physical step <= ds/c);
   /// < 0: chosen from the scene (the spin-orbit rate).
   double omega_c = -1.0;
+  /// Located along the run (BodyResult::events); the run then observes every step (or every dt_out).
+  std::vector<Event> events;
 };
 
 /// How one body's run ended.
@@ -81,7 +115,9 @@ struct BodyResult {
   std::string reason;                  ///< one line; empty when ok
   RunResult run;                       ///< final state, steps, cost, invariants (unless refused or failed)
   std::optional<AccuracyReport> accuracy;
-  /// The force evaluations this body cost in all: the run, and the search of the accuracy mode.
+  std::vector<EventHit> events;  ///< Options::events located, in time order
+  long event_force_evals = 0;    ///< spent locating them
+  /// The force evaluations this body cost in all: the run, the search of the accuracy mode, the events.
   [[nodiscard]] long total_force_evals() const;
 };
 
@@ -134,6 +170,8 @@ class Stepper {
   [[nodiscard]] long force_evals() const { return force_evals_; }
   [[nodiscard]] long steps() const { return steps_; }
   [[nodiscard]] const std::string& reason() const { return reason_; }  ///< of the last segment that was not ok
+  /// Options::events located so far, at absolute times.
+  [[nodiscard]] const std::vector<EventHit>& events() const { return events_; }
 
  private:
   const MethodInfo* method_;
@@ -144,6 +182,7 @@ class Stepper {
   double t_ = 0.0;
   long force_evals_ = 0, steps_ = 0;
   std::string reason_;
+  std::vector<EventHit> events_;
 };
 
 }  // namespace bodypoint

@@ -1,0 +1,140 @@
+// bodypoint: locating events along a run (events.hpp).
+#include "events.hpp"
+
+#include "bodypoint/io.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <string>
+
+namespace bodypoint {
+
+std::string Event::label() const {
+  std::ostringstream os;
+  switch (kind) {
+    case Kind::closest_approach:
+      os << "closest";
+      if (centre) os << "(" << centre << ")";
+      break;
+    case Kind::radius:
+      os << "r";
+      if (centre) os << "(" << centre << ")";
+      os << "=" << fmt(value);
+      break;
+    case Kind::plane:
+      if (normal == Vec3::UnitX()) os << "x";
+      else if (normal == Vec3::UnitY()) os << "y";
+      else if (normal == Vec3::UnitZ()) os << "z";
+      else os << "plane(" << fmt(normal.x()) << "," << fmt(normal.y()) << "," << fmt(normal.z()) << ")";
+      os << "=" << fmt(value);
+      break;
+  }
+  return os.str();
+}
+
+namespace detail {
+
+/// The root finder stops when the bracket is this many ulps of the time wide: t is then known to
+/// round-off (a few ulps, the accuracy of the state's own time).
+constexpr double kBracketUlps = 4.0;
+/// Illinois regula falsi converges superlinearly; bisection every third step guarantees that the
+/// bracket halves at least that often, so a 2^-52 bracket needs at most ~160 evaluations.
+constexpr int kMaxIterations = 200;
+
+void validate_events(const std::vector<Event>& events, const std::vector<Centre>& centres) {
+  for (const Event& e : events) {
+    if (e.kind != Event::Kind::plane && e.centre >= centres.size())
+      throw Error("event " + e.label() + ": the scene has " + std::to_string(centres.size()) + " centre(s)");
+    if (e.kind == Event::Kind::radius && !(std::isfinite(e.value) && e.value > 0.0))
+      throw Error("event " + e.label() + ": the radius must be a finite number > 0");
+    if (e.kind == Event::Kind::plane && !(std::isfinite(e.value) && e.normal.allFinite() && e.normal.norm() > 0.0))
+      throw Error("event " + e.label() + ": a plane needs a finite non-zero normal and a finite offset");
+  }
+}
+
+double event_function(const Event& e, const std::vector<Centre>& centres, const State& s) {
+  switch (e.kind) {
+    case Event::Kind::closest_approach: return (s.R - centres[e.centre].c).dot(s.v);
+    case Event::Kind::radius: return (s.R - centres[e.centre].c).norm() - e.value;
+    case Event::Kind::plane: return e.normal.dot(s.R) - e.value;
+  }
+  return 0.0;
+}
+
+namespace {
+
+bool crosses(const Event& e, double g_a, double g_b) {
+  if (e.kind == Event::Kind::closest_approach) return g_a < 0.0 && g_b >= 0.0;
+  return (g_a < 0.0 && g_b >= 0.0) || (g_a > 0.0 && g_b <= 0.0);
+}
+
+double distance_for(const Event& e, const std::vector<Centre>& centres, const State& s) {
+  const std::size_t c = e.kind == Event::Kind::plane ? 0 : e.centre;
+  return centres.empty() ? s.R.norm() : (s.R - centres[c].c).norm();
+}
+
+}  // namespace
+
+void EventWatch::observe(double t, const State& s) {
+  for (std::size_t k = 0; k < events_.size(); ++k) {
+    const double g = event_function(events_[k], centres_, s);
+    if (started_ && t > t_ && crosses(events_[k], g_[k], g)) brackets_.push_back({k, t_, t, g_[k], g, s_, s});
+    g_[k] = g;
+  }
+  started_ = true;
+  t_ = t;
+  s_ = s;
+}
+
+std::vector<EventHit> locate(const EventWatch& watch, const std::vector<Event>& events,
+                             const std::vector<Centre>& centres, const Advancer& advance, long& evals) {
+  std::vector<EventHit> hits;
+  for (const EventWatch::Bracket& b : watch.brackets()) {
+    const Event& e = events[b.event];
+    // g(tau) on [lo, hi] within [0, t_b - t_a]; g(lo) < 0 <= g(hi) after orienting the sign.
+    const double sign = b.g_a < 0.0 ? 1.0 : -1.0;
+    double lo = 0.0, hi = b.t_b - b.t_a, g_lo = sign * b.g_a, g_hi = sign * b.g_b;
+    // The state reported is the one evaluated closest to the root (an end of the bracket if the
+    // root is there).
+    const bool b_closer = std::abs(b.g_b) < std::abs(b.g_a);
+    State best = b_closer ? b.s_b : b.s_a;
+    double best_tau = b_closer ? hi : 0.0, best_g = std::min(std::abs(b.g_a), std::abs(b.g_b));
+    int side = 0;  // Illinois: which end was kept last time
+    const double width_min = kBracketUlps * std::numeric_limits<double>::epsilon() * std::max(std::abs(b.t_b), 1e-300);
+    for (int it = 0; it < kMaxIterations && hi - lo > width_min && g_hi != 0.0; ++it) {
+      double tau = (it % 3 == 2) ? 0.5 * (lo + hi) : lo - g_lo * (hi - lo) / (g_hi - g_lo);
+      if (!(tau > lo && tau < hi)) tau = 0.5 * (lo + hi);
+      const State s = tau > 0.0 ? advance(b.s_a, tau, evals) : b.s_a;
+      const double g = sign * event_function(e, centres, s);
+      if (std::abs(g) <= best_g) {
+        best = s;
+        best_tau = tau;
+        best_g = std::abs(g);
+      }
+      if (g < 0.0) {
+        lo = tau;
+        g_lo = g;
+        if (side == -1) g_hi *= 0.5;
+        side = -1;
+      } else {
+        hi = tau;
+        g_hi = g;
+        if (side == 1) g_lo *= 0.5;
+        side = 1;
+      }
+    }
+    EventHit h;
+    h.event = b.event;
+    h.t = b.t_a + best_tau;
+    h.s = best;
+    h.distance = distance_for(e, centres, best);
+    hits.push_back(h);
+  }
+  std::stable_sort(hits.begin(), hits.end(), [](const EventHit& x, const EventHit& y) { return x.t < y.t; });
+  return hits;
+}
+
+}  // namespace detail
+}  // namespace bodypoint

@@ -1,0 +1,155 @@
+// bodypoint: the observables of a scattering encounter (scattering.hpp; docs/physics.md, "Scattering").
+#include "bodypoint/scattering.hpp"
+
+#include "bodypoint/field.hpp"
+#include "bodypoint/invariants.hpp"
+
+#include <cmath>
+
+namespace bodypoint {
+
+double angle_between(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
+
+std::optional<Asymptote> kepler_asymptote(double mu, double kappa, const Vec3& X, const Vec3& P, bool outgoing) {
+  const double r = X.norm(), E = P.squaredNorm() / (2.0 * mu) + kappa / r;
+  if (!(E > 0.0) || !(r > 0.0)) return std::nullopt;
+  const double p_inf = std::sqrt(2.0 * mu * E);
+  const Vec3 Lv = X.cross(P);
+  const Vec3 Avec = P.cross(Lv) + (mu * kappa / r) * X;
+  Vec3 u = (outgoing ? mu * kappa : -mu * kappa) * Avec + p_inf * Lv.cross(Avec);
+  // Avec = 0 only without a force (kappa = 0) on a line through the centre: the body moves along P.
+  if (!(u.squaredNorm() > 0.0)) u = P;
+  Asymptote a;
+  a.direction = u.normalized();
+  a.impact = a.direction.cross(Lv) / p_inf;
+  a.p_inf = p_inf;
+  return a;
+}
+
+std::optional<Periapsis> kepler_periapsis(double mu, double kappa, const Vec3& X, const Vec3& P) {
+  const double r = X.norm(), E = P.squaredNorm() / (2.0 * mu) + kappa / r;
+  if (!(E > 0.0) || !(r > 0.0)) return std::nullopt;
+  const double l2 = X.cross(P).squaredNorm();
+  // E r^2 - kappa r - l^2/(2 mu) = 0 at the turning point (P perpendicular to X): the larger root,
+  // written without cancellation for either sign of kappa.
+  const double disc = std::sqrt(kappa * kappa + 2.0 * E * l2 / mu);
+  Periapsis q;
+  q.r = kappa >= 0.0 ? (kappa + disc) / (2.0 * E) : (l2 / mu) / (disc - kappa);
+  const double v_inf = std::sqrt(2.0 * E / mu);
+  if (kappa == 0.0) {  // a straight line
+    q.dt = -X.dot(P) / mu / (v_inf * v_inf);
+    return q;
+  }
+  // Hyperbolic anomaly H: r = a (e cosh H - s), s = +1 attracting, -1 repelling, a = |kappa|/(2E);
+  // mean anomaly e sinh H - s H = n t (t from periapsis), n = v_inf/a; sinh H = X.P/(mu n a^2 e).
+  const double a = std::abs(kappa) / (2.0 * E), n = v_inf / a;
+  const double e = std::sqrt(1.0 + 2.0 * E * l2 / (mu * kappa * kappa));
+  const double s = kappa < 0.0 ? 1.0 : -1.0;
+  const double sinh_H = X.dot(P) / (mu * n * a * a * e);
+  q.dt = -(e * sinh_H - s * std::asinh(sinh_H)) / n;
+  return q;
+}
+
+std::optional<KeplerParticle> kepler_particle(const BodyPoint& p, const State& s, const Vec3& c) {
+  const Momenta q = to_momenta(p, s);
+  KeplerParticle k;
+  k.P = q.K1;
+  if (p.B == 0.0) {
+    k.mu = p.m;
+    k.X = s.R - c;
+    return k;
+  }
+  const double K1sq = q.K1.squaredNorm();
+  const double drift = p.J * K1sq - p.B * q.K2.dot(q.K1);  // u |K1| D
+  if (!(K1sq > 0.0) || !(drift > 0.0)) return std::nullopt;
+  k.mu = p.D() * K1sq / drift;
+  k.X = s.R + q.K1.cross(q.K2) / K1sq - c;
+  return k;
+}
+
+Scattering scattering(const BodyPoint& p, const std::vector<Centre>& centres, const State& start, const State& end) {
+  Scattering out;
+  const Momenta q0 = to_momenta(p, start), q1 = to_momenta(p, end);
+  out.K1_start = q0.K1;
+  out.K1_end = q1.K1;
+  out.K2_start = q0.K2;
+  out.K2_end = q1.K2;
+  const CentreList field{centres};
+  out.E_start = energy(p, field, start);
+  out.E_end = energy(p, field, end);
+  out.K1_turn = angle_between(q0.K1, q1.K1);
+  out.spin_turn = angle_between(q0.K2, q1.K2);
+  if (centres.size() != 1) {
+    out.asymptotes = "none: asymptotes need a single centre";
+    return out;
+  }
+  const Centre& k = centres.front();
+  out.has_K2Q = true;
+  out.K2Q_start = total_angular_momentum(p, start, k.c);
+  out.K2Q_end = total_angular_momentum(p, end, k.c);
+  if (k.law != ForceLaw::coulomb) {
+    out.asymptotes = "none: asymptotes need Coulomb's law";
+    return out;
+  }
+  const auto in = kepler_particle(p, start, k.c), fin = kepler_particle(p, end, k.c);
+  if (!in || !fin) {
+    out.asymptotes = "none: the body does not drift along K1";
+    return out;
+  }
+  const double kappa = -k.A;
+  out.in = kepler_asymptote(in->mu, kappa, in->X, in->P, false);
+  out.out = kepler_asymptote(fin->mu, kappa, fin->X, fin->P, true);
+  if (!out.in || !out.out) {
+    out.asymptotes = "none: the orbit is bound (energy at infinity <= 0)";
+    out.in.reset();
+    out.out.reset();
+    return out;
+  }
+  out.asymptotes = p.B == 0.0 ? "kepler" : "guiding-centre";
+  out.deflection = angle_between(out.in->direction, out.out->direction);
+  out.b = out.in->b();
+  out.v_inf = out.in->p_inf / in->mu;
+  const Vec3 normal = out.in->direction.cross(out.in->impact);
+  out.out_of_plane = normal.squaredNorm() > 0.0 ? std::asin(std::clamp(out.out->direction.dot(normal.normalized()), -1.0, 1.0))
+                                                : 0.0;
+  return out;
+}
+
+namespace {
+
+/// Secant iterations stop when d changes by less than this relative amount: b(d) is then exact to
+/// round-off (the map is smooth and close to a shift, db/dd ~ 1).
+constexpr double kImpactRelTol = 1e-14;
+constexpr int kImpactIterations = 60;
+
+double incoming_b(const SceneParams& params, double d) {
+  SceneParams p = params;
+  p.start.d = d;
+  const Scene s = thesis_scene(p);
+  const Body& body = s.bodies.front();
+  const auto k = kepler_particle(body.p, body.s0, s.centres.front().c);
+  if (!k) throw Error("the scene's body does not drift along K1: it has no incoming asymptote");
+  const auto a = kepler_asymptote(k->mu, -s.centres.front().A, k->X, k->P, false);
+  if (!a) throw Error("the scene's orbit is bound (energy at infinity <= 0): it has no incoming asymptote");
+  return a->b();
+}
+
+}  // namespace
+
+double d_for_impact_parameter(SceneParams params, double b) {
+  if (!(std::isfinite(b) && b > 0.0)) throw Error("the impact parameter b must be a finite number > 0");
+  double d0 = params.B == 0.0 ? params.start.Kz / params.start.K1 + b : b;
+  double f0 = incoming_b(params, d0) - b;
+  double d1 = d0 - f0;  // db/dd ~ 1
+  for (int i = 0; i < kImpactIterations; ++i) {
+    const double f1 = incoming_b(params, d1) - b;
+    if (f1 == 0.0 || std::abs(d1 - d0) <= kImpactRelTol * std::max(std::abs(d1), b)) return d1;
+    const double slope = (f1 - f0) / (d1 - d0);
+    d0 = d1;
+    f0 = f1;
+    d1 = d1 - (std::isfinite(slope) && slope != 0.0 ? f1 / slope : f1);
+  }
+  return d1;
+}
+
+}  // namespace bodypoint

@@ -1,0 +1,100 @@
+// bodypoint: the observables of a scattering encounter (docs/physics.md, "Scattering").
+//
+// A run that starts far from a single Coulomb centre and ends far from it again is an encounter.
+// What is measured on it:
+//   - K1, K2, the energy E and (one centre) K2Q at the start and at the end of the run;
+//   - the incoming and outgoing asymptotes: straight lines the body travels on at infinity, with their
+//     directions, the impact parameter b of the incoming one and the momentum at infinity;
+//   - the deflection: the angle between the two asymptotes' directions, and its part out of the
+//     incoming plane (a material point stays in that plane; a spinning body need not);
+//   - the angle K1 turned between the start and the end (no asymptote: at the run's own distances)
+//     and the angle the spin K2 turned.
+// The closest approach is an event of the run (located on the method's own steps, bodypoint.hpp).
+//
+// Asymptotes. For B = 0 (a material point of mass m) the orbit about the centre is a Kepler
+// hyperbola, and its asymptotes follow exactly from the state at any distance: with kappa = -A, the
+// energy E = P^2/(2 mu) + kappa/|X|, the angular momentum Lv = X x P and the Laplace-Runge-Lenz
+// vector Avec = P x Lv + mu kappa X/|X| (all three conserved), the outgoing direction u solves
+// Avec = mu kappa u + p_inf u x Lv and the incoming one Avec = -mu kappa u + p_inf u x Lv, so
+//   u_out = ( mu kappa Avec + p_inf Lv x Avec) / |Avec|^2,
+//   u_in  = (-mu kappa Avec + p_inf Lv x Avec) / |Avec|^2,      p_inf = sqrt(2 mu E),
+// and the deflection satisfies Rutherford's tan(theta/2) = |A|/(mu v_inf^2 b), b = |Lv|/p_inf.
+// For B != 0 the body travels on a helix about its guiding centre G = R + K1 x K2/|K1|^2, which the
+// kinetic drift moves exactly along K1 at the speed u = (J |K1| - B K2.K1/|K1|)/D (docs/physics.md,
+// "Exact Lie-Poisson splitting"): far from the centre G is a Kepler particle of momentum K1 and mass
+// mu = |K1|/u. Its asymptotes are those of that hyperbola ("guiding-centre"); the model neglects
+// the helix's radius against the distance and the slow change of K2.K1, an error that falls as
+// 1/L^2 with the starting distance L (`bodypoint study --name scattering` measures it).
+#pragma once
+
+#include "bodypoint/model.hpp"
+
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace bodypoint {
+
+/// A straight line the body travels on at infinity.
+struct Asymptote {
+  Vec3 direction = Vec3::Zero();  ///< unit vector of the motion along the line
+  Vec3 impact = Vec3::Zero();     ///< from the centre to the line's closest point; its length is b
+  double p_inf = 0.0;             ///< momentum at infinity
+  [[nodiscard]] double b() const { return impact.norm(); }
+};
+
+/// The asymptote (outgoing, or incoming) of the Kepler orbit of a particle of mass mu at X relative
+/// to a centre of force kappa X/|X|^3 (kappa = -A > 0 repels) with momentum P. Nothing when the
+/// orbit is bound (E <= 0) or P = 0.
+std::optional<Asymptote> kepler_asymptote(double mu, double kappa, const Vec3& X, const Vec3& P, bool outgoing);
+
+/// The periapsis of that orbit (E > 0): the closest distance and the time from the state at (X, P)
+/// until the body is there (negative once past it), from Kepler's hyperbolic equation.
+struct Periapsis {
+  double r = 0.0, dt = 0.0;
+};
+std::optional<Periapsis> kepler_periapsis(double mu, double kappa, const Vec3& X, const Vec3& P);
+
+/// The Kepler particle a body-point's state is far from a centre at c: (mu, X, P) as above (B = 0:
+/// the body itself; B != 0: its guiding centre). Nothing when it does not drift along K1 (u <= 0).
+struct KeplerParticle {
+  double mu = 0.0;
+  Vec3 X = Vec3::Zero(), P = Vec3::Zero();
+};
+std::optional<KeplerParticle> kepler_particle(const BodyPoint& p, const State& s, const Vec3& c);
+
+/// The observables of an encounter between two states of one run (start and end).
+struct Scattering {
+  Vec3 K1_start = Vec3::Zero(), K1_end = Vec3::Zero(), K2_start = Vec3::Zero(), K2_end = Vec3::Zero();
+  double E_start = 0.0, E_end = 0.0;
+  bool has_K2Q = false;  ///< one centre: K2Q about it
+  Vec3 K2Q_start = Vec3::Zero(), K2Q_end = Vec3::Zero();
+  double K1_turn = 0.0;    ///< angle between K1 at the start and at the end (rad)
+  double spin_turn = 0.0;  ///< angle between K2 at the start and at the end (rad)
+  /// "kepler" (B = 0, exact), "guiding-centre" (B != 0), or why there are none (several centres,
+  /// a centre not following Coulomb's law, a bound orbit, no drift along K1).
+  std::string asymptotes;
+  std::optional<Asymptote> in, out;
+  double deflection = kNaN;    ///< angle between in and out directions (rad), in [0, pi]
+  double out_of_plane = kNaN;  ///< angle of out's direction out of the plane of in (direction, impact)
+  double b = kNaN;             ///< impact parameter of the incoming asymptote
+  double v_inf = kNaN;         ///< speed at infinity (B != 0: of the guiding centre), incoming
+
+  static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// The encounter's observables from the first and last state of a run in this field.
+Scattering scattering(const BodyPoint& p, const std::vector<Centre>& centres, const State& start, const State& end);
+
+/// The thesis's scene (model.hpp, thesis_scene) whose incoming asymptote has impact parameter b: the
+/// parameter d solved for it (secant iterations on the asymptote of the starting state, to a relative
+/// 1e-14). For B = 0 the body starts at height d - Kz/K1 above the axis, so d ~ Kz/K1 + b; for B != 0
+/// its guiding centre starts at height d, so d ~ b. Error when b is not a finite number > 0, or the
+/// scene has no incoming asymptote (an attracting centre and a bound orbit).
+double d_for_impact_parameter(SceneParams params, double b);
+
+/// The angle between two vectors, accurate for small and for near-opposite angles: atan2(|a x b|, a.b).
+double angle_between(const Vec3& a, const Vec3& b);
+
+}  // namespace bodypoint
