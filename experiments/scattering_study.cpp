@@ -100,8 +100,6 @@ Point run_point(const Series& s, double b) {
   return p;
 }
 
-double kNaNd() { return std::numeric_limits<double>::quiet_NaN(); }
-
 double rutherford(double A, double mu, double v_inf, double b) { return 2.0 * std::atan(std::abs(A) / (mu * v_inf * v_inf * b)); }
 
 }  // namespace
@@ -138,20 +136,20 @@ void write_scattering_study(const std::filesystem::path& dir, bool quick, unsign
     const Series& s = all[si];
     const Point* row = &points[si * bs.size()];
     const std::size_t n = bs.size();
-    double max_rel = 0.0, max_oop = 0.0, min_r = kNaNd(), first_rainbow = kNaNd();
+    double max_rel = 0.0, max_oop = 0.0, min_r = Point::kNaN, first_rainbow = Point::kNaN;
     long evals = 0, rainbows = 0, failed = 0;
     for (std::size_t i = 0; i < n; ++i) {
       const Point& p = row[i];
       evals += p.force_evals;
       const bool ok = p.failure.empty() && std::isfinite(p.sc.deflection);
       failed += ok ? 0 : 1;
-      const double th_r = ok && s.B == 0.0 ? rutherford(A, m, p.sc.v_inf, p.sc.b) : kNaNd();
-      const double rel = ok && s.B == 0.0 ? std::abs(p.sc.deflection / th_r - 1.0) : kNaNd();
+      const double th_r = ok && s.B == 0.0 ? rutherford(A, m, p.sc.v_inf, p.sc.b) : Point::kNaN;
+      const double rel = ok && s.B == 0.0 ? std::abs(p.sc.deflection / th_r - 1.0) : Point::kNaN;
       if (rel > max_rel) max_rel = rel;
       if (ok) max_oop = std::max(max_oop, std::abs(p.sc.out_of_plane));
       if (ok && !(p.r_min >= min_r)) min_r = p.r_min;
       // dsigma/dOmega = b/sin(theta) |db/dtheta| from the neighbours (centred differences)
-      double dsigma = kNaNd(), dsigma_r = kNaNd();
+      double dsigma = Point::kNaN, dsigma_r = Point::kNaN;
       if (ok && i > 0 && i + 1 < n && row[i - 1].failure.empty() && row[i + 1].failure.empty()) {
         const double dtheta_db = (row[i + 1].sc.deflection - row[i - 1].sc.deflection) / (row[i + 1].sc.b - row[i - 1].sc.b);
         dsigma = p.sc.b / std::sin(p.sc.deflection) / std::abs(dtheta_db);
@@ -178,7 +176,7 @@ void write_scattering_study(const std::filesystem::path& dir, bool quick, unsign
     line.quoted(s.name).num(s.B).num(s.Kx).num(s.Kz).count(static_cast<long>(n)).count(failed);
     line.num_if(s.B == 0.0, max_rel).num(first.sc.deflection);
     // a material point of mass m with the same momentum at infinity and impact parameter
-    const double p_inf = first.sc.in ? first.sc.in->p_inf : kNaNd();
+    const double p_inf = first.sc.in ? first.sc.in->p_inf : Point::kNaN;
     line.num(rutherford(A, m, p_inf / m, first.sc.b)).num(max_oop).count(rainbows);
     line.num_if(std::isfinite(first_rainbow), first_rainbow).num(min_r).count(evals);
     ss << line.str() << "\n";

@@ -40,13 +40,13 @@ const std::vector<Observable>& observables() {
        [](const Sample& s, const BodyPoint&) { return s.abs_dK2Q; }},
       {"spin_angle", "angle between w and K1 = m v + B w, radians", false, always, spin_angle},
       {"K1x", "linear momentum K1 = m v + B w = (K1x, K1y, K1z)", false, always,
-       [](const Sample& s, const BodyPoint& p) { return (p.m * s.s.v + p.B * s.s.w).x(); }},
-      {"K1y", "", false, always, [](const Sample& s, const BodyPoint& p) { return (p.m * s.s.v + p.B * s.s.w).y(); }},
-      {"K1z", "", false, always, [](const Sample& s, const BodyPoint& p) { return (p.m * s.s.v + p.B * s.s.w).z(); }},
+       [](const Sample& s, const BodyPoint& p) { return to_momenta(p, s.s).K1.x(); }},
+      {"K1y", "", false, always, [](const Sample& s, const BodyPoint& p) { return to_momenta(p, s.s).K1.y(); }},
+      {"K1z", "", false, always, [](const Sample& s, const BodyPoint& p) { return to_momenta(p, s.s).K1.z(); }},
       {"K2x", "proper angular momentum K2 = B v + J w = (K2x, K2y, K2z)", false, always,
-       [](const Sample& s, const BodyPoint& p) { return (p.B * s.s.v + p.J * s.s.w).x(); }},
-      {"K2y", "", false, always, [](const Sample& s, const BodyPoint& p) { return (p.B * s.s.v + p.J * s.s.w).y(); }},
-      {"K2z", "", false, always, [](const Sample& s, const BodyPoint& p) { return (p.B * s.s.v + p.J * s.s.w).z(); }},
+       [](const Sample& s, const BodyPoint& p) { return to_momenta(p, s.s).K2.x(); }},
+      {"K2y", "", false, always, [](const Sample& s, const BodyPoint& p) { return to_momenta(p, s.s).K2.y(); }},
+      {"K2z", "", false, always, [](const Sample& s, const BodyPoint& p) { return to_momenta(p, s.s).K2.z(); }},
   };
   return list;
 }
