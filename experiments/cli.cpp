@@ -1,6 +1,7 @@
 #include "cli.hpp"
 
 #include "bodypoint/io.hpp"
+#include "bodypoint/scattering.hpp"
 #include "bodypoint/scene_file.hpp"
 #include "sweep.hpp"
 
@@ -41,19 +42,33 @@ void add_scene_options(po::options_description& desc, SceneOptions& o) {
        }),
        "coulomb (the model); thesis-code (the thesis's published code: F ~ R/|R|^1.5 and its third-kick slip, "
        "to regenerate its figures as published); thesis-code-force (that force law alone)")
+      ("b", po::value(&o.b), "the scene by its impact parameter b (of the incoming asymptote): d is solved for it "
+       "(docs/physics.md, Scattering)")
+      ("v-inf", po::value(&o.v_inf), "the scene by its speed at infinity (B != 0: the guiding centre's): K1 is solved for it")
       ("scene", po::value(&o.scene_file), "TOML scene file with several centres and bodies (see scenes/)");
+}
+
+SceneParams scene_params(const po::variables_map& vm, const SceneOptions& o) {
+  if (vm.count("b") && vm.count("d") && !vm["d"].defaulted()) throw Error("give --b or --d, not both (--b solves d)");
+  if (vm.count("v-inf") && vm.count("K1") && !vm["K1"].defaulted())
+    throw Error("give --v-inf or --K1, not both (--v-inf solves K1)");
+  if (vm.count("b") && !(std::isfinite(o.b) && o.b > 0.0)) throw Error("--b must be a finite number > 0");
+  if (vm.count("v-inf") && !(std::isfinite(o.v_inf) && o.v_inf > 0.0)) throw Error("--v-inf must be a finite number > 0");
+  if (!vm.count("b") && !vm.count("v-inf")) return o.params;
+  validate(thesis_scene(o.params));  // the scene's own errors first, in their words
+  return with_asymptotic_data(o.params, o.b, o.v_inf);
 }
 
 Scene make_scene(const po::variables_map& vm, const SceneOptions& o) {
   if (vm.count("scene")) {
-    std::vector<std::string> keys{"force-law"};
+    std::vector<std::string> keys{"force-law", "b", "v-inf"};
     for (const SceneParameter& q : scene_parameters()) keys.emplace_back(q.name);
     for (const std::string& k : keys)
       if (vm.count(k) && !vm[k].defaulted())
         throw Error("--" + k + " cannot be combined with --scene (set it in the scene file)");
     return read_scene_file(o.scene_file);
   }
-  return thesis_scene(o.params);
+  return thesis_scene(scene_params(vm, o));
 }
 
 void add_step_options(po::options_description& desc, StepOptions& o) {

@@ -8,6 +8,7 @@
 #include <boost/program_options.hpp>
 
 #include <optional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -19,11 +20,15 @@ namespace po = boost::program_options;
 struct SceneOptions {
   SceneParams params;
   std::string scene_file;
+  /// --b, --v-inf: the scene by its asymptotic data (NaN: not given); d and K1 solved for them.
+  double b = std::numeric_limits<double>::quiet_NaN(), v_inf = std::numeric_limits<double>::quiet_NaN();
 };
 void add_scene_options(po::options_description& desc, SceneOptions& o);
 /// --force-law NAME: coulomb, thesis-code or thesis-code-force (model.hpp, ForceLaw).
 ForceLaw parse_force_law(const std::string& name);
 const char* force_law_name(ForceLaw law);
+/// The thesis's parameters with --b and --v-inf applied (d and K1 solved for them; scattering.hpp).
+SceneParams scene_params(const po::variables_map& vm, const SceneOptions& o);
 /// The scene from --scene or from the thesis's parameters (never both).
 Scene make_scene(const po::variables_map& vm, const SceneOptions& o);
 

@@ -9,6 +9,7 @@
 #include "budget.hpp"
 #include "cli.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -75,7 +76,7 @@ struct Encounter {
 
 Encounter encounter(const Body& body, const std::vector<Centre>& centres, const std::vector<Event>& events,
                     const BodyRun& run) {
-  Encounter e{scattering(body.p, centres, body.s0, run.result.final), std::nullopt};
+  Encounter e{scattering(body.p, centres, body.s0, run.result.final, run.result.t_end), std::nullopt};
   for (const EventHit& h : run.events)
     if (events[h.event].kind == Event::Kind::closest_approach && (!e.closest || h.distance < e.closest->distance))
       e.closest = h;
@@ -93,6 +94,8 @@ std::string events_json(const std::vector<Event>& events, const BodyRun& run) {
        << ", \"w\": " << json_vec(h.s.w) << "}";
   }
   os << "], \"event_force_evals\": " << run.event_force_evals;
+  if (std::any_of(events.begin(), events.end(), [](const Event& e) { return e.stop; }))
+    os << ", \"stopped_by\": " << (run.result.stopped ? json_string(events[run.events.back().event].label()) : "null");
   return os.str();
 }
 
@@ -104,7 +107,8 @@ std::string scattering_json(const std::optional<Encounter>& e) {
   std::ostringstream os;
   os << ", \"scattering\": {\"asymptotes\": " << json_string(sc.asymptotes)
      << ", \"deflection\": " << json_or_null(sc.deflection) << ", \"out_of_plane\": " << json_or_null(sc.out_of_plane)
-     << ", \"b\": " << json_or_null(sc.b) << ", \"v_inf\": " << json_or_null(sc.v_inf);
+     << ", \"b\": " << json_or_null(sc.b) << ", \"v_inf\": " << json_or_null(sc.v_inf)
+     << ", \"time_delay\": " << json_or_null(sc.time_delay);
   if (sc.in) os << ", \"direction_in\": " << json_vec(sc.in->direction) << ", \"direction_out\": " << json_vec(sc.out->direction);
   os << ", \"r_min\": " << (e->closest ? json_number(e->closest->distance) : "null")
      << ", \"t_min\": " << (e->closest ? json_number(e->closest->t) : "null")
@@ -121,12 +125,14 @@ void print_encounter(const std::vector<Event>& events, const BodyRun& run, const
   for (const EventHit& h : run.events)
     std::cout << "  event " << events[h.event].label() << ": t = " << fmt(h.t) << ", r = " << fmt(h.distance)
               << ", R = " << json_vec(h.s.R) << "\n";
+  if (run.result.stopped) std::cout << "  the run stopped at event " << events[run.events.back().event].label() << "\n";
   if (!e) return;
   const Scattering& sc = e->sc;
   std::cout << "  scattering (asymptotes: " << sc.asymptotes << ")\n";
   if (sc.in)
     std::cout << "    deflection = " << fmt(sc.deflection) << " rad (out of the incoming plane: " << fmt(sc.out_of_plane)
-              << "), impact parameter b = " << fmt(sc.b) << ", v_inf = " << fmt(sc.v_inf) << "\n";
+              << "), impact parameter b = " << fmt(sc.b) << ", v_inf = " << fmt(sc.v_inf)
+              << ", time delay = " << fmt(sc.time_delay) << "\n";
   if (e->closest) std::cout << "    closest approach r_min = " << fmt(e->closest->distance) << " at t_min = " << fmt(e->closest->t) << "\n";
   else std::cout << "    no closest approach within the run (the distance has no minimum between its ends)\n";
   std::cout << "    K1 turned " << fmt(sc.K1_turn) << " rad, the spin K2 " << fmt(sc.spin_turn) << " rad; K1: "
@@ -145,7 +151,7 @@ struct SimulateOptions {
   long every = 1;
   double tol = RunSpec{}.tol, dt_out = 0.0, omega_c = RunSpec{}.omega_c;
   bool json = false, no_invariants = false, with_reference = false, dry_run = false, quiet = false, scattering = false;
-  std::vector<std::string> event_text;
+  std::vector<std::string> event_text, stop_text;
   std::vector<Event> events;  ///< parsed from event_text, and the closest approaches --scattering adds
   double max_seconds = 3600.0, max_rows = 1e7;
   std::vector<std::string> observe;
@@ -170,6 +176,9 @@ void add_simulate_options(po::options_description& desc, SimulateOptions& o) {
       ("event", po::value(&o.event_text)->multitoken()->composing(),
        "locate events on the method's own steps and report them: closest (a closest approach; closest:K to "
        "centre K), r=RADIUS (r:K=RADIUS), x=X, y=Y, z=Z or plane=nx,ny,nz,offset")
+      ("stop-at", po::value(&o.stop_text)->multitoken()->composing(),
+       "end the run at the first hit of this event (same forms as --event; e.g. r=300 once the body has left): "
+       "its state is the final one, its time t_end")
       ("scattering", po::bool_switch(&o.scattering),
        "report the encounter: asymptotes, deflection, impact parameter, closest approach, K1 and spin turn "
        "(docs/physics.md, Scattering)")
@@ -359,8 +368,16 @@ int cmd_simulate(int argc, char** argv) {
   const Scene scene = make_scene(vm, o.so);
   apply_output_options(vm, o, scene, plan);
   for (const std::string& text : o.event_text) o.events.push_back(parse_event(text));
-  if (o.scattering)
-    for (std::size_t c = 0; c < scene.centres.size(); ++c) o.events.push_back(Event{Event::Kind::closest_approach, c, 0.0, Vec3::UnitX()});
+  for (const std::string& text : o.stop_text) {
+    o.events.push_back(parse_event(text));
+    o.events.back().stop = true;
+  }
+  if (o.scattering)  // every centre's closest approach, unless --event asked for it already
+    for (std::size_t c = 0; c < scene.centres.size(); ++c)
+      if (std::none_of(o.events.begin(), o.events.end(), [c](const Event& e) {
+            return e.kind == Event::Kind::closest_approach && e.centre == c && !e.stop;
+          }))
+        o.events.push_back(Event{Event::Kind::closest_approach, c, 0.0, Vec3::UnitX(), false});
   if (o.dry_run) {
     print_dry_run(plan, o.method_name, scene);
     return 0;

@@ -14,6 +14,7 @@
 #include <memory>
 #include <sstream>
 #include <thread>
+#include <tuple>
 #include <utility>
 #include <unistd.h>
 
@@ -68,7 +69,7 @@ unsigned thread_count(long requested) {
   return std::max(1u, std::thread::hardware_concurrency());
 }
 
-std::string format_row(const SweepRow& r) {
+std::string format_row(const SweepSpec& spec, const SweepRow& r) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const InvariantStats s = r.result.invariants ? *r.result.invariants : InvariantStats{nan, nan, nan};
   // A run that stopped reads "refused" as one that was not run: neither has a state.
@@ -78,12 +79,19 @@ std::string format_row(const SweepRow& r) {
   row.text(r.method->name).num(s.max_rel_dE).num(s.max_rel_dK2sq).num(s.max_abs_dK2Q);
   row.num(r.result.final.R.x()).num(r.result.final.R.y()).num(r.result.final.R.z());
   row.count(r.result.force_evals).num(r.result.wall_s).text(std::string(status)).quoted(r.reason);
+  if (spec.scattering) {  // NaN where there is no value (no minimum, no asymptotes, a run that did not finish)
+    const Scattering sc = r.scattering ? *r.scattering : Scattering{};
+    row.num(r.r_min).num(r.t_min).num(sc.deflection).num(sc.out_of_plane).num(sc.b).num(sc.v_inf).num(sc.time_delay);
+    row.num(r.scattering ? sc.K1_turn : nan).num(r.scattering ? sc.spin_turn : nan);
+    row.num(sc.K1_end.x()).num(sc.K1_end.y()).num(sc.K1_end.z());
+    row.quoted(r.scattering ? sc.asymptotes : std::string("none: the run did not finish"));
+  }
   return row.str();
 }
 
 std::vector<std::string> run_sweep_unit(const SweepSpec& spec, const std::vector<std::size_t>& unit) {
   std::vector<std::string> rows;
-  for (const SweepRow& r : run_sweep_unit_rows(spec, unit)) rows.push_back(format_row(r));
+  for (const SweepRow& r : run_sweep_unit_rows(spec, unit)) rows.push_back(format_row(spec, r));
   return rows;
 }
 
@@ -105,7 +113,7 @@ std::vector<std::string> run_sweep(const SweepSpec& spec, const SweepControl& co
   runner.simd = control.simd;
   runner.stop = [] { return interrupted(); };
   runner.on_row = [&](SweepRow&& r) {  // one call at a time: the rows, the journal, the progress bar
-    rows[r.task] = format_row(r);
+    rows[r.task] = format_row(spec, r);
     if (control.journal) control.journal->append(r.task, rows[r.task]);
     ++finished;
     if (control.progress) progress_bar(finished, todo.size());
@@ -142,8 +150,20 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
               " Rx,Ry,Rz = final position; force_evals; wall_s = step-loop time (runs share the cores; a batch of"
               " trajectories run in vector lanes shares its time equally);"
               " status = ok | diverged (non-finite, or energy error above 1) | collision (diverged after a fall onto"
-              " an attracting centre) | refused (not run); reason = why, when not ok",
-          names + ",method,max_rel_dE,max_rel_dK2sq,max_abs_dK2Q,Rx,Ry,Rz,force_evals,wall_s,status,reason"};
+              " an attracting centre) | refused (not run); reason = why, when not ok" +
+              std::string(spec.scattering
+                              ? "; r_min,t_min = the closest approach to any centre (located on the method's steps);"
+                                " deflection, out_of_plane = angles between the incoming and outgoing asymptotes (rad);"
+                                " b_in = impact parameter of the incoming asymptote, v_inf_in = speed at infinity on it (of the guiding centre"
+                                " for B != 0);"
+                                " time_delay = against free motion, Coulomb logarithm removed; K1_turn, spin_turn ="
+                                " angles K1 and K2 turned over the run (rad); K1x,K1y,K1z = final K1;"
+                                " asymptotes = kepler | guiding-centre | none: why (docs/physics.md, Scattering)"
+                              : ""),
+          names + ",method,max_rel_dE,max_rel_dK2sq,max_abs_dK2Q,Rx,Ry,Rz,force_evals,wall_s,status,reason" +
+              (spec.scattering ? ",r_min,t_min,deflection,out_of_plane,b_in,v_inf_in,time_delay,K1_turn,spin_turn,K1x,K1y,K1z,"
+                                 "asymptotes"
+                               : "")};
 }
 
 std::string sweep_key(const SweepSpec& spec) {
@@ -154,6 +174,7 @@ std::string sweep_key(const SweepSpec& spec) {
     for (double v : a.values) s.append(",").append(fmt(v));
   }
   for (const MethodInfo* m : spec.methods) s.append("|").append(m->name);
+  if (spec.scattering) s.append("|scattering");
   return hex64(fnv1a(s));
 }
 
@@ -275,7 +296,8 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
   add_scene_options(desc, so);
   add_step_options(desc, st);
   desc.add_options()
-      ("param", po::value<std::string>(), "parameter to vary: d, L, h, Kx, Kz, K1, A, B, J, m")
+      ("param", po::value<std::string>(), "parameter to vary: d, L, h, Kx, Kz, K1, A, B, J, m, or the asymptotic data b "
+       "(impact parameter; d is solved for it) and v_inf (speed at infinity; K1 is solved for it)")
       ("from", po::value<double>(), "first value")
       ("to", po::value<double>(), "last value")
       ("step", po::value<double>(), "linear increment")
@@ -289,6 +311,8 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
       ("threads", po::value(&job.threads)->default_value(0), "worker threads (0: all cores)")
       ("out", po::value(&job.out), "CSV file (default: standard output); with --shard, this shard's rows file")
       ("resume", po::bool_switch(&job.resume), "finish an interrupted run of the same sweep and --out from its journal")
+      ("scattering", po::bool_switch(&job.spec.scattering), "also report each run's encounter: closest approach, "
+       "deflection, impact parameter b, v_inf, time delay, K1 and spin turn (columns after reason)")
       ("no-simd", po::bool_switch(&job.no_simd), "run every trajectory alone instead of in batches of vector lanes (same numbers, slower; for comparison)")
       ("shard", po::value(&shard), "K/N: run only shard K of N (every method on every N-th grid point, staggered) and write a rows file for 'bodypoint merge'");
   po::variables_map vm;
@@ -304,6 +328,14 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
   if (job.shards > 1 && job.out.empty()) throw Error("--shard needs --out (the shard's rows file)");
   job.spec.methods = parse_methods(methods_arg);
   job.spec.base = so.params;
+  // Fixed asymptotic data are solved for at every grid point (a sweep over L keeps b, not d).
+  for (const auto& [option, param, value] : {std::tuple{"b", "b", so.b}, std::tuple{"v-inf", "v_inf", so.v_inf}}) {
+    if (!vm.count(option)) continue;
+    if (!(std::isfinite(value) && value > 0.0)) throw Error(std::string("--") + option + " must be a finite number > 0");
+    if (std::any_of(job.spec.axes.begin(), job.spec.axes.end(), [&](const Axis& a) { return a.param == param; }))
+      throw Error(std::string("--") + option + " is fixed and varied at once");
+    job.spec.axes.push_back(Axis{param, {value}});
+  }
   job.spec.h = st.h;
   bool sweeps_h = false;
   for (const Axis& a : job.spec.axes) sweeps_h = sweeps_h || a.param == "h";

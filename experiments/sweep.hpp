@@ -25,7 +25,7 @@ std::string run_sweep_task(const SweepSpec& spec, std::size_t i);
 /// Runs a unit of plan_units (one task, or a batch) and returns its CSV rows in the unit's order.
 std::vector<std::string> run_sweep_unit(const SweepSpec& spec, const std::vector<std::size_t>& unit);
 /// One CSV row (the columns of sweep_header) of a task's result.
-std::string format_row(const SweepRow& row);
+std::string format_row(const SweepSpec& spec, const SweepRow& row);
 
 /// How a sweep runs: threads, which tasks (shard K of N takes the tasks with shard_of == K), and a
 /// journal that keeps finished rows durably and supplies those of an interrupted run (rows_file.hpp).

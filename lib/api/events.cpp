@@ -77,9 +77,29 @@ double distance_for(const Event& e, const std::vector<Centre>& centres, const St
 
 }  // namespace
 
+namespace {
+
+/// A run that starts on an event (g = 0 to round-off, e.g. a Stepper continuing from a stop) does
+/// not report it again: a first g within kStartUlps of its own scale counts as zero, which no sign
+/// change starts from.
+constexpr double kStartUlps = 64.0;
+
+double event_scale(const Event& e, const std::vector<Centre>& centres, const State& s) {
+  switch (e.kind) {
+    case Event::Kind::closest_approach: return (s.R - centres[e.centre].c).norm() * s.v.norm();
+    case Event::Kind::radius: return std::max((s.R - centres[e.centre].c).norm(), e.value);
+    case Event::Kind::plane: return e.normal.norm() * s.R.norm() + std::abs(e.value);
+  }
+  return 0.0;
+}
+
+}  // namespace
+
 void EventWatch::observe(double t, const State& s) {
   for (std::size_t k = 0; k < events_.size(); ++k) {
-    const double g = event_function(events_[k], centres_, s);
+    double g = event_function(events_[k], centres_, s);
+    if (!started_ && std::abs(g) <= kStartUlps * std::numeric_limits<double>::epsilon() * event_scale(events_[k], centres_, s))
+      g = 0.0;
     if (started_ && t > t_ && crosses(events_[k], g_[k], g)) brackets_.push_back({k, t_, t, g_[k], g, s_, s});
     g_[k] = g;
   }

@@ -3,9 +3,13 @@
 
 #include "bodypoint/adaptive/methods.hpp"
 #include "bodypoint/adaptive/tolerance.hpp"
+#include "bodypoint/field.hpp"
+#include "bodypoint/invariants.hpp"
 #include "events.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <type_traits>
 #include <utility>
@@ -90,13 +94,24 @@ BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& cen
                                 const Advance& how, const Options& options);
 
 /// The sink of a run with events: every observed state goes to the watch; the caller's sink gets the
-/// states it asked for (every `every`-th step and the last; with dt_out all of them).
+/// states it asked for (every `every`-th step and the last; with dt_out all of them). Once a stop
+/// event is bracketed no later state is passed on; with `stop_run` the run is ended there (StopRun).
 class WatchingSink {
  public:
-  WatchingSink(detail::EventWatch& watch, const Options& options, bool every_state)
-      : watch_(watch), user_(options.sink), every_(every_state ? 1 : options.every) {}
+  WatchingSink(detail::EventWatch& watch, const Options& options, bool every_state, bool stop_run)
+      : watch_(watch), events_(options.events), user_(options.sink), every_(every_state ? 1 : options.every),
+        stop_run_(stop_run) {}
   void operator()(const Sample& s) {
+    if (stopped_) return;
     watch_.observe(s.t, s.s);
+    for (; seen_ < watch_.brackets().size(); ++seen_)
+      stopped_ = stopped_ || events_[watch_.brackets()[seen_].event].stop;
+    if (stopped_) {
+      pending_.reset();
+      stop_step_ = s.step;
+      if (stop_run_) throw StopRun{s.step, s.t, s.s};
+      return;
+    }
     if (!user_) return;
     if (s.step % every_ == 0) {
       (*user_)(s);
@@ -105,9 +120,11 @@ class WatchingSink {
       pending_ = Pending{s.step, s.t, s.s, s.rel_dE, s.rel_dK2sq, s.abs_dK2Q};
     }
   }
-  /// The last state, when the every-th rule skipped it.
-  void finish() {
-    if (user_ && pending_) (*user_)(Sample{pending_->step, pending_->t, pending_->s, pending_->dE, pending_->dK2, pending_->dK2Q});
+  /// The last state: the one the every-th rule skipped, or the stop event's (its deviations given).
+  void finish(const EventHit* stop, double rel_dE, double rel_dK2sq, double abs_dK2Q) {
+    if (!user_) return;
+    if (stop) (*user_)(Sample{stop_step_, stop->t, stop->s, rel_dE, rel_dK2sq, abs_dK2Q});
+    else if (pending_) (*user_)(Sample{pending_->step, pending_->t, pending_->s, pending_->dE, pending_->dK2, pending_->dK2Q});
   }
 
  private:
@@ -118,10 +135,34 @@ class WatchingSink {
     double dE, dK2, dK2Q;
   };
   detail::EventWatch& watch_;
+  const std::vector<Event>& events_;
   const SampleSink* user_;
   long every_;
+  bool stop_run_;
+  bool stopped_ = false;
+  std::size_t seen_ = 0;
+  long stop_step_ = 0;
   std::optional<Pending> pending_;
 };
+
+/// A run cut at its stop event `hit` (a state of the run's own steps): the final state and time are
+/// the event's, the invariants' deviations include it. Returns those deviations (for the last sample).
+InvariantStats cut_at(RunResult& run, const EventHit& hit, const Body& body, const std::vector<Centre>& centres) {
+  run.final = hit.s;
+  run.t_end = hit.t;
+  run.stopped = true;
+  const CentreList field{centres};
+  InvariantMonitor<CentreList> mon(body.p, field, body.s0);
+  mon.update(hit.s);
+  InvariantStats last{mon.last_rel_dE(), mon.last_rel_dK2sq(), mon.last_abs_dK2Q()};
+  if (run.invariants) {
+    InvariantStats& s = *run.invariants;
+    s.max_rel_dE = InvariantMonitor<CentreList>::max_keeping_nan(s.max_rel_dE, last.max_rel_dE);
+    s.max_rel_dK2sq = InvariantMonitor<CentreList>::max_keeping_nan(s.max_rel_dK2sq, last.max_rel_dK2sq);
+    if (s.has_K2Q) s.max_abs_dK2Q = InvariantMonitor<CentreList>::max_keeping_nan(s.max_abs_dK2Q, last.max_abs_dK2Q);
+  }
+  return last;
+}
 
 /// The run's configuration for a time tau from a state: what locates its events (events.hpp).
 detail::Advancer advancer(const BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Advance& how,
@@ -168,8 +209,11 @@ BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& cen
     const double dt_out = std::holds_alternative<FictitiousSteps>(how) ? std::get<FictitiousSteps>(how).dt_out
                           : std::holds_alternative<Accuracy>(how)       ? std::get<Accuracy>(how).dt_out
                                                                         : 0.0;
+    // The accuracy mode hands its delivered run's states on after its search: it cannot be stopped
+    // mid-run, only cut at the event afterwards.
+    const bool accuracy = std::holds_alternative<Accuracy>(how);
     detail::EventWatch watch(options.events, centres);
-    WatchingSink watching(watch, options, dt_out > 0.0);
+    WatchingSink watching(watch, options, dt_out > 0.0, !accuracy);
     const SampleSink sink = [&watching](const Sample& s) { watching(s); };
     Options inner = options;
     inner.events.clear();
@@ -177,9 +221,20 @@ BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& cen
     inner.every = 1;
     BodyResult r = integrate_valid_body(body, centres, method, how, inner);
     if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return r;
-    watching.finish();
     r.events = detail::locate(watch, options.events, centres, advancer(r, body, centres, how, options),
                               r.event_force_evals);
+    const auto stop = std::find_if(r.events.begin(), r.events.end(),
+                                   [&](const EventHit& h) { return options.events[h.event].stop; });
+    if (stop == r.events.end()) {
+      watching.finish(nullptr, 0.0, 0.0, 0.0);
+      return r;
+    }
+    r.events.erase(std::next(stop), r.events.end());  // nothing after the stop happened
+    const InvariantStats last = cut_at(r.run, r.events.back(), body, centres);
+    watching.finish(&r.events.back(), last.max_rel_dE, last.max_rel_dK2sq, last.max_abs_dK2Q);
+    r.outcome = Outcome::ok;
+    r.reason.clear();
+    judge(r);
     return r;
   }
   BodyResult r;
@@ -297,7 +352,8 @@ Outcome Stepper::advance_to(double t) {
     events_.push_back(h);
   }
   body_.s0 = r.run.final;
-  t_ = t;
+  stopped_ = r.run.stopped;
+  t_ = r.run.stopped ? t0 + r.run.t_end : t;
   force_evals_ += r.run.force_evals;
   steps_ += r.run.steps;
   if (r.outcome != Outcome::ok) reason_ = r.reason;

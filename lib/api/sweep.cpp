@@ -42,6 +42,29 @@ SweepRow run_row(SweepRow row, RunResult result) {
   return row;
 }
 
+/// The row of a run with its encounter (SweepSpec::scattering): integrate_body with every centre's
+/// closest approach as events, then scattering() of the run.
+SweepRow encounter_row(SweepRow row, const MethodInfo& method, const Scene& scene, const RunSpec& spec) {
+  const Body& body = scene.bodies.front();
+  Options options;
+  options.track_invariants = spec.track_invariants;
+  options.omega_c = spec.omega_c;
+  for (std::size_t c = 0; c < scene.centres.size(); ++c)
+    options.events.push_back(Event{Event::Kind::closest_approach, c, 0.0, Vec3::UnitX(), false});
+  BodyResult r = integrate_body(body, scene.centres, &method, advance_of(method, spec), options);
+  if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return unrun_row(std::move(row), r.outcome, r.reason);
+  for (const EventHit& h : r.events)
+    if (!(h.distance >= row.r_min)) {  // the first, or a closer one
+      row.r_min = h.distance;
+      row.t_min = h.t;
+    }
+  if (r.outcome == Outcome::ok) row.scattering = scattering(body.p, scene.centres, body.s0, r.run.final, r.run.t_end);
+  row.result = std::move(r.run);
+  row.outcome = r.outcome;
+  row.reason = std::move(r.reason);
+  return row;
+}
+
 }  // namespace
 
 std::size_t task_count(const SweepSpec& spec) {
@@ -63,9 +86,14 @@ std::vector<double> grid_point(const SweepSpec& spec, std::size_t p) {
 
 SceneParams point_params(const SweepSpec& spec, const std::vector<double>& point) {
   SceneParams p = spec.base;
-  for (std::size_t a = 0; a < spec.axes.size(); ++a)
-    if (spec.axes[a].param != "h") scene_field(p, spec.axes[a].param) = point[a];
-  return p;
+  double b = Scattering::kNaN, v_inf = Scattering::kNaN;  // asymptotic data: solved for once the rest is set
+  for (std::size_t a = 0; a < spec.axes.size(); ++a) {
+    const std::string& name = spec.axes[a].param;
+    if (name == "b") b = point[a];
+    else if (name == "v_inf") v_inf = point[a];
+    else if (name != "h") scene_field(p, name) = point[a];
+  }
+  return std::isnan(b) && std::isnan(v_inf) ? p : with_asymptotic_data(p, b, v_inf);
 }
 
 RunSpec fixed_run_spec(double h, long steps, double t_end, double tol) {
@@ -103,6 +131,10 @@ void validate_sweep(const SweepSpec& spec) {
   if (spec.axes.empty()) throw Error("the sweep has no varied parameter");
   for (const Axis& a : spec.axes)
     if (a.values.empty()) throw Error("the sweep has no values of " + a.param);
+  for (const Axis& a : spec.axes)
+    for (const Axis& other : spec.axes)
+      if ((a.param == "b" && other.param == "d") || (a.param == "v_inf" && other.param == "K1"))
+        throw Error("the sweep varies " + a.param + " and " + other.param + ", which it solves for " + a.param);
   const std::size_t points = task_count(spec) / spec.methods.size();
   for (std::size_t p = 0; p < points; ++p) {
     const std::vector<double> point = grid_point(spec, p);
@@ -121,7 +153,11 @@ std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vect
   std::vector<SweepRow> rows;
   std::vector<batch::Member> members;
   for (std::size_t i : unit) {
-    rows.push_back(SweepRow{i, grid_point(spec, i / M), &method, Outcome::ok, {}, {}});
+    SweepRow row;
+    row.task = i;
+    row.point = grid_point(spec, i / M);
+    row.method = &method;
+    rows.push_back(std::move(row));
     const Scene scene = thesis_scene(point_params(spec, rows.back().point));
     members.push_back({scene.bodies.front().p, scene.bodies.front().s0, scene.centres.front().A});
   }
@@ -132,6 +168,10 @@ std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vect
   }
   SweepRow& row = rows.front();
   const Scene scene = thesis_scene(point_params(spec, row.point));
+  if (spec.scattering) {
+    row = encounter_row(std::move(row), method, scene, point_spec(spec, row.point));
+    return rows;
+  }
   try {
     // The run first: an argument list that also moved `row` may move it before reading row.point.
     RunResult result = run(method, scene.bodies.front(), scene.centres, point_spec(spec, row.point));
@@ -145,7 +185,7 @@ std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vect
 
 std::vector<std::vector<std::size_t>> plan_units(const SweepSpec& spec, const std::vector<std::size_t>& todo, bool simd) {
   std::vector<std::vector<std::size_t>> units;
-  const std::size_t M = spec.methods.size(), lanes = simd ? batch::width() : 1;
+  const std::size_t M = spec.methods.size(), lanes = simd && !spec.scattering ? batch::width() : 1;
   std::map<std::pair<std::size_t, double>, std::vector<std::size_t>> open;  // (method, h) -> a filling batch
   for (std::size_t i : todo) {
     const MethodInfo& method = *spec.methods[i % M];

@@ -103,7 +103,7 @@ const std::vector<SceneParameter>& scene_parameters() {
       {"K1", "initial linear momentum K1(0) = K1 i", [](SceneParams& p) -> double& { return p.start.K1; }},
       {"Kx", "K2(0) = Kx i - Kz k", [](SceneParams& p) -> double& { return p.start.Kx; }},
       {"Kz", "K2(0) = Kx i - Kz k", [](SceneParams& p) -> double& { return p.start.Kz; }},
-      {"d", "impact parameter", [](SceneParams& p) -> double& { return p.start.d; }},
+      {"d", "angular-momentum impact parameter: K2Q_z = -d K1 (not the asymptote's b; see --b)", [](SceneParams& p) -> double& { return p.start.d; }},
       {"L", "initial distance along -x", [](SceneParams& p) -> double& { return p.start.L; }},
   };
   return list;

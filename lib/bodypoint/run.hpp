@@ -44,6 +44,14 @@ struct Sample {
   double rel_dE, rel_dK2sq, abs_dK2Q;
 };
 using SampleSink = std::function<void(const Sample&)>;
+/// Thrown by a sink to end a run after the state it was just handed (an event that stops the run).
+/// The run returns what it has: that state as final, its step and time, the invariants up to it,
+/// the force evaluations made, stopped = true.
+struct StopRun {
+  long step;
+  double t;
+  State s;
+};
 
 struct RunResult {
   State final;
@@ -53,6 +61,7 @@ struct RunResult {
   double wall_s = 0.0;
   std::optional<InvariantStats> invariants;
   double min_step = 0.0, max_step = 0.0;  ///< smallest and largest accepted physical step
+  bool stopped = false;  ///< a sink ended the run early (StopRun): t_end is where
 };
 
 /// Thesis: the thesis's drift/kick schemes; LiePoisson: exact splittings; Odeint: fixed-step

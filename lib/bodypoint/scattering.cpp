@@ -4,7 +4,10 @@
 #include "bodypoint/field.hpp"
 #include "bodypoint/invariants.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <string>
+#include <utility>
 
 namespace bodypoint {
 
@@ -44,6 +47,7 @@ std::optional<Periapsis> kepler_periapsis(double mu, double kappa, const Vec3& X
   // mean anomaly e sinh H - s H = n t (t from periapsis), n = v_inf/a; sinh H = X.P/(mu n a^2 e).
   const double a = std::abs(kappa) / (2.0 * E), n = v_inf / a;
   const double e = std::sqrt(1.0 + 2.0 * E * l2 / (mu * kappa * kappa));
+  q.e = e;
   const double s = kappa < 0.0 ? 1.0 : -1.0;
   const double sinh_H = X.dot(P) / (mu * n * a * a * e);
   q.dt = -(e * sinh_H - s * std::asinh(sinh_H)) / n;
@@ -67,7 +71,18 @@ std::optional<KeplerParticle> kepler_particle(const BodyPoint& p, const State& s
   return k;
 }
 
-Scattering scattering(const BodyPoint& p, const std::vector<Centre>& centres, const State& start, const State& end) {
+namespace {
+
+/// One leg's Coulomb time delay, -kappa/(mu v_inf^3) (1 + ln e) (scattering.hpp, time_delay).
+double leg_delay(double mu, double kappa, const Periapsis& q, double p_inf) {
+  const double v = p_inf / mu;
+  return kappa == 0.0 ? 0.0 : -kappa / (mu * v * v * v) * (1.0 + std::log(q.e));
+}
+
+}  // namespace
+
+Scattering scattering(const BodyPoint& p, const std::vector<Centre>& centres, const State& start, const State& end,
+                      double elapsed) {
   Scattering out;
   const Momenta q0 = to_momenta(p, start), q1 = to_momenta(p, end);
   out.K1_start = q0.K1;
@@ -112,6 +127,10 @@ Scattering scattering(const BodyPoint& p, const std::vector<Centre>& centres, co
   const Vec3 normal = out.in->direction.cross(out.in->impact);
   out.out_of_plane = normal.squaredNorm() > 0.0 ? std::asin(std::clamp(out.out->direction.dot(normal.normalized()), -1.0, 1.0))
                                                 : 0.0;
+  const auto q_in = kepler_periapsis(in->mu, kappa, in->X, in->P), q_out = kepler_periapsis(fin->mu, kappa, fin->X, fin->P);
+  if (std::isfinite(elapsed) && q_in && q_out)
+    out.time_delay = elapsed - q_in->dt + q_out->dt + leg_delay(in->mu, kappa, *q_in, out.in->p_inf) +
+                     leg_delay(fin->mu, kappa, *q_out, out.out->p_inf);
   return out;
 }
 
@@ -122,34 +141,72 @@ namespace {
 constexpr double kImpactRelTol = 1e-14;
 constexpr int kImpactIterations = 60;
 
-double incoming_b(const SceneParams& params, double d) {
-  SceneParams p = params;
-  p.start.d = d;
+/// The incoming asymptote of the thesis's scene with parameters p, and the mass of its Kepler particle.
+std::pair<Asymptote, double> incoming(const SceneParams& p) {
   const Scene s = thesis_scene(p);
   const Body& body = s.bodies.front();
   const auto k = kepler_particle(body.p, body.s0, s.centres.front().c);
   if (!k) throw Error("the scene's body does not drift along K1: it has no incoming asymptote");
   const auto a = kepler_asymptote(k->mu, -s.centres.front().A, k->X, k->P, false);
   if (!a) throw Error("the scene's orbit is bound (energy at infinity <= 0): it has no incoming asymptote");
-  return a->b();
+  return {*a, k->mu};
+}
+
+/// Secant iterations on one scene parameter x (field) for f(x) = target, from x0 and x1.
+double solve_parameter(SceneParams params, double& (*field)(SceneParams&), double (*f)(const SceneParams&),
+                       double target, double x0, double x1) {
+  field(params) = x0;
+  double f0 = f(params) - target;
+  for (int i = 0; i < kImpactIterations; ++i) {
+    field(params) = x1;
+    const double f1 = f(params) - target;
+    if (f1 == 0.0 || std::abs(x1 - x0) <= kImpactRelTol * std::max(std::abs(x1), std::abs(target))) return x1;
+    const double slope = (f1 - f0) / (x1 - x0);
+    x0 = x1;
+    f0 = f1;
+    x1 = x1 - (std::isfinite(slope) && slope != 0.0 ? f1 / slope : f1);
+  }
+  return x1;
+}
+
+double& d_of(SceneParams& p) { return p.start.d; }
+double& k1_of(SceneParams& p) { return p.start.K1; }
+double b_of(const SceneParams& p) { return incoming(p).first.b(); }
+double v_of(const SceneParams& p) {
+  const auto [a, mu] = incoming(p);
+  return a.p_inf / mu;
 }
 
 }  // namespace
 
 double d_for_impact_parameter(SceneParams params, double b) {
   if (!(std::isfinite(b) && b > 0.0)) throw Error("the impact parameter b must be a finite number > 0");
-  double d0 = params.B == 0.0 ? params.start.Kz / params.start.K1 + b : b;
-  double f0 = incoming_b(params, d0) - b;
-  double d1 = d0 - f0;  // db/dd ~ 1
+  const double d0 = params.B == 0.0 ? params.start.Kz / params.start.K1 + b : b;
+  params.start.d = d0;
+  return solve_parameter(params, d_of, b_of, b, d0, d0 - (b_of(params) - b));  // db/dd ~ 1
+}
+
+double k1_for_speed_at_infinity(SceneParams params, double v_inf) {
+  if (!(std::isfinite(v_inf) && v_inf > 0.0)) throw Error("the speed at infinity v_inf must be a finite number > 0");
+  const double k0 = params.start.K1;
+  const double k1 = k0 * v_inf / v_of(params);  // v_inf ~ K1 / mass
+  const double k = solve_parameter(params, k1_of, v_of, v_inf, k0, k1);
+  if (!(std::isfinite(k) && k > 0.0)) throw Error("no momentum K1 > 0 gives the speed at infinity v_inf = " + std::to_string(v_inf));
+  return k;
+}
+
+SceneParams with_asymptotic_data(SceneParams params, double b, double v_inf) {
   for (int i = 0; i < kImpactIterations; ++i) {
-    const double f1 = incoming_b(params, d1) - b;
-    if (f1 == 0.0 || std::abs(d1 - d0) <= kImpactRelTol * std::max(std::abs(d1), b)) return d1;
-    const double slope = (f1 - f0) / (d1 - d0);
-    d0 = d1;
-    f0 = f1;
-    d1 = d1 - (std::isfinite(slope) && slope != 0.0 ? f1 / slope : f1);
+    const SceneParams before = params;
+    if (!std::isnan(v_inf)) params.start.K1 = k1_for_speed_at_infinity(params, v_inf);
+    if (!std::isnan(b)) params.start.d = d_for_impact_parameter(params, b);
+    if (std::isnan(b) || std::isnan(v_inf) ||
+        (params.start.K1 == before.start.K1 && params.start.d == before.start.d) ||
+        (std::abs(params.start.K1 - before.start.K1) <= kImpactRelTol * params.start.K1 &&
+         std::abs(params.start.d - before.start.d) <= kImpactRelTol * std::max(params.start.d, b)))
+      return params;
   }
-  return d1;
+  return params;
 }
 
 }  // namespace bodypoint

@@ -53,6 +53,7 @@ std::optional<Asymptote> kepler_asymptote(double mu, double kappa, const Vec3& X
 /// until the body is there (negative once past it), from Kepler's hyperbolic equation.
 struct Periapsis {
   double r = 0.0, dt = 0.0;
+  double e = 1.0;  ///< the hyperbola's eccentricity (a straight line: 1)
 };
 std::optional<Periapsis> kepler_periapsis(double mu, double kappa, const Vec3& X, const Vec3& P);
 
@@ -80,12 +81,22 @@ struct Scattering {
   double out_of_plane = kNaN;  ///< angle of out's direction out of the plane of in (direction, impact)
   double b = kNaN;             ///< impact parameter of the incoming asymptote
   double v_inf = kNaN;         ///< speed at infinity (B != 0: of the guiding centre), incoming
+  /// The time delay against free motion (needs the run's duration): the run's time minus the Kepler
+  /// time of the two legs (start to the incoming hyperbola's periapsis, the outgoing one's periapsis
+  /// to the end), plus each leg's Coulomb time delay -kappa/(mu v_inf^3) (1 + ln e). For B = 0 it is
+  /// -2 kappa/(mu v_inf^3)(1 + ln e) (the run's own timing error aside): free motion along the
+  /// asymptotes takes that much longer than the orbit once the logarithm (kappa/(mu v_inf^3)) ln(2r/a)
+  /// per leg (a = |kappa|/(mu v_inf^2)), which grows without bound in any Coulomb field, is removed.
+  /// For B != 0: the guiding centre's delay, the spin's part included. docs/physics.md, "Scattering".
+  double time_delay = kNaN;
 
   static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 };
 
-/// The encounter's observables from the first and last state of a run in this field.
-Scattering scattering(const BodyPoint& p, const std::vector<Centre>& centres, const State& start, const State& end);
+/// The encounter's observables from the first and last state of a run in this field; `elapsed` (the
+/// run's duration, t_end) gives the time delay.
+Scattering scattering(const BodyPoint& p, const std::vector<Centre>& centres, const State& start, const State& end,
+                      double elapsed = Scattering::kNaN);
 
 /// The thesis's scene (model.hpp, thesis_scene) whose incoming asymptote has impact parameter b: the
 /// parameter d solved for it (secant iterations on the asymptote of the starting state, to a relative
@@ -93,6 +104,16 @@ Scattering scattering(const BodyPoint& p, const std::vector<Centre>& centres, co
 /// its guiding centre starts at height d, so d ~ b. Error when b is not a finite number > 0, or the
 /// scene has no incoming asymptote (an attracting centre and a bound orbit).
 double d_for_impact_parameter(SceneParams params, double b);
+
+/// The thesis's scene whose body moves at speed v_inf at infinity (B != 0: its guiding centre): the
+/// momentum K1 solved for it (secant iterations, relative 1e-14), d and the rest kept. Error when
+/// v_inf is not a finite number > 0 or no K1 reaches it (a bound orbit on the way).
+double k1_for_speed_at_infinity(SceneParams params, double v_inf);
+
+/// The scene given by its asymptotic data: impact parameter b and/or speed at infinity v_inf (NaN:
+/// not given, the scene's own d or K1 kept). Both are solved together (each depends a little on the
+/// other through the start at finite distance L) until neither d nor K1 changes.
+SceneParams with_asymptotic_data(SceneParams params, double b, double v_inf);
 
 /// The angle between two vectors, accurate for small and for near-opposite angles: atan2(|a x b|, a.b).
 double angle_between(const Vec3& a, const Vec3& b);

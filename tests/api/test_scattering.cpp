@@ -26,6 +26,11 @@ constexpr double kRutherfordRel = 1e-10;
 /// few ulps of d, not of b: at b = 1e-3 that is ~1e-13 of b.
 constexpr double kImpactUlps = 8.0;
 
+/// The time delay of a material point's run at tol 1e-12 over t ~ 100: the run's time is exact, its
+/// position ~1e-12 relative at r ~ 200 (2e-10), i.e. ~1e-10 in time at v ~ 5; the Kepler legs' times
+/// are evaluated to round-off of t.
+constexpr double kDelayAbs = 1e-9;
+
 /// A material point passing a repelling (A = -2) or attracting (A = 2) centre at b ~ 1 from L = 20.
 Scene kepler_scene(double A) {
   SceneParams p;
@@ -126,6 +131,60 @@ TEST(Events, AStepperReportsEventsAtAbsoluteTimes) {
   EXPECT_NEAR(st.events()[0].t, whole.bodies.front().events[0].t, kKeplerRel);
 }
 
+TEST(Events, AStopEventEndsTheRunOnEveryFamily) {
+  const Scene s = kepler_scene(-2.0);
+  const Event x0{Event::Kind::plane, 0, 0.0, Vec3::UnitX(), false};
+  Event stop_x0 = x0;
+  stop_x0.stop = true;
+  for (const Case& c : every_family()) {
+    Options watch;
+    watch.events = {Event{}, x0, Event{Event::Kind::radius, 0, 5.0, Vec3::UnitX(), false}};
+    const Result whole = integrate(s, c.method, c.how, watch);
+    ASSERT_EQ(whole.outcome, Outcome::ok) << c.method << ": " << whole.reason;
+    ASSERT_EQ(whole.bodies.front().events.size(), 4u) << c.method;  // r = 5, closest, x = 0, r = 5
+    const EventHit& crossing = whole.bodies.front().events[2];
+    std::vector<double> times;
+    const SampleSink sink = [&](const Sample& x) { times.push_back(x.t); };
+    Options cut = watch;
+    cut.events[1] = stop_x0;
+    cut.sink = &sink;
+    const Result r = integrate(s, c.method, c.how, cut);
+    ASSERT_EQ(r.outcome, Outcome::ok) << c.method << ": " << r.reason;
+    const BodyResult& b = r.bodies.front();
+    EXPECT_TRUE(b.run.stopped) << c.method;
+    ASSERT_EQ(b.events.size(), 3u) << c.method;  // the outbound r = 5 never happened
+    EXPECT_EQ(b.events.back().event, 1u);
+    EXPECT_EQ(b.run.t_end, b.events.back().t);
+    EXPECT_EQ(b.run.final.R, b.events.back().s.R);
+    EXPECT_NEAR(b.run.t_end, crossing.t, kKeplerRel * crossing.t) << c.method;
+    EXPECT_NEAR(b.run.final.R.x(), 0.0, kEventRoundOff) << c.method;
+    ASSERT_FALSE(times.empty());
+    EXPECT_EQ(times.back(), b.run.t_end) << c.method;  // the last sample is the event's state
+    EXPECT_LT(*std::max_element(times.begin(), times.end() - 1), b.run.t_end) << c.method;
+    if (!b.accuracy) {  // stepping stopped at the crossing, not at t_end
+      EXPECT_LT(b.run.steps, whole.bodies.front().run.steps) << c.method;
+    }
+  }
+}
+
+TEST(Events, AStepperStopsAtAStopEventAndContinuesWhenAsked) {
+  const Scene s = kepler_scene(-2.0);
+  Options o;
+  o.events = {Event{Event::Kind::plane, 0, 0.0, Vec3::UnitX(), true}};
+  Stepper st("lp-y8", s.bodies.front(), s.centres, 2e-3, o);
+  ASSERT_EQ(st.advance_to(8.0), Outcome::ok);
+  EXPECT_TRUE(st.stopped());
+  ASSERT_EQ(st.events().size(), 1u);
+  EXPECT_EQ(st.time(), st.events()[0].t);
+  EXPECT_LT(st.time(), 8.0);
+  EXPECT_NEAR(st.state().R.x(), 0.0, kEventRoundOff);
+  // Continuing from the event's state does not stop on it again.
+  ASSERT_EQ(st.advance_to(8.0), Outcome::ok);
+  EXPECT_FALSE(st.stopped());
+  EXPECT_EQ(st.time(), 8.0);
+  EXPECT_EQ(st.events().size(), 1u);
+}
+
 TEST(Events, InvalidEventsAreRefusedWithAReason) {
   const Scene s = kepler_scene(-2.0);
   Options o;
@@ -153,6 +212,31 @@ TEST(Scattering, MaterialPointDeflectionIsRutherfordsFromBEqual1em3To1e3) {
     const double rutherford = 2.0 * std::atan(std::abs(p.A) / (p.m * sc.v_inf * sc.v_inf * sc.b));
     EXPECT_NEAR(sc.deflection / rutherford, 1.0, kRutherfordRel) << "b = " << b;
     EXPECT_EQ(sc.out_of_plane, 0.0) << b;  // the plane z = 0 holds the whole orbit
+  }
+}
+
+TEST(Scattering, MaterialPointTimeDelayIsKeplersAtEveryDistance) {
+  // Runs stopped at r = 300 (from L = 200) and at r = 5000 (from L = 4000): the delay is a property
+  // of the orbit, -2 kappa/(m v^3)(1 + ln e), whatever the distances the run starts and ends at.
+  SceneParams p;
+  p.B = 0.0;
+  for (double L : {200.0, 4000.0}) {
+    p.start.L = L;
+    p.start.d = d_for_impact_parameter(p, 0.5);
+    const Scene s = thesis_scene(p);
+    const Body& body = s.bodies.front();
+    Options o;
+    o.events = {Event{Event::Kind::radius, 0, 1.25 * L, Vec3::UnitX(), true}};
+    const Result r = integrate(s, "ks", FictitiousSteps{0.02, 4.0 * L / p.start.K1, 0, 0.0}, o);
+    ASSERT_EQ(r.outcome, Outcome::ok) << r.reason;
+    ASSERT_TRUE(r.bodies.front().run.stopped);
+    const RunResult& run = r.bodies.front().run;
+    const Scattering sc = scattering(body.p, s.centres, body.s0, run.final, run.t_end);
+    const double kappa = -p.A, v = sc.v_inf;
+    const auto q = kepler_periapsis(body.p.m, kappa, body.s0.R, to_momenta(body.p, body.s0).K1);
+    ASSERT_TRUE(q.has_value());
+    const double kepler = -2.0 * kappa / (body.p.m * v * v * v) * (1.0 + std::log(q->e));
+    EXPECT_NEAR(sc.time_delay, kepler, kDelayAbs) << "L = " << L;
   }
 }
 

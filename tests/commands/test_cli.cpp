@@ -295,5 +295,57 @@ TEST(Cli, ScatteringAndEventsAreTheLibrarysToTheLastBit) {
                                                 {"--event plane=0,0,0,1", "normal must not be zero"}});
 }
 
+TEST(Cli, SweepScatteringColumnsAreThoseOfSingleRuns) {
+  // A sweep over the impact parameter with two families; each row's encounter columns equal, to the
+  // last bit, simulate's --scattering --json for the same scene given by --b.
+  const fs::path csv = test::temp_path("bp_sweep_scattering.csv");
+  const std::string common = " --B 0 --L 50 --h 0.01 --t-end 25";
+  const Result sweep = run_cli("sweep --param b --values 0.5,2 --methods lp-kl8,ks --scattering --threads 2 --out " +
+                               csv.string() + common);
+  ASSERT_EQ(sweep.code, 0) << sweep.err;
+  std::istringstream in(test::read(csv));
+  std::vector<std::string> names;
+  int rows = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    if (names.empty()) {
+      names = test::csv_fields(line);
+      continue;
+    }
+    const std::vector<std::string> f = test::csv_fields(line);
+    ASSERT_EQ(f.size(), names.size()) << line;
+    std::map<std::string, std::string> row;
+    for (std::size_t i = 0; i < f.size(); ++i) row.emplace(names[i], f[i]);  // the first "b" is the varied one
+    const Result one = run_cli("simulate --method " + row.at("method") + " --b " + row.at("b") + common +
+                               " --scattering --json --quiet");
+    ASSERT_EQ(one.code, 0) << one.err;
+    for (const char* key : {"deflection", "r_min", "t_min", "time_delay", "spin_turn"})
+      EXPECT_EQ(std::stod(row.at(key)), json_num(one.out, key)) << row.at("method") << " b = " << row.at("b") << ": " << key;
+    EXPECT_EQ(std::stod(row.at("b_in")), json_num(one.out, "b"));
+    EXPECT_EQ(std::stod(row.at("Rx")), json_vec(one.out, "R").x());
+    EXPECT_EQ(row.at("asymptotes"), "kepler");
+    ++rows;
+  }
+  EXPECT_EQ(rows, 4);
+  fs::remove(csv);
+}
+
+TEST(Cli, StopAtEndsTheRunAtTheEvent) {
+  // The crossing is located to a few ulps of t (speed ~5): |R| = 25 to ~1e-14, printed to 17 digits.
+  constexpr double kLocatedRadius = 1e-12;
+  const Result r = run_cli("simulate --method lp-y8 --h 2e-3 --t-end 40 --B 0 --d 2 --L 20 --stop-at r=25 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"stopped_by\": \"r=25\""), std::string::npos) << r.out;
+  EXPECT_NEAR(json_vec(r.out, "R").norm(), 25.0, kLocatedRadius);
+  EXPECT_LT(json_num(r.out, "t_end"), 40.0);
+  const Result never = run_cli("simulate --method lp-y8 --h 2e-3 --t-end 4 --B 0 --d 2 --L 20 --stop-at r=25 --json");
+  ASSERT_EQ(never.code, 0) << never.err;
+  EXPECT_NE(never.out.find("\"stopped_by\": null"), std::string::npos);
+  EXPECT_EQ(json_num(never.out, "t_end"), 4.0);
+  test::expect_refused("simulate --steps 10 ", {{"--stop-at nowhere", "unknown --event 'nowhere'"},
+                                                {"--b 1 --d 2", "give --b or --d, not both"},
+                                                {"--v-inf 0", "--v-inf must be a finite number > 0"}});
+}
+
 }  // namespace
 }  // namespace bodypoint

@@ -173,17 +173,7 @@ TEST(Reliability, OutputsCollideWithNothing) {
 namespace bodypoint {
 namespace {
 
-/// Fields of one CSV line with double-quoted fields (no quotes inside them).
-std::vector<std::string> csv_fields(const std::string& line) {
-  std::vector<std::string> out(1);
-  bool quoted = false;
-  for (const char c : line) {
-    if (c == '"') quoted = !quoted;
-    else if (c == ',' && !quoted) out.emplace_back();
-    else out.back() += c;
-  }
-  return out;
-}
+using test::csv_fields;
 
 // Bound on the energy error of a run the study calls ok (assess(): kDivergedEnergy).
 constexpr double kOkEnergyBound = 1.0;

@@ -57,6 +57,11 @@ struct Event {
   std::size_t centre = 0;  ///< closest_approach, radius: which of the scene's centres
   double value = 0.0;      ///< radius: the distance; plane: the offset
   Vec3 normal = Vec3::UnitX();
+  /// The run ends at this event's first hit: the state there is the run's final state (RunResult::
+  /// stopped, t_end its time) and the last of BodyResult::events. A fixed-step, time-transformed or
+  /// step-size-controlled run stops stepping on the step that crosses it; the accuracy mode searches
+  /// its step over the whole span t_end and delivers the run cut at the event.
+  bool stop = false;
   /// "closest", "r=5", "plane(1,0,0)=0": for outputs and messages.
   [[nodiscard]] std::string label() const;
 };
@@ -172,6 +177,9 @@ class Stepper {
   [[nodiscard]] const std::string& reason() const { return reason_; }  ///< of the last segment that was not ok
   /// Options::events located so far, at absolute times.
   [[nodiscard]] const std::vector<EventHit>& events() const { return events_; }
+  /// True once an event with stop = true ended a segment: time() is the event's, and advance_to
+  /// continues from there only when asked again.
+  [[nodiscard]] bool stopped() const { return stopped_; }
 
  private:
   const MethodInfo* method_;
@@ -183,6 +191,7 @@ class Stepper {
   long force_evals_ = 0, steps_ = 0;
   std::string reason_;
   std::vector<EventHit> events_;
+  bool stopped_ = false;
 };
 
 }  // namespace bodypoint

@@ -19,16 +19,21 @@
 
 #include <cstddef>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace bodypoint {
 
-/// The parameters a sweep can vary: the step h and every scene parameter (model.hpp).
+/// The parameters a sweep can vary: the step h, every scene parameter (model.hpp), and the scene's
+/// asymptotic data, b (the incoming asymptote's impact parameter: d is solved for it) and v_inf (the
+/// speed at infinity: K1 is solved for it; scattering.hpp, with_asymptotic_data).
 inline const std::vector<std::string>& sweep_parameters() {
   static const std::vector<std::string> p = [] {
     std::vector<std::string> names{"h"};
     for (const SceneParameter& q : scene_parameters()) names.emplace_back(q.name);
+    names.emplace_back("b");
+    names.emplace_back("v_inf");
     return names;
   }();
   return p;
@@ -50,6 +55,9 @@ struct SweepSpec {
   long steps = 0;           ///< fixed number of steps, or 0 when t_end is fixed
   double t_end = 0;         ///< fixed end time (steps = ceil(t_end/h), h = t_end/steps), or 0
   double tol = RunSpec{}.tol;  ///< step-size-controlled methods: tolerance per step
+  /// Also locate each run's closest approaches and report the encounter (SweepRow::scattering): each
+  /// task then runs alone through integrate_body (no vector lanes), the same run with an observer.
+  bool scattering = false;
 };
 
 /// Number of (grid point, method) tasks; Error above 1e9.
@@ -80,6 +88,10 @@ struct SweepRow {
   Outcome outcome = Outcome::ok;
   std::string reason;  ///< one line; empty when ok
   RunResult result;    ///< final state NaN when refused or failed
+  /// With SweepSpec::scattering, a run that finished: its encounter (time delay included) and the
+  /// closest of its closest approaches to any centre (NaN when the distance had no minimum).
+  std::optional<Scattering> scattering;
+  double r_min = Scattering::kNaN, t_min = Scattering::kNaN;
 };
 
 /// The tasks of `todo` in units: batches of up to batch::width() tasks of one method and step whose

@@ -103,10 +103,12 @@ struct StepStats {
     min_dt = std::min(min_dt, dt);
     max_dt = std::max(max_dt, dt);
   }
-  /// Fills r.steps, r.t_end, r.min_step and r.max_step.
+  /// Fills r.steps, r.t_end (unless a sink stopped the run: observe set them), r.min_step and r.max_step.
   void record(RunResult& r, double t_end) const {
-    r.steps = steps;
-    r.t_end = t_end;
+    if (!r.stopped) {
+      r.steps = steps;
+      r.t_end = t_end;
+    }
     r.min_step = steps ? min_dt : 0.0;
     r.max_step = max_dt;
   }
@@ -144,7 +146,8 @@ template <class Says, class X, class TryStep, class Observer>
   return x;
 }
 
-/// Runs `loop(observer)` with a null observer or a monitor, timing the loop only.
+/// Runs `loop(observer)` with a null observer or a monitor, timing the loop only. A sink that throws
+/// StopRun ends the loop: the run ends at the state it was handed.
 template <class Field, class ToPhysical, class Loop>
 RunResult observe(const BodyPoint& p, const Field& field, const State& s0, const RunSpec& spec,
                   const SampleSink* sink, ToPhysical to_physical, Loop&& loop) {
@@ -154,7 +157,14 @@ RunResult observe(const BodyPoint& p, const Field& field, const State& s0, const
   if (spec.track_invariants || sink) {
     Monitor<Field, ToPhysical> mon(p, field, s0, spec, sink, to_physical);
     const auto t0 = Clock::now();
-    r.final = loop(mon);
+    try {
+      r.final = loop(mon);
+    } catch (const StopRun& stop) {
+      r.final = stop.s;
+      r.steps = stop.step;
+      r.t_end = stop.t;
+      r.stopped = true;
+    }
     r.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
     r.invariants = mon.stats();
   } else {
