@@ -7,6 +7,7 @@
 // run of 10^6 steps still makes a page of a few MB.
 #include "bodypoint/field.hpp"
 #include "bodypoint/io.hpp"
+#include "bodypoint/scattering.hpp"
 #include "cli.hpp"
 #include "view_bundle.hpp"
 
@@ -146,6 +147,26 @@ struct TrackJson {
   double t_end = 0.0;
 };
 
+/// The marks of the encounter: the located closest approach (nearest of every centre's) and, for a
+/// single Coulomb centre, the incoming and outgoing asymptotes (scattering.hpp) as a point on each line
+/// and its direction.
+std::string encounter_json(const Body& body, const std::vector<Centre>& centres, const BodyRun& br) {
+  const EventHit* nearest = nullptr;
+  for (const EventHit& h : br.events)
+    if (!nearest || h.distance < nearest->distance) nearest = &h;
+  const Scattering sc = scattering(body.p, centres, body.s0, br.result.final, br.result.t_end);
+  std::string out = ", \"encounter\": {\"R_min\": " + (nearest ? json_vec(nearest->s.R) : std::string("null"));
+  if (nearest) out += ", \"r_min\": " + json_number(nearest->distance) + ", \"t_min\": " + json_number(nearest->t);
+  out += ", \"asymptotes\": [";
+  if (sc.in && sc.out) {
+    const Vec3& c = centres.front().c;
+    out += "{\"point\": " + json_vec(c + sc.in->impact) + ", \"direction\": " + json_vec(sc.in->direction) +
+           ", \"incoming\": true}, {\"point\": " + json_vec(c + sc.out->impact) + ", \"direction\": " +
+           json_vec(sc.out->direction) + ", \"incoming\": false}";
+  }
+  return out + "], \"deflection\": " + (std::isfinite(sc.deflection) ? json_number(sc.deflection) : "null") + "}";
+}
+
 TrackJson body_json(const Body& body, const std::vector<Centre>& centres, const RunPlan& plan, RunSpec spec,
                     std::size_t frames, const std::string& method_label) {
   spec.track_invariants = true;  // the energy panel and the header show the deviations
@@ -153,7 +174,9 @@ TrackJson body_json(const Body& body, const std::vector<Centre>& centres, const 
   spec.dt_out = 0.0;
   Decimator d(centres, std::max<std::size_t>(8 * frames, 1 << 16));
   const SampleSink sink = [&d](const Sample& s) { d.add(s); };
-  const BodyRun br = run_body(plan, body, centres, spec, &sink);
+  std::vector<Event> closest;  // every centre's closest approach, located for the marks
+  for (std::size_t c = 0; c < centres.size(); ++c) closest.push_back(Event{Event::Kind::closest_approach, c, 0.0, Vec3::UnitX(), false});
+  const BodyRun br = run_body(plan, body, centres, spec, &sink, closest);
   const std::string who = "body '" + body.name + "' with " + method_label;
   if (d.non_finite_at())
     throw Error(who + ": the state became non-finite at t = " + fmt(*d.non_finite_at()) + "; no page written");
@@ -182,7 +205,7 @@ TrackJson body_json(const Body& body, const std::vector<Centre>& centres, const 
   });
   out += ", ";
   put_array(out, "dt", f, kOtherDigits, [](std::string& o, const Frame& x, int g) { put(o, x.dt, g); });
-  out += "}}";
+  out += "}" + encounter_json(body, centres, br) + "}";
   return {out, br.result.t_end};
 }
 

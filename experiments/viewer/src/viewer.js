@@ -5,7 +5,10 @@
 // Data (written by experiments/view.cpp):
 //   { title, scene, revision, centres: [{c: [x,y,z], A}],
 //     runs: [{ method, step, bodies: [{ name, steps, force_evals, invariants: {...}, closest: {t, r},
-//              frames: { t: [...], R: [x,y,z,...], v: [...], w: [...], dE: [...], dt: [...] } }] }] }
+//              frames: { t: [...], R: [x,y,z,...], v: [...], w: [...], dE: [...], dt: [...] },
+//              encounter: { R_min, r_min, t_min, asymptotes: [{point, direction, incoming}], deflection } }] }] }
+// encounter.R_min is the closest approach located on the method's steps; the asymptotes (one Coulomb
+// centre) are lines the body travels at infinity (docs/physics.md, Scattering).
 // Frames are decimated by arc length (closest approach kept); the page interpolates linearly in t.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
@@ -187,6 +190,32 @@ for (const tr of tracks) {
   }
 }
 
+// Encounter marks: the located closest approach (a white wire octahedron) and the incoming and outgoing
+// asymptotes as dashed half-lines in the track's colour, from infinity to their closest point to the
+// centre and from there on.
+const marks = { closest: 0, asymptotes: 0 };
+for (const tr of tracks) {
+  const e = data.runs[tr.run].bodies[tr.body].encounter;
+  if (!e) continue;
+  if (e.R_min) {
+    const m = new THREE.Mesh(new THREE.OctahedronGeometry(1.8 * bodyRadius),
+      new THREE.MeshBasicMaterial({ color: 0xffffff, wireframe: true }));
+    m.position.set(...e.R_min);
+    scene.add(m);
+    ++marks.closest;
+  }
+  for (const a of e.asymptotes) {
+    const p = new THREE.Vector3(...a.point), d = new THREE.Vector3(...a.direction);
+    const far = p.clone().addScaledVector(d, a.incoming ? -extent : extent);
+    const g = new THREE.BufferGeometry().setFromPoints([far, p]);
+    const line = new THREE.Line(g, new THREE.LineDashedMaterial({ color: tr.colour, dashSize: extent / 100,
+      gapSize: extent / 100, transparent: true, opacity: 0.7 }));
+    line.computeLineDistances();
+    scene.add(line);
+    ++marks.asymptotes;
+  }
+}
+
 // ---------- state at time t ----------
 function frameIndex(tr, t) {  // last frame with t_i <= t
   let lo = 0, hi = tr.n - 1;
@@ -347,6 +376,8 @@ window.bodypointViewer = {
   get frames() { return frames; },
   get time() { return time; },
   tracks: tracks.length,
+  /** Encounter marks drawn: located closest approaches and asymptote lines. */
+  marks,
   get playing() { return playing; },
   pause() { playing = false; document.getElementById('bp-play').textContent = 'Play'; },
   play() { playing = true; document.getElementById('bp-play').textContent = 'Pause'; },

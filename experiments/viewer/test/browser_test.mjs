@@ -73,6 +73,13 @@ try {
     page.on('request', (r) => { if (!r.url().startsWith('file:') && !r.url().startsWith('data:') && !r.url().startsWith('blob:')) errors.push(`network request: ${r.url()}`); });
     await page.goto(pathToFileURL(file).href);
     await page.waitForFunction(() => window.bodypointViewer && window.bodypointViewer.frames > 2, null, { timeout: TIMEOUT_MS });
+    // Every track marks its located closest approach; a single Coulomb centre adds two asymptotes per track.
+    const marks = await page.evaluate(() => window.bodypointViewer.marks);
+    const tracks = await page.evaluate(() => window.bodypointViewer.tracks);
+    result.marks = marks;
+    if (marks.closest !== tracks) failures.push(`${p.name}: ${marks.closest} closest-approach marks for ${tracks} tracks`);
+    if (p.name !== 'two-centres' && marks.asymptotes !== 2 * tracks)
+      failures.push(`${p.name}: ${marks.asymptotes} asymptote lines for ${tracks} tracks`);
 
     // Frame rate while playing, then pause for the still checks.
     const fps = await page.evaluate(async () => {
