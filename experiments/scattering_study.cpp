@@ -87,7 +87,7 @@ Point run_point(const Series& s, double b) {
       p.failure = r.reason;
       return p;
     }
-    p.sc = scattering(body.p, scene.centres, body.s0, br.run.final);
+    p.sc = scattering(body.p, scene.centres, body.s0, br.run.final, br.run.t_end);
     p.r_end = (br.run.final.R - scene.centres.front().c).norm();
     for (const EventHit& h : br.events)
       if (!(h.distance >= p.r_min)) {
@@ -126,7 +126,7 @@ void write_scattering_study(const std::filesystem::path& dir, bool quick, unsign
      << "x looser where out of reach; column tol) to t_end = 2 L / v_inf; no asymptotes where the body does not "
         "drift away along K1\n"
      << "series,B,Kx,Kz,b,d,v_inf,theta,theta_rutherford,rel_diff_rutherford,out_of_plane,dsigma_domega,"
-        "dsigma_rutherford,r_min,t_min,r_end,spin_turn,K1_turn,asymptotes,method,tol,force_evals,failure\n";
+        "dsigma_rutherford,rainbow,r_min,t_min,r_end,spin_turn,K1_turn,time_delay,asymptotes,method,tol,force_evals,failure\n";
   std::ostream& ss = summary.stream();
   ss << "# bodypoint study --name scattering" << (quick ? " --quick" : "") << ", revision " << git_revision()
      << ": one row per series; rainbows where dtheta/db changes sign (b of the extremum between grid points)\n"
@@ -150,6 +150,7 @@ void write_scattering_study(const std::filesystem::path& dir, bool quick, unsign
       if (ok && !(p.r_min >= min_r)) min_r = p.r_min;
       // dsigma/dOmega = b/sin(theta) |db/dtheta| from the neighbours (centred differences)
       double dsigma = Point::kNaN, dsigma_r = Point::kNaN;
+      bool rainbow = false;
       if (ok && i > 0 && i + 1 < n && row[i - 1].failure.empty() && row[i + 1].failure.empty()) {
         const double dtheta_db = (row[i + 1].sc.deflection - row[i - 1].sc.deflection) / (row[i + 1].sc.b - row[i - 1].sc.b);
         dsigma = p.sc.b / std::sin(p.sc.deflection) / std::abs(dtheta_db);
@@ -160,6 +161,7 @@ void write_scattering_study(const std::filesystem::path& dir, bool quick, unsign
         // a rainbow between i-1 and i+1: theta(b) has an extremum at i
         const double left = p.sc.deflection - row[i - 1].sc.deflection, right = row[i + 1].sc.deflection - p.sc.deflection;
         if (left * right < 0.0) {
+          rainbow = true;
           ++rainbows;
           if (!std::isfinite(first_rainbow)) first_rainbow = p.sc.b;
         }
@@ -167,8 +169,8 @@ void write_scattering_study(const std::filesystem::path& dir, bool quick, unsign
       CsvLine line;
       line.quoted(s.name).num(s.B).num(s.Kx).num(s.Kz).num(ok ? p.sc.b : p.b_target).num(p.d).num(p.sc.v_inf).num(p.sc.deflection);
       line.num_if(s.B == 0.0 && ok, th_r).num_if(s.B == 0.0 && ok, rel).num(p.sc.out_of_plane).num_if(std::isfinite(dsigma), dsigma);
-      line.num_if(std::isfinite(dsigma_r), dsigma_r).num(p.r_min).num(p.t_min).num(p.r_end).num(p.sc.spin_turn).num(p.sc.K1_turn);
-      line.quoted(p.sc.asymptotes).text(p.method).num(p.tol).count(p.force_evals).quoted(p.failure);
+      line.num_if(std::isfinite(dsigma_r), dsigma_r).count(rainbow ? 1 : 0).num(p.r_min).num(p.t_min).num(p.r_end).num(p.sc.spin_turn).num(p.sc.K1_turn);
+      line.num(p.sc.time_delay).quoted(p.sc.asymptotes).text(p.method).num(p.tol).count(p.force_evals).quoted(p.failure);
       os << line.str() << "\n";
     }
     const Point& first = row[0];

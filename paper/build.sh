@@ -6,7 +6,7 @@
 #   paper/build.sh --quick    the same recipes, scenes and sections on coarse grids into paper/results-quick/
 #
 # Steps: bodypoint study (d, L, h, Kx sweeps, timing, force evaluations, appendix 1, errata, the sweeps
-# as published, stress, the (d, L) map), bodypoint work-precision (ladders and --by-tol), bench_steps
+# as published, stress, the (d, L) map, scattering), bodypoint work-precision (ladders and --by-tol), bench_steps
 # (cost per step), bench_batch (sweep throughput per core),
 # make_figures.py (vector PDF), make_macros.py (LaTeX macros and tables), latexmk.
 # BODYPOINT_NO_SETUP=1 skips scripts/setup.sh and BODYPOINT_BUILD_DIR names the build tree (default
@@ -34,6 +34,7 @@ q=()
 # --resume: an interrupted build continues its sweeps from their journals (rows of this same build).
 $bin study "${q[@]}" --resume --results "$results"
 $bin study "${q[@]}" --name stress --results "$results"
+$bin study "${q[@]}" --name scattering --results "$results"
 # The (d, L) stability map (thesis resolution in the full build), timed: its wall time is a number of
 # the paper.
 map_start=$(date +%s.%N)

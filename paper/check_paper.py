@@ -15,7 +15,8 @@ import sys
 # Inputs, not measurements, that the text may type: the thesis's scene parameters (table 3.1: d = 10,
 # L = 200, B = 0.7; the sweeps' d = 50, T = hn = 25, n = 250000, t = 50; appendix set P1.2's J = 0.2;
 # the close scene's Kz = 0.1, d = 0.05, t = 80; the convergence scenes' L = 20, t = 30).
-ALLOWED = {"10", "200", "0.7", "50", "25", "250000", "0.2", "0.1", "0.05", "80", "20", "30"}
+# The scattering study's couplings B = 0.2, 0.5, 0.7, 0.9 are inputs too.
+ALLOWED = {"10", "200", "0.7", "50", "25", "250000", "0.2", "0.1", "0.05", "80", "20", "30", "0.5", "0.9"}
 # Powers of ten are step sizes, targets and tolerances the reader or a recipe chooses (h = 10^{-4},
 # targets 10^{-7}, the reference's tolerance 10^{-18}), never results.
 POWER_OF_TEN = re.compile(r"10\^\{?-?\d+\}?")
@@ -27,7 +28,8 @@ NAMES = re.compile(r"\\(cmd|texttt|cite|citet|citep|ref|label|eqref|includegraph
 NUMBER = re.compile(r"(?<![A-Za-z\\_^{])\d+(\.\d+)?")
 MAX_OVERFULL_PT = 10.0
 SECTIONS = ["Introduction", "The model and its corrected equations", "Errata", "Methods", "Chapter 4 reproduced",
-            "Close encounters", "Work against precision", "Numerical stability", "Conclusions"]
+            "Close encounters", "Work against precision", "Numerical stability", "Scattering of a spinning body",
+            "Conclusions"]
 
 
 def body_of(tex):

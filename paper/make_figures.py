@@ -5,7 +5,7 @@ usage: make_figures.py RESULTS_DIR FIGURES_DIR
 
 Reads (all written by paper/build.sh through `bodypoint study`, `bodypoint work-precision`):
   {d,L,h,Kx}_sweep.csv and published_{d,L,h,Kx}_sweep.csv, timing.csv, appendix1/index.csv and
-  appendix1/P1.*.csv, work_precision.csv, by_tol.csv, and dL_map.csv when present
+  appendix1/P1.*.csv, work_precision.csv, by_tol.csv, and dL_map.csv and scattering.csv when present
 Writes fig_*.pdf and figures.md (which thesis figure each one stands for). Nothing here computes
 physics: it only draws what the drivers measured.
 """
@@ -255,6 +255,50 @@ def map_figure(res, figs, listing):
     save(fig, os.path.join(figs, "fig_dL_map.pdf"), listing, "the (d, L) stability map, one panel per fixed-step method")
 
 
+def scattering_figure(res, figs, listing):
+    """bodypoint study --name scattering: the deflection function theta(b), the differential cross-section
+    against theta, and the closest approach r_min(b), one line per series; Rutherford's for B = 0 in grey,
+    rainbows (theta(b) extremal, the study's column) as open circles."""
+    path = os.path.join(res, "scattering.csv")
+    if not os.path.exists(path):
+        return
+    rows = read_csv(path)
+    series = list(dict.fromkeys(r["series"] for r in rows))
+    fig, axes = plt.subplots(1, 3, figsize=(WIDE, 2.3))
+    cmap = plt.get_cmap("tab10")
+    for i, name in enumerate(series):
+        rs = [r for r in rows if r["series"] == name and r["failure"] == "" and num(r["theta"]) > 0]
+        if not rs:
+            continue
+        style = dict(color=cmap(i % 10), linewidth=0.9, label=name)
+        b = [num(r["b"]) for r in rs]
+        axes[0].plot(b, [num(r["theta"]) for r in rs], **style)
+        rb = [r for r in rs if r["rainbow"] == "1"]
+        axes[0].plot([num(r["b"]) for r in rb], [num(r["theta"]) for r in rb], "o", markersize=4,
+                     markerfacecolor="none", color=cmap(i % 10))
+        ds = [r for r in rs if num(r["dsigma_domega"]) > 0]
+        axes[1].plot([num(r["theta"]) for r in ds], [num(r["dsigma_domega"]) for r in ds], **style)
+        axes[2].plot(b, [num(r["r_min"]) for r in rs], **style)
+        if name == "B=0":
+            axes[0].plot(b, [num(r["theta_rutherford"]) for r in rs], color="grey", linewidth=2.5, alpha=0.35,
+                         label="Rutherford", zorder=0)
+            rr = [r for r in ds if num(r["dsigma_rutherford"]) > 0]
+            axes[1].plot([num(r["theta"]) for r in rr], [num(r["dsigma_rutherford"]) for r in rr], color="grey",
+                         linewidth=2.5, alpha=0.35, zorder=0)
+    for ax, (xl, yl) in zip(axes, [("impact parameter b", "deflection theta (rad)"),
+                                   ("deflection theta (rad)", "dsigma/dOmega"),
+                                   ("impact parameter b", "closest approach r_min")]):
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel(xl)
+        ax.set_ylabel(yl)
+    fig.tight_layout()
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="upper center", ncol=5, bbox_to_anchor=(0.5, 0.0), frameon=False)
+    save(fig, os.path.join(figs, "fig_scattering.pdf"), listing,
+         "scattering: deflection function, differential cross-section and closest approach per series")
+
+
 def main():
     if len(sys.argv) != 3:
         sys.exit("usage: make_figures.py RESULTS_DIR FIGURES_DIR")
@@ -268,6 +312,7 @@ def main():
     work_precision_figures(res, figs, listing)
     by_tol_figure(res, figs, listing)
     map_figure(res, figs, listing)
+    scattering_figure(res, figs, listing)
     with open(os.path.join(figs, "figures.md"), "w") as f:
         f.write("| file | what it shows |\n|---|---|\n")
         for name, what in listing:

@@ -451,6 +451,44 @@ def ensembles(res, M):
     M.add("BatchSpeedupMax", sci(max(ratios.values())))
 
 
+def scattering(res, M):
+    """bodypoint study --name scattering: Rutherford's agreement, the spinning body's head-on deflection
+    against a material point's, rainbows, and the series without asymptotes."""
+    path = os.path.join(res, "scattering_summary.csv")
+    if not os.path.exists(path):
+        return
+    summary, _ = read_csv(path)
+    rows, _ = read_csv(os.path.join(res, "scattering.csv"))
+    by = {r["series"]: r for r in summary}
+    M.add("ScatPoints", count(int(by["B=0"]["points"])))
+    M.add("ScatRuns", count(len(rows)))
+    M.add("ScatSeries", count(len(summary)))
+    bs = [num(r["b"]) for r in rows if r["series"] == "B=0"]
+    M.add("ScatBMin", sci(min(bs)))
+    M.add("ScatBMax", sci(max(bs)))
+    M.add("ScatRutherfordAuto", sci(num(by["B=0"]["max_rel_diff_rutherford"])))
+    M.add("ScatRutherfordLpKlEight", sci(num(by["B=0 lp-kl8"]["max_rel_diff_rutherford"])))
+    M.add("ScatAutoMethods", ", ".join(tt(m) for m in sorted({r["method"] for r in rows if r["series"] == "B=0"})),
+          math_mode=False)
+    M.add("ScatThetaMaterial", sci(num(by["B=0"]["theta_at_smallest_b"]), 3))
+    for B in ("0.2", "0.5", "0.7", "0.9"):
+        r = by["B=" + B]
+        word = camel("B" + B.replace("0.", ""))
+        M.add(f"ScatTheta{word}", sci(num(r["theta_at_smallest_b"]), 2))
+        M.add(f"ScatRainbow{word}", sci(num(r["first_rainbow_b"]), 2))
+        M.add(f"ScatOutOfPlane{word}", sci(num(r["max_abs_out_of_plane"]), 2))
+        M.add(f"ScatRMin{word}", sci(num(r["min_r_min"]), 2))
+    along, across = by["B=0.7 spin along K1"], by["B=0.7 spin across K1"]
+    M.add("ScatAlongFailed", count(int(along["failed"])))
+    M.add("ScatThetaAcross", sci(num(across["theta_at_smallest_b"]), 2))
+    delays = [num(r["time_delay"]) for r in rows if r["series"] == "B=0.7" and r["failure"] == ""]
+    delays0 = [num(r["time_delay"]) for r in rows if r["series"] == "B=0" and r["failure"] == ""]
+    M.add("ScatDelaySevenMin", sci(min(delays), 2))
+    M.add("ScatDelaySevenMax", sci(max(delays), 2))
+    M.add("ScatDelayZeroMin", sci(min(delays0), 2))
+    M.add("ScatDelayZeroMax", sci(max(delays0), 2))
+
+
 def main():
     if len(sys.argv) != 4:
         sys.exit("usage: make_macros.py RESULTS_DIR OUT_DIR MODE")
@@ -470,6 +508,7 @@ def main():
     stress(res, out, M)
     appendix(res, M)
     ensembles(res, M)
+    scattering(res, M)
     M.write(os.path.join(out, "macros.tex"))
     print(f"wrote {len(M.defs)} macros and the tables to {out}")
 
