@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Draws every figure of the bodypoint research appendix, as vector PDF, from the CSVs the drivers wrote.
 
-usage: make_figures.py RESULTS_DIR FIGURES_DIR
+usage: make_figures.py [--only scattering] RESULTS_DIR FIGURES_DIR
 
 Reads (all written by paper/build.sh through `bodypoint study`, `bodypoint work-precision`):
   {d,L,h,Kx}_sweep.csv and published_{d,L,h,Kx}_sweep.csv, timing.csv, appendix1/index.csv and
@@ -300,12 +300,22 @@ def scattering_figure(res, figs, listing):
 
 
 def main():
-    if len(sys.argv) != 3:
-        sys.exit("usage: make_figures.py RESULTS_DIR FIGURES_DIR")
-    res, figs = sys.argv[1], sys.argv[2]
-    load_catalogue(res)
+    args = sys.argv[1:]
+    only = None
+    if len(args) == 4 and args[0] == "--only" and args[1] == "scattering":
+        only, args = args[1], args[2:]
+    if len(args) != 2:
+        sys.exit("usage: make_figures.py [--only scattering] RESULTS_DIR FIGURES_DIR")
+    res, figs = args
     os.makedirs(figs, exist_ok=True)
     listing = []
+    if only == "scattering":  # scripts/scattering-study.sh: that study's figure alone
+        scattering_figure(res, figs, listing)
+        if not listing:
+            sys.exit(f"make_figures.py: no scattering.csv in {res}")
+        print(f"wrote {figs}/fig_scattering.pdf")
+        return
+    load_catalogue(res)
     sweep_figures(res, figs, listing)
     timing_figure(res, figs, listing)
     appendix_figure(res, figs, listing)
