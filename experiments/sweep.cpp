@@ -14,7 +14,6 @@
 #include <memory>
 #include <sstream>
 #include <thread>
-#include <tuple>
 #include <utility>
 #include <unistd.h>
 
@@ -329,12 +328,17 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
   job.spec.methods = parse_methods(methods_arg);
   job.spec.base = so.params;
   // Fixed asymptotic data are solved for at every grid point (a sweep over L keeps b, not d).
-  for (const auto& [option, param, value] : {std::tuple{"b", "b", so.b}, std::tuple{"v-inf", "v_inf", so.v_inf}}) {
-    if (!vm.count(option)) continue;
-    if (!(std::isfinite(value) && value > 0.0)) throw Error(std::string("--") + option + " must be a finite number > 0");
-    if (std::any_of(job.spec.axes.begin(), job.spec.axes.end(), [&](const Axis& a) { return a.param == param; }))
-      throw Error(std::string("--") + option + " is fixed and varied at once");
-    job.spec.axes.push_back(Axis{param, {value}});
+  struct Fixed {
+    const char* option;
+    std::string param;
+    double value;
+  };
+  for (const Fixed& f : {Fixed{"b", "b", so.b}, Fixed{"v-inf", "v_inf", so.v_inf}}) {
+    if (!vm.count(f.option)) continue;
+    if (!(std::isfinite(f.value) && f.value > 0.0)) throw Error(std::string("--") + f.option + " must be a finite number > 0");
+    if (std::any_of(job.spec.axes.begin(), job.spec.axes.end(), [&f](const Axis& a) { return a.param == f.param; }))
+      throw Error(std::string("--") + f.option + " is fixed and varied at once");
+    job.spec.axes.push_back(Axis{f.param, {f.value}});
   }
   job.spec.h = st.h;
   bool sweeps_h = false;
