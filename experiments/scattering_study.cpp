@@ -89,11 +89,10 @@ Point run_point(const Series& s, double b) {
     }
     p.sc = scattering(body.p, scene.centres, body.s0, br.run.final, br.run.t_end);
     p.r_end = (br.run.final.R - scene.centres.front().c).norm();
-    for (const EventHit& h : br.events)
-      if (!(h.distance >= p.r_min)) {
-        p.r_min = h.distance;
-        p.t_min = h.t;
-      }
+    if (const EventHit* nearest = nearest_approach(br.events, o.events)) {
+      p.r_min = nearest->distance;
+      p.t_min = nearest->t;
+    }
   } catch (const Error& e) {
     p.failure = e.what();
   }

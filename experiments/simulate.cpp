@@ -77,9 +77,7 @@ struct Encounter {
 Encounter encounter(const Body& body, const std::vector<Centre>& centres, const std::vector<Event>& events,
                     const BodyRun& run) {
   Encounter e{scattering(body.p, centres, body.s0, run.result.final, run.result.t_end), std::nullopt};
-  for (const EventHit& h : run.events)
-    if (events[h.event].kind == Event::Kind::closest_approach && (!e.closest || h.distance < e.closest->distance))
-      e.closest = h;
+  if (const EventHit* nearest = nearest_approach(run.events, events)) e.closest = *nearest;
   return e;
 }
 
@@ -373,11 +371,11 @@ int cmd_simulate(int argc, char** argv) {
     o.events.back().stop = true;
   }
   if (o.scattering)  // every centre's closest approach, unless --event asked for it already
-    for (std::size_t c = 0; c < scene.centres.size(); ++c)
-      if (std::none_of(o.events.begin(), o.events.end(), [c](const Event& e) {
-            return e.kind == Event::Kind::closest_approach && e.centre == c && !e.stop;
+    for (const Event& closest : closest_approaches(scene.centres.size()))
+      if (std::none_of(o.events.begin(), o.events.end(), [&closest](const Event& e) {
+            return e.kind == Event::Kind::closest_approach && e.centre == closest.centre && !e.stop;
           }))
-        o.events.push_back(Event{Event::Kind::closest_approach, c, 0.0, Vec3::UnitX(), false});
+        o.events.push_back(closest);
   if (o.dry_run) {
     print_dry_run(plan, o.method_name, scene);
     return 0;

@@ -150,10 +150,9 @@ struct TrackJson {
 /// The marks of the encounter: the located closest approach (nearest of every centre's) and, for a
 /// single Coulomb centre, the incoming and outgoing asymptotes (scattering.hpp) as a point on each line
 /// and its direction.
-std::string encounter_json(const Body& body, const std::vector<Centre>& centres, const BodyRun& br) {
-  const EventHit* nearest = nullptr;
-  for (const EventHit& h : br.events)
-    if (!nearest || h.distance < nearest->distance) nearest = &h;
+std::string encounter_json(const Body& body, const std::vector<Centre>& centres, const BodyRun& br,
+                           const std::vector<Event>& closest) {
+  const EventHit* nearest = nearest_approach(br.events, closest);
   const Scattering sc = scattering(body.p, centres, body.s0, br.result.final, br.result.t_end);
   std::string out = ", \"encounter\": {\"R_min\": " + (nearest ? json_vec(nearest->s.R) : std::string("null"));
   if (nearest) out += ", \"r_min\": " + json_number(nearest->distance) + ", \"t_min\": " + json_number(nearest->t);
@@ -174,8 +173,7 @@ TrackJson body_json(const Body& body, const std::vector<Centre>& centres, const 
   spec.dt_out = 0.0;
   Decimator d(centres, std::max<std::size_t>(8 * frames, 1 << 16));
   const SampleSink sink = [&d](const Sample& s) { d.add(s); };
-  std::vector<Event> closest;  // every centre's closest approach, located for the marks
-  for (std::size_t c = 0; c < centres.size(); ++c) closest.push_back(Event{Event::Kind::closest_approach, c, 0.0, Vec3::UnitX(), false});
+  const std::vector<Event> closest = closest_approaches(centres.size());  // located for the marks
   const BodyRun br = run_body(plan, body, centres, spec, &sink, closest);
   const std::string who = "body '" + body.name + "' with " + method_label;
   if (d.non_finite_at())
@@ -205,7 +203,7 @@ TrackJson body_json(const Body& body, const std::vector<Centre>& centres, const 
   });
   out += ", ";
   put_array(out, "dt", f, kOtherDigits, [](std::string& o, const Frame& x, int g) { put(o, x.dt, g); });
-  out += "}" + encounter_json(body, centres, br) + "}";
+  out += "}" + encounter_json(body, centres, br, closest) + "}";
   return {out, br.result.t_end};
 }
 

@@ -34,6 +34,21 @@ std::string Event::label() const {
   return os.str();
 }
 
+std::vector<Event> closest_approaches(std::size_t centres) {
+  std::vector<Event> out;
+  for (std::size_t c = 0; c < centres; ++c) out.push_back(Event{Event::Kind::closest_approach, c, 0.0, Vec3::UnitX(), false});
+  return out;
+}
+
+const EventHit* nearest_approach(const std::vector<EventHit>& hits, const std::vector<Event>& events) {
+  const EventHit* nearest = nullptr;
+  for (const EventHit& h : hits)
+    if (events[h.event].kind == Event::Kind::closest_approach &&
+        (!nearest || h.distance < nearest->distance || (std::isnan(nearest->distance) && !std::isnan(h.distance))))
+      nearest = &h;
+  return nearest;
+}
+
 namespace detail {
 
 /// The root finder stops when the bracket is this many ulps of the time wide: t is then known to

@@ -49,15 +49,13 @@ SweepRow encounter_row(SweepRow row, const MethodInfo& method, const Scene& scen
   Options options;
   options.track_invariants = spec.track_invariants;
   options.omega_c = spec.omega_c;
-  for (std::size_t c = 0; c < scene.centres.size(); ++c)
-    options.events.push_back(Event{Event::Kind::closest_approach, c, 0.0, Vec3::UnitX(), false});
+  options.events = closest_approaches(scene.centres.size());
   BodyResult r = integrate_body(body, scene.centres, &method, advance_of(method, spec), options);
   if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return unrun_row(std::move(row), r.outcome, r.reason);
-  for (const EventHit& h : r.events)
-    if (!(h.distance >= row.r_min)) {  // the first, or a closer one
-      row.r_min = h.distance;
-      row.t_min = h.t;
-    }
+  if (const EventHit* nearest = nearest_approach(r.events, options.events)) {
+    row.r_min = nearest->distance;
+    row.t_min = nearest->t;
+  }
   if (r.outcome == Outcome::ok) row.scattering = scattering(body.p, scene.centres, body.s0, r.run.final, r.run.t_end);
   row.result = std::move(r.run);
   row.outcome = r.outcome;

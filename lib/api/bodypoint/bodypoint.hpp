@@ -74,6 +74,12 @@ struct EventHit {
   double distance = 0.0;  ///< |R - c| to the event's centre (plane: to the scene's first centre)
 };
 
+/// Every centre's closest approach (Kind::closest_approach for centres 0 .. n-1), as events.
+std::vector<Event> closest_approaches(std::size_t centres);
+/// The nearest of the closest-approach hits among `hits` (`events`: the Options::events they index);
+/// a hit with a finite distance before one without. nullptr when there is none.
+const EventHit* nearest_approach(const std::vector<EventHit>& hits, const std::vector<Event>& events);
+
 /// What a run asks for besides the way of advancing time. By default the invariants are tracked
 /// and nothing else is kept: the step loop stores no trajectory.
 struct Options {
