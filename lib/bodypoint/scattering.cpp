@@ -200,8 +200,8 @@ SceneParams with_asymptotic_data(SceneParams params, double b, double v_inf) {
     const SceneParams before = params;
     if (!std::isnan(v_inf)) params.start.K1 = k1_for_speed_at_infinity(params, v_inf);
     if (!std::isnan(b)) params.start.d = d_for_impact_parameter(params, b);
+    // One datum given: one solve is exact. Both: until neither moves (each depends a little on the other).
     if (std::isnan(b) || std::isnan(v_inf) ||
-        (params.start.K1 == before.start.K1 && params.start.d == before.start.d) ||
         (std::abs(params.start.K1 - before.start.K1) <= kImpactRelTol * params.start.K1 &&
          std::abs(params.start.d - before.start.d) <= kImpactRelTol * std::max(params.start.d, b)))
       return params;
