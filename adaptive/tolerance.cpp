@@ -16,7 +16,8 @@
 // 3. A trusted estimate at most kAccept tol delivers the answer; otherwise back to 2.
 // The delivered run is the one that carries the observers (invariants, samples): samples go to a buffer
 // handed to the caller's sink only when its run is delivered, so nothing is integrated twice.
-// Differences that stop shrinking far below 1 are round-off: the search reports the floor it met.
+// Differences that stop shrinking far below 1 are round-off: the search reports the floor it met
+// (what the finest runs still differ by).
 #include "bodypoint/adaptive/tolerance.hpp"
 
 #include "bodypoint/adaptive/methods.hpp"
@@ -265,8 +266,12 @@ class Search {
         best_bound = estimate_;
         stalled = 0;
       } else if (++stalled >= kMaxStalls) {
+        // The floor is what finer runs still disagree by, not the smallest estimate: an early pair
+        // can agree by chance (B = 0.9, b = 1 at tol 1e-12: first estimate 9.9e-15, then three
+        // refinements each 4e-12 apart, which one of them must be wrong by half of).
         throw Error("tol " + fmt_tol() + " is out of reach of " + std::string(m_.name) +
-                    " on this scene: the error estimate stalls at " + fmt_number(best_bound));
+                    " on this scene: runs at finer steps still differ by " + fmt_number(d) +
+                    " (round-off amplified by the scene, or resonances that refinement does not remove)");
       }
     }
     throw Error("tol " + fmt_tol() + ": " + std::string(m_.name) + " did not reach it in " +
