@@ -4,13 +4,13 @@
 // - `reference_state`: Boost.Odeint's runge_kutta_fehlberg78 with step-size control, in long
 //   double, on PreciseEquations (rhs.hpp), which shares no code with the production kernels.
 // - `kepler_state`: the analytic two-body (Rutherford/Kepler) motion of a material point (B = 0)
-//   in one centre's field, by the universal-variable form of Kepler's equation
-//   (J. M. A. Danby, Fundamentals of Celestial Mechanics, 2nd ed. 1988, sec. 6.9; Stumpff
-//   functions), valid for attraction and repulsion alike (mu = A/m of either sign).
+//   in one centre's field, by the universal-variable form of Kepler's equation in long double
+//   (kepler.hpp), valid for attraction and repulsion alike (mu = A/m of either sign).
 // - `helix_state`: the exact free motion (A = 0): K1 constant, K2 rotating about K1 at rate
 //   -(B/D)|K1|, R from the conservation of R x K1 + K2 (docs/physics.md, kinetic drift).
 #pragma once
 
+#include "bodypoint/kepler.hpp"
 #include "bodypoint/model.hpp"
 #include "bodypoint/rhs.hpp"
 
@@ -53,89 +53,16 @@ inline State reference_state(const Body& body, const std::vector<Centre>& centre
 }
 
 namespace detail {
-/// Stumpff functions c0..c3 of z (Danby eq. 6.9.x), in long double.
-inline void stumpff(long double z, long double c[4]) {
-  if (std::abs(z) < 0.1L) {
-    // Series c_n(z) = sum (-z)^k/(2k+n)!, enough terms for |z| < 0.1 to reach long double.
-    for (int n = 0; n < 4; ++n) {
-      long double term = 1.0L, sum = 0.0L;
-      for (int j = 1; j <= n; ++j) term /= j;
-      for (int k = 0; k < 20; ++k) {
-        sum += term;
-        term *= -z / ((2 * k + n + 1) * (2 * k + n + 2));
-      }
-      c[n] = sum;
-    }
-    return;
-  }
-  if (z > 0) {
-    const long double s = std::sqrt(z);
-    c[0] = std::cos(s);
-    c[1] = std::sin(s) / s;
-  } else {
-    const long double s = std::sqrt(-z);
-    c[0] = std::cosh(s);
-    c[1] = std::sinh(s) / s;
-  }
-  c[2] = (1.0L - c[0]) / z;
-  c[3] = (1.0L - c[1]) / z;
-}
-}  // namespace detail
-
-namespace detail {
 using ld = long double;
 using Vec3L = std::array<ld, 3>;
 inline ld dot(const Vec3L& a, const Vec3L& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
-/// Kepler propagation in long double: (R0, v0) -> (R, v) after time t, mu = A/m.
+/// Kepler propagation in long double: (R0, v0) -> (R, v) after time t, mu = A/m (kepler.hpp).
 inline void kepler_state_ld(ld mu, const Vec3L& R0, const Vec3L& v0, ld t, Vec3L& R, Vec3L& v) {
-  const ld r0 = std::sqrt(dot(R0, R0));
-  const ld sigma0 = dot(R0, v0);
-  const ld beta = 2.0L * mu / r0 - dot(v0, v0);  // -2 x energy per mass
-  auto G = [&](ld s, ld g[4]) {
-    ld c[4];
-    detail::stumpff(beta * s * s, c);
-    g[0] = c[0];
-    g[1] = s * c[1];
-    g[2] = s * s * c[2];
-    g[3] = s * s * s * c[3];
-  };
-  // Solve t = r0 G1 + sigma0 G2 + mu G3 for s; dt/ds = r(s) > 0. Start from a lower bound,
-  // s >= t/(r0 + v_max t) with v_max^2 = |v0|^2 + 2|mu|/r0 (r grows at most that fast), and double:
-  // a first guess like t/r0 overshoots by orders of magnitude when the start is near the centre,
-  // and cosh of the overshoot overflows.
-  ld g[4];
-  auto tof = [&](ld s) {
-    G(s, g);
-    return r0 * g[1] + sigma0 * g[2] + mu * g[3];
-  };
-  const ld v_max = std::sqrt(dot(v0, v0) + 2.0L * std::abs(mu) / r0);
-  ld lo = 0.0L, hi = t / (r0 + v_max * t);
-  while (tof(hi) < t) {
-    lo = hi;
-    hi *= 2.0L;
-    if (!(hi < 1e6L)) throw std::runtime_error("kepler_state: no bracket");
-  }
-  ld s = 0.5L * (lo + hi);
-  for (int it = 0; it < 400; ++it) {
-    const ld f = tof(s) - t;
-    const ld r = r0 * g[0] + sigma0 * g[1] + mu * g[2];
-    if (f > 0) hi = s; else lo = s;
-    ld next = s - f / r;
-    if (!(next > lo && next < hi)) next = 0.5L * (lo + hi);
-    if (std::abs(next - s) <= 4e-19L * std::abs(s) || hi - lo <= 4e-19L * hi) {
-      s = next;
-      break;
-    }
-    s = next;
-  }
-  G(s, g);
-  const ld r = r0 * g[0] + sigma0 * g[1] + mu * g[2];
-  const ld f = 1.0L - mu * g[2] / r0, gg = t - mu * g[3];
-  const ld fd = -mu * g[1] / (r0 * r), gd = 1.0L - mu * g[2] / r;
+  const KeplerCoefficients<ld> k = kepler_flow<ld>(mu, std::sqrt(dot(R0, R0)), dot(R0, v0), dot(v0, v0), t);
   for (int i = 0; i < 3; ++i) {
-    R[i] = f * R0[i] + gg * v0[i];
-    v[i] = fd * R0[i] + gd * v0[i];
+    R[i] = (1.0L + k.f_minus_1) * R0[i] + k.g * v0[i];
+    v[i] = k.fd * R0[i] + (1.0L + k.gd_minus_1) * v0[i];
   }
 }
 }  // namespace detail

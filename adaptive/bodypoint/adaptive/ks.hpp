@@ -13,6 +13,7 @@
 // The spin w of a material point is constant and carried along.
 #pragma once
 
+#include "bodypoint/kepler.hpp"
 #include "bodypoint/model.hpp"
 
 #include <Eigen/Core>
@@ -25,33 +26,6 @@
 namespace bodypoint::adaptive {
 
 using Vec4 = Eigen::Vector4d;
-
-/// Stumpff functions c0..c3 at z.
-inline void stumpff(double z, double c[4]) {
-  if (std::abs(z) < 0.1) {
-    for (int n = 0; n < 4; ++n) {
-      double term = 1.0, sum = 0.0;
-      for (int j = 1; j <= n; ++j) term /= j;
-      for (int k = 0; k < 12; ++k) {
-        sum += term;
-        term *= -z / ((2 * k + n + 1) * (2 * k + n + 2));
-      }
-      c[n] = sum;
-    }
-    return;
-  }
-  if (z > 0) {
-    const double q = std::sqrt(z);
-    c[0] = std::cos(q);
-    c[1] = std::sin(q) / q;
-  } else {
-    const double q = std::sqrt(-z);
-    c[0] = std::cosh(q);
-    c[1] = std::sinh(q) / q;
-  }
-  c[2] = (1.0 - c[0]) / z;
-  c[3] = (1.0 - c[1]) / z;
-}
 
 /// The KS state of a material point about centre c.
 class KsMotion {
