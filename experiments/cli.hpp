@@ -107,7 +107,7 @@ std::vector<double> parse_numbers(const std::string& list, const std::string& op
 /// "bodypoint <argv...>", for output headers.
 std::string command_line(int argc, char** argv);
 
-/// Method list from 'all', 'fixed' (every fixed-step method) or comma-separated names.
+/// Method list from 'all', 'fixed' (every fixed-step method but the Kepler split) or comma-separated names.
 std::vector<const MethodInfo*> parse_methods(const std::string& list);
 
 }  // namespace bodypoint::cli

@@ -305,7 +305,7 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
       ("values", po::value<std::string>(), "explicit comma-separated values instead of a range")
       ("grid", po::value(&grid)->composing(), "instead of --param: one varied parameter of a grid, NAME=FROM:TO:STEP, "
        "NAME=log:FROM:TO:POINTS or NAME=a,b,c; repeat for each (every combination is run)")
-      ("methods", po::value(&methods_arg)->default_value(methods_arg), "comma-separated names, 'fixed' (every fixed-step method) or 'all'")
+      ("methods", po::value(&methods_arg)->default_value(methods_arg), "comma-separated names, 'fixed' (every fixed-step method but the Kepler split kep-*) or 'all'")
       ("tol", po::value(&job.spec.tol)->default_value(job.spec.tol), "adaptive methods: error tolerance")
       ("threads", po::value(&job.threads)->default_value(0), "worker threads (0: all cores)")
       ("out", po::value(&job.out), "CSV file (default: standard output); with --shard, this shard's rows file")

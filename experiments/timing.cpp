@@ -80,7 +80,7 @@ int cmd_timing(int argc, char** argv) {
       ("to", po::value(&to)->default_value(to), "largest n")
       ("step", po::value(&step)->default_value(step), "increment of n")
       ("values", po::value(&values), "explicit comma-separated values of n instead")
-      ("methods", po::value(&methods_arg)->default_value(methods_arg), "comma-separated names, 'fixed' or 'all'")
+      ("methods", po::value(&methods_arg)->default_value(methods_arg), "comma-separated names, 'fixed' (every fixed-step method but the Kepler split kep-*) or 'all'")
       ("repeats", po::value(&spec.repeats)->default_value(spec.repeats), "timed repeats per point (median, min, max)")
       ("warmup", po::value(&spec.warmup)->default_value(spec.warmup), "untimed runs before the repeats")
       ("out", po::value(&out), "CSV file (default: standard output)");

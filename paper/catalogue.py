@@ -11,6 +11,7 @@ PAPER_FAMILY = {
     "thesis": "thesis's seven",
     "odeint": "thesis's seven",
     "lie-poisson": "Lie-Poisson",
+    "kepler-split": "Kepler split",
     "time-transformed": "time-transformed",
     "regularised": "KS",
     "odeint-adaptive": "Boost.Odeint",

@@ -27,7 +27,7 @@ plt.rcParams.update({"font.size": 8, "axes.titlesize": 8, "legend.fontsize": 6, 
 THESIS_SEVEN = ["thesis-euler", "thesis-verlet", "thesis-ruth3", "thesis-fr4", "thesis-y6", "rk4", "ab4"]
 # Families of the work-precision figures, in drawing order, with a colour each.
 FAMILIES = [("thesis's seven", "tab:red"), ("Lie-Poisson", "tab:blue"), ("time-transformed", "tab:green"),
-            ("KS", "tab:purple"), ("Boost.Odeint", "tab:orange"), ("GSL", "tab:brown")]
+            ("KS", "tab:purple"), ("Kepler split", "tab:cyan"), ("Boost.Odeint", "tab:orange"), ("GSL", "tab:brown")]
 # Deviations above this mean the run diverged (the thesis's schemes reach 1e190 at coarse steps); they
 # are drawn at this ceiling so the other curves stay readable.
 DIVERGED = 1e2

@@ -14,6 +14,7 @@
 #include "bodypoint/rk/run_gsl.hpp"
 #endif
 #include "bodypoint/splitting/catalogue.hpp"
+#include "bodypoint/splitting/kepler_split.hpp"
 #include "bodypoint/splitting/lie_poisson.hpp"
 #include "bodypoint/splitting/thesis.hpp"
 
@@ -87,6 +88,24 @@ MethodInfo lie_row() {
           &run_splitting<sp::LiePoissonKernel, seq>};
 }
 
+/// The Kepler split's assumptions: one centre (its Kepler flow is the two-body problem) of Coulomb's law.
+std::string kepler_split_check(const MethodInfo& m, const Body& /*body*/, const std::vector<Centre>& centres) {
+  if (centres.size() != 1) return m.name + " needs exactly one centre (its Kepler flow is the two-body problem); use lp-* or logh-*";
+  if (non_coulomb(centres)) return m.name + " assumes Coulomb's law (its Kepler flow is built on -A/|R|)";
+  return "";
+}
+
+/// The row of a Kepler-split method from its entry in KeplerSplitTables (catalogue.hpp).
+template <class E>
+MethodInfo kepler_row() {
+  using T = typename E::type;
+  constexpr const auto& seq = sp::ops_of<T>;
+  const int k = static_cast<int>(seq.kicks());
+  return {"kep-" + std::string(E::tag), Family::KeplerSplit, T::order, k, k,
+          sp::describe<T>("Kepler split (one centre), a stage is a Kepler solve"),
+          &run_splitting<sp::KeplerSplitKernel, seq>, &kepler_split_check};
+}
+
 std::vector<MethodInfo> make_rows() {
   std::vector<MethodInfo> all = {
       {"rk4", Family::Odeint, 4, 4, 4, "classical Runge-Kutta (thesis 2.1; odeint runge_kutta4)",
@@ -112,6 +131,7 @@ std::vector<MethodInfo> make_rows() {
   };
   sp::for_each(sp::ThesisTables{}, [&all]<class E>() { all.push_back(thesis_row<E>()); });
   sp::for_each(sp::LiePoissonTables{}, [&all]<class E>() { all.push_back(lie_row<E>()); });
+  sp::for_each(sp::KeplerSplitTables{}, [&all]<class E>() { all.push_back(kepler_row<E>()); });
   return all;
 }
 

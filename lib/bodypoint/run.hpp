@@ -69,13 +69,14 @@ struct RunResult {
 /// Gsl: GSL's step-size-controlled steppers (--tol; peers, present when built with GSL);
 /// TimeTransformed: fixed fictitious step ds, variable physical step (logh-*, ttl-*);
 /// Regularised: the Kustaanheimo-Stiefel flow, exact in its fictitious time (ks).
-enum class Family { Thesis, LiePoisson, Odeint, OdeintAdaptive, Gsl, TimeTransformed, Regularised };
+enum class Family { Thesis, LiePoisson, KeplerSplit, Odeint, OdeintAdaptive, Gsl, TimeTransformed, Regularised };
 
 /// The family's name as `bodypoint methods --markdown` prints it.
 constexpr std::string_view family_name(Family f) {
   switch (f) {
     case Family::Thesis: return "thesis drift/kick";
     case Family::LiePoisson: return "exact Lie-Poisson";
+    case Family::KeplerSplit: return "Kepler split";
     case Family::Odeint: return "Boost.Odeint fixed step";
     case Family::OdeintAdaptive: return "Boost.Odeint adaptive";
     case Family::Gsl: return "GSL adaptive";
@@ -90,6 +91,7 @@ constexpr std::string_view family_key(Family f) {
   switch (f) {
     case Family::Thesis: return "thesis";
     case Family::LiePoisson: return "lie-poisson";
+    case Family::KeplerSplit: return "kepler-split";
     case Family::Odeint: return "odeint";
     case Family::OdeintAdaptive: return "odeint-adaptive";
     case Family::Gsl: return "gsl";

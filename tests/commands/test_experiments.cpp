@@ -146,8 +146,9 @@ TEST(Study, QuickRecipesWriteEveryCsv) {
   ds << d.rdbuf();
   const auto rows = csv_rows(ds.str());
   std::size_t fixed = 0;
-  for (const MethodInfo& m : methods()) fixed += has_variable_step(m) ? 0 : 1;
-  EXPECT_EQ(rows.size(), 6u * fixed);  // 6 values of d, every fixed-step method
+  // 'fixed' (cli.cpp): every fixed-step method but the Kepler split, whose stages are Kepler solves.
+  for (const MethodInfo& m : methods()) fixed += has_variable_step(m) || m.family == Family::KeplerSplit ? 0 : 1;
+  EXPECT_EQ(rows.size(), 6u * fixed);  // 6 values of d
   std::ifstream ix(dir / "appendix1/index.csv");
   std::stringstream is;
   is << ix.rdbuf();

@@ -35,6 +35,11 @@ const double kOrbitTEnd = convergence_orbit(0.0).t_end;
 // above it the h^12 term still dominates (measured slopes 11.2 at B = 0 and 12.1 at B = 0.7 on the
 // orbit). Only "clearly above order 8" is asserted, which any wrong weight breaks.
 constexpr double kSs10Lowest = 9.0;
+// kep-kl8 (the Kepler split, B = 0.7) approaches order 8 from above: its h^8 term is small against the
+// h^10 term over the whole window above round-off (slopes of successive pairs on the orbit 10.4, 9.8,
+// 8.5, 8.2, 8.1 as h falls from 0.18 to 0.044), so the fitted slope is 8.3. The order is asserted
+// from below as for every method; above, this much is allowed.
+constexpr double kKeplerSplit8Excess = 0.5;
 
 struct Case {
   std::string method;
@@ -59,16 +64,18 @@ Case default_case(const MethodInfo& m) {
 /// Where a method's window differs from its order's: six-stage fourth-order tables are accurate
 /// enough to start at h = 0.5; lp-rkn6 (and lp-kl6 at B = 0) reach round-off on the encounter before
 /// their slope settles; on the encounter at B = 0.7 Ruth 3's error is hidden by conjugacy (the orbit
-/// shows it), while lp-y8's settles there.
+/// shows it), while lp-y8's settles there; kep-kl8 (kKeplerSplit8Excess).
 struct Override {
   const char* method;
   std::optional<double> B;  // only at this B (both when empty)
   double h0;
   bool on_orbit;
+  double above = kSlopeTol;
 };
 const Override kOverrides[] = {
     {"lp-bm4", {}, 0.5, false},   {"lp-rkn4", {}, 0.5, false}, {"lp-rkn6", {}, 0.5, true},
     {"lp-ruth3", 0.7, 0.2, true}, {"lp-y8", 0.7, 1.0, false},  {"lp-kl6", 0.0, 0.5, true},
+    {"kep-kl8", 0.7, 1.0, true, kKeplerSplit8Excess},
 };
 
 /// Whether this file measures the order of a family's methods at this B, by family: a family added to
@@ -78,6 +85,8 @@ bool measured_here(Family f, double B) {
   switch (f) {
     case Family::Odeint:
     case Family::LiePoisson: return true;
+    // At B = 0 exact whatever its step (test_lie_poisson.cpp, KeplerSplitIsExactForAMaterialPoint).
+    case Family::KeplerSplit: return B != 0.0;
     // At B != 0 first order whatever its table: ThesisFamilyIsFirstOrderForBodyPoint.
     case Family::Thesis: return B == 0.0;
     // Fictitious steps: tests/adaptive/test_adaptive.cpp (ConvergenceOrderInTheFictitiousStep...); ks is
@@ -103,6 +112,7 @@ std::vector<Case> cases_at(double B) {
       if (m.name == o.method && (!o.B || *o.B == B)) {
         c.h0 = o.h0;
         c.on_orbit = o.on_orbit;
+        c.above = o.above;
       }
     cases.push_back(c);
   }

@@ -109,6 +109,10 @@ using AllTables = List<Euler, VerletKdk, StrangDkd, Ruth3, Yoshida4, BlanesMoan4
 /// The exact Lie-Poisson splitting (lp-*) takes every table.
 using LiePoissonTables = AllTables;
 
+/// The Kepler split (kepler_split.hpp) takes the drift-first symmetric compositions, whose stages are
+/// Kepler solves: one per stage, none shared between steps.
+using KeplerSplitTables = List<Use<StrangDkd, "verlet">, Yoshida4, BlanesMoan4, Yoshida6, KahanLi6, Yoshida8, KahanLi8>;
+
 /// The thesis's five schemes (sec. 2.5) with the published code's index slip (code_slip.hpp) of
 /// each; the thesis calls Yoshida 4 "Forest-Ruth 4".
 using ThesisTables = List<Euler, VerletKdk, Use<Ruth3, "", CodeSlip::third_v_z>,
