@@ -88,22 +88,29 @@ MethodInfo lie_row() {
           &run_splitting<sp::LiePoissonKernel, seq>};
 }
 
-/// The Kepler split's assumptions: one centre (its Kepler flow is the two-body problem) of Coulomb's law.
+/// The Kepler split's assumption: Coulomb's law (its Kepler flow is built on -A/|R|).
 std::string kepler_split_check(const MethodInfo& m, const Body& /*body*/, const std::vector<Centre>& centres) {
-  if (centres.size() != 1) return m.name + " needs exactly one centre (its Kepler flow is the two-body problem); use lp-* or logh-*";
   if (non_coulomb(centres)) return m.name + " assumes Coulomb's law (its Kepler flow is built on -A/|R|)";
   return "";
+}
+
+/// The Kepler split of table T: two parts for one centre, three (the other centres' kicks) for several.
+template <sp::TableType T>
+RunResult run_kepler_split(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
+                           const SampleSink* sink) {
+  static_assert(sp::is_dkd_composition(T::table), "the three-part Kepler split needs a DKD composition");
+  if (centres.size() == 1) return run_splitting<sp::KeplerSplitKernel, sp::ops_of<T>>(body, centres, spec, sink);
+  return run_splitting<sp::KeplerSplitKernel, sp::three_part_ops_of<T>>(body, centres, spec, sink);
 }
 
 /// The row of a Kepler-split method from its entry in KeplerSplitTables (catalogue.hpp).
 template <class E>
 MethodInfo kepler_row() {
   using T = typename E::type;
-  constexpr const auto& seq = sp::ops_of<T>;
-  const int k = static_cast<int>(seq.kicks());
+  const int k = static_cast<int>(sp::ops_of<T>.kicks());
   return {"kep-" + std::string(E::tag), Family::KeplerSplit, T::order, k, k,
-          sp::describe<T>("Kepler split (one centre), a stage is a Kepler solve"),
-          &run_splitting<sp::KeplerSplitKernel, seq>, &kepler_split_check};
+          sp::describe<T>("Kepler split (a stage is a Kepler solve about the first centre)"),
+          &run_kepler_split<T>, &kepler_split_check};
 }
 
 std::vector<MethodInfo> make_rows() {

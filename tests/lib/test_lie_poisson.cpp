@@ -7,6 +7,7 @@
 #include "bodypoint/methods.hpp"
 #include "bodypoint/reference.hpp"
 #include "bodypoint/run.hpp"
+#include "bodypoint/scenes.hpp"
 #include "bodypoint/splitting/classic.hpp"
 #include "bodypoint/splitting/kahan_li.hpp"
 #include "bodypoint/splitting/lie_poisson.hpp"
@@ -16,6 +17,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace bodypoint {
@@ -57,6 +60,11 @@ constexpr double kRutherfordTolV = 1e-12;
 // variable's solution to 4 eps and the sums' rounding err, over <= 500 steps of t = 50 (measured
 // 1e-15..4e-15 in R and v against the long-double Kepler reference).
 constexpr double kKeplerSplitExactTol = 1e-13;
+// The three-part Kepler split's order is measured between this step and its half on the two-centres
+// scene, where every table tested is in its asymptotic range (errors 1e-13..1e-3) and the slope is
+// within this much of the order (issue #3's tolerance for measured orders).
+constexpr double kThreePartCoarseStep = 0.025;
+constexpr double kThreePartSlopeTol = 0.15;
 
 std::vector<const MethodInfo*> lie_methods() {
   std::vector<const MethodInfo*> out;
@@ -304,15 +312,32 @@ TEST(LiePoisson, KeplerSplitIsExactForAMaterialPoint) {
   EXPECT_GT(checked, 0);
 }
 
-TEST(LiePoisson, KeplerSplitRefusesWhatItCannotSplit) {
-  const MethodInfo& m = method_or_throw("kep-kl8");
-  Scene two = test::table31(0.7);
-  two.centres.push_back({Vec3(5.0, 5.0, 0.0), -1.0});
-  EXPECT_NE(refusal(m, two.bodies.front(), two.centres).find("exactly one centre"), std::string::npos);
+TEST(LiePoisson, KeplerSplitOfSeveralCentresKeepsItsOrder) {
+  // Two centres: the first is the Kepler centre, the second a third part (kicks flanking each Kepler
+  // flow, composition.hpp flatten_three). The composition keeps the table's order: slopes between
+  // h = 0.025 and 0.0125 on the two-centres scene (measured 2.00, 4.00, 6.04), |K2|^2 to round-off.
+  const NamedScene ns = named_scene("two-centres");
+  const Body& b = ns.scene.bodies.front();
+  const State ref = reference_state(b, ns.scene.centres, ns.t_end, 1e-18L);
+  for (const char* name : {"kep-verlet", "kep-y4", "kep-kl6"}) {
+    const MethodInfo& m = method_or_throw(name);
+    EXPECT_EQ(refusal(m, b, ns.scene.centres), "") << name;
+    double err[2] = {0.0, 0.0};
+    for (int k = 0; k < 2; ++k) {
+      RunSpec spec;
+      spec.h = kThreePartCoarseStep / (1 << k);
+      spec.steps = std::lround(ns.t_end / spec.h);
+      spec.track_invariants = true;
+      const RunResult r = run(m, b, ns.scene.centres, spec);
+      err[k] = std::max(test::rel_err(r.final.R, ref.R), test::rel_err(r.final.v, ref.v));
+      EXPECT_LT(r.invariants->max_rel_dK2sq, kInvariantTol) << name;
+    }
+    EXPECT_NEAR(std::log2(err[0] / err[1]), m.order, kThreePartSlopeTol) << name << " " << err[0] << " " << err[1];
+  }
+  // The thesis code's force law is not Coulomb's: no Kepler flow for it.
   Scene code = test::table31(0.7);
   code.centres.front().law = ForceLaw::thesis_code;
-  EXPECT_NE(refusal(m, code.bodies.front(), code.centres).find("Coulomb"), std::string::npos);
-  EXPECT_EQ(refusal(m, test::table31(0.7).bodies.front(), test::table31(0.7).centres), "");
+  EXPECT_NE(refusal(method_or_throw("kep-kl8"), code.bodies.front(), code.centres).find("Coulomb"), std::string::npos);
 }
 
 }  // namespace

@@ -40,6 +40,9 @@ concept TableType = requires {
 /// A table flattened to its sub-flows; static storage, so it can be a template argument of `integrate`.
 template <TableType T>
 inline constexpr auto ops_of = flatten(T::table);
+/// A DKD composition's three-part method (composition.hpp, flatten_three).
+template <TableType T>
+inline constexpr auto three_part_ops_of = flatten_three(T::table);
 
 /// Runge-Kutta-Nystrom tables reach their order only for a kinetic part quadratic in the momenta
 /// and a potential part of the positions (blanes_moan.hpp says why the body-point qualifies).
@@ -109,9 +112,9 @@ using AllTables = List<Euler, VerletKdk, StrangDkd, Ruth3, Yoshida4, BlanesMoan4
 /// The exact Lie-Poisson splitting (lp-*) takes every table.
 using LiePoissonTables = AllTables;
 
-/// The Kepler split (kepler_split.hpp) takes the drift-first symmetric compositions, whose stages are
-/// Kepler solves: one per stage, none shared between steps.
-using KeplerSplitTables = List<Use<StrangDkd, "verlet">, Yoshida4, BlanesMoan4, Yoshida6, KahanLi6, Yoshida8, KahanLi8>;
+/// The Kepler split (kepler_split.hpp) takes the DKD compositions (a stage is a Kepler solve, none
+/// shared between steps); being compositions, they also make its three-part methods for several centres.
+using KeplerSplitTables = List<Use<StrangDkd, "verlet">, Yoshida4, Yoshida6, KahanLi6, Yoshida8, KahanLi8>;
 
 /// The thesis's five schemes (sec. 2.5) with the published code's index slip (code_slip.hpp) of
 /// each; the thesis calls Yoshida 4 "Forest-Ruth 4".

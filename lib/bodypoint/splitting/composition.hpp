@@ -18,6 +18,13 @@
 //   observer in between is exact), so this works with or without an observer;
 // - a table that starts and ends with a drift merges the two drifts into one, which is possible only
 //   when no observer needs the state at the step boundary.
+//
+// A sub-flow is one of up to three parts: the drift, the kick and a third exactly solvable part of a
+// kernel that splits its Hamiltonian in three (`third(x, tau)`; the Kepler split's other centres).
+// `flatten_three` makes a three-part method of a DKD composition (strang_dkd(g)): its basic step
+// D(g/2) K(g) D(g/2) becomes the symmetric D(g/2) O(g/2) K(g) O(g/2) D(g/2), and the composition with
+// the same weights g keeps the table's order (the composition theorem needs only a symmetric
+// second-order basic method; Yoshida 1990, sec. 4; HLW II.4).
 #pragma once
 
 #include <array>
@@ -104,44 +111,73 @@ constexpr Table<S + 1> strang_kdk(const std::array<double, S>& g) {
   return t;
 }
 
-/// One sub-flow of a step: a drift or a kick for c*h.
+/// The part of the Hamiltonian a sub-flow belongs to.
+enum class Part : unsigned char { drift, kick, third };
+
+/// One sub-flow of a step: a drift, a kick or the third part for c*h.
 struct Op {
-  bool kick = false;
+  Part part = Part::drift;
   double c = 0.0;
 };
 
-/// A table flattened to its non-zero sub-flows, adjacent flows of one type merged.
+/// A table flattened to its non-zero sub-flows, adjacent flows of one part merged.
 template <std::size_t M>
 struct OpSequence {
   std::array<Op, M> ops{};
   std::size_t size = 0;
-  [[nodiscard]] constexpr std::size_t kicks() const {
+  [[nodiscard]] constexpr std::size_t count(Part p) const {
     std::size_t k = 0;
-    for (std::size_t i = 0; i < size; ++i) k += ops[i].kick ? 1 : 0;
+    for (std::size_t i = 0; i < size; ++i) k += ops[i].part == p ? 1 : 0;
     return k;
   }
-  /// First and last sub-flows are of one type, so consecutive steps can share them.
-  [[nodiscard]] constexpr bool fsal() const { return size >= 2 && ops[0].kick == ops[size - 1].kick; }
+  [[nodiscard]] constexpr std::size_t kicks() const { return count(Part::kick); }
+  /// True when the sequence uses a third part (the kernel must provide `third`).
+  [[nodiscard]] constexpr bool has_third() const { return count(Part::third) > 0; }
+  /// First and last sub-flows are of one part, so consecutive steps can share them.
+  [[nodiscard]] constexpr bool fsal() const { return size >= 2 && ops[0].part == ops[size - 1].part; }
   /// Force evaluations per step when consecutive steps are merged.
   [[nodiscard]] constexpr std::size_t kicks_merged() const {
-    return fsal() && ops[0].kick ? kicks() - 1 : kicks();
+    return fsal() && ops[0].part == Part::kick ? kicks() - 1 : kicks();
+  }
+  /// Appends c of part p, merged into the last sub-flow when it is of the same part; zeros skipped.
+  constexpr void push(Part p, double c) {
+    if (c == 0.0) return;
+    if (size > 0 && ops[size - 1].part == p) {
+      ops[size - 1].c += c;
+    } else {
+      ops[size++] = Op{p, c};
+    }
   }
 };
 
 template <std::size_t N>
 constexpr OpSequence<2 * N> flatten(const Table<N>& t) {
   OpSequence<2 * N> s{};
-  auto push = [&s](bool kick, double c) {
-    if (c == 0.0) return;
-    if (s.size > 0 && s.ops[s.size - 1].kick == kick) {
-      s.ops[s.size - 1].c += c;
-    } else {
-      s.ops[s.size++] = Op{kick, c};
-    }
-  };
   for (std::size_t i = 0; i < N; ++i) {
-    push(false, t.a[i]);
-    push(true, t.b[i]);
+    s.push(Part::drift, t.a[i]);
+    s.push(Part::kick, t.b[i]);
+  }
+  return s;
+}
+
+/// True when t is strang_dkd(g) for some weights g (then g = b): the tables built as compositions.
+template <std::size_t N>
+constexpr bool is_dkd_composition(const Table<N>& t) {
+  if (N < 2 || t.b[N - 1] != 0.0 || t.a[0] != 0.5 * t.b[0] || t.a[N - 1] != 0.5 * t.b[N - 2]) return false;
+  for (std::size_t i = 1; i + 1 < N; ++i)
+    if (t.a[i] != 0.5 * (t.b[i - 1] + t.b[i])) return false;
+  return true;
+}
+
+/// The three-part method of a DKD composition (file comment): every kick K(g) becomes O(g/2) K(g) O(g/2).
+template <std::size_t N>
+constexpr OpSequence<4 * N> flatten_three(const Table<N>& t) {
+  OpSequence<4 * N> s{};
+  for (std::size_t i = 0; i < N; ++i) {
+    s.push(Part::drift, t.a[i]);
+    s.push(Part::third, 0.5 * t.b[i]);
+    s.push(Part::kick, t.b[i]);
+    s.push(Part::third, 0.5 * t.b[i]);
   }
   return s;
 }
@@ -167,7 +203,8 @@ struct NullObserver {
   void operator()(long, const X&) const {}
 };
 
-/// Kernel concept: `state_type`, `drift(x, tau)`, `kick(x, tau)`, `begin_step(x)`,
+/// Kernel concept: `state_type`, `drift(x, tau)`, `kick(x, tau)`, `begin_step(x)`, `third(x, tau)` for
+/// sequences with a third part,
 /// `static constexpr bool mergeable` (false when a step depends on the state at its start), and for
 /// mergeable kernels `force(x)` (one evaluation) and `apply_kick(x, tau, F)`.
 template <const auto& Seq, class Kernel, class Observer>
@@ -175,14 +212,20 @@ void integrate(Kernel& k, typename Kernel::state_type& x, double h, long n, Obse
   constexpr std::size_t M = Seq.size;
   static_assert(M >= 1, "empty splitting");
   auto apply = [&k, &x](const Op& op, double hh) {
-    if (op.kick) {
+    if (op.part == Part::kick) {
       k.kick(x, op.c * hh);
+    } else if constexpr (Seq.has_third()) {
+      if (op.part == Part::third) {
+        k.third(x, op.c * hh);
+      } else {
+        k.drift(x, op.c * hh);
+      }
     } else {
       k.drift(x, op.c * hh);
     }
   };
-  constexpr bool share_force = Seq.fsal() && Seq.ops[0].kick && Kernel::mergeable;
-  constexpr bool merge_drift = Seq.fsal() && !Seq.ops[0].kick && Kernel::mergeable && !Observer::active;
+  constexpr bool share_force = Seq.fsal() && Seq.ops[0].part == Part::kick && Kernel::mergeable;
+  constexpr bool merge_drift = Seq.fsal() && Seq.ops[0].part != Part::kick && Kernel::mergeable && !Observer::active;
   if constexpr (share_force) {
     if (n <= 0) return;
     auto F = k.force(x);

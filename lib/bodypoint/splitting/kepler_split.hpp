@@ -17,7 +17,11 @@
 // Lie-Poisson split pays for near the centre).
 //
 // The engine's "kick" is the Kepler flow and its "drift" the spin-orbit flow, so a table's stages are
-// Kepler solves (counted as force evaluations).
+// Kepler solves (counted as force evaluations). With several centres the first is the Kepler centre
+// and the others' potential is a third part, H_O = sum_{k>0} Pi_k(R), whose flow is a kick
+// K1 += tau F_O(R); the three-part methods are the tables' compositions with each Kepler flow
+// flanked by two half kicks of H_O (composition.hpp, flatten_three), of the tables' orders.
+// K2Q is then not conserved (several centres), |K2|^2 still is.
 #pragma once
 
 #include "bodypoint/field.hpp"
@@ -25,6 +29,7 @@
 #include "bodypoint/model.hpp"
 #include "bodypoint/splitting/lie_poisson.hpp"
 
+#include <cstddef>
 #include <type_traits>
 
 namespace bodypoint::splitting {
@@ -79,6 +84,24 @@ struct KeplerSplitKernel {
     compensated_add(x.R, x.R_err, k.f_minus_1 * X0 + k.g * u0);
     const Vec3 du = k.fd * X0 + k.gd_minus_1 * u0;
     compensated_add(x.K1, x.K1_err, (sign / u_per_K1_) * du);
+  }
+
+  /// H_O for tau: K1 += tau F(R) of every centre but the Kepler one (several centres only).
+  void third(LieState& x, double tau) const {
+    if constexpr (std::is_same_v<Field, CentreList>) {
+      const Vec3 R = x.R - x.R_err;
+      Vec3 F = Vec3::Zero();
+      for (std::size_t k = 1; k < field.centres.size(); ++k) {
+        const Centre& c = field.centres[k];
+        const Vec3 d = R - c.c;
+        const double inv_r = 1.0 / d.norm();
+        F -= (c.A * inv_r * inv_r * inv_r) * d;
+      }
+      compensated_add(x.K1, x.K1_err, tau * F);
+    } else {
+      (void)x;
+      (void)tau;
+    }
   }
 
   [[nodiscard]] State to_physical(const LieState& x) const { return to_state(p, from_lie(x)); }
