@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 seconds="${FUZZ_SECONDS:-60}"
 
 CC=clang CXX=clang++ cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DBODYPOINT_FUZZ=ON \
-  -DBODYPOINT_BUILD_BENCH=OFF -DBODYPOINT_WITH_MPI=OFF -DBODYPOINT_WERROR="${BODYPOINT_WERROR:-OFF}" >/dev/null
+  -DBODYPOINT_BUILD_BENCH=OFF -DBODYPOINT_WITH_MPI=OFF -DBODYPOINT_BUILD_PYTHON=OFF -DBODYPOINT_WERROR="${BODYPOINT_WERROR:-OFF}" >/dev/null
 cmake --build build-asan --parallel "$(nproc)"
 
 # MPI is left out of this build: Open MPI's own allocations at MPI_Init would read as leaks; the MPI

@@ -14,7 +14,7 @@ gen=()
 command -v ninja >/dev/null && gen=(-G Ninja)
 
 cmake -S "$src" -B "$work/lib" "${gen[@]}" -DCMAKE_BUILD_TYPE=Release -DBODYPOINT_BUILD_EXPERIMENTS=OFF \
-      -DBODYPOINT_BUILD_TESTS=OFF -DBODYPOINT_BUILD_BENCH=OFF -DBODYPOINT_INSTALL=ON >"$work/lib.log"
+      -DBODYPOINT_BUILD_TESTS=OFF -DBODYPOINT_BUILD_BENCH=OFF -DBODYPOINT_BUILD_PYTHON=OFF -DBODYPOINT_INSTALL=ON >"$work/lib.log"
 if grep -qi "program_options" "$work/lib/CMakeCache.txt"; then
   echo "FAIL: the library-only configuration looked for Boost.program_options"; exit 1
 fi

@@ -1,0 +1,410 @@
+// bodypoint's Python module (`import bodypoint`): the public API (bodypoint.hpp, sweep.hpp) with numpy
+// arrays. Results are plain dicts of numbers and arrays (a sweep's is a dict of equal-length 1-D
+// columns, which pandas.DataFrame takes as it is); errors are bodypoint.Error (a ValueError) with the
+// library's one-line reason; the GIL is released while integrating. The Python-side docs and the
+// keyword interface are in bodypoint/__init__.py; this file holds only the conversions.
+#include "bodypoint/bodypoint.hpp"
+#include "bodypoint/sweep.hpp"
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace py = pybind11;
+using namespace bodypoint;
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+py::array_t<double> vec(const Vec3& x) {
+  py::array_t<double> a(3);
+  auto m = a.mutable_unchecked<1>();
+  for (py::ssize_t i = 0; i < 3; ++i) m(i) = x[static_cast<Eigen::Index>(i)];
+  return a;
+}
+
+Vec3 to_vec(const py::handle& o, const char* what) {
+  const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(o);
+  if (!a || a.ndim() != 1 || a.shape(0) != 3) throw Error(std::string(what) + " must be a sequence of 3 numbers");
+  return Vec3(a.at(0), a.at(1), a.at(2));
+}
+
+double number(const py::dict& d, const char* key, double fallback) {
+  return d.contains(key) ? d[key].cast<double>() : fallback;
+}
+
+py::dict centre_dict(const Centre& c) {
+  py::dict d;
+  d["c"] = vec(c.c);
+  d["A"] = c.A;
+  d["law"] = c.law == ForceLaw::coulomb ? "coulomb" : "thesis_code";
+  return d;
+}
+
+py::dict body_dict(const Body& b) {
+  py::dict d;
+  d["name"] = b.name;
+  d["m"] = b.p.m;
+  d["B"] = b.p.B;
+  d["J"] = b.p.J;
+  d["R"] = vec(b.s0.R);
+  d["v"] = vec(b.s0.v);
+  d["w"] = vec(b.s0.w);
+  return d;
+}
+
+Centre centre_from(const py::dict& d) {
+  Centre c;
+  if (d.contains("c")) c.c = to_vec(d["c"], "a centre's c");
+  c.A = number(d, "A", 0.0);
+  if (d.contains("law")) {
+    const auto law = d["law"].cast<std::string>();
+    if (law == "coulomb") c.law = ForceLaw::coulomb;
+    else if (law == "thesis_code") c.law = ForceLaw::thesis_code;
+    else throw Error("a centre's law must be 'coulomb' or 'thesis_code', got '" + law + "'");
+  }
+  return c;
+}
+
+Body body_from(const py::dict& d) {
+  Body b;
+  b.p.m = number(d, "m", 1.0);
+  b.p.B = number(d, "B", 0.0);
+  b.p.J = number(d, "J", 1.0);
+  if (!d.contains("R") || !d.contains("v")) throw Error("a body needs its start R and velocity v");
+  b.s0.R = to_vec(d["R"], "a body's R");
+  b.s0.v = to_vec(d["v"], "a body's v");
+  b.s0.w = d.contains("w") ? to_vec(d["w"], "a body's w") : Vec3::Zero();
+  if (d.contains("name")) b.name = d["name"].cast<std::string>();
+  return b;
+}
+
+/// The thesis's scene from keyword parameters (model.hpp scene_parameters(); b and v_inf: asymptotic data).
+Scene thesis_from(const py::dict& kw) {
+  SceneParams sp;
+  double b = kNaN, v_inf = kNaN;
+  for (const auto& [k, v] : kw) {
+    const auto key = k.cast<std::string>();
+    if (key == "b") b = v.cast<double>();
+    else if (key == "v_inf") v_inf = v.cast<double>();
+    else scene_field(sp, key) = v.cast<double>();
+  }
+  if (!std::isnan(b) || !std::isnan(v_inf)) sp = with_asymptotic_data(sp, b, v_inf);
+  return thesis_scene(sp);
+}
+
+py::dict invariants_dict(const std::optional<InvariantStats>& inv) {
+  py::dict d;
+  if (!inv) return d;
+  d["max_rel_dE"] = inv->max_rel_dE;
+  d["max_rel_dK2sq"] = inv->max_rel_dK2sq;
+  if (inv->has_K2Q) d["max_abs_dK2Q"] = inv->max_abs_dK2Q;
+  return d;
+}
+
+py::dict body_result(const Body& body, const BodyResult& r, const std::vector<Event>& events) {
+  py::dict d;
+  d["name"] = body.name;
+  d["method"] = r.method ? py::cast(r.method->name) : py::none();
+  d["outcome"] = std::string(outcome_name(r.outcome));
+  d["reason"] = r.reason;
+  d["t_end"] = r.run.t_end;
+  d["steps"] = r.run.steps;
+  d["force_evals"] = r.total_force_evals();
+  d["wall_s"] = r.run.wall_s;
+  d["R"] = vec(r.run.final.R);
+  d["v"] = vec(r.run.final.v);
+  d["w"] = vec(r.run.final.w);
+  d["invariants"] = invariants_dict(r.run.invariants);
+  if (!r.chosen.empty()) d["chosen"] = r.chosen;
+  if (r.accuracy) {
+    py::dict a;
+    a["tol"] = r.accuracy->tol;
+    a["err_estimate"] = r.accuracy->err_estimate;
+    a["step"] = r.accuracy->step;
+    a["omega_c"] = r.accuracy->omega_c;
+    a["runs"] = r.accuracy->runs;
+    a["force_evals"] = r.accuracy->force_evals;
+    d["accuracy"] = a;
+  }
+  py::list hits;
+  for (const EventHit& h : r.events) {
+    py::dict e;
+    e["event"] = events[h.event].label();
+    e["t"] = h.t;
+    e["distance"] = h.distance;
+    e["R"] = vec(h.s.R);
+    e["v"] = vec(h.s.v);
+    e["w"] = vec(h.s.w);
+    hits.append(e);
+  }
+  d["events"] = hits;
+  return d;
+}
+
+/// The Advance the keywords ask for, by the method's kind (the command line's rules, cli.hpp).
+Advance advance_for(const MethodInfo* m, std::optional<double> h, std::optional<long> steps,
+                    std::optional<double> t_end, std::optional<double> tol) {
+  if (!m || (tol && !is_step_controlled(*m))) {
+    if (!tol) throw Error("method 'auto' needs tol (the accuracy to deliver)");
+    if (!t_end) throw Error("the accuracy mode (tol) needs t_end");
+    if (h || steps) throw Error("tol chooses the step: give t_end, not h or steps");
+    return Accuracy{*tol, *t_end};
+  }
+  if (h && !(std::isfinite(*h) && *h > 0.0)) throw Error("h must be a finite number > 0");
+  const double step = h.value_or(RunSpec{}.h);
+  if (t_end && steps) throw Error("give steps or t_end, not both");
+  if (is_step_controlled(*m)) {
+    const double end = t_end ? *t_end : step * static_cast<double>(steps.value_or(RunSpec{}.steps));
+    return ControlledSteps{std::min(step, end), end, tol.value_or(RunSpec{}.tol)};
+  }
+  if (is_time_transformed(*m)) return FictitiousSteps{step, t_end.value_or(0.0), t_end ? 0 : steps.value_or(RunSpec{}.steps), 0.0};
+  if (t_end) return fixed_steps_to(*t_end, step);
+  return FixedSteps{step, steps.value_or(RunSpec{}.steps)};
+}
+
+Event event_from(const std::string& text) {
+  // The library's events by the command line's names: closest, closest:K, r=V, r:K=V.
+  Event e;
+  const auto eq = text.find('=');
+  const std::string key = text.substr(0, eq);
+  const std::string name = key.substr(0, key.find(':'));
+  const std::size_t centre = key.find(':') == std::string::npos ? 0 : std::stoul(key.substr(key.find(':') + 1));
+  if (name == "closest" && eq == std::string::npos) {
+    e.kind = Event::Kind::closest_approach;
+  } else if (name == "r" && eq != std::string::npos) {
+    e.kind = Event::Kind::radius;
+    e.value = std::stod(text.substr(eq + 1));
+  } else {
+    throw Error("event '" + text + "': use closest, closest:K, r=V or r:K=V");
+  }
+  e.centre = centre;
+  return e;
+}
+
+py::dict integrate_py(const Scene& scene, const std::string& method, std::optional<double> h,
+                      std::optional<long> steps, std::optional<double> t_end, std::optional<double> tol,
+                      bool invariants, double omega_c, const std::vector<std::string>& event_names) {
+  const MethodInfo* m = method == "auto" ? nullptr : &method_or_throw(method);
+  const Advance how = advance_for(m, h, steps, t_end, tol);
+  Options o;
+  o.track_invariants = invariants;
+  o.omega_c = omega_c;
+  for (const std::string& e : event_names) o.events.push_back(event_from(e));
+  Result r;
+  {
+    py::gil_scoped_release free;
+    r = integrate(scene, m, how, o);
+  }
+  py::dict d;
+  d["outcome"] = std::string(outcome_name(r.outcome));
+  d["reason"] = r.reason;
+  d["force_evals"] = r.force_evals;
+  d["wall_s"] = r.wall_s;
+  py::list bodies;
+  for (std::size_t i = 0; i < r.bodies.size(); ++i) bodies.append(body_result(scene.bodies[i], r.bodies[i], o.events));
+  d["bodies"] = bodies;
+  return d;
+}
+
+/// Each body's state at the given times (increasing, >= 0), by a Stepper landing on every one.
+py::list trajectory_py(const Scene& scene, const std::string& method, double step, const std::vector<double>& times,
+                       double omega_c) {
+  for (std::size_t k = 0; k < times.size(); ++k)
+    if (!std::isfinite(times[k]) || times[k] < 0.0 || (k > 0 && !(times[k] > times[k - 1])))
+      throw Error("times must be finite, >= 0 and increasing");
+  validate(scene);
+  py::list out;
+  for (const Body& body : scene.bodies) {
+    const std::size_t n = times.size();
+    py::array_t<double> t(static_cast<py::ssize_t>(n));
+    py::array_t<double> R({static_cast<py::ssize_t>(n), py::ssize_t{3}}), v({static_cast<py::ssize_t>(n), py::ssize_t{3}}),
+        w({static_cast<py::ssize_t>(n), py::ssize_t{3}});
+    auto tm = t.mutable_unchecked<1>();
+    auto Rm = R.mutable_unchecked<2>();
+    auto vm = v.mutable_unchecked<2>();
+    auto wm = w.mutable_unchecked<2>();
+    Options o;
+    o.track_invariants = false;
+    o.omega_c = omega_c;
+    Stepper s(method, body, scene.centres, step, o);
+    std::string failure;
+    {
+      py::gil_scoped_release free;
+      for (std::size_t k = 0; k < n && failure.empty(); ++k) {
+        if (times[k] > s.time() && s.advance_to(times[k]) != Outcome::ok) failure = s.reason();
+        const State& x = s.state();
+        tm(static_cast<py::ssize_t>(k)) = times[k];
+        for (py::ssize_t j = 0; j < 3; ++j) {
+          const auto i = static_cast<py::ssize_t>(k);
+          Rm(i, j) = x.R[static_cast<Eigen::Index>(j)];
+          vm(i, j) = x.v[static_cast<Eigen::Index>(j)];
+          wm(i, j) = x.w[static_cast<Eigen::Index>(j)];
+        }
+      }
+    }
+    if (!failure.empty()) throw Error((body.name.empty() ? std::string("body") : body.name) + ": " + failure);
+    py::dict d;
+    d["name"] = body.name;
+    d["t"] = t;
+    d["R"] = R;
+    d["v"] = v;
+    d["w"] = w;
+    d["force_evals"] = s.force_evals();
+    out.append(d);
+  }
+  return out;
+}
+
+/// A sweep or grid of the thesis's scene as columns (sweep.hpp).
+py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>& axes,
+                  const std::vector<std::string>& methods, const py::dict& base, double h, long steps, double t_end,
+                  double tol, unsigned threads) {
+  SweepSpec s;
+  for (const auto& [param, values] : axes) s.axes.push_back({param, values});
+  for (const std::string& m : methods) s.methods.push_back(&method_or_throw(m));
+  for (const auto& [k, v] : base) scene_field(s.base, k.cast<std::string>()) = v.cast<double>();
+  s.h = h;
+  s.steps = t_end > 0.0 ? 0 : steps;
+  s.t_end = t_end;
+  s.tol = tol;
+  std::vector<SweepRow> rows;
+  {
+    py::gil_scoped_release free;
+    rows = run_sweep_rows(s, threads);
+  }
+  const auto n = static_cast<py::ssize_t>(rows.size());
+  py::dict cols;
+  std::vector<py::array_t<double>> point(s.axes.size(), py::array_t<double>(n));
+  for (auto& p : point) p = py::array_t<double>(n);
+  py::list method, outcome, reason;
+  const char* names[] = {"t_end", "Rx", "Ry", "Rz", "vx", "vy", "vz", "wx", "wy", "wz", "max_rel_dE", "max_rel_dK2sq", "max_abs_dK2Q"};
+  std::vector<py::array_t<double>> num;
+  for (std::size_t c = 0; c < std::size(names); ++c) num.emplace_back(n);
+  py::array_t<long> force_evals(n), nsteps(n);
+  for (py::ssize_t i = 0; i < n; ++i) {
+    const SweepRow& r = rows[static_cast<std::size_t>(i)];
+    for (std::size_t a = 0; a < point.size(); ++a) point[a].mutable_at(i) = r.point[a];
+    method.append(r.method->name);
+    outcome.append(std::string(outcome_name(r.outcome)));
+    reason.append(r.reason);
+    const State& f = r.result.final;
+    const auto& inv = r.result.invariants;
+    const double v[] = {r.result.t_end, f.R.x(), f.R.y(), f.R.z(), f.v.x(), f.v.y(), f.v.z(), f.w.x(), f.w.y(), f.w.z(),
+                        inv ? inv->max_rel_dE : kNaN, inv ? inv->max_rel_dK2sq : kNaN,
+                        inv && inv->has_K2Q ? inv->max_abs_dK2Q : kNaN};
+    for (std::size_t c = 0; c < std::size(names); ++c) num[c].mutable_at(i) = v[c];
+    force_evals.mutable_at(i) = r.result.force_evals;
+    nsteps.mutable_at(i) = r.result.steps;
+  }
+  for (std::size_t a = 0; a < point.size(); ++a) cols[py::str(s.axes[a].param)] = point[a];
+  cols["method"] = method;
+  cols["outcome"] = outcome;
+  cols["reason"] = reason;
+  cols["steps"] = nsteps;
+  cols["force_evals"] = force_evals;
+  for (std::size_t c = 0; c < std::size(names); ++c) cols[names[c]] = num[c];
+  return cols;
+}
+
+py::dict encounter_py(const Scene& scene, const std::string& method, double tol, double t_end) {
+  const MethodInfo* m = method == "auto" ? nullptr : &method_or_throw(method);
+  Options o;
+  o.track_invariants = false;
+  o.events = closest_approaches(scene.centres.size());
+  Result r;
+  {
+    py::gil_scoped_release free;
+    r = integrate(scene, m, Accuracy{tol, t_end}, o);
+  }
+  if (r.outcome != Outcome::ok) throw Error(r.reason);
+  const Body& body = scene.bodies.front();
+  const BodyResult& br = r.bodies.front();
+  const Scattering sc = scattering(body.p, scene.centres, body.s0, br.run.final, br.run.t_end);
+  py::dict d;
+  d["method"] = br.method ? br.method->name : std::string();
+  d["deflection"] = sc.deflection;
+  d["out_of_plane"] = sc.out_of_plane;
+  d["b"] = sc.b;
+  d["v_inf"] = sc.v_inf;
+  d["time_delay"] = sc.time_delay;
+  d["K1_turn"] = sc.K1_turn;
+  d["spin_turn"] = sc.spin_turn;
+  d["asymptotes"] = sc.asymptotes;
+  d["K1_start"] = vec(sc.K1_start);
+  d["K1_end"] = vec(sc.K1_end);
+  const EventHit* nearest = nearest_approach(br.events, o.events);
+  d["r_min"] = nearest ? nearest->distance : kNaN;
+  d["t_min"] = nearest ? nearest->t : kNaN;
+  d["err_estimate"] = br.accuracy ? br.accuracy->err_estimate : kNaN;
+  d["force_evals"] = br.total_force_evals();
+  return d;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_bodypoint, mod) {
+  mod.doc() = "bodypoint: integrator of a body-point (translation and rotation) in Coulomb fields";
+  py::register_exception<Error>(mod, "Error", PyExc_ValueError);
+
+  py::class_<Scene>(mod, "Scene", "Fixed Coulomb centres and independent body-points (docs/physics.md).")
+      .def(py::init([](const std::vector<py::dict>& centres, const std::vector<py::dict>& bodies) {
+             Scene s;
+             for (const py::dict& c : centres) s.centres.push_back(centre_from(c));
+             for (const py::dict& b : bodies) s.bodies.push_back(body_from(b));
+             validate(s);
+             return s;
+           }),
+           py::arg("centres"), py::arg("bodies"))
+      .def_property_readonly("centres", [](const Scene& s) {
+        py::list l;
+        for (const Centre& c : s.centres) l.append(centre_dict(c));
+        return l;
+      })
+      .def_property_readonly("bodies", [](const Scene& s) {
+        py::list l;
+        for (const Body& b : s.bodies) l.append(body_dict(b));
+        return l;
+      })
+      .def("__repr__", [](const Scene& s) {
+        return "<bodypoint.Scene: " + std::to_string(s.centres.size()) + " centre(s), " + std::to_string(s.bodies.size()) +
+               " body-point(s)>";
+      });
+
+  mod.def("_thesis_scene", &thesis_from, py::arg("params"));
+  mod.def("_read_scene", &read_scene_file, py::arg("path"));
+  mod.def("_parse_scene", [](const std::string& text) { return parse_scene(text, "<string>"); }, py::arg("text"));
+  mod.def("_scene_parameters", [] {
+    std::vector<std::string> names;
+    for (const SceneParameter& p : scene_parameters()) names.emplace_back(p.name);
+    return names;
+  });
+  mod.def("_methods", [] {
+    py::list l;
+    for (const MethodInfo& m : methods()) {
+      py::dict d;
+      d["name"] = m.name;
+      d["family"] = std::string(family_key(m.family));
+      d["order"] = m.order;
+      d["stages"] = m.stages;
+      d["evals_per_step"] = m.evals_per_step;
+      d["description"] = m.description;
+      l.append(d);
+    }
+    return l;
+  });
+  mod.def("_integrate", &integrate_py, py::arg("scene"), py::arg("method"), py::arg("h"), py::arg("steps"),
+          py::arg("t_end"), py::arg("tol"), py::arg("invariants"), py::arg("omega_c"), py::arg("events"));
+  mod.def("_trajectory", &trajectory_py, py::arg("scene"), py::arg("method"), py::arg("step"), py::arg("times"),
+          py::arg("omega_c"));
+  mod.def("_sweep", &sweep_py, py::arg("axes"), py::arg("methods"), py::arg("base"), py::arg("h"), py::arg("steps"),
+          py::arg("t_end"), py::arg("tol"), py::arg("threads"));
+  mod.def("_encounter", &encounter_py, py::arg("scene"), py::arg("method"), py::arg("tol"), py::arg("t_end"));
+}

@@ -1,0 +1,152 @@
+"""The Python module (`import bodypoint`): results equal to the command line's to the last bit, arrays
+of the right shapes, errors as bodypoint.Error. ctest runs this file with the module of the build tree
+(PYTHONPATH) and the command line (BODYPOINT_BIN)."""
+import csv
+import io
+import json
+import math
+import os
+import subprocess
+import threading
+
+import numpy as np
+import pytest
+
+import bodypoint as bp
+
+BIN = os.environ.get("BODYPOINT_BIN", "bodypoint")
+SOURCE = os.environ.get("BODYPOINT_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+
+# A trajectory landing on intermediate times merges no sub-steps across them, so it agrees with one
+# run of the same steps to round-off of ~1e3 steps, not bit for bit (bodypoint.hpp, Stepper).
+SEGMENTED_RUN_TOL = 1e-12
+# docs/physics.md's scattering check: the accuracy mode at tol 1e-12 gives Rutherford's deflection to
+# ~1e-12 (the scattering study's largest difference over 61 b is 6.7e-13); a newcomer is promised 1e-6.
+RUTHERFORD_TOL = 1e-10
+
+
+def cli(*args):
+    out = subprocess.run([BIN, *args], check=True, capture_output=True, text=True, stdin=subprocess.DEVNULL)
+    return out.stdout
+
+
+def test_methods_are_the_catalogue():
+    rows = list(csv.DictReader(io.StringIO(cli("methods", "--csv"))))
+    assert [m["name"] for m in bp.methods()] == [r["method"] for r in rows]
+    assert {m["family"] for m in bp.methods()} == {r["family"] for r in rows}
+
+
+def test_fixed_step_run_equals_the_command_line_bit_for_bit():
+    scene = bp.thesis_scene()
+    got = bp.integrate(scene, "lp-y4", h=1e-3, steps=20000)["bodies"][0]
+    want = json.loads(cli("simulate", "--method", "lp-y4", "--h", "1e-3", "--steps", "20000", "--json"))
+    for key in ("R", "v", "w"):
+        assert got[key].tolist() == want[key]
+    assert got["force_evals"] == want["force_evals"]
+    assert got["invariants"]["max_rel_dE"] == want["max_rel_dE"]
+
+
+def test_scene_parameters_and_accuracy_mode_equal_the_command_line():
+    scene = bp.thesis_scene(Kz=0.1, d=0.05)
+    got = bp.integrate(scene, tol=1e-8, t_end=80)["bodies"][0]
+    want = json.loads(cli("simulate", "--tol", "1e-8", "--Kz", "0.1", "--d", "0.05", "--t-end", "80", "--json"))
+    assert got["method"] == want["method"]
+    assert got["R"].tolist() == want["R"]
+    assert got["accuracy"]["err_estimate"] == want["err_estimate"]
+    assert got["accuracy"]["err_estimate"] <= 1e-8
+
+
+def test_time_transformed_and_controlled_runs_reach_t_end():
+    scene = bp.thesis_scene()
+    for method, kw in (("logh-kl8", dict(h=0.05, t_end=50)), ("gsl-rk8pd", dict(tol=1e-12, t_end=50)),
+                       ("odeint-rkf78", dict(tol=1e-12, t_end=50))):
+        if method not in {m["name"] for m in bp.methods()}:
+            continue
+        b = bp.integrate(scene, method, **kw)["bodies"][0]
+        assert b["outcome"] == "ok" and b["t_end"] == 50.0, method
+
+
+def test_trajectory_arrays_at_requested_times():
+    scene = bp.thesis_scene()
+    times = np.linspace(0.0, 50.0, 11)
+    for method, step in (("lp-kl8", 0.05), ("rk4", 1e-3), ("logh-kl8", 0.05), ("gsl-rk8pd", 1e-12)):
+        if method not in {m["name"] for m in bp.methods()}:
+            continue
+        tr = bp.trajectory(scene, method, step, times)[0]
+        assert tr["t"].shape == (11,) and tr["R"].shape == (11, 3) and tr["v"].shape == (11, 3)
+        assert tr["R"][0].tolist() == scene.bodies[0]["R"].tolist()
+        end = bp.integrate(scene, "lp-kl8", h=0.05, t_end=50)["bodies"][0]["R"]
+        assert np.max(np.abs(tr["R"][-1] - end)) / np.linalg.norm(end) < 1e-9, method
+    one = bp.integrate(scene, "lp-kl8", h=0.05, t_end=50)["bodies"][0]["R"]
+    seg = bp.trajectory(scene, "lp-kl8", 0.05, times)[0]["R"][-1]
+    assert np.linalg.norm(seg - one) / np.linalg.norm(one) < SEGMENTED_RUN_TOL
+
+
+def test_sweep_columns_equal_the_command_line_sweep():
+    cols = bp.sweep({"d": [5, 10]}, ["lp-y4", "rk4"], steps=1000)
+    n = len(cols["method"])
+    assert n == 4 and all(len(v) == n for v in cols.values())
+    text = cli("sweep", "--param", "d", "--values", "5,10", "--methods", "lp-y4,rk4", "--steps", "1000")
+    rows = list(csv.DictReader(line for line in io.StringIO(text) if not line.startswith("#")))
+    assert [r["method"] for r in rows] == list(cols["method"])
+    for i, r in enumerate(rows):
+        assert float(r["d"]) == cols["d"][i]
+        for c in ("Rx", "Ry", "Rz", "max_rel_dE", "max_abs_dK2Q"):
+            assert float(r[c]) == cols[c][i], c
+        assert int(r["force_evals"]) == cols["force_evals"][i]
+
+
+def test_grid_is_every_combination_last_axis_fastest():
+    cols = bp.sweep({"d": [5, 10], "L": [100, 200, 300]}, "lp-y4", steps=100, threads=2)
+    assert list(cols["d"]) == [5, 5, 5, 10, 10, 10]
+    assert list(cols["L"]) == [100, 200, 300] * 2
+    assert set(cols["outcome"]) == {"ok"}
+
+
+def test_rutherford_deflection_for_a_material_point():
+    A, m = -2.0, 1.0
+    for b in (0.1, 1.0, 10.0):
+        scene = bp.thesis_scene(B=0, b=b)
+        e = bp.encounter(scene, t_end=2 * 200 / 5.0, tol=1e-12)
+        rutherford = 2 * math.atan(abs(A) / (m * e["v_inf"] ** 2 * e["b"]))
+        assert abs(e["deflection"] / rutherford - 1) < RUTHERFORD_TOL, b
+        assert abs(e["b"] / b - 1) < 1e-12
+
+
+def test_scene_from_dicts_and_from_a_file_are_one_scene():
+    f = bp.read_scene(os.path.join(SOURCE, "scenes", "two-centres.toml"))
+    again = bp.Scene(centres=f.centres, bodies=f.bodies)
+    a = bp.integrate(f, "lp-y4", h=1e-2, steps=1000)["bodies"]
+    b = bp.integrate(again, "lp-y4", h=1e-2, steps=1000)["bodies"]
+    assert [x["R"].tolist() for x in a] == [x["R"].tolist() for x in b]
+
+
+@pytest.mark.parametrize("call, words", [
+    (lambda: bp.integrate(bp.thesis_scene(B=2.0), "lp-y4", h=1e-3, steps=10), "D = m J - B^2"),
+    (lambda: bp.integrate(bp.thesis_scene(), "lp-y5", h=1e-3, steps=10), "did you mean"),
+    (lambda: bp.integrate(bp.thesis_scene(), "lp-y4", h=float("nan"), steps=10), "h must be"),
+    (lambda: bp.integrate(bp.thesis_scene(), "lp-y4", h=-1.0, steps=10), "h must be"),
+    (lambda: bp.integrate(bp.thesis_scene(), tol=1e-8), "t_end"),
+    (lambda: bp.thesis_scene(q=1.0), "q"),
+    (lambda: bp.Scene(centres=[{"c": (0, 0, 0), "A": -2}], bodies=[{"R": (0, 0, 0), "v": (1, 0, 0)}]), "centre"),
+    (lambda: bp.trajectory(bp.thesis_scene(), "lp-y4", 1e-3, [2.0, 1.0]), "increasing"),
+])
+def test_bad_input_raises_one_line_error(call, words):
+    with pytest.raises(bp.Error) as e:
+        call()
+    assert words in str(e.value) and "\n" not in str(e.value)
+
+
+def test_runs_in_threads_release_the_gil():
+    scene = bp.thesis_scene()
+    results = [None] * 4
+
+    def work(i):
+        results[i] = bp.integrate(scene, "lp-kl8", h=1e-3, steps=20000)["bodies"][0]["R"].tolist()
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert all(r == results[0] for r in results)
