@@ -257,6 +257,10 @@ void check_view_options(const po::variables_map& vm, const ViewOptions& o) {
     throw Error("this binary was built without the viewer's script: run scripts/setup.sh (it needs npm) to "
                 "install experiments/viewer's packages, then rebuild");
   if (o.frames < 16 || o.frames > 10'000'000) throw Error("--frames must be between 16 and 10000000");
+  // The page is HTML whatever its name: a name like v.png would hold HTML that no image viewer opens.
+  const std::string_view html = ".html";
+  if (o.out.size() <= html.size() || o.out.compare(o.out.size() - html.size(), html.size(), html) != 0)
+    throw Error("--out " + o.out + ": the viewer writes an HTML page; give a name ending in .html");
   if (!(std::isfinite(o.max_mb) && o.max_mb > 0.0)) throw Error("--max-mb must be a finite number > 0");
   if (vm.count("compare-h") && !vm.count("compare")) throw Error("--compare-h needs --compare");
   if (vm.count("compare-h") && !(std::isfinite(o.compare_h) && o.compare_h > 0.0))

@@ -124,6 +124,11 @@ TEST(View, BadInputIsRefusedWithoutAPage) {
     for (const auto& e : fs::directory_iterator(dir))
       EXPECT_EQ(e.path().string().find(".tmp."), std::string::npos) << args << ": temporary left behind";
   }
+  // An output name that is not .html would hold HTML under an image's name.
+  const auto png = run_cli("view --steps 10 --out " + (dir / "v.png").string());
+  EXPECT_NE(png.code, 0);
+  EXPECT_NE(png.err.find("ending in .html"), std::string::npos) << png.err;
+  EXPECT_FALSE(fs::exists(dir / "v.png"));
   const auto unwritable = run_cli("view --steps 10 --out /nonexistent-dir/v.html");
   EXPECT_NE(unwritable.code, 0);
   EXPECT_NE(unwritable.err.find("cannot write output file"), std::string::npos) << unwritable.err;
