@@ -9,6 +9,7 @@
 #include <exception>
 #include <string>
 #include <utility>
+#include <variant>
 
 namespace bodypoint::cli {
 
@@ -63,7 +64,9 @@ BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre
   options.sink = sink;
   options.every = spec.every;
   options.omega_c = spec.omega_c;
-  const Advance how = plan.search ? Advance(Accuracy{plan.tol, spec.t_end, spec.dt_out}) : advance_of(*plan.method, spec);
+  Advance how = plan.search ? Advance(Accuracy{plan.tol, spec.t_end, spec.dt_out}) : advance_of(*plan.method, spec);
+  if (auto* fixed = std::get_if<FixedSteps>(&how)) fixed->dt_out = spec.dt_out;
+  if (auto* controlled = std::get_if<ControlledSteps>(&how)) controlled->dt_out = spec.dt_out;
   BodyResult r = integrate_body(body, centres, plan.method, how, options);
   if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) throw Error(r.reason);
   BodyRun b;

@@ -167,7 +167,7 @@ void add_simulate_options(po::options_description& desc, SimulateOptions& o) {
       ("tol", po::value(&o.tol)->default_value(o.tol),
        "odeint-*/gsl-*: error tolerance per step; any other method: the final state's relative error "
        "(R and v) to deliver, the step is chosen for it")
-      ("dt-out", po::value(&o.dt_out), "with --out, time-transformed methods: write states at t = k dt-out")
+      ("dt-out", po::value(&o.dt_out), "with --out: write the states at t = k dt-out (and at the end), every method")
       ("omega-c", po::value(&o.omega_c), "time-transformed methods: constant c added to the time-step function "
        "(physical step <= ds/c); default: from the scene's spin-orbit rate")
       ("every", po::value(&o.every)->default_value(o.every), "with --out: write every k-th step (and the last)")
@@ -196,8 +196,6 @@ void apply_output_options(const po::variables_map& vm, const SimulateOptions& o,
   RunSpec& spec = plan.spec;
   if (plan.search && vm.count("omega-c")) throw Error("--tol uses the automatic time-step constant: drop --omega-c");
   if (vm.count("dt-out")) {
-    if (plan.method && !is_time_transformed(*plan.method))
-      throw Error("--dt-out is for time-transformed methods (logh-*, ttl-*, ks)");
     if (!(o.dt_out > 0.0) || !std::isfinite(o.dt_out)) throw Error("--dt-out must be a finite number > 0");
     if (!vm.count("out")) throw Error("--dt-out needs --out");
     spec.dt_out = o.dt_out;
@@ -212,7 +210,8 @@ void apply_output_options(const po::variables_map& vm, const SimulateOptions& o,
   if (vm.count("out") && !plan.search) {
     // Rows the output would get: one per dt-out, or per every-th step (fictitious steps to t_end are
     // not known in advance: the sink counts them and stops the run at the limit).
-    const double rows = spec.dt_out > 0.0 ? spec.t_end / spec.dt_out
+    const double span = spec.t_end > 0.0 ? spec.t_end : spec.h * static_cast<double>(spec.steps);
+    const double rows = spec.dt_out > 0.0 ? span / spec.dt_out
                         : spec.steps > 0 ? static_cast<double>(spec.steps) / static_cast<double>(spec.every) : 0.0;
     if (rows * static_cast<double>(scene.bodies.size()) > o.max_rows)
       throw Error("--out would get about " + fmt(std::ceil(rows)) + " rows per body, more than --max-rows " +

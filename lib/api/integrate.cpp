@@ -11,6 +11,7 @@
 #include <cmath>
 #include <iterator>
 #include <limits>
+#include <optional>
 #include <type_traits>
 #include <utility>
 
@@ -190,7 +191,7 @@ detail::Advancer advancer(const BodyResult& r, const Body& body, const std::vect
     Advance a;
     if (is_time_transformed(m)) a = FictitiousSteps{step, tau, 0, 0.0};
     else if (is_step_controlled(m)) a = ControlledSteps{std::min(step, tau), tau, tol};
-    else a = FixedSteps{tau, 1};
+    else a = fixed_steps_to(tau, step);  // one step of tau inside a step; steps <= h across output times
     const BodyResult x = integrate_valid_body(from, centres, &m, a, sub);
     evals += x.run.force_evals;
     if (x.outcome == Outcome::refused || x.outcome == Outcome::failed) {
@@ -201,14 +202,78 @@ detail::Advancer advancer(const BodyResult& r, const Body& body, const std::vect
   };
 }
 
+/// The output interval of any way of advancing time (0: none).
+double output_interval(const Advance& how) {
+  return std::visit([](const auto& a) -> double { return a.dt_out; }, how);
+}
+
+/// The sink of a fixed-step or step-size-controlled run with output times: it observes every step and
+/// hands the caller the states at t = k dt_out, each from the step that contains it, taken again from
+/// that step's start for the shorter time (the run's own method and configuration: `advance`), then
+/// the last state. The time-transformed methods do the same inside their loop (FictitiousLoop).
+class OutputTimesSink {
+ public:
+  OutputTimesSink(const Body& body, const std::vector<Centre>& centres, double dt_out, const SampleSink& user,
+                  detail::Advancer advance)
+      : field_{centres}, monitor_(body.p, field_, body.s0), dt_out_(dt_out), user_(user), advance_(std::move(advance)) {}
+  void operator()(const Sample& x) {
+    if (!started_) {
+      started_ = true;
+      emit(x);  // t = 0
+      next_ = 1;
+    } else {
+      for (double t = next_time(); t <= x.t; t = next_time()) {
+        if (t == x.t) {
+          emit(x);
+        } else {
+          const State s = advance_(prev_s_, t - prev_t_, evals_);
+          monitor_.update(s);
+          user_(Sample{x.step, t, s, monitor_.last_rel_dE(), monitor_.last_rel_dK2sq(), monitor_.last_abs_dK2Q()});
+          last_t_ = t;
+        }
+        ++next_;
+      }
+    }
+    prev_t_ = x.t;
+    prev_s_ = x.s;
+    prev_ = Last{x.step, x.t, x.s, x.rel_dE, x.rel_dK2sq, x.abs_dK2Q};
+  }
+  /// The last state, unless it was an output time.
+  void finish() {
+    if (prev_ && prev_->t > last_t_) user_(Sample{prev_->step, prev_->t, prev_->s, prev_->dE, prev_->dK2, prev_->dK2Q});
+  }
+  [[nodiscard]] long evals() const { return evals_; }
+
+ private:
+  struct Last {
+    long step;
+    double t;
+    State s;
+    double dE, dK2, dK2Q;
+  };
+  [[nodiscard]] double next_time() const { return static_cast<double>(next_) * dt_out_; }
+  void emit(const Sample& x) {
+    user_(x);
+    last_t_ = x.t;
+  }
+  CentreList field_;
+  InvariantMonitor<CentreList> monitor_;
+  double dt_out_;
+  const SampleSink& user_;
+  detail::Advancer advance_;
+  bool started_ = false;
+  long next_ = 0, evals_ = 0;
+  double prev_t_ = 0.0, last_t_ = -1.0;
+  State prev_s_;
+  std::optional<Last> prev_;
+};
+
 /// integrate_body for a body and centres already validated.
 BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
                                 const Advance& how, const Options& options) {
   if (!options.events.empty()) {
     // Every observed state goes through the watch; the run itself is the one asked for.
-    const double dt_out = std::holds_alternative<FictitiousSteps>(how) ? std::get<FictitiousSteps>(how).dt_out
-                          : std::holds_alternative<Accuracy>(how)       ? std::get<Accuracy>(how).dt_out
-                                                                        : 0.0;
+    const double dt_out = output_interval(how);
     // The accuracy mode hands its delivered run's states on after its search: it cannot be stopped
     // mid-run, only cut at the event afterwards.
     const bool accuracy = std::holds_alternative<Accuracy>(how);
@@ -235,6 +300,27 @@ BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& cen
     r.outcome = Outcome::ok;
     r.reason.clear();
     judge(r);
+    return r;
+  }
+  const bool own_steps = std::holds_alternative<FixedSteps>(how) || std::holds_alternative<ControlledSteps>(how);
+  if (const double dt_out = output_interval(how); own_steps && dt_out != 0.0 && !(std::isfinite(dt_out) && dt_out > 0.0))
+    throw Error("dt_out must be a finite number > 0 (or 0: no output times)");
+  if (options.sink && own_steps && output_interval(how) > 0.0) {
+    const double dt_out = output_interval(how);
+    if (!method) throw Error("only the accuracy mode chooses a method by itself; name one");
+    BodyResult probe;
+    probe.method = method;
+    OutputTimesSink outputs(body, centres, dt_out, *options.sink, advancer(probe, body, centres, how, options));
+    const SampleSink sink = [&outputs](const Sample& x) { outputs(x); };
+    Options inner = options;
+    inner.sink = &sink;
+    inner.every = 1;
+    Advance plain = how;
+    std::visit([](auto& a) { a.dt_out = 0.0; }, plain);
+    BodyResult r = integrate_valid_body(body, centres, method, plain, inner);
+    if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return r;
+    outputs.finish();
+    r.event_force_evals += outputs.evals();
     return r;
   }
   BodyResult r;

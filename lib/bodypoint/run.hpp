@@ -159,10 +159,13 @@ Health assess(const RunResult& r);
 /// and Odeint's fixed-step loop, under one observer: run_support.hpp); fixed fictitious steps ds to
 /// exactly t_end, or `steps` of them when t_end = 0, with output times dt_out (FictitiousLoop,
 /// adaptive/run.cpp); step-size control to exactly t_end at tolerance tol from a first trial step h0
-/// (controlled_loop, run_support.hpp).
+/// (controlled_loop, run_support.hpp). dt_out > 0 (with a sink) hands the sink the states at
+/// t = k dt_out and at the end instead of every `every`-th step's; fixed and controlled steps reach an
+/// output time inside a step by a shorter step of the same method from that step's start (integrate.cpp).
 struct FixedSteps {
   double h;
   long steps;
+  double dt_out = 0.0;
 };
 struct FictitiousSteps {
   double ds, t_end;
@@ -171,6 +174,7 @@ struct FictitiousSteps {
 };
 struct ControlledSteps {
   double h0, t_end, tol;
+  double dt_out = 0.0;
 };
 /// The accuracy mode: the final state's relative error max(|dR|/|R|, |dv|/|v|) at t_end is to be at
 /// most tol; the step (h, or ds) is searched with a Richardson error estimate (adaptive/tolerance.hpp).

@@ -3,6 +3,7 @@
 // run as one run of the same steps would.
 #include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/bodypoint.hpp"
+#include "bodypoint/reference.hpp"
 #include "bodypoint/sweep.hpp"
 
 #include <gtest/gtest.h>
@@ -10,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <utility>
 #include <vector>
 
 namespace bodypoint {
@@ -21,6 +23,11 @@ namespace {
 constexpr double kSegmentRoundOff = 1e-12;
 /// Sample times are t0 + i h with h = 0.01: a few ulp of times of order 1.
 constexpr double kTimeRoundOff = 1e-12;
+
+/// Output times inside a step are reached by a shorter step of the same method from the step's start:
+/// the sample differs from the exact state by the method's own error at these steps (lp-kl8 and logh-kl8
+/// at 0.01, rk4 at h = 1e-3, rk8pd and rkf78 at tol 1e-12, over t = 2 on table 3.1).
+constexpr double kOutputTimeError = 1e-10;
 
 Scene thesis() { return thesis_scene(SceneParams{}); }
 
@@ -215,6 +222,50 @@ TEST(Api, AStepperRefusesTimeThatDoesNotAdvanceAndKeepsItsState) {
   EXPECT_EQ(ks.advance_to(1.0), Outcome::refused);
   EXPECT_EQ(ks.time(), 0.0);
   EXPECT_FALSE(ks.reason().empty());
+}
+
+TEST(Api, EveryFamilyHandsOnStatesAtOutputTimes) {
+  // dt_out = 0.3 is no multiple of the step: each output time lies inside a step (issue #23).
+  const Scene s = thesis();
+  const Body& b = s.bodies.front();
+  constexpr double kDtOut = 0.3, kEnd = 2.0;
+  const std::vector<std::pair<const char*, Advance>> runs = {
+      {"lp-kl8", fixed_steps_to(kEnd, 0.01)},
+      {"rk4", fixed_steps_to(kEnd, 0.001)},
+      {"odeint-rkf78", ControlledSteps{1e-3, kEnd, 1e-12}},
+      {"gsl-rk8pd", ControlledSteps{1e-3, kEnd, 1e-12}},
+      {"logh-kl8", FictitiousSteps{0.01, kEnd, 0, 0.0}},
+  };
+  for (const auto& [name, plain] : runs) {
+    if (!find_method(name)) continue;  // built without GSL
+    Advance with = plain;
+    std::visit([](auto& a) { a.dt_out = kDtOut; }, with);
+    std::vector<std::pair<double, State>> got;
+    const SampleSink sink = [&got](const Sample& x) { got.emplace_back(x.t, x.s); };
+    Options o;
+    o.sink = &sink;
+    const Result r = integrate(s, name, with, o);
+    ASSERT_EQ(r.outcome, Outcome::ok) << name << ": " << r.reason;
+    // t = 0, 0.3, ..., 1.8 and the end.
+    ASSERT_EQ(got.size(), 8u) << name;
+    for (std::size_t k = 0; k + 1 < got.size(); ++k) {
+      EXPECT_EQ(got[k].first, static_cast<double>(k) * kDtOut) << name;
+      if (k > 0) {
+        EXPECT_LT(rel(got[k].second.R, reference_state(b, s.centres, got[k].first).R), kOutputTimeError)
+            << name << " t=" << got[k].first;
+      }
+    }
+    EXPECT_EQ(got.back().first, kEnd) << name;
+    // The run itself is the one without output times, to the last bit.
+    const Result bare = integrate(s, name, plain, Options{});
+    EXPECT_EQ(r.bodies[0].run.final.R, bare.bodies[0].run.final.R) << name;
+    EXPECT_EQ(got.back().second.R, bare.bodies[0].run.final.R) << name;
+  }
+  Advance bad = FixedSteps{0.01, 10, -1.0};
+  const SampleSink none = [](const Sample&) {};
+  Options o;
+  o.sink = &none;
+  EXPECT_THROW(integrate(s, "lp-y4", bad, o), Error);
 }
 
 TEST(Api, MultiBodyTotalsAreTheSumOfTheBodies) {
