@@ -201,7 +201,7 @@ class Search {
 
   /// The pilot pair at h0 and h0/2 (a refused step halves h0); sets the first estimate and returns
   /// the finer run (never delivered: an estimate from the pilot pair alone was
-  /// off by 25x on two-centres at 1e-4, README "Limits").
+  /// off by 25x on two-centres at 1e-4, docs/developers.md, "Limits, measured").
   Level pilot(Level& coarse) {
     double h = initial_step(m_, b_, c_, t_end_);
     for (int k = 0;; ++k) {

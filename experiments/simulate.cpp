@@ -237,13 +237,16 @@ class TrajectoryFile {
   TrajectoryFile(const std::string& path, const SimulateOptions& o, const po::variables_map& vm, const RunPlan& plan,
                  const Scene& scene)
       : file_(path), writer_(file_.stream(), select_observables(scene.centres, o.observe), true), max_rows_(o.max_rows) {
+    // The column names come first, the description after them as comments: numpy's
+    // genfromtxt(names=True, comments="#") takes the first line for the names, pandas' read_csv
+    // (comment="#") the first line that is not a comment; both read the file as it is.
+    writer_.header();
     std::ostream& os = file_.stream();
     os << "# bodypoint simulate, revision " << git_revision() << "\n# method=" << o.method_name;
     if (plan.search) os << " tol=" << fmt(plan.tol) << " t_end=" << fmt(plan.spec.t_end);
     else os << " h=" << fmt(plan.spec.h) << " steps=" << plan.spec.steps;
     os << " every=" << plan.spec.every << " " << scene_header(vm, o.so) << "\n";
     writer_.help();
-    writer_.header();
   }
   SampleSink sink(long body, const BodyPoint& p) {
     return [this, body, &p](const Sample& s) {

@@ -243,14 +243,14 @@ TEST(Cli, ObserveAddsTheSpinAngleColumn) {
   ASSERT_EQ(r.code, 0) << r.err;
   std::ifstream in(out);
   std::string line, header;
-  while (std::getline(in, line) && line.rfind("#", 0) == 0) {
-  }
-  header = line;
+  // The names are the first line (numpy's genfromtxt(names=True) reads them there), the comments follow.
+  std::getline(in, header);
   ASSERT_EQ(header, "body,t,Rx,Ry,Rz,vx,vy,vz,wx,wy,wz,rel_dE,rel_dK2sq,abs_dK2Q,spin_angle");
   const double m = 1.0, B = 0.7;  // the default scene (thesis table 3.1)
   int rows = 0;
   double lo = 4.0, hi = -1.0;
   while (std::getline(in, line)) {
+    if (line.rfind("#", 0) == 0) continue;
     std::vector<double> x;
     std::stringstream ss(line);
     for (std::string cell; std::getline(ss, cell, ',');) x.push_back(std::stod(cell));
