@@ -247,6 +247,10 @@ class TrajectoryFile {
     else os << " h=" << fmt(plan.spec.h) << " steps=" << plan.spec.steps;
     os << " every=" << plan.spec.every << " " << scene_header(vm, o.so) << "\n";
     writer_.help();
+    // The body column holds each body's index in the scene (a number, for numpy); its name is here.
+    os << "# body names:";
+    for (std::size_t i = 0; i < scene.bodies.size(); ++i) os << (i ? ", " : " ") << i << " = " << scene.bodies[i].name;
+    os << "\n";
   }
   SampleSink sink(long body, const BodyPoint& p) {
     return [this, body, &p](const Sample& s) {
