@@ -139,7 +139,16 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
   std::string fixed = "# fixed: " + describe(spec.base) + (grid ? " (the varied ones excepted)" : " (the varied one excepted)");
   if (!sweeps_h) fixed += " h=" + fmt(spec.h);
   fixed += spec.t_end > 0 ? " t_end=" + fmt(spec.t_end) : " steps=" + std::to_string(spec.steps);
-  return {"# bodypoint sweep, revision " + std::string(git_revision()),
+  // The column names come first, the description after them as comments (numpy's
+  // genfromtxt(names=True, comments="#") takes the first line for the names; pandas' read_csv(comment="#")
+  // the first line that is not a comment).
+  std::string columns =
+      names + ",method,max_rel_dE,max_rel_dK2sq,max_abs_dK2Q,Rx,Ry,Rz,force_evals,wall_s,status,reason" +
+      (spec.scattering ? ",r_min,t_min,deflection,out_of_plane,b_in,v_inf_in,time_delay,K1_turn,spin_turn,K1x,K1y,K1z,"
+                         "asymptotes"
+                       : "");
+  return {std::move(columns),
+          "# bodypoint sweep, revision " + std::string(git_revision()),
           "# command: " + command,
           "# varied: " + varied + (grid ? " (a grid: every combination, the last one varying fastest)" : ""),
           fixed,
@@ -158,11 +167,7 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
                                 " time_delay = against free motion, Coulomb logarithm removed; K1_turn, spin_turn ="
                                 " angles K1 and K2 turned over the run (rad); K1x,K1y,K1z = final K1;"
                                 " asymptotes = kepler | guiding-centre | none: why (docs/physics.md, Scattering)"
-                              : ""),
-          names + ",method,max_rel_dE,max_rel_dK2sq,max_abs_dK2Q,Rx,Ry,Rz,force_evals,wall_s,status,reason" +
-              (spec.scattering ? ",r_min,t_min,deflection,out_of_plane,b_in,v_inf_in,time_delay,K1_turn,spin_turn,K1x,K1y,K1z,"
-                                 "asymptotes"
-                               : "")};
+                              : "")};
 }
 
 std::string sweep_key(const SweepSpec& spec) {
