@@ -162,10 +162,10 @@ void measure_peer_ladders(const NamedScene& ns, const State& ref, long repeats, 
 }
 
 void write_tol_rows(std::ostream& csv, const std::vector<TolRow>& rows) {
-  csv << "# bodypoint work-precision --by-tol, revision " << git_revision() << "\n"
+  csv << "scene,method,kind,tol,h,err_estimate,err,met,runs,force_evals,wall_s\n"
+      << "# bodypoint work-precision --by-tol, revision " << git_revision() << "\n"
       << "# err = max(|dR|/|R_ref|, |dv|/|v_ref|) against odeint rkf78 in long double at tol 1e-18; met = err <= tol\n"
-      << "# wall_s = median over repeats of the step loops (auto: all runs of its search); h = ds for logh/ttl/ks\n"
-      << "scene,method,kind,tol,h,err_estimate,err,met,runs,force_evals,wall_s\n";
+      << "# wall_s = median over repeats of the step loops (auto: all runs of its search); h = ds for logh/ttl/ks\n";
   for (const TolRow& r : rows)
     csv << CsvLine().text(r.scene).text(r.method).text(r.is_auto ? "auto" : r.is_ladder ? "ladder" : "at-tol")
                .num(r.tol).num_if(r.is_auto, r.h).num_if(r.is_auto, r.err_estimate).num(r.err)

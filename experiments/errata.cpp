@@ -182,9 +182,9 @@ Scene with_law(SceneParams p, ForceLaw law) {
 }  // namespace
 
 void write_errata(std::ostream& csv) {
-  csv << "# bodypoint study errata: the thesis's errata and its published code's faults, measured on table 3.1\n"
-      << "# (T = 25, h = 1e-4 unless a row says otherwise); revision " << git_revision() << "\n"
-      << "key,value,description\n";
+  csv << "key,value,description\n"
+      << "# bodypoint study errata: the thesis's errata and its published code's faults, measured on table 3.1\n"
+      << "# (T = 25, h = 1e-4 unless a row says otherwise); revision " << git_revision() << "\n";
   Writer w{csv};
   const SceneParams table;
   SceneParams material = table;

@@ -82,11 +82,11 @@ double measured_order(const MethodInfo& m, const Probe& p, std::size_t* used) {
 }  // namespace
 
 void write_orders(std::ostream& csv) {
-  csv << "# bodypoint study orders: slope of the final-position error against the step, fitted above\n"
+  csv << "method,nominal,encounter,encounter_points,orbit,orbit_points\n"
+      << "# bodypoint study orders: slope of the final-position error against the step, fitted above\n"
       << "# round-off (lib/bodypoint/order_fit.hpp), on the encounter (L = 20, d = 1, t = 3) and the bound\n"
       << "# orbit (A = 1, t = 30) of tests/lib/test_convergence.cpp, B = 0.7 (ks: B = 0); time-transformed\n"
-      << "# methods with c = 0; empty: the method does not run there; revision " << git_revision() << "\n"
-      << "method,nominal,encounter,encounter_points,orbit,orbit_points\n";
+      << "# methods with c = 0; empty: the method does not run there; revision " << git_revision() << "\n";
   const Probe enc_spin = probe(convergence_encounter(0.7)), enc_material = probe(convergence_encounter(0.0));
   const Probe orb_spin = probe(convergence_orbit(0.7)), orb_material = probe(convergence_orbit(0.0));
   for (const MethodInfo& m : methods()) {

@@ -120,18 +120,18 @@ void write_scattering_study(const std::filesystem::path& dir, bool quick, unsign
   const double A = SceneParams{}.A, m = SceneParams{}.m;
   AtomicFile csv((dir / "scattering.csv").string()), summary((dir / "scattering_summary.csv").string());
   std::ostream& os = csv.stream();
-  os << "# bodypoint study --name scattering" << (quick ? " --quick" : "") << ", revision " << git_revision()
+  os << "series,B,Kx,Kz,b,d,v_inf,theta,theta_rutherford,rel_diff_rutherford,out_of_plane,dsigma_domega,"
+        "dsigma_rutherford,rainbow,r_min,t_min,r_end,spin_turn,K1_turn,time_delay,asymptotes,method,tol,force_evals,failure\n"
+     << "# bodypoint study --name scattering" << (quick ? " --quick" : "") << ", revision " << git_revision()
      << ": thesis table 3.1 with B and spin (Kx, Kz) per series, d solved for the incoming impact parameter b, "
         "the accuracy mode at tol " << fmt(kStudyTolerance) << " (" << fmt(kRetryLooser)
      << "x looser where out of reach; column tol) to t_end = 2 L / v_inf; no asymptotes where the body does not "
-        "drift away along K1\n"
-     << "series,B,Kx,Kz,b,d,v_inf,theta,theta_rutherford,rel_diff_rutherford,out_of_plane,dsigma_domega,"
-        "dsigma_rutherford,rainbow,r_min,t_min,r_end,spin_turn,K1_turn,time_delay,asymptotes,method,tol,force_evals,failure\n";
+        "drift away along K1\n";
   std::ostream& ss = summary.stream();
-  ss << "# bodypoint study --name scattering" << (quick ? " --quick" : "") << ", revision " << git_revision()
-     << ": one row per series; rainbows where dtheta/db changes sign (b of the extremum between grid points)\n"
-     << "series,B,Kx,Kz,points,failed,max_rel_diff_rutherford,theta_at_smallest_b,theta_material_point_at_smallest_b,"
-        "max_abs_out_of_plane,rainbows,first_rainbow_b,min_r_min,force_evals\n";
+  ss << "series,B,Kx,Kz,points,failed,max_rel_diff_rutherford,theta_at_smallest_b,theta_material_point_at_smallest_b,"
+        "max_abs_out_of_plane,rainbows,first_rainbow_b,min_r_min,force_evals\n"
+     << "# bodypoint study --name scattering" << (quick ? " --quick" : "") << ", revision " << git_revision()
+     << ": one row per series; rainbows where dtheta/db changes sign (b of the extremum between grid points)\n";
   for (std::size_t si = 0; si < all.size(); ++si) {
     const Series& s = all[si];
     const Point* row = &points[si * bs.size()];

@@ -154,9 +154,9 @@ std::vector<StressRow> run_stress(bool quick, const std::function<void(const Str
 }
 
 void write_stress(std::ostream& csv, std::ostream& md, const std::vector<StressRow>& rows) {
-  csv << "# bodypoint study stress, revision " << git_revision() << "\n"
-      << "# status: ok | refused (not run, reason) | diverged | collision (flagged, reason); max_rel_dE only for runs\n"
-      << "case,method,status,max_rel_dE,steps,wall_s,reason\n";
+  csv << "case,method,status,max_rel_dE,steps,wall_s,reason\n"
+      << "# bodypoint study stress, revision " << git_revision() << "\n"
+      << "# status: ok | refused (not run, reason) | diverged | collision (flagged, reason); max_rel_dE only for runs\n";
   for (const StressRow& r : rows) {
     csv << CsvLine().quoted(r.case_name).text(r.method).text(r.status).num(r.max_rel_dE).count(r.steps)
                .num(r.wall_s).quoted(r.reason).str()

@@ -135,12 +135,12 @@ void study_evals(const StudyContext& c) {
   const Scene scene = thesis_scene(SceneParams{});
   AtomicFile f((c.dir / "force_evals.csv").string());
   std::ostream& os = f.stream();
-  os << "# bodypoint study evals (thesis table 4.1), revision " << git_revision() << "\n"
+  os << "method,order,stages,evals_per_step,measured_per_step\n"
+     << "# bodypoint study evals (thesis table 4.1), revision " << git_revision() << "\n"
      << "# evals_per_step: as listed by 'bodypoint methods'; measured_per_step: force evaluations of a\n"
      << "# 1000-step run on table 3.1 divided by 1000 (adaptive methods: per accepted step, tol 1e-10;\n"
      << "# time-transformed methods: per fictitious step of ds = 1e-3; ks: on table 3.1 with B = 0, and it\n"
-     << "# evaluates no force at all: its regularised flow is exact)\n"
-     << "method,order,stages,evals_per_step,measured_per_step\n";
+     << "# evaluates no force at all: its regularised flow is exact)\n";
   SceneParams material;
   material.B = 0.0;
   const Scene material_scene = thesis_scene(material);
@@ -208,9 +208,9 @@ void study_appendix(const StudyContext& c) {
   const long steps = 250000, every = c.quick ? 2500 : 250;
   AtomicFile index((dir / "index.csv").string());
   std::ostream& ix = index.stream();
-  ix << "# bodypoint study appendix (thesis appendix 1): thesis-euler, h = 1e-4, n = 250000, every "
-     << every << "-th step written; revision " << git_revision() << "\n"
-     << "figure,A,m,B,J,L,d,K1,Kz,Kx,status,file,max_rel_dE,max_rel_dK2sq\n";
+  ix << "figure,A,m,B,J,L,d,K1,Kz,Kx,status,file,max_rel_dE,max_rel_dK2sq\n"
+     << "# bodypoint study appendix (thesis appendix 1): thesis-euler, h = 1e-4, n = 250000, every "
+     << every << "-th step written; revision " << git_revision() << "\n";
   for (const AppendixSet& set : appendix_sets()) {
     SceneParams p;
     p.A = -0.5;
@@ -229,9 +229,9 @@ void study_appendix(const StudyContext& c) {
     const std::string name = "P1." + std::to_string(set.figure) + ".csv";
     AtomicFile f((dir / name).string());
     std::ostream& os = f.stream();
-    os << "# thesis appendix 1, fig. P1." << set.figure << "; thesis-euler h=1e-4 n=250000\n";
     const TrajectoryWriter writer(os, select_observables(scene.centres), false);
-    writer.header();
+    writer.header();  // the names first (numpy's genfromtxt(names=True)), the description after them
+    os << "# thesis appendix 1, fig. P1." << set.figure << "; thesis-euler h=1e-4 n=250000\n";
     const BodyPoint& bp = scene.bodies.front().p;
     SampleSink sink = [&writer, &bp](const Sample& s) { writer.row(0, s, bp); };
     RunSpec rs;

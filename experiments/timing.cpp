@@ -52,12 +52,12 @@ std::vector<TimingRow> run_timing(const TimingSpec& spec, bool progress) {
 void write_timing_csv(std::ostream& os, const TimingSpec& spec, const std::vector<TimingRow>& rows,
                       const std::string& command) {
   const SceneParams& p = spec.base;
-  os << "# bodypoint timing, revision " << git_revision() << "\n"
+  os << "n,method,median_s,min_s,max_s,repeats,force_evals\n"
+     << "# bodypoint timing, revision " << git_revision() << "\n"
      << "# command: " << command << "\n"
      << "# scene: " << describe(p) << " h=" << fmt(spec.h) << "\n"
      << "# " << spec.warmup << " warm-up run(s), then " << spec.repeats
-     << " timed repeats of the step loop alone (no invariants, no output), one thread\n"
-     << "n,method,median_s,min_s,max_s,repeats,force_evals\n";
+     << " timed repeats of the step loop alone (no invariants, no output), one thread\n";
   for (const TimingRow& r : rows)
     os << CsvLine().count(r.n).text(r.method->name).num(r.median_s).num(r.min_s).num(r.max_s).count(r.repeats)
               .count(r.force_evals).str()

@@ -200,13 +200,13 @@ void run_ladder(const NamedScene& ns, const MethodInfo& m, const State& ref, con
 }
 
 void write_rows(std::ostream& os, const std::vector<Row>& rows, const std::string& refs) {
-  os << "# bodypoint work-precision, revision " << git_revision() << "\n"
+  os << "scene,method,h,tol,err_R,err_rel,max_rel_dE,force_evals,wall_s\n"
+     << "# bodypoint work-precision, revision " << git_revision() << "\n"
      << "# err_R = |R(t_end) - R_ref| against odeint rkf78 in long double at tol 1e-18; err_rel = err_R/|R_ref|\n"
      << "# wall_s = median over repeats of the step loop alone (no invariants, no output)\n";
   std::istringstream ref_lines(refs);
   for (std::string line; std::getline(ref_lines, line);) os << "# " << line << "\n";
-  os << "# h is the fictitious step ds for time-transformed methods (logh-*, ttl-*, ks)\n"
-     << "scene,method,h,tol,err_R,err_rel,max_rel_dE,force_evals,wall_s\n";
+  os << "# h is the fictitious step ds for time-transformed methods (logh-*, ttl-*, ks)\n";
   for (const Row& r : rows)
     os << CsvLine().text(r.scene).text(r.method).num_if(r.h > 0, r.h).num_if(r.tol > 0, r.tol).num(r.err_R)
               .num(r.err_rel).num(r.max_rel_dE).count(r.force_evals).num(r.wall_s).str()
