@@ -306,6 +306,16 @@ void report_json(const std::vector<BodyRun>& runs, const Scene& scene, const Run
             << ", \"t_end\": " << json_number(r0.result.t_end) << ", " << json_body(r0.result, r0.err_R, r0.err_rel)
             << events_json(o.events, r0) << scattering_json(enc.front());
   if (runs.size() > 1) {
+    // The run's totals (the top-level fields above are the first body's): every body's force
+    // evaluations, its accuracy search and its events included, and its step-loop time.
+    long evals = 0;
+    double wall = 0.0;
+    for (const BodyRun& r : runs) {
+      evals += (r.search ? r.search->force_evals : r.result.force_evals) + r.event_force_evals;
+      wall += r.search ? r.search->wall_s : r.result.wall_s;
+    }
+    std::cout << ", \"run\": {\"bodies\": " << runs.size() << ", \"force_evals\": " << evals
+              << ", \"wall_s\": " << json_number(wall) << "}";
     std::cout << ", \"bodies\": [";
     for (std::size_t b = 0; b < runs.size(); ++b)
       std::cout << (b ? ", " : "") << "{\"name\": " << json_string(scene.bodies[b].name) << ", \"method\": "

@@ -116,6 +116,19 @@ TEST(Cli, SceneFileWithSeveralCentresAndBodies) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("\"bodies\": ["), std::string::npos);
   EXPECT_EQ(r.out.find("max_abs_dK2Q"), std::string::npos) << "K2Q is not an integral with two centres";
+  // The run's totals: the sum over the bodies, whose own counts follow in "bodies" (the top-level
+  // force_evals is the first body's).
+  const auto run_at = r.out.find("\"run\": {");
+  ASSERT_NE(run_at, std::string::npos) << r.out;
+  const std::string run = r.out.substr(run_at, r.out.find('}', run_at) - run_at);
+  EXPECT_EQ(json_num(run, "bodies"), 2);
+  const std::string bodies = r.out.substr(r.out.find("\"bodies\": ["));
+  const std::regex evals("\"force_evals\": ([0-9]+)");
+  double sum = 0.0;
+  for (auto it = std::sregex_iterator(bodies.begin(), bodies.end(), evals); it != std::sregex_iterator(); ++it)
+    sum += std::stod((*it)[1]);
+  EXPECT_EQ(json_num(run, "force_evals"), sum);
+  EXPECT_GT(sum, json_num(r.out, "force_evals"));
 }
 
 struct BadInput {
