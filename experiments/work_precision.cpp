@@ -7,6 +7,7 @@
 // ladder of steps (halving h) or tolerances (dividing by 10) is run; each configuration is timed as
 // the median of several repeats with no invariant tracking and no output inside the timed region, and
 // run once more, untimed, to measure max_rel_dE.
+#include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
 #include "bodypoint/reference.hpp"
@@ -287,8 +288,17 @@ int cmd_work_precision(int argc, char** argv) {
   if (!a.out.empty()) csv = std::make_unique<AtomicFile>(a.out);
   if (!a.summary.empty()) md = std::make_unique<AtomicFile>(a.summary);
   if (a.by_tol) {
+    // Every tolerance is one the accuracy mode takes (finite, in [1e-13, 1)): a nan, 0 or 2 made nan rows.
+    const std::vector<double> tols = parse_numbers(a.tols, "--tols");
+    for (double tol : tols) {
+      try {
+        adaptive::check_tolerance(tol);
+      } catch (const Error& e) {
+        throw Error("--tols: " + std::string(e.what()));
+      }
+    }
     std::ostringstream sum;
-    run_by_tolerance(scenes, parse_numbers(a.tols, "--tols"), a.o.repeats, csv ? &csv->stream() : nullptr, sum);
+    run_by_tolerance(scenes, tols, a.o.repeats, csv ? &csv->stream() : nullptr, sum);
     report(sum.str(), " --by-tol", csv.get(), md.get());
     return 0;
   }

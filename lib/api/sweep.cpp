@@ -133,6 +133,10 @@ void validate_sweep(const SweepSpec& spec) {
     for (const Axis& other : spec.axes)
       if ((a.param == "b" && other.param == "d") || (a.param == "v_inf" && other.param == "K1"))
         throw Error("the sweep varies " + a.param + " and " + other.param + ", which it solves for " + a.param);
+  // A step-size-controlled method's tolerance, checked once for the sweep (each row refused it before).
+  for (const MethodInfo* m : spec.methods)
+    if (is_step_controlled(*m) && !(std::isfinite(spec.tol) && spec.tol > 0.0))
+      throw Error("the tolerance tol of " + m->name + " must be a finite number > 0");
   const std::size_t points = task_count(spec) / spec.methods.size();
   for (std::size_t p = 0; p < points; ++p) {
     const std::vector<double> point = grid_point(spec, p);

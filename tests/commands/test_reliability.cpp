@@ -57,6 +57,11 @@ TEST(Reliability, EveryIssueExampleEndsWithItsReason) {
       {"timing --values 1e308", "must be at most"},
       {"simulate --scene /dev/zero", "not a regular file"},
       {"simulate --ou x.csv --steps 10", "unrecognised option '--ou'"},
+      // Issue #24: tolerances that wrote nan rows.
+      {"work-precision --by-tol --tols 1e-4,nan --scenes material", "--tols: tol must be a finite number > 0"},
+      {"work-precision --by-tol --tols 2 --scenes material", "--tols: tol must be below 1"},
+      {"work-precision --by-tol --tols 1e-20 --scenes material", "--tols: tol below 1e-13"},
+      {"sweep --param d --values 5 --methods odeint-rkf78 --steps 10 --tol nan", "tolerance tol of odeint-rkf78"},
   };
   for (const Example& c : cases) {
     const auto t0 = std::chrono::steady_clock::now();
