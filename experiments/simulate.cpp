@@ -195,6 +195,14 @@ void add_simulate_options(po::options_description& desc, SimulateOptions& o) {
 void apply_output_options(const po::variables_map& vm, const SimulateOptions& o, const Scene& scene, RunPlan& plan) {
   RunSpec& spec = plan.spec;
   if (plan.search && vm.count("omega-c")) throw Error("--tol uses the automatic time-step constant: drop --omega-c");
+  if (vm.count("omega-c")) {
+    // Given, it is used: a constant c >= 0 for a time-transformed method (issue #24: -5, nan and a
+    // fixed-step method's --omega-c were ignored).
+    if (!(std::isfinite(o.omega_c) && o.omega_c >= 0.0)) throw Error("--omega-c must be a finite number >= 0");
+    if (plan.method && (!is_time_transformed(*plan.method) || plan.method->family == Family::Regularised))
+      throw Error("--omega-c is the time-step constant of the time-transformed methods (logh-*, ttl-*); " +
+                  plan.method->name + " does not take it");
+  }
   if (vm.count("dt-out")) {
     if (!(o.dt_out > 0.0) || !std::isfinite(o.dt_out)) throw Error("--dt-out must be a finite number > 0");
     if (!vm.count("out")) throw Error("--dt-out needs --out");

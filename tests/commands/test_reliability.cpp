@@ -62,6 +62,12 @@ TEST(Reliability, EveryIssueExampleEndsWithItsReason) {
       {"work-precision --by-tol --tols 2 --scenes material", "--tols: tol must be below 1"},
       {"work-precision --by-tol --tols 1e-20 --scenes material", "--tols: tol below 1e-13"},
       {"sweep --param d --values 5 --methods odeint-rkf78 --steps 10 --tol nan", "tolerance tol of odeint-rkf78"},
+      // Issue #24: options that were silently ignored.
+      {"simulate --method logh-y4 --h 0.1 --t-end 1 --omega-c -5", "--omega-c must be a finite number >= 0"},
+      {"simulate --method logh-y4 --h 0.1 --t-end 1 --omega-c nan", "--omega-c must be a finite number >= 0"},
+      {"simulate --method lp-y4 --steps 10 --omega-c 0.1", "lp-y4 does not take it"},
+      {"work-precision --tols 1e-4", "--tols is for --by-tol"},
+      {"work-precision --scenes ,", "--scenes is empty"},
   };
   for (const Example& c : cases) {
     const auto t0 = std::chrono::steady_clock::now();
