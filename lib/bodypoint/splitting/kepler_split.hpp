@@ -58,15 +58,8 @@ struct KeplerSplitKernel {
   void drift(LieState& x, double tau) const {
     if constexpr (Spin) {
       const double BD = p.B * inv_D_;
-      const Vec3 Omega = -BD * x.K1;
-      const Vec3 u = Omega.cross(x.K2);
-      const Vec3 W = Omega.cross(u);
-      const DriftFunctions f = drift_functions(Omega.squaredNorm() * tau * tau);
-      const double t2 = tau * tau;
-      const Vec3 dR = -BD * (tau * x.K2 + (t2 * f.C1) * u + (t2 * tau * f.S3) * W);
-      x.K2 += (tau * f.S1) * u + (t2 * f.C1) * W;
-      x.K2 += ((x.K2sq0 - x.K2.squaredNorm()) * x.half_inv_K2sq0) * x.K2;
-      compensated_add(x.R, x.R_err, dR);
+      const Vec3 straight = (-BD * tau) * x.K2;  // with K2 before it turns
+      compensated_add(x.R, x.R_err, straight + precess(x, BD, tau));
     } else {
       (void)x;
       (void)tau;

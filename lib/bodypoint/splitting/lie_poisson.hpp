@@ -106,6 +106,24 @@ inline DriftFunctions drift_functions(double x) {
   return {s / phi, (1.0 - c) / x, (phi - s) / (x * phi)};
 }
 
+/// The spin part of the kinetic drift for tau, shared by the Lie-Poisson drift and the Kepler split's
+/// spin-orbit flow: K2 turns about K1 (Omega = -(B/D) K1, BD = B/D), rescaled to its initial length,
+/// and the returned vector is what the turning adds to R beyond the straight -(B/D) tau K2(0):
+/// -(B/D) [tau^2 C1 u + tau^3 S3 W] (file comment).
+inline Vec3 precess(LieState& x, double BD, double tau) {
+  const Vec3 Omega = -BD * x.K1;
+  const Vec3 u = Omega.cross(x.K2);
+  const Vec3 W = Omega.cross(u);
+  const DriftFunctions f = drift_functions(Omega.squaredNorm() * tau * tau);
+  const double t2 = tau * tau;
+  const Vec3 dR = -BD * ((t2 * f.C1) * u + (t2 * tau * f.S3) * W);
+  x.K2 += (tau * f.S1) * u + (t2 * f.C1) * W;
+  // Added as a correction, not as a factor: 1 + delta with delta ~ 1e-16 would round to 1 or
+  // 1 +- 2.2e-16 and over-correct systematically.
+  x.K2 += ((x.K2sq0 - x.K2.squaredNorm()) * x.half_inv_K2sq0) * x.K2;
+  return dR;
+}
+
 /// Exact drift and kick for one body-point in `Field`. `Spin = false` requires B = 0.
 template <class Field, bool Spin>
 struct LiePoissonKernel {
@@ -126,18 +144,8 @@ struct LiePoissonKernel {
     if constexpr (!Spin) {
       compensated_add(x.R, x.R_err, (tau * inv_m_) * x.K1);  // B = 0: v = K1/m
     } else {
-      const double BD = p.B * inv_D_;
-      const Vec3 Omega = -BD * x.K1;
-      const Vec3 u = Omega.cross(x.K2);
-      const Vec3 W = Omega.cross(u);
-      const DriftFunctions f = drift_functions(Omega.squaredNorm() * tau * tau);
-      const double t2 = tau * tau;
-      const Vec3 dR = (tau * inv_D_) * (p.J * x.K1 - p.B * x.K2) - BD * ((t2 * f.C1) * u + (t2 * tau * f.S3) * W);
-      x.K2 += (tau * f.S1) * u + (t2 * f.C1) * W;
-      // Added as a correction, not as a factor: 1 + delta with delta ~ 1e-16 would round to 1 or
-      // 1 +- 2.2e-16 and over-correct systematically.
-      x.K2 += ((x.K2sq0 - x.K2.squaredNorm()) * x.half_inv_K2sq0) * x.K2;
-      compensated_add(x.R, x.R_err, dR);
+      const Vec3 straight = (tau * inv_D_) * (p.J * x.K1 - p.B * x.K2);  // with K2 before it turns
+      compensated_add(x.R, x.R_err, straight + precess(x, p.B * inv_D_, tau));
     }
   }
 
