@@ -73,20 +73,12 @@ struct SearchLimit : Error {
   using Error::Error;
 };
 
-/// A sample kept until its run is known to be the delivered one.
-struct KeptSample {
-  long step;
-  double t;
-  State s;
-  double rel_dE, rel_dK2sq, abs_dK2Q;
-};
-
 struct Level {
   double h = 0.0;
   long steps = 0;
   double omega_c = 0.0;
   RunResult run;
-  std::vector<KeptSample> samples;
+  std::vector<KeptSample> samples;  ///< kept until the run is known to be the delivered one
 };
 
 int effective_order(const MethodInfo& m, const Body& b) {
@@ -159,7 +151,7 @@ class Search {
     out.total_force_evals = total_evals_;
     out.total_wall_s = total_wall_;
     if (delivery_.sink)
-      for (const KeptSample& k : best.samples) (*delivery_.sink)(Sample{k.step, k.t, k.s, k.rel_dE, k.rel_dK2sq, k.abs_dK2Q});
+      for (const KeptSample& k : best.samples) (*delivery_.sink)(k.sample());
     return out;
   }
 
@@ -178,7 +170,7 @@ class Search {
       s.every = delivery_.every;
       s.dt_out = delivery_.sink ? delivery_.dt_out : 0.0;
       if (delivery_.sink)
-        keep = [&l](const Sample& x) { l.samples.push_back({x.step, x.t, x.s, x.rel_dE, x.rel_dK2sq, x.abs_dK2Q}); };
+        keep = [&l](const Sample& x) { l.samples.push_back(KeptSample::of(x)); };
     }
     const double expected = expected_evals(s);
     if (spent_evals_ + expected > kMaxEvals)

@@ -118,23 +118,17 @@ class WatchingSink {
       (*user_)(s);
       pending_.reset();
     } else {
-      pending_ = Pending{s.step, s.t, s.s, s.rel_dE, s.rel_dK2sq, s.abs_dK2Q};
+      pending_ = KeptSample::of(s);
     }
   }
   /// The last state: the one the every-th rule skipped, or the stop event's (its deviations given).
   void finish(const EventHit* stop, double rel_dE, double rel_dK2sq, double abs_dK2Q) {
     if (!user_) return;
     if (stop) (*user_)(Sample{stop_step_, stop->t, stop->s, rel_dE, rel_dK2sq, abs_dK2Q});
-    else if (pending_) (*user_)(Sample{pending_->step, pending_->t, pending_->s, pending_->dE, pending_->dK2, pending_->dK2Q});
+    else if (pending_) (*user_)(pending_->sample());
   }
 
  private:
-  struct Pending {
-    long step;
-    double t;
-    State s;
-    double dE, dK2, dK2Q;
-  };
   detail::EventWatch& watch_;
   const std::vector<Event>& events_;
   const SampleSink* user_;
@@ -143,7 +137,7 @@ class WatchingSink {
   bool stopped_ = false;
   std::size_t seen_ = 0;
   long stop_step_ = 0;
-  std::optional<Pending> pending_;
+  std::optional<KeptSample> pending_;
 };
 
 /// A run cut at its stop event `hit` (a state of the run's own steps): the final state and time are
@@ -217,8 +211,7 @@ class OutputTimesSink {
                   detail::Advancer advance)
       : field_{centres}, monitor_(body.p, field_, body.s0), dt_out_(dt_out), user_(user), advance_(std::move(advance)) {}
   void operator()(const Sample& x) {
-    if (!started_) {
-      started_ = true;
+    if (!prev_) {
       emit(x);  // t = 0
       next_ = 1;
     } else {
@@ -226,7 +219,7 @@ class OutputTimesSink {
         if (t == x.t) {
           emit(x);
         } else {
-          const State s = advance_(prev_s_, t - prev_t_, evals_);
+          const State s = advance_(prev_->s, t - prev_->t, evals_);
           monitor_.update(s);
           user_(Sample{x.step, t, s, monitor_.last_rel_dE(), monitor_.last_rel_dK2sq(), monitor_.last_abs_dK2Q()});
           last_t_ = t;
@@ -234,23 +227,15 @@ class OutputTimesSink {
         ++next_;
       }
     }
-    prev_t_ = x.t;
-    prev_s_ = x.s;
-    prev_ = Last{x.step, x.t, x.s, x.rel_dE, x.rel_dK2sq, x.abs_dK2Q};
+    prev_ = KeptSample::of(x);
   }
   /// The last state, unless it was an output time.
   void finish() {
-    if (prev_ && prev_->t > last_t_) user_(Sample{prev_->step, prev_->t, prev_->s, prev_->dE, prev_->dK2, prev_->dK2Q});
+    if (prev_ && prev_->t > last_t_) user_(prev_->sample());
   }
   [[nodiscard]] long evals() const { return evals_; }
 
  private:
-  struct Last {
-    long step;
-    double t;
-    State s;
-    double dE, dK2, dK2Q;
-  };
   [[nodiscard]] double next_time() const { return static_cast<double>(next_) * dt_out_; }
   void emit(const Sample& x) {
     user_(x);
@@ -261,11 +246,9 @@ class OutputTimesSink {
   double dt_out_;
   const SampleSink& user_;
   detail::Advancer advance_;
-  bool started_ = false;
   long next_ = 0, evals_ = 0;
-  double prev_t_ = 0.0, last_t_ = -1.0;
-  State prev_s_;
-  std::optional<Last> prev_;
+  double last_t_ = -1.0;
+  std::optional<KeptSample> prev_;  ///< the last step's state, from which an output time inside the next is reached
 };
 
 /// integrate_body for a body and centres already validated.

@@ -43,6 +43,15 @@ struct Sample {
   const State& s;
   double rel_dE, rel_dK2sq, abs_dK2Q;
 };
+/// A Sample that owns its state, for a sink that hands a state on later than it saw it.
+struct KeptSample {
+  long step = 0;
+  double t = 0.0;
+  State s;
+  double rel_dE = 0.0, rel_dK2sq = 0.0, abs_dK2Q = 0.0;
+  static KeptSample of(const Sample& x) { return {x.step, x.t, x.s, x.rel_dE, x.rel_dK2sq, x.abs_dK2Q}; }
+  [[nodiscard]] Sample sample() const { return {step, t, s, rel_dE, rel_dK2sq, abs_dK2Q}; }
+};
 using SampleSink = std::function<void(const Sample&)>;
 /// Thrown by a sink to end a run after the state it was just handed (an event that stops the run).
 /// The run returns what it has: that state as final, its step and time, the invariants up to it,
