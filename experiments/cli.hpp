@@ -67,6 +67,7 @@ struct BodyRun {
   std::string reason;  ///< of an outcome other than ok
   std::vector<EventHit> events;  ///< the events asked for, located
   long event_force_evals = 0;
+  long total_force_evals = 0;  ///< the run, the accuracy search and the events (BodyResult::total_force_evals)
 };
 /// Runs one body as planned through the library (plan.cpp; integrate_body; spec may add invariants, output
 /// steps and a sink to plan.spec). A method that refuses the scene or a run that fails throws Error

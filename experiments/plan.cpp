@@ -78,6 +78,7 @@ BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre
   b.reason = std::move(r.reason);
   b.events = std::move(r.events);
   b.event_force_evals = r.event_force_evals;
+  b.total_force_evals = r.total_force_evals();
   return b;
 }
 

@@ -319,7 +319,7 @@ void report_json(const std::vector<BodyRun>& runs, const Scene& scene, const Run
     long evals = 0;
     double wall = 0.0;
     for (const BodyRun& r : runs) {
-      evals += (r.search ? r.search->force_evals : r.result.force_evals) + r.event_force_evals;
+      evals += r.total_force_evals;
       wall += r.search ? r.search->wall_s : r.result.wall_s;
     }
     std::cout << ", \"run\": {\"bodies\": " << runs.size() << ", \"force_evals\": " << evals
