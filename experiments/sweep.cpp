@@ -375,7 +375,7 @@ void write_output(const SweepJob& job, AtomicFile* file, RowJournal* journal, co
     write_sweep_csv(file->stream(), job.spec, rows, job.command);
   }
   file->commit();
-  journal->remove();
+  if (journal) journal->remove();
 }
 
 /// Under mpirun: rank 0 opens the output and the journal and coordinates; the other ranks compute.
@@ -392,7 +392,7 @@ void run_job_mpi(const SweepJob& job) {
   try {
     validate_sweep(job.spec);
     if (!job.out.empty()) file = std::make_unique<AtomicFile>(job.out);
-    if (file)
+    if (file && !file->direct())
       journal = std::make_unique<RowJournal>(job.out + ".journal", sweep_key(job.spec), task_count(job.spec),
                                              sweep_header(job.spec, job.command), job.resume);
   } catch (...) {
@@ -413,7 +413,8 @@ void run_job(const SweepJob& job) {
   const std::vector<std::string> header = sweep_header(job.spec, job.command);
   const std::size_t tasks = task_count(job.spec);
   std::unique_ptr<RowJournal> journal;
-  if (file) journal = std::make_unique<RowJournal>(job.out + ".journal", sweep_key(job.spec), tasks, header, job.resume);
+  if (file && file->direct() && job.resume) throw Error("--resume needs an --out that is a file (a FIFO or device keeps no journal)");
+  if (file && !file->direct()) journal = std::make_unique<RowJournal>(job.out + ".journal", sweep_key(job.spec), tasks, header, job.resume);
   SweepControl control{thread_count(job.threads), ::isatty(2) == 1, job.shard, job.shards, journal.get(), !job.no_simd};
   std::vector<std::string> rows;
   try {

@@ -16,6 +16,8 @@
 #include <mutex>
 #include <set>
 #include <signal.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <sstream>
 #include <unistd.h>
 #include <vector>
@@ -75,65 +77,126 @@ extern "C" void on_signal(int sig) {
   ::raise(sig);
 }
 
-/// True when a process with this pid exists (a lock whose writer has died is stale).
-bool process_alive(long pid) { return pid > 0 && (::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM); }
-
-/// Removes "<target>.tmp.<pid>.*", the temporaries a writer killed without cleanup (kill -9) left.
-void remove_temporaries(const std::string& target, long pid) {
+/// Removes "<target>.tmp.<digits>.<digits>", temporaries of writers that died without cleanup (kill -9,
+/// power loss). Called by the holder of the target's lock: every writer holds the lock for as long as its
+/// temporary exists, so no live writer owns one of these.
+void remove_orphaned_temporaries(const std::string& target) {
   namespace fs = std::filesystem;
   const fs::path t(target);
-  const std::string prefix = t.filename().string() + ".tmp." + std::to_string(pid) + ".";
+  const std::string prefix = t.filename().string() + ".tmp.";
+  auto ours = [&](const std::string& name) {
+    if (name.rfind(prefix, 0) != 0) return false;
+    const std::string rest = name.substr(prefix.size());  // "<pid>.<counter>"
+    const std::size_t dot = rest.find('.');
+    auto digits = [](std::string_view x) {
+      return !x.empty() && std::all_of(x.begin(), x.end(), [](char c) { return c >= '0' && c <= '9'; });
+    };
+    return dot != std::string::npos && digits(std::string_view(rest).substr(0, dot)) &&
+           digits(std::string_view(rest).substr(dot + 1));
+  };
   std::error_code ec;
   const fs::path dir = t.has_parent_path() ? t.parent_path() : fs::path(".");
   for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
-    if (it->path().filename().string().rfind(prefix, 0) == 0) fs::remove(it->path(), ec);
+    if (ours(it->path().filename().string()) && it->is_regular_file(ec)) fs::remove(it->path(), ec);
 }
 
-/// Creates path exclusively with our pid in it; a stale lock (its writer is gone) is replaced once.
-void take_lock(const std::string& lock, const std::string& target) {
-  for (int attempt = 0; attempt < 2; ++attempt) {
-    const int fd = ::open(lock.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
-    if (fd >= 0) {
-      const std::string pid = std::to_string(::getpid()) + "\n";
-      const bool ok = ::write(fd, pid.data(), pid.size()) == static_cast<ssize_t>(pid.size());
+/// The pid a lock file names ("" when it names none yet: its writer locks before it writes the pid).
+std::string lock_holder(int fd) {
+  char buf[32] = {};
+  const ssize_t n = ::pread(fd, buf, sizeof buf - 1, 0);
+  std::string pid(buf, n > 0 ? static_cast<std::size_t>(n) : 0);
+  while (!pid.empty() && (pid.back() == '\n' || pid.back() == ' ')) pid.pop_back();
+  return std::all_of(pid.begin(), pid.end(), [](char c) { return c >= '0' && c <= '9'; }) ? pid : std::string();
+}
+
+/// Takes the target's lock: an flock on "<target>.lock", which the kernel holds for exactly as long as
+/// the writer lives (kill -9 releases it; no pid is ever guessed, so a lock file left behind, empty or
+/// naming any pid of any namespace, is simply taken). A writer removes the lock file before it lets go of
+/// the lock, so a writer that locked a file just removed finds another inode at the path and tries again.
+/// Returns the lock's descriptor.
+int take_lock(const std::string& lock, const std::string& target) {
+  constexpr int kAttempts = 1000;  // each retry means another writer finished in between
+  for (int attempt = 0; attempt < kAttempts; ++attempt) {
+    const int fd = ::open(lock.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd < 0) {
+      if (errno == ELOOP) throw Error("the lock file " + lock + " of '" + target + "' is a symbolic link; remove it");
+      throw Error("cannot write output file '" + target + "' (directory missing or not writable)");
+    }
+    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+      const int e = errno;
+      const std::string pid = lock_holder(fd);
       ::close(fd);
-      if (!ok) {
+      if (e == EWOULDBLOCK)
+        throw Error("another run" + (pid.empty() ? std::string() : " (pid " + pid + ")") + " is writing '" + target +
+                    "' (lock file " + lock + "); wait for it or choose another path");
+      throw Error("cannot lock '" + target + "' (" + std::strerror(e) + ")");
+    }
+    struct stat held {}, named {};
+    if (::fstat(fd, &held) == 0 && ::stat(lock.c_str(), &named) == 0 && held.st_dev == named.st_dev &&
+        held.st_ino == named.st_ino) {
+      const std::string pid = std::to_string(::getpid()) + "\n";
+      if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, pid.data(), pid.size(), 0) != static_cast<ssize_t>(pid.size())) {
         ::unlink(lock.c_str());
+        ::close(fd);
         throw Error("cannot write output file '" + target + "' (writing its lock file failed)");
       }
-      return;
+      remove_orphaned_temporaries(target);
+      return fd;
     }
-    if (errno != EEXIST) throw Error("cannot write output file '" + target + "' (directory missing or not writable)");
-    std::ifstream in(lock);
-    long pid = 0;
-    in >> pid;
-    if (process_alive(pid))
-      throw Error("another run (pid " + std::to_string(pid) + ") is writing '" + target + "' (lock file " + lock +
-                  "); wait for it or choose another path");
-    // Stale: its writer is gone (kill -9, power loss), so are its temporaries. They go first: killed
-    // between the two, this run leaves the lock that names them for the next run to clean up (the
-    // other order orphaned a temporary that no lock names; ASan's slow start made that window real).
-    remove_temporaries(target, pid);
-    ::unlink(lock.c_str());
+    ::close(fd);  // the file we locked was removed by its finishing writer: lock the new one
   }
   throw Error("cannot take the lock file " + lock + " of '" + target + "'");
+}
+
+/// Where an output path leads: the regular file (or the place of a new one) that a symbolic link
+/// names, followed link by link, so that the link stays and its target is replaced.
+std::string resolve_links(const std::string& path) {
+  namespace fs = std::filesystem;
+  fs::path p(path);
+  for (int hop = 0; hop < 40; ++hop) {
+    struct stat st {};
+    if (::lstat(p.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) return p.string();
+    std::error_code ec;
+    const fs::path to = fs::read_symlink(p, ec);
+    if (ec) throw Error("cannot read the symbolic link '" + p.string() + "': " + ec.message());
+    p = to.is_absolute() ? to : p.parent_path() / to;
+  }
+  throw Error("output '" + path + "' is a loop of symbolic links");
 }
 
 }  // namespace
 
 AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
   if (path_.empty()) throw Error("output path is empty");
-  key_ = key_of(path_);
+  if (path_ == "-")
+    throw Error("output '-': the command prints its report on standard output, so data cannot go there; give a file name");
+  if (std::any_of(path_.begin(), path_.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20; }))
+    throw Error("output path contains a control character (a newline or tab); choose another name");
+  // What the path names: a regular file (or nothing yet) is replaced atomically; a FIFO or character
+  // device (/dev/null, /dev/stdout, a pipe) is written directly and never replaced; anything else is refused.
+  struct stat st {};
+  if (::stat(path_.c_str(), &st) == 0) {
+    if (S_ISDIR(st.st_mode)) throw Error("output '" + path_ + "' is a directory; give a file name");
+    if (S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode)) {
+      open_direct(S_ISFIFO(st.st_mode));
+      return;
+    }
+    if (!S_ISREG(st.st_mode)) throw Error("output '" + path_ + "' is neither a regular file, a FIFO nor a character device");
+  } else if (errno != ENOENT && errno != ENOTDIR) {
+    throw Error("cannot write output file '" + path_ + "' (" + std::strerror(errno) + ")");
+  }
+  target_ = resolve_links(path_);
+  key_ = key_of(target_);
   {
     std::lock_guard<std::mutex> g(g_paths_mutex);
     if (g_inputs.count(key_)) throw Error("output '" + path_ + "' is an input of this run; choose another path");
     if (g_outputs.count(key_)) throw Error("two outputs of this run write '" + path_ + "'; give them different paths");
     g_outputs.insert(key_);
   }
-  tmp_ = path_ + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(g_counter.fetch_add(1));
-  lock_ = path_ + ".lock";
+  tmp_ = target_ + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(g_counter.fetch_add(1));
+  lock_ = target_ + ".lock";
   try {
-    take_lock(lock_, path_);
+    lock_fd_ = take_lock(lock_, path_);
   } catch (...) {
     std::lock_guard<std::mutex> g(g_paths_mutex);
     g_outputs.erase(key_);
@@ -147,27 +210,48 @@ AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
   }
 }
 
+void AtomicFile::open_direct(bool fifo) {
+  direct_ = true;
+  int probe = -1;
+  if (fifo) {
+    // Opening a FIFO for writing waits for a reader; without one, say so instead of waiting forever.
+    // The probe stays open until the stream is, so the reader never sees the FIFO without a writer.
+    probe = ::open(path_.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+    if (probe < 0)
+      throw Error(errno == ENXIO ? "output '" + path_ + "' is a FIFO that nobody reads; start its reader first"
+                                 : "cannot write output file '" + path_ + "' (" + std::strerror(errno) + ")");
+  }
+  out_.open(path_, std::ios::out);
+  if (probe >= 0) ::close(probe);
+  if (!out_) throw Error("cannot write output file '" + path_ + "' (" + std::strerror(errno) + ")");
+}
+
 void AtomicFile::release() noexcept {
   if (out_.is_open()) out_.close();
+  if (direct_) return;
   if (!committed_) std::remove(tmp_.c_str());
-  ::unlink(lock_.c_str());
   if (slot_ >= 0) g_slots[slot_].used.store(false);
   slot_ = -1;
+  if (lock_fd_ >= 0) {
+    ::unlink(lock_.c_str());  // before the lock is let go: see take_lock
+    ::close(lock_fd_);
+    lock_fd_ = -1;
+  }
   std::lock_guard<std::mutex> g(g_paths_mutex);
   g_outputs.erase(key_);
 }
 
 AtomicFile::~AtomicFile() {
-  if (slot_ >= 0 || !committed_) release();
+  if (slot_ >= 0 || lock_fd_ >= 0 || !committed_) release();
 }
 
 void AtomicFile::commit() {
   out_.flush();
   const bool ok = static_cast<bool>(out_);
   out_.close();
-  if (!ok || out_.fail()) throw Error("writing '" + path_ + "' failed (disk full?)");
-  if (std::rename(tmp_.c_str(), path_.c_str()) != 0)
-    throw Error("cannot move the finished output onto '" + path_ + "'");
+  if (!ok || out_.fail()) throw Error("writing '" + path_ + "' failed (disk full or file size limit?)");
+  if (!direct_ && std::rename(tmp_.c_str(), target_.c_str()) != 0)
+    throw Error("cannot move the finished output onto '" + path_ + "' (" + std::strerror(errno) + ")");
   committed_ = true;
   release();
 }
@@ -181,7 +265,11 @@ void install_signal_cleanup() {
   struct sigaction sa {};
   sa.sa_handler = on_signal;
   sigemptyset(&sa.sa_mask);
-  for (const int sig : {SIGINT, SIGTERM, SIGHUP}) ::sigaction(sig, &sa, nullptr);
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF, SIGPIPE})
+    ::sigaction(sig, &sa, nullptr);
+  // Past `ulimit -f` a write fails (EFBIG) and the output's commit reports it, instead of the default
+  // SIGXFSZ ending the process with its temporary and lock in place.
+  ::signal(SIGXFSZ, SIG_IGN);
 }
 
 int interrupted() { return g_signal.load(); }

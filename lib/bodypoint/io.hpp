@@ -2,11 +2,13 @@
 //
 // `AtomicFile` writes to a temporary file beside the target and renames it over the target on
 // commit(), so a failed or interrupted run never leaves a half-written result: each output has its
-// own temporary name, a lock file (<path>.lock with the writer's pid) refuses a second writer of the
-// same path (a lock whose writer died without cleanup, as by kill -9, is taken over and that writer's
-// temporaries removed), an output that is another output or an input of the same run is refused, and SIGINT,
-// SIGTERM and SIGHUP remove every temporary and lock file (install_signal_cleanup). Numbers are
-// written so that a value read back is exactly the value computed.
+// own temporary name, an flock on <target>.lock (which names the writer's pid) refuses a second writer
+// of the same path for as long as the first lives (kill -9 releases it; the next writer removes the
+// temporaries it left), an output that is another output or an input of the same run is refused, and
+// the terminating signals remove every temporary and lock file (install_signal_cleanup). Only a regular
+// file is ever replaced: a symbolic link's target is replaced and the link kept, a FIFO or character
+// device (/dev/null, /dev/stdout) is written directly, a directory or anything else is refused before
+// any work. Numbers are written so that a value read back is exactly the value computed.
 #pragma once
 
 #include "bodypoint/model.hpp"
@@ -20,8 +22,9 @@ namespace bodypoint {
 
 class AtomicFile {
  public:
-  /// Opens "<path>.tmp.<pid>" for writing; throws Error if that is impossible (missing directory,
-  /// no permission), before any computation has been spent.
+  /// Opens "<target>.tmp.<pid>.<n>" for writing (or, for a FIFO or device, the path itself); throws
+  /// Error if that is impossible (missing directory, no permission, a directory, a FIFO nobody reads),
+  /// before any computation has been spent.
   explicit AtomicFile(std::string path);
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
@@ -31,20 +34,24 @@ class AtomicFile {
   std::ofstream& stream() { return out_; }
   /// Flushes, closes and renames onto the target path; throws Error on any failure.
   void commit();
+  /// True when the output is a FIFO or a device, written directly (nothing to resume from).
+  [[nodiscard]] bool direct() const { return direct_; }
 
  private:
   void release() noexcept;
+  void open_direct(bool fifo);
 
-  std::string path_, tmp_, lock_, key_;
+  std::string path_, target_, tmp_, lock_, key_;
   std::ofstream out_;
-  bool committed_ = false;
-  int slot_ = -1;
+  bool committed_ = false, direct_ = false;
+  int slot_ = -1, lock_fd_ = -1;
 };
 
 /// Records a file this run reads (a scene file), so that no output of the run may replace it.
 void register_input(const std::string& path);
 
-/// Installs handlers for SIGINT, SIGTERM and SIGHUP that remove the temporary and lock files of every
+/// Installs handlers for the terminating signals (SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1/2, SIGALRM,
+/// SIGVTALRM, SIGPROF, SIGPIPE; SIGXFSZ is ignored, so a write past the size limit fails) that remove the temporary and lock files of every
 /// open AtomicFile and then end the process with the signal (exit status 128 + signal). While a
 /// `CooperativeInterrupt` is alive the handler only records the signal, so that a loop can stop at a
 /// boundary of its own (a sweep's row) and unwind normally.

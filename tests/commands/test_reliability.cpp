@@ -2,8 +2,11 @@
 // never a hang or a number that means nothing; outputs are complete or absent.
 #include "cli_helpers.hpp"
 
+#include "bodypoint/io.hpp"
+
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <algorithm>
 #include <csignal>
@@ -14,6 +17,10 @@
 #include <map>
 #include <spawn.h>
 #include <string>
+#include <sys/file.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
@@ -160,21 +167,180 @@ TEST(Reliability, OutputsCollideWithNothing) {
   EXPECT_NE(same.code, 0);
   EXPECT_NE(same.err.find("is an input of this run"), std::string::npos) << same.err;
   EXPECT_NE(read(scene).find("[[centre]]"), std::string::npos) << "the scene file is intact";
-  // A second writer of the same path: the lock names a live process (this test).
+  // A second writer of the same path: this test holds the lock as a live writer does.
   const fs::path out = dir / "y.csv";
-  std::ofstream(dir / "y.csv.lock") << ::getpid() << "\n";
-  const auto locked = run_cli("simulate --steps 10 --out " + out.string());
-  EXPECT_NE(locked.code, 0);
-  EXPECT_NE(locked.err.find("another run (pid " + std::to_string(::getpid()) + ")"), std::string::npos) << locked.err;
-  EXPECT_FALSE(fs::exists(out));
-  // A stale lock (its writer is gone) is taken over, and released after the run.
-  const pid_t gone = spawn({"methods"}, dir / "err.txt");
-  ::waitpid(gone, nullptr, 0);
-  std::ofstream(dir / "y.csv.lock", std::ios::trunc) << gone << "\n";
-  const auto stale = run_cli("simulate --steps 10 --out " + out.string());
-  EXPECT_EQ(stale.code, 0) << stale.err;
-  EXPECT_TRUE(fs::exists(out));
-  EXPECT_FALSE(fs::exists(dir / "y.csv.lock"));
+  {
+    const int fd = ::open((dir / "y.csv.lock").c_str(), O_RDWR | O_CREAT, 0644);
+    ASSERT_GE(fd, 0);
+    ASSERT_EQ(::flock(fd, LOCK_EX), 0);
+    const std::string pid = std::to_string(::getpid()) + "\n";
+    ASSERT_EQ(::write(fd, pid.data(), pid.size()), static_cast<ssize_t>(pid.size()));
+    const auto locked = run_cli("simulate --steps 10 --out " + out.string());
+    EXPECT_NE(locked.code, 0);
+    EXPECT_NE(locked.err.find("another run (pid " + std::to_string(::getpid()) + ")"), std::string::npos) << locked.err;
+    EXPECT_FALSE(fs::exists(out));
+    ::close(fd);
+  }
+  // A lock file nobody holds (its writer was killed), whatever pid it names (ours, alive, included), is
+  // taken over; the temporaries its writer left go, other files that merely look alike stay.
+  for (const std::string& names : {std::to_string(::getpid()), std::string(), std::string("garbage")}) {
+    std::ofstream(dir / "y.csv.lock", std::ios::trunc) << names << "\n";
+    std::ofstream(dir / "y.csv.tmp.999999.0") << "half a run";
+    std::ofstream(dir / "y.csv.tmp.notes") << "the user's";
+    const auto stale = run_cli("simulate --steps 10 --out " + out.string());
+    EXPECT_EQ(stale.code, 0) << stale.err;
+    EXPECT_TRUE(fs::exists(out));
+    auto left = leftovers(dir, "y.csv");
+    std::sort(left.begin(), left.end());
+    EXPECT_EQ(left, (std::vector<std::string>{"y.csv", "y.csv.tmp.notes"})) << "lock naming '" << names << "'";
+    fs::remove(dir / "y.csv.tmp.notes");
+  }
+  fs::remove_all(dir);
+}
+
+/// Lock races: this many trials of two writers of one path started together.
+constexpr int kLockRaceTrials = 1000;
+
+TEST(Reliability, TheLockAdmitsOneWriterAtATime) {
+  // Two processes open one output at the same moment, each holding it for a random time up to 200 us;
+  // a third of the trials start with a lock file left by a killed writer (naming a live pid, none, or
+  // garbage). Shared memory counts how many hold the output at once: never more than one, in any trial.
+  const fs::path dir = test::temp_path("bp_rel_race");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string out = (dir / "race.csv").string();
+  struct Shared {
+    std::atomic<int> go, holders, overlaps;
+  };
+  void* mem = ::mmap(nullptr, sizeof(Shared), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+  ASSERT_NE(mem, MAP_FAILED);
+  auto* shared = new (mem) Shared{};
+  int both = 0, one = 0, none = 0;
+  for (int trial = 0; trial < kLockRaceTrials; ++trial) {
+    if (trial % 3 == 1) std::ofstream(out + ".lock") << (trial % 2 ? std::to_string(::getpid()) : "x") << "\n";
+    shared->go = 0;
+    pid_t kids[2];
+    for (int k = 0; k < 2; ++k) {
+      kids[k] = ::fork();
+      ASSERT_GE(kids[k], 0);
+      if (kids[k] == 0) {
+        while (shared->go.load() == 0) {
+        }
+        int code = 3;
+        try {
+          AtomicFile f(out);
+          if (shared->holders.fetch_add(1) != 0) shared->overlaps.fetch_add(1);
+          f.stream() << "writer " << k << "\n";
+          ::usleep(static_cast<useconds_t>((trial * 37 + k * 101) % 200));
+          shared->holders.fetch_sub(1);
+          f.commit();
+          code = 0;
+        } catch (const Error&) {
+        }
+        ::_exit(code);
+      }
+    }
+    shared->go = 1;
+    int ok = 0;
+    for (const pid_t kid : kids) {
+      int status = 0;
+      ::waitpid(kid, &status, 0);
+      ASSERT_TRUE(WIFEXITED(status));
+      ok += WEXITSTATUS(status) == 0;
+    }
+    (ok == 2 ? both : ok == 1 ? one : none)++;
+    ASSERT_EQ(leftovers(dir, "race.csv"), std::vector<std::string>{"race.csv"}) << "trial " << trial;
+    const std::string text = read(out);
+    ASSERT_TRUE(text == "writer 0\n" || text == "writer 1\n") << "trial " << trial << ": " << text;
+  }
+  EXPECT_EQ(shared->overlaps.load(), 0) << "two writers held the output at once";
+  EXPECT_EQ(none, 0) << "some trial wrote nothing";
+  std::printf("  %d trials: %d refused the second writer, %d ran one after the other, 0 overlapped\n",
+              kLockRaceTrials, one, both);
+  ::munmap(mem, sizeof(Shared));
+  fs::remove_all(dir);
+}
+
+TEST(Reliability, OnlyARegularFileIsEverReplaced) {
+  // In a folder of the test's own: a FIFO, symbolic links, a directory and (as root) character devices
+  // made with mknod, never the machine's /dev.
+  const fs::path dir = test::temp_path("bp_rel_dev");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string run = "simulate --steps 100 --out ";
+  // A directory is refused before any work; '-' and a newline in the name are refused.
+  fs::create_directory(dir / "folder");
+  const auto folder = run_cli("simulate --steps 100000000 --every 100000 --out " + (dir / "folder").string());
+  EXPECT_NE(folder.err.find("is a directory"), std::string::npos) << folder.err;
+  EXPECT_NE(run_cli(run + "-").err.find("give a file name"), std::string::npos);
+  EXPECT_NE(run_cli(run + "'" + (dir / "a\nb.csv").string() + "'").err.find("control character"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir / "-"));
+  // A symbolic link stays a link; its target (existing or not yet) is what is written.
+  fs::create_symlink("target.csv", dir / "link.csv");
+  for (int k = 0; k < 2; ++k) {
+    const auto r = run_cli(run + (dir / "link.csv").string());
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::is_symlink(dir / "link.csv"));
+    EXPECT_NE(read(dir / "target.csv").find("body,t,Rx"), std::string::npos);
+  }
+  fs::create_symlink("loop2", dir / "loop1");
+  fs::create_symlink("loop1", dir / "loop2");
+  EXPECT_NE(run_cli(run + (dir / "loop1").string()).code, 0);
+  // A FIFO: refused while nobody reads it, written directly (and left a FIFO) when someone does.
+  ASSERT_EQ(::mkfifo((dir / "fifo").c_str(), 0644), 0);
+  const auto unread = run_cli(run + (dir / "fifo").string());
+  EXPECT_NE(unread.err.find("nobody reads"), std::string::npos) << unread.err;
+  std::string received;
+  std::thread reader([&] { received = read(dir / "fifo"); });
+  const auto piped = run_cli(run + (dir / "fifo").string());
+  reader.join();
+  EXPECT_EQ(piped.code, 0) << piped.err;
+  EXPECT_NE(received.find("body,t,Rx"), std::string::npos);
+  struct stat st {};
+  ASSERT_EQ(::lstat((dir / "fifo").c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+  // Character devices (root only): null takes the output, full makes the write fail with a reason;
+  // both stay devices, and a sweep keeps no journal beside them.
+  if (::mknod((dir / "null").c_str(), S_IFCHR | 0666, makedev(1, 3)) != 0 ||
+      ::mknod((dir / "full").c_str(), S_IFCHR | 0666, makedev(1, 7)) != 0) {
+    fs::remove_all(dir);
+    GTEST_SKIP() << "mknod needs root: the device cases are left out";
+  }
+  EXPECT_EQ(run_cli(run + (dir / "null").string()).code, 0);
+  const auto full = run_cli(run + (dir / "full").string());
+  EXPECT_NE(full.err.find("failed (disk full"), std::string::npos) << full.err;
+  EXPECT_EQ(run_cli("sweep --param d --values 1,2 --steps 100 --out " + (dir / "null").string()).code, 0);
+  for (const char* dev : {"null", "full"}) {
+    ASSERT_EQ(::lstat((dir / dev).c_str(), &st), 0);
+    EXPECT_TRUE(S_ISCHR(st.st_mode)) << dev << " was replaced";
+  }
+  EXPECT_EQ(leftovers(dir, "null").size(), 1u) << "no journal, lock or temporary beside a device";
+  fs::remove_all(dir);
+}
+
+TEST(Reliability, EveryTerminatingSignalRemovesTemporaryAndLockFiles) {
+  // SIGINT is ASignalRemovesTemporaryAndLockFiles; these ended the process with its files in place.
+  const fs::path dir = test::temp_path("bp_rel_sigs");
+  for (const int sig : {SIGQUIT, SIGUSR1, SIGALRM, SIGPIPE, SIGHUP}) {
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const pid_t pid = spawn({"simulate", "--steps", "200000000", "--every", "1000", "--quiet", "--out",
+                             (dir / "traj.csv").string()}, dir / "err.txt");
+    ASSERT_GT(pid, 0);
+    std::this_thread::sleep_for(kSignalDelay);
+    ::kill(pid, sig);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == sig) << "signal " << sig;
+    EXPECT_TRUE(leftovers(dir, "traj.csv").empty()) << "signal " << sig << " left " << leftovers(dir, "traj.csv").size();
+  }
+  // Past `ulimit -f` (4 KiB) the write fails with a reason instead of SIGXFSZ killing the run.
+  const std::string limited = "ulimit -f 4; exec '" + std::string(BODYPOINT_BIN) + "' simulate --steps 10000 --out '" +
+                              (dir / "traj.csv").string() + "' 2>'" + (dir / "err.txt").string() + "'";
+  const int rc = std::system(("bash -c \"" + limited + "\" >/dev/null").c_str());
+  EXPECT_TRUE(WIFEXITED(rc) && WEXITSTATUS(rc) == 2) << rc;
+  EXPECT_NE(read(dir / "err.txt").find("file size limit"), std::string::npos) << read(dir / "err.txt");
+  EXPECT_TRUE(leftovers(dir, "traj.csv").empty());
   fs::remove_all(dir);
 }
 
