@@ -49,9 +49,13 @@ int main(int argc, char** argv) {
 #ifdef BODYPOINT_MPI_PROGRAM
   if (bodypoint::cli::launched_by_mpi()) exec_mpi_program(argv);
 #endif
-  if (argc < 2 || std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0) {
+  if (argc < 2) {  // an error: the one-line reason, then the usage, on standard error
+    std::cerr << "bodypoint: error: no command given\n" << usage << "\n";
+    return 2;
+  }
+  if (std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0) {
     std::cout << usage << "\n";
-    return argc < 2 ? 2 : 0;
+    return 0;
   }
   const std::string cmd = argv[1];
   bodypoint::install_signal_cleanup();

@@ -1,6 +1,7 @@
 // A sweep across MPI processes (mpi_sweep.hpp): rank 0 coordinates and computes, the others compute.
 #include "mpi_sweep.hpp"
 
+#include "bodypoint/detail/threads.hpp"
 #include "bodypoint/io.hpp"
 #include "rows_file.hpp"
 
@@ -179,10 +180,10 @@ std::vector<std::string> run_sweep_mpi(const MpiSession& mpi, const SweepSpec& s
       board.fail(std::current_exception());
     }
   };
-  std::vector<std::thread> pool;
-  for (unsigned k = 0; k < std::max(1u, control.threads); ++k) pool.emplace_back(worker);
-  coordinate(mpi, board);
-  for (std::thread& t : pool) t.join();
+  {
+    const detail::WorkerThreads pool(std::max(1u, control.threads), worker);  // none: the other ranks do it all
+    coordinate(mpi, board);
+  }
   CooperativeInterrupt::check();
   return board.result();
 }

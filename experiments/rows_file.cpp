@@ -27,6 +27,20 @@ std::string record(std::size_t index, const std::string& row) {
   return body + "\t" + hex64(fnv1a(body)) + "\n";
 }
 
+/// A header line, checksummed like a record, so that an edited or injected header is caught.
+std::string header_record(const std::string& line) {
+  const std::string body = "H\t" + line;
+  return body + "\t" + hex64(fnv1a(body)) + "\n";
+}
+
+/// Parses "H\t<line>\t<check>"; false for a corrupt header line.
+bool parse_header(const std::string& record, std::string& line) {
+  const std::size_t last = record.rfind('\t');
+  if (last == std::string::npos || last < 2 || record.substr(last + 1) != hex64(fnv1a(record.substr(0, last)))) return false;
+  line = record.substr(2, last - 2);
+  return true;
+}
+
 /// Parses "R\t<index>\t<row>\t<check>" (without the newline); false for a torn or corrupt record.
 bool parse_record(const std::string& line, std::size_t& index, std::string& row) {
   const std::size_t last = line.rfind('\t');
@@ -49,7 +63,10 @@ void parse_magic(const std::string& line, const std::string& path, RowsContent& 
   if (line.rfind(kMagic, 0) != 0 || !(in >> key >> tasks) || key.rfind("key=", 0) != 0 || tasks.rfind("tasks=", 0) != 0)
     throw Error("'" + path + "' is not a bodypoint rows file (a sweep's journal or shard output)");
   c.key = key.substr(4);
-  c.tasks = static_cast<std::size_t>(std::stoull(tasks.substr(6)));
+  const std::string n = tasks.substr(6);
+  const auto [end, ec] = std::from_chars(n.data(), n.data() + n.size(), c.tasks);
+  if (ec != std::errc() || end != n.data() + n.size())
+    throw Error("'" + path + "' is not a bodypoint rows file (its task count '" + n + "' is not a number)");
 }
 
 /// Cuts a torn last line (no newline: the writer died in the middle of it) off the file at `fd`.
@@ -88,6 +105,10 @@ std::string hex64(std::uint64_t x) {
 }
 
 RowsContent read_rows_file(const std::string& path, std::size_t* dropped) {
+  // A FIFO would block and a device (/dev/zero) never end: rows files are regular files.
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) throw Error("cannot read '" + path + "': " + std::strerror(errno));
+  if (!S_ISREG(st.st_mode)) throw Error("'" + path + "' is not a regular file, so not a bodypoint rows file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error("cannot read '" + path + "'");
   RowsContent c;
@@ -101,7 +122,11 @@ RowsContent read_rows_file(const std::string& path, std::size_t* dropped) {
       break;
     }
     if (line.rfind("H\t", 0) == 0) {
-      c.header.push_back(line.substr(2));
+      std::string h;
+      if (parse_header(line, h))
+        c.header.push_back(std::move(h));
+      else
+        ++bad;
       continue;
     }
     std::size_t index = 0;
@@ -110,7 +135,10 @@ RowsContent read_rows_file(const std::string& path, std::size_t* dropped) {
       ++bad;
       continue;
     }
-    c.rows.emplace(index, std::move(row));  // a repeated index keeps its first row
+    // A record written twice (a resumed run that redid a row) is the same row; two different rows
+    // under one index mean the file was edited or mixed.
+    if (const auto [at, fresh] = c.rows.emplace(index, row); !fresh && at->second != row)
+      throw Error("'" + path + "' holds two different rows for task " + std::to_string(index) + ": it was edited or mixed with another file");
   }
   if (dropped) *dropped = bad;
   return c;
@@ -118,7 +146,7 @@ RowsContent read_rows_file(const std::string& path, std::size_t* dropped) {
 
 std::string rows_file_text(const RowsContent& c) {
   std::string s = std::string(kMagic) + " key=" + c.key + " tasks=" + std::to_string(c.tasks) + "\n";
-  for (const std::string& h : c.header) s += "H\t" + h + "\n";
+  for (const std::string& h : c.header) s += header_record(h);
   for (const auto& [index, row] : c.rows) s += record(index, row);
   return s;
 }

@@ -3,8 +3,10 @@
 //
 // A rows file is text, one record per line:
 //   #bodypoint-rows 1 key=<16 hex digits> tasks=<T>    first line: which sweep (key) and its size
-//   H\t<line>                                           the CSV header of the sweep, line by line
+//   H\t<line>\t<check>                                 the CSV header of the sweep, line by line
 //   R\t<task index>\t<CSV row>\t<check>                 one finished row; check = FNV-1a of the rest
+// Two different rows under one task index are refused (an edited or mixed file), the same row twice
+// (a resumed run that redid it) is one row.
 // A journal (<out>.journal) is appended one record per finished row, each in one write() at the row's
 // boundary, so after a kill -9 it holds every row that finished (the page cache outlives the process).
 // fsync runs at row boundaries too, at most every kSyncInterval and when the journal closes, so a

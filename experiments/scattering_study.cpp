@@ -12,6 +12,7 @@
 #include "scattering_study.hpp"
 
 #include "bodypoint/bodypoint.hpp"
+#include "bodypoint/detail/threads.hpp"
 #include "bodypoint/io.hpp"
 #include "sweep.hpp"
 
@@ -112,10 +113,10 @@ void write_scattering_study(const std::filesystem::path& dir, bool quick, unsign
   auto worker = [&] {
     for (std::size_t i; (i = next++) < points.size();) points[i] = run_point(all[i / bs.size()], bs[i % bs.size()]);
   };
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < std::max(1u, threads); ++t) pool.emplace_back(worker);
-  worker();
-  for (std::thread& t : pool) t.join();
+  {
+    const detail::WorkerThreads pool(std::max(1u, threads) - 1, worker);
+    worker();
+  }
 
   const double A = SceneParams{}.A, m = SceneParams{}.m;
   AtomicFile csv((dir / "scattering.csv").string()), summary((dir / "scattering_summary.csv").string());

@@ -294,6 +294,7 @@ BodyRun simulate_body(const SimulateOptions& o, const RunPlan& plan, const Body&
   if (br.outcome != Outcome::ok)
     throw Error("body '" + body.name + "' (" + std::string(br.method->name) + "): " + br.reason +
                 (br.outcome == Outcome::collision ? "; a time-transformed method (ttl-*) or a smaller --h can follow it"
+                 : is_step_controlled(*br.method) ? "; the tolerance is too loose for this scene (reduce --tol)"
                                                   : "; the step is too large for this scene (reduce --h)") +
                 "; no output written");
   if (o.with_reference) {

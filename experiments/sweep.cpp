@@ -64,6 +64,9 @@ RunSpec resolve_steps(double h, long steps, double t_end, double tol) {
 
 unsigned thread_count(long requested) {
   if (requested < 0) throw Error("--threads must be >= 0");
+  // More threads than this are not a machine, and each costs a stack: refused before any is made.
+  constexpr long kMaxThreads = 1024;
+  if (requested > kMaxThreads) throw Error("--threads must be at most " + std::to_string(kMaxThreads));
   if (requested > 0) return static_cast<unsigned>(requested);
   return std::max(1u, std::thread::hardware_concurrency());
 }
@@ -228,6 +231,7 @@ struct SweepJob {
   bool resume = false;
   long threads = 0;
   std::size_t shard = 0, shards = 1;
+  bool sharded = false;  ///< --shard given (1/1 too): the output is a rows file for merge
   bool no_simd = false;
   std::string command;  ///< the command without the options that do not change the rows
 };
@@ -241,6 +245,7 @@ void parse_shard(const std::string& text, SweepJob& job) {
   const long kk = whole_number(k, "--shard K", 1e6);
   if (static_cast<std::size_t>(kk) > job.shards) throw Error("--shard K/N needs K <= N, got " + text);
   job.shard = static_cast<std::size_t>(kk - 1);
+  job.sharded = true;
 }
 
 /// The command line without --out, --threads, --shard and --resume: the same for every shard, resumed
@@ -329,7 +334,7 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
   if (vm.count("scene")) throw Error("sweep varies the thesis's scene parameters; --scene is not supported");
   if (!shard.empty()) parse_shard(shard, job);
   if (job.resume && job.out.empty()) throw Error("--resume needs --out (the journal is <out>.journal)");
-  if (job.shards > 1 && job.out.empty()) throw Error("--shard needs --out (the shard's rows file)");
+  if (job.sharded && job.out.empty()) throw Error("--shard needs --out (the shard's rows file)");
   job.spec.methods = parse_methods(methods_arg);
   job.spec.base = so.params;
   // Fixed asymptotic data are solved for at every grid point (a sweep over L keeps b, not d).
@@ -366,7 +371,7 @@ void write_output(const SweepJob& job, AtomicFile* file, RowJournal* journal, co
     write_sweep_csv(std::cout, job.spec, rows, job.command);
     return;
   }
-  if (job.shards > 1) {
+  if (job.sharded) {
     RowsContent mine{sweep_key(job.spec), rows.size(), sweep_header(job.spec, job.command), {}};
     for (std::size_t i = 0; i < rows.size(); ++i)
       if (shard_of(job.spec, i, job.shards) == job.shard) mine.rows.emplace(i, rows[i]);
@@ -380,7 +385,7 @@ void write_output(const SweepJob& job, AtomicFile* file, RowJournal* journal, co
 
 /// Under mpirun: rank 0 opens the output and the journal and coordinates; the other ranks compute.
 void run_job_mpi(const SweepJob& job) {
-  if (job.shards > 1) throw Error("give --shard or run under mpirun, not both");
+  if (job.sharded) throw Error("give --shard or run under mpirun, not both");
   MpiSession mpi;
   const unsigned threads = job.threads > 0 ? thread_count(job.threads) : 1;  // one per rank unless asked
   if (mpi.rank() != 0) {

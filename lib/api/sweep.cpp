@@ -2,6 +2,7 @@
 #include "bodypoint/sweep.hpp"
 
 #include "bodypoint/batch.hpp"
+#include "bodypoint/detail/threads.hpp"
 #include "bodypoint/io.hpp"
 
 #include <algorithm>
@@ -230,10 +231,10 @@ void run_sweep_tasks(const SweepSpec& spec, const std::vector<std::size_t>& todo
       }
     }
   };
-  std::vector<std::thread> pool;
-  for (unsigned k = 1; k < std::min<std::size_t>(runner.threads, units.size()); ++k) pool.emplace_back(worker);
-  worker();
-  for (std::thread& t : pool) t.join();
+  {
+    const detail::WorkerThreads pool(static_cast<unsigned>(std::min<std::size_t>(runner.threads, units.size())) - 1, worker);
+    worker();
+  }
   if (error) std::rethrow_exception(error);
 }
 

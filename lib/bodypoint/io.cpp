@@ -77,12 +77,12 @@ extern "C" void on_signal(int sig) {
   ::raise(sig);
 }
 
-/// Removes "<target>.tmp.<digits>.<digits>", temporaries of writers that died without cleanup (kill -9,
+/// Removes "<stem>.tmp.<digits>.<digits>", temporaries of writers that died without cleanup (kill -9,
 /// power loss). Called by the holder of the target's lock: every writer holds the lock for as long as its
 /// temporary exists, so no live writer owns one of these.
-void remove_orphaned_temporaries(const std::string& target) {
+void remove_orphaned_temporaries(const std::string& stem) {
   namespace fs = std::filesystem;
-  const fs::path t(target);
+  const fs::path t(stem);
   const std::string prefix = t.filename().string() + ".tmp.";
   auto ours = [&](const std::string& name) {
     if (name.rfind(prefix, 0) != 0) return false;
@@ -114,7 +114,7 @@ std::string lock_holder(int fd) {
 /// naming any pid of any namespace, is simply taken). A writer removes the lock file before it lets go of
 /// the lock, so a writer that locked a file just removed finds another inode at the path and tries again.
 /// Returns the lock's descriptor.
-int take_lock(const std::string& lock, const std::string& target) {
+int take_lock(const std::string& lock, const std::string& target, const std::string& stem) {
   constexpr int kAttempts = 1000;  // each retry means another writer finished in between
   for (int attempt = 0; attempt < kAttempts; ++attempt) {
     const int fd = ::open(lock.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644);
@@ -140,12 +140,24 @@ int take_lock(const std::string& lock, const std::string& target) {
         ::close(fd);
         throw Error("cannot write output file '" + target + "' (writing its lock file failed)");
       }
-      remove_orphaned_temporaries(target);
+      remove_orphaned_temporaries(stem);
       return fd;
     }
     ::close(fd);  // the file we locked was removed by its finishing writer: lock the new one
   }
   throw Error("cannot take the lock file " + lock + " of '" + target + "'");
+}
+
+/// A file name at most this long keeps its whole name in its temporary's and lock's names; a longer
+/// one (up to the 255 bytes a name may have) is cut to it, so that those names fit too.
+constexpr std::size_t kMaxStem = 255 - 32;
+
+/// The path the temporaries and the lock of target are named after: target, its file name cut to kMaxStem.
+std::string stem_of(const std::string& target) {
+  const std::filesystem::path t(target);
+  const std::string name = t.filename().string();
+  if (name.size() <= kMaxStem) return target;
+  return (t.parent_path() / name.substr(0, kMaxStem)).string();
 }
 
 /// Where an output path leads: the regular file (or the place of a new one) that a symbolic link
@@ -193,10 +205,11 @@ AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
     if (g_outputs.count(key_)) throw Error("two outputs of this run write '" + path_ + "'; give them different paths");
     g_outputs.insert(key_);
   }
-  tmp_ = target_ + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(g_counter.fetch_add(1));
-  lock_ = target_ + ".lock";
+  const std::string stem = stem_of(target_);
+  tmp_ = stem + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(g_counter.fetch_add(1));
+  lock_ = stem + ".lock";
   try {
-    lock_fd_ = take_lock(lock_, path_);
+    lock_fd_ = take_lock(lock_, path_, stem);
   } catch (...) {
     std::lock_guard<std::mutex> g(g_paths_mutex);
     g_outputs.erase(key_);

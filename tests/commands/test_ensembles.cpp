@@ -11,6 +11,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <thread>
 #include <vector>
@@ -149,10 +150,47 @@ TEST(Shards, MergedShardsEqualTheSingleProcessCsv) {
   std::ofstream(files[1], std::ios::trunc) << text;
   const auto corrupt = run_cli("merge --input " + files[0] + " " + files[1] + " " + files[2]);
   EXPECT_NE(corrupt.err.find("torn or corrupt"), std::string::npos) << corrupt.err;
-  for (const auto* r : {&missing, &twice, &foreign, &not_rows, &corrupt}) {
+  // An edited header line (issue #24: headers carried no checksum and were merged as edited).
+  std::string header = read(files[2]);
+  header.replace(header.find("\nH\t") + 3, 1, "X");
+  const fs::path edited = dir.path / "edited.rows";
+  std::ofstream(edited) << header;
+  const auto headed = run_cli("merge --input " + files[0] + " " + edited.string());
+  EXPECT_NE(headed.err.find("torn or corrupt"), std::string::npos) << headed.err;
+  // Two different rows under one task index: a file edited or mixed (the first was kept silently).
+  std::string both = read(files[0]);
+  const std::size_t rec = both.find("\nR\t") + 1;
+  const std::string line = both.substr(rec, both.find('\n', rec) + 1 - rec);
+  both += line;  // the same record twice is one row
+  const fs::path dup = dir.path / "dup.rows";
+  std::ofstream(dup) << both;
+  const auto same = run_cli("merge --input " + dup.string() + " " + files[2]);
+  EXPECT_EQ(same.err.find("two different rows"), std::string::npos) << same.err;
+  ASSERT_EQ(run_cli(std::string(kShardSweep) + " --h 3e-3 --shard 1/3 --out " + (dir.path / "o.rows").string()).code, 0);
+  const std::string foreign_text = read(dir.path / "o.rows");
+  const std::size_t frec = foreign_text.find("\nR\t") + 1;
+  std::ofstream(dup, std::ios::app) << foreign_text.substr(frec, foreign_text.find('\n', frec) + 1 - frec);
+  const auto mixed = run_cli("merge --input " + dup.string() + " " + files[1] + " " + files[2]);
+  EXPECT_NE(mixed.err.find("two different rows for task"), std::string::npos) << mixed.err;
+  // Inputs that are not regular files are refused at once (a FIFO blocked, /dev/zero read 4 GB).
+  ASSERT_EQ(::mkfifo((dir.path / "fifo").c_str(), 0644), 0);
+  const auto fifo = run_cli("merge --input " + (dir.path / "fifo").string());
+  EXPECT_NE(fifo.err.find("is not a regular file"), std::string::npos) << fifo.err;
+  for (const auto* r : {&missing, &twice, &foreign, &not_rows, &corrupt, &headed, &mixed, &fifo}) {
     EXPECT_EQ(r->code, 2);
     EXPECT_TRUE(r->out.empty());
   }
+}
+
+TEST(Shards, OneShardOfOneIsARowsFileToo) {
+  // --shard 1/1 wrote a plain CSV that merge refused.
+  const TempDir dir("bp_shard1");
+  const auto single = run_cli(std::string(kShardSweep) + " --h 5e-3 --threads 1");
+  const std::string rows = (dir.path / "all.rows").string();
+  ASSERT_EQ(run_cli(std::string(kShardSweep) + " --h 5e-3 --shard 1/1 --out " + rows).code, 0);
+  const auto merged = run_cli("merge --input " + rows);
+  ASSERT_EQ(merged.code, 0) << merged.err;
+  EXPECT_EQ(without_wall(merged.out), without_wall(single.out));
 }
 
 /// A sweep of 50 rows of ~10 ms each on 2 threads: long enough to be killed in the middle.

@@ -75,6 +75,11 @@ TEST(Reliability, EveryIssueExampleEndsWithItsReason) {
       {"simulate --method lp-y4 --steps 10 --omega-c 0.1", "lp-y4 does not take it"},
       {"work-precision --tols 1e-4", "--tols is for --by-tol"},
       {"work-precision --scenes ,", "--scenes is empty"},
+      // Issue #24: the advice fits the method; limits refused before any work.
+      {"simulate --method odeint-dopri5 --tol 5 --t-end 1", "too loose for this scene (reduce --tol)"},
+      {"sweep --param d --values 1 --steps 10 --threads 5000", "--threads must be at most 1024"},
+      {"merge --input /dev/zero", "is not a regular file"},
+      {"simulate --steps 10 --out -", "give a file name"},
   };
   for (const Example& c : cases) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -87,6 +92,13 @@ TEST(Reliability, EveryIssueExampleEndsWithItsReason) {
   }
   EXPECT_FALSE(fs::exists("/tmp/bp_rel_dt.csv"));
   EXPECT_FALSE(fs::exists("/tmp/bp_rel_rows.csv"));
+}
+
+TEST(Reliability, NoCommandIsAnErrorOnStandardError) {
+  const auto r = run_cli("");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  EXPECT_EQ(r.err.rfind("bodypoint: error: no command given\nusage: bodypoint <command>", 0), 0u) << r.err;
 }
 
 TEST(Reliability, SubnormalValuesAreNumbersAndSweepRowsCarryAStatus) {
