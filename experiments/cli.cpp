@@ -153,6 +153,10 @@ bool parse(int argc, char** argv, const po::options_description& desc, po::varia
            const std::string& usage) {
   po::options_description all(desc);
   all.add_options()("help", "show this help");
+  // One budget for every command (simulate has its own default): past it, every loop stops alike.
+  if (!desc.find_nothrow("max-seconds", false))
+    all.add_options()("max-seconds", po::value<double>()->default_value(0.0),
+                      "stop with an error after this many seconds of wall-clock time (0: no limit)");
   // Whole option names only: with boost's default prefix guessing, "--ou x" would mean "--out x".
   const int style = po::command_line_style::default_style & ~po::command_line_style::allow_guessing;
   try {
@@ -171,6 +175,9 @@ bool parse(int argc, char** argv, const po::options_description& desc, po::varia
     return false;
   }
   po::notify(vm);
+  const double budget = vm["max-seconds"].as<double>();
+  if (!(budget >= 0.0)) throw Error("--max-seconds must be a number >= 0");
+  set_deadline(budget, "stopped after --max-seconds " + fmt(budget) + " s of wall-clock time (the run's budget); no output written");
   return true;
 }
 

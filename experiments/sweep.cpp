@@ -47,6 +47,8 @@ std::vector<double> log_range(double from, double to, long points) {
   if (!(from > 0.0) || !(to > 0.0) || !std::isfinite(from) || !std::isfinite(to))
     throw Error("--log needs --from and --to finite and > 0");
   if (points < 2) throw Error("--log needs --points >= 2");
+  // As many as a grid axis may have (whole_number's bound for --grid's N): 1e12 allocated until bad_alloc.
+  if (points > 1'000'000) throw Error("--points must be at most 1e6");
   std::vector<double> v;
   const double a = std::log(from), b = std::log(to);
   for (long k = 0; k < points; ++k) v.push_back(std::exp(a + (b - a) * static_cast<double>(k) / static_cast<double>(points - 1)));

@@ -19,6 +19,8 @@ std::vector<TimingRow> run_timing(const TimingSpec& spec, bool progress) {
   if (spec.methods.empty()) throw Error("the method list is empty");
   if (spec.ns.empty()) throw Error("no values of n");
   if (spec.repeats < 1) throw Error("--repeats must be >= 1");
+  // Each repeat keeps its time for the median: 1e15 of them ran (and allocated) without end.
+  if (spec.repeats > 1'000'000) throw Error("--repeats must be at most 1e6");
   if (spec.warmup < 0) throw Error("--warmup must be >= 0");
   const Scene scene = thesis_scene(spec.base);
   std::vector<TimingRow> rows;

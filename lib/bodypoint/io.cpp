@@ -17,6 +17,8 @@
 #include <set>
 #include <signal.h>
 #include <sys/file.h>
+#include <sys/time.h>
+#include <ctime>
 #include <sys/stat.h>
 #include <sstream>
 #include <unistd.h>
@@ -41,6 +43,15 @@ struct Slot {
 };
 Slot g_slots[kSlots];
 std::atomic<int> g_signal{0};
+std::atomic<bool> g_deadline{false};
+std::atomic<long long> g_deadline_ns{0};  // CLOCK_MONOTONIC: a SIGALRM from outside before it is a signal like any other
+
+long long monotonic_ns() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_MONOTONIC, &ts);  // async-signal-safe
+  return static_cast<long long>(ts.tv_sec) * 1'000'000'000LL + ts.tv_nsec;
+}
+char g_deadline_message[512];
 std::atomic<int> g_cooperative{0};
 std::atomic<long> g_counter{0};
 
@@ -65,14 +76,26 @@ int claim_slot(const std::string& tmp, const std::string& lock) {
   return -1;
 }
 
-extern "C" void on_signal(int sig) {
-  g_signal.store(sig);
-  if (g_cooperative.load() > 0) return;
+void remove_open_outputs() {
   for (Slot& s : g_slots)
     if (s.used.load()) {
       ::unlink(s.tmp);
       ::unlink(s.lock);
     }
+}
+
+extern "C" void on_signal(int sig) {
+  if (sig == SIGALRM && g_deadline.load() && monotonic_ns() >= g_deadline_ns.load()) {  // the budget: stop now, wherever the process is
+    remove_open_outputs();
+    const ssize_t n = ::write(2, g_deadline_message, std::strlen(g_deadline_message));
+    (void)n;
+    ::_exit(2);
+  }
+  // A loop that stops at a boundary of its own (a sweep's row) gets one signal to do so; a second one
+  // (a row of minutes) stops the process at once.
+  const int before = g_signal.exchange(sig);
+  if (g_cooperative.load() > 0 && before == 0) return;
+  remove_open_outputs();
   ::signal(sig, SIG_DFL);
   ::raise(sig);
 }
@@ -286,6 +309,18 @@ void install_signal_cleanup() {
 }
 
 int interrupted() { return g_signal.load(); }
+
+void set_deadline(double seconds, const std::string& what) {
+  if (!(seconds > 0.0) || !std::isfinite(seconds) || seconds > 1e9) return;
+  std::snprintf(g_deadline_message, sizeof g_deadline_message, "bodypoint: error: %s\n", what.c_str());
+  g_deadline_ns.store(monotonic_ns() + static_cast<long long>(seconds * 1e9) - 1'000'000);  // the timer's slack
+  g_deadline.store(true);
+  itimerval t{};
+  t.it_value.tv_sec = static_cast<time_t>(seconds);
+  t.it_value.tv_usec = static_cast<suseconds_t>((seconds - std::floor(seconds)) * 1e6);
+  if (t.it_value.tv_sec == 0 && t.it_value.tv_usec == 0) t.it_value.tv_usec = 1;
+  ::setitimer(ITIMER_REAL, &t, nullptr);
+}
 
 CooperativeInterrupt::CooperativeInterrupt() { g_cooperative.fetch_add(1); }
 CooperativeInterrupt::~CooperativeInterrupt() { g_cooperative.fetch_sub(1); }

@@ -60,6 +60,13 @@ void install_signal_cleanup();
 /// The signal received since install_signal_cleanup(), or 0.
 int interrupted();
 
+/// The whole process's budget of wall-clock time (--max-seconds of every command): when it has passed,
+/// every loop (runs, the accuracy search, the reference, peers' steppers, timing repeats, a sweep's row)
+/// is stopped alike, by SIGALRM: the temporary and lock files go, "<what>" is printed as the one-line
+/// error and the process exits with status 2 (a sweep's journal keeps its finished rows for --resume).
+/// seconds <= 0 or infinite: no budget. Needs install_signal_cleanup().
+void set_deadline(double seconds, const std::string& what);
+
 class CooperativeInterrupt {
  public:
   CooperativeInterrupt();

@@ -80,6 +80,9 @@ TEST(Reliability, EveryIssueExampleEndsWithItsReason) {
       {"sweep --param d --values 1 --steps 10 --threads 5000", "--threads must be at most 1024"},
       {"merge --input /dev/zero", "is not a regular file"},
       {"simulate --steps 10 --out -", "give a file name"},
+      {"sweep --param d --log --from 1 --to 10 --points 1000000000000 --steps 10", "--points must be at most 1e6"},
+      {"timing --repeats 1000000000000000", "--repeats must be at most 1e6"},
+      {"sweep --param d --values 1 --steps 10 --max-seconds -1", "--max-seconds must be a number >= 0"},
   };
   for (const Example& c : cases) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -92,6 +95,35 @@ TEST(Reliability, EveryIssueExampleEndsWithItsReason) {
   }
   EXPECT_FALSE(fs::exists("/tmp/bp_rel_dt.csv"));
   EXPECT_FALSE(fs::exists("/tmp/bp_rel_rows.csv"));
+}
+
+/// The budget of the runs below, and how late past it their stop may come on a loaded machine.
+constexpr double kBudgetSeconds = 1.0;
+constexpr double kBudgetLateness = 5.0;
+
+TEST(Reliability, MaxSecondsStopsEveryLoopAlike) {
+  // Loops that ran on past --max-seconds (issue #24): the accuracy search, a peer's stepper, timing's
+  // repeats, a sweep's row, the reference; each stops with the budget's reason and leaves no output.
+  const fs::path dir = test::temp_path("bp_rel_budget");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string budget = " --max-seconds " + std::to_string(kBudgetSeconds) + " --out " + (dir / "o.csv").string();
+  for (const std::string args : {"simulate --tol 1e-12 --t-end 1e6", "simulate --method gsl-rk8pd --tol 1e-12 --t-end 1e7",
+                                 "simulate --h 1 --t-end 1000000 --reference --every 1000000",
+                                 "timing --repeats 1000000 --values 100000",
+                                 "sweep --param d --values 1,2 --steps 100000000 --threads 1 --methods lp-y4"}) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto r = run_cli(args + budget);
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_NE(r.err.find("stopped after --max-seconds"), std::string::npos) << args << " -> " << r.err;
+    EXPECT_GE(s, kBudgetSeconds) << args;
+    EXPECT_LT(s, kBudgetSeconds + kBudgetLateness) << args;
+    EXPECT_FALSE(fs::exists(dir / "o.csv")) << args;
+    EXPECT_TRUE(leftovers(dir, "o.csv.tmp").empty() && !fs::exists(dir / "o.csv.lock")) << args;
+    fs::remove(dir / "o.csv.journal");
+  }
+  fs::remove_all(dir);
 }
 
 TEST(Reliability, NoCommandIsAnErrorOnStandardError) {
