@@ -5,10 +5,12 @@
 #include "mpi_sweep.hpp"
 #include "rows_file.hpp"
 
+#include <cstdio>
 #include <cstring>
 #include <exception>
 #include <iostream>
 #include <string>
+#include <string_view>
 
 #ifdef BODYPOINT_MPI_PROGRAM
 #include <climits>
@@ -43,6 +45,26 @@ void exec_mpi_program(char** argv) {
 }
 #endif
 
+/// The error as one line: an echoed value's newline, tab or other control character is shown escaped
+/// ("\\n"), so that a reason is always exactly one line of standard error.
+std::string one_line(std::string_view s) {
+  std::string out;
+  for (const unsigned char c : s) {
+    if (c == '\n') {
+      out += "\\n";
+    } else if (c == '\t') {
+      out += "\\t";
+    } else if (c < 0x20 || c == 0x7f) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      out += buf;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -71,7 +93,7 @@ int main(int argc, char** argv) {
     std::cerr << "bodypoint: error: unknown command '" << cmd << "' (simulate, methods, work-precision, sweep, merge, timing, study, view)\n";
     return 2;
   } catch (const std::exception& e) {  // bodypoint::Error, boost::program_options::error and the rest
-    if (bodypoint::cli::launcher_rank() == 0) std::cerr << "bodypoint: error: " << e.what() << "\n";
+    if (bodypoint::cli::launcher_rank() == 0) std::cerr << "bodypoint: error: " << one_line(e.what()) << "\n";
   }
   return 2;
 }

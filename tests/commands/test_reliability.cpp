@@ -83,6 +83,9 @@ TEST(Reliability, EveryIssueExampleEndsWithItsReason) {
       {"sweep --param d --log --from 1 --to 10 --points 1000000000000 --steps 10", "--points must be at most 1e6"},
       {"timing --repeats 1000000000000000", "--repeats must be at most 1e6"},
       {"sweep --param d --values 1 --steps 10 --max-seconds -1", "--max-seconds must be a number >= 0"},
+      // An echoed value with a newline or tab stays on the one line of the reason, escaped.
+      {"simulate --B '1\n2'", "the argument ('1\\n2') for option '--B' is invalid"},
+      {"simulate --method 'lp\ty4'", "unknown method 'lp\\ty4'"},
   };
   for (const Example& c : cases) {
     const auto t0 = std::chrono::steady_clock::now();
