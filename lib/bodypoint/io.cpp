@@ -100,6 +100,15 @@ extern "C" void on_signal(int sig) {
   ::raise(sig);
 }
 
+/// True for "<digits>.<digits>", the tail of a temporary's name after ".tmp." (pid and counter).
+bool pid_and_counter(std::string_view rest) {
+  auto digits = [](std::string_view x) {
+    return !x.empty() && std::all_of(x.begin(), x.end(), [](char c) { return c >= '0' && c <= '9'; });
+  };
+  const std::size_t dot = rest.find('.');
+  return dot != std::string_view::npos && digits(rest.substr(0, dot)) && digits(rest.substr(dot + 1));
+}
+
 /// Removes "<stem>.tmp.<digits>.<digits>", temporaries of writers that died without cleanup (kill -9,
 /// power loss). Called by the holder of the target's lock: every writer holds the lock for as long as its
 /// temporary exists, so no live writer owns one of these.
@@ -107,16 +116,7 @@ void remove_orphaned_temporaries(const std::string& stem) {
   namespace fs = std::filesystem;
   const fs::path t(stem);
   const std::string prefix = t.filename().string() + ".tmp.";
-  auto ours = [&](const std::string& name) {
-    if (name.rfind(prefix, 0) != 0) return false;
-    const std::string rest = name.substr(prefix.size());  // "<pid>.<counter>"
-    const std::size_t dot = rest.find('.');
-    auto digits = [](std::string_view x) {
-      return !x.empty() && std::all_of(x.begin(), x.end(), [](char c) { return c >= '0' && c <= '9'; });
-    };
-    return dot != std::string::npos && digits(std::string_view(rest).substr(0, dot)) &&
-           digits(std::string_view(rest).substr(dot + 1));
-  };
+  auto ours = [&](const std::string& name) { return name.rfind(prefix, 0) == 0 && pid_and_counter(name.substr(prefix.size())); };
   std::error_code ec;
   const fs::path dir = t.has_parent_path() ? t.parent_path() : fs::path(".");
   for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
@@ -221,6 +221,15 @@ AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
     throw Error("cannot write output file '" + path_ + "' (" + std::strerror(errno) + ")");
   }
   target_ = resolve_links(path_);
+  // The names of the writer's and the sweeps' own files: an output there would replace a live lock or
+  // journal of another run (or be removed by it as an orphan).
+  {
+    const std::string name = std::filesystem::path(target_).filename().string();
+    auto ends = [&](std::string_view tail) { return name.size() >= tail.size() && name.compare(name.size() - tail.size(), tail.size(), tail) == 0; };
+    const std::size_t tmp = name.rfind(".tmp.");
+    if (ends(".lock") || ends(".journal") || (tmp != std::string::npos && pid_and_counter(std::string_view(name).substr(tmp + 5))))
+      throw Error("output '" + path_ + "': names ending in .lock, .journal or .tmp.<pid>.<n> are bodypoint's own files; choose another name");
+  }
   key_ = key_of(target_);
   {
     std::lock_guard<std::mutex> g(g_paths_mutex);

@@ -80,6 +80,9 @@ TEST(Reliability, EveryIssueExampleEndsWithItsReason) {
       {"sweep --param d --values 1 --steps 10 --threads 5000", "--threads must be at most 1024"},
       {"merge --input /dev/zero", "is not a regular file"},
       {"simulate --steps 10 --out -", "give a file name"},
+      // A name of another run's journal or lock: that run's live file would be replaced.
+      {"simulate --steps 10 --out /tmp/bp_rel_x.csv.journal", "are bodypoint's own files"},
+      {"simulate --steps 10 --out /tmp/bp_rel_x.csv.lock", "are bodypoint's own files"},
       {"sweep --param d --log --from 1 --to 10 --points 1000000000000 --steps 10", "--points must be at most 1e6"},
       {"timing --repeats 1000000000000000", "--repeats must be at most 1e6"},
       {"sweep --param d --values 1 --steps 10 --max-seconds -1", "--max-seconds must be a number >= 0"},
