@@ -10,17 +10,17 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <fcntl.h>
 #include <filesystem>
 #include <limits>
 #include <mutex>
 #include <set>
 #include <signal.h>
-#include <sys/file.h>
-#include <sys/time.h>
-#include <ctime>
-#include <sys/stat.h>
 #include <sstream>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <sys/time.h>
 #include <unistd.h>
 #include <vector>
 
@@ -43,17 +43,19 @@ struct Slot {
 };
 Slot g_slots[kSlots];
 std::atomic<int> g_signal{0};
+std::atomic<int> g_cooperative{0};
+std::atomic<long> g_counter{0};
+// The budget (set_deadline): its end on CLOCK_MONOTONIC (a SIGALRM from outside before it is a signal
+// like any other) and its message, formatted beforehand for the handler.
 std::atomic<bool> g_deadline{false};
-std::atomic<long long> g_deadline_ns{0};  // CLOCK_MONOTONIC: a SIGALRM from outside before it is a signal like any other
+std::atomic<long long> g_deadline_ns{0};
+char g_deadline_message[512];
 
 long long monotonic_ns() {
   timespec ts{};
   ::clock_gettime(CLOCK_MONOTONIC, &ts);  // async-signal-safe
   return static_cast<long long>(ts.tv_sec) * 1'000'000'000LL + ts.tv_nsec;
 }
-char g_deadline_message[512];
-std::atomic<int> g_cooperative{0};
-std::atomic<long> g_counter{0};
 
 std::mutex g_paths_mutex;
 std::set<std::string> g_outputs, g_inputs;  // weakly canonical paths
