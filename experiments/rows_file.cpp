@@ -22,31 +22,37 @@ namespace {
 
 constexpr const char* kMagic = "#bodypoint-rows 1";
 
+/// One line of a rows file: body, a tab and the FNV-1a checksum of the body.
+std::string with_check(const std::string& body) { return body + "\t" + hex64(fnv1a(body)) + "\n"; }
+
+/// The body of a checked line ("X\t...\t<check>", without the newline), or false when the check does
+/// not match (a torn or corrupt line).
+bool checked_body(const std::string& line, std::string& body) {
+  const std::size_t last = line.rfind('\t');
+  if (last == std::string::npos || last < 2) return false;
+  body = line.substr(0, last);
+  return line.substr(last + 1) == hex64(fnv1a(body));
+}
+
 std::string record(std::size_t index, const std::string& row) {
-  const std::string body = "R\t" + std::to_string(index) + "\t" + row;
-  return body + "\t" + hex64(fnv1a(body)) + "\n";
+  return with_check("R\t" + std::to_string(index) + "\t" + row);
 }
 
 /// A header line, checksummed like a record, so that an edited or injected header is caught.
-std::string header_record(const std::string& line) {
-  const std::string body = "H\t" + line;
-  return body + "\t" + hex64(fnv1a(body)) + "\n";
-}
+std::string header_record(const std::string& line) { return with_check("H\t" + line); }
 
 /// Parses "H\t<line>\t<check>"; false for a corrupt header line.
 bool parse_header(const std::string& record, std::string& line) {
-  const std::size_t last = record.rfind('\t');
-  if (last == std::string::npos || last < 2 || record.substr(last + 1) != hex64(fnv1a(record.substr(0, last)))) return false;
-  line = record.substr(2, last - 2);
+  std::string body;
+  if (!checked_body(record, body)) return false;
+  line = body.substr(2);
   return true;
 }
 
 /// Parses "R\t<index>\t<row>\t<check>" (without the newline); false for a torn or corrupt record.
 bool parse_record(const std::string& line, std::size_t& index, std::string& row) {
-  const std::size_t last = line.rfind('\t');
-  if (line.rfind("R\t", 0) != 0 || last == std::string::npos || last < 2) return false;
-  const std::string body = line.substr(0, last);
-  if (line.substr(last + 1) != hex64(fnv1a(body))) return false;
+  std::string body;
+  if (line.rfind("R\t", 0) != 0 || !checked_body(line, body)) return false;
   const std::size_t second = body.find('\t', 2);
   if (second == std::string::npos) return false;
   const char* first = body.data() + 2;

@@ -385,6 +385,17 @@ void write_output(const SweepJob& job, AtomicFile* file, RowJournal* journal, co
   if (journal) journal->remove();
 }
 
+/// The journal of a sweep that writes a file (none for standard output, a FIFO or a device).
+std::unique_ptr<RowJournal> open_journal(const SweepJob& job, const AtomicFile* file) {
+  if (!file) return nullptr;
+  if (file->direct()) {
+    if (job.resume) throw Error("--resume needs an --out that is a file (a FIFO or device keeps no journal)");
+    return nullptr;
+  }
+  return std::make_unique<RowJournal>(job.out + ".journal", sweep_key(job.spec), task_count(job.spec),
+                                      sweep_header(job.spec, job.command), job.resume);
+}
+
 /// Under mpirun: rank 0 opens the output and the journal and coordinates; the other ranks compute.
 void run_job_mpi(const SweepJob& job) {
   if (job.sharded) throw Error("give --shard or run under mpirun, not both");
@@ -399,9 +410,7 @@ void run_job_mpi(const SweepJob& job) {
   try {
     validate_sweep(job.spec);
     if (!job.out.empty()) file = std::make_unique<AtomicFile>(job.out);
-    if (file && !file->direct())
-      journal = std::make_unique<RowJournal>(job.out + ".journal", sweep_key(job.spec), task_count(job.spec),
-                                             sweep_header(job.spec, job.command), job.resume);
+    journal = open_journal(job, file.get());
   } catch (...) {
     mpi.agree(false);  // the other ranks stop without running anything
     throw;
@@ -417,11 +426,7 @@ void run_job(const SweepJob& job) {
   std::unique_ptr<AtomicFile> file;
   if (!job.out.empty()) file = std::make_unique<AtomicFile>(job.out);
   validate_sweep(job.spec);  // before a journal exists
-  const std::vector<std::string> header = sweep_header(job.spec, job.command);
-  const std::size_t tasks = task_count(job.spec);
-  std::unique_ptr<RowJournal> journal;
-  if (file && file->direct() && job.resume) throw Error("--resume needs an --out that is a file (a FIFO or device keeps no journal)");
-  if (file && !file->direct()) journal = std::make_unique<RowJournal>(job.out + ".journal", sweep_key(job.spec), tasks, header, job.resume);
+  const std::unique_ptr<RowJournal> journal = open_journal(job, file.get());
   SweepControl control{thread_count(job.threads), ::isatty(2) == 1, job.shard, job.shards, journal.get(), !job.no_simd};
   std::vector<std::string> rows;
   try {
