@@ -75,7 +75,16 @@ void add_step_options(po::options_description& desc, StepOptions& o) {
   desc.add_options()
       ("h", po::value(&o.h)->default_value(o.h), "step size")
       ("steps", po::value(&o.steps)->default_value(o.steps), "number of steps n")
-      ("t-end", po::value(&o.t_end), "end time T (steps = ceil(T/h), h adjusted to T/steps)");
+      ("t-end", po::value(&o.t_end), "end time T (steps = ceil(T/h), h adjusted to T/steps)")
+      ("max-energy-error", po::value(&o.max_energy_error)->default_value(o.max_energy_error),
+       "flag a run whose relative energy error exceeds this bound as inaccurate (inf: no bound; not applied "
+       "under --force-law thesis-code, whose flow does not conserve E)");
+}
+
+double energy_bound(const StepOptions& o) {
+  if (!(o.max_energy_error > 0.0))
+    throw Error("--max-energy-error must be a number > 0 (inf: no bound), got " + fmt(o.max_energy_error));
+  return o.max_energy_error;
 }
 
 void apply_step_options(const po::variables_map& vm, const StepOptions& o, RunSpec& spec) {

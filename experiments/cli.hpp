@@ -37,8 +37,11 @@ struct StepOptions {
   double h = RunSpec{}.h;  // the defaults of every run are RunSpec's (run.hpp)
   long steps = RunSpec{}.steps;
   double t_end = 0.0;
+  double max_energy_error = kDefaultMaxEnergyError;  ///< the accuracy flag's bound (Options)
 };
 void add_step_options(po::options_description& desc, StepOptions& o);
+/// o.max_energy_error, checked: a number > 0 (inf: no bound); Error otherwise.
+double energy_bound(const StepOptions& o);
 /// Fills spec.h and spec.steps. With --t-end T: steps = ceil(T/h), h = T/steps (hits T exactly).
 void apply_step_options(const po::variables_map& vm, const StepOptions& o, RunSpec& spec);
 
@@ -50,6 +53,7 @@ struct RunPlan {
   bool search = false;     ///< --tol chooses the step (any method but odeint-*/gsl-*)
   double tol = 0.0;
   RunSpec spec;
+  double max_energy_error = kDefaultMaxEnergyError;  ///< Options::max_energy_error of the run
 };
 /// Validates the step options against the method; throws Error with the reason (plan.cpp).
 RunPlan plan_run(const po::variables_map& vm, const StepOptions& st, const std::string& method_name,

@@ -22,6 +22,7 @@ RunPlan plan_run(const po::variables_map& vm, const StepOptions& st, const std::
   plan.method = plan.automatic ? nullptr : &method_or_throw(method_name);
   plan.search = plan.automatic || (tol_given && !is_step_controlled(*plan.method));
   plan.tol = tol;
+  plan.max_energy_error = energy_bound(st);
   RunSpec& spec = plan.spec;
   spec.tol = tol;
   if (plan.search) {
@@ -64,6 +65,7 @@ BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre
   options.sink = sink;
   options.every = spec.every;
   options.omega_c = spec.omega_c;
+  options.max_energy_error = plan.max_energy_error;
   Advance how = plan.search ? Advance(Accuracy{plan.tol, spec.t_end, spec.dt_out}) : advance_of(*plan.method, spec);
   if (auto* fixed = std::get_if<FixedSteps>(&how)) fixed->dt_out = spec.dt_out;
   if (auto* controlled = std::get_if<ControlledSteps>(&how)) controlled->dt_out = spec.dt_out;

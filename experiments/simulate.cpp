@@ -291,12 +291,15 @@ BodyRun simulate_body(const SimulateOptions& o, const RunPlan& plan, const Body&
     const ProgressBar bar(estimate, progress_wanted(o.quiet));
     br = run_body(plan, body, scene.centres, plan.spec, sink, o.events);
   }
-  if (br.outcome != Outcome::ok)
-    throw Error("body '" + body.name + "' (" + std::string(br.method->name) + "): " + br.reason +
-                (br.outcome == Outcome::collision ? "; a time-transformed method (ttl-*) or a smaller --h can follow it"
-                 : is_step_controlled(*br.method) ? "; the tolerance is too loose for this scene (reduce --tol)"
-                                                  : "; the step is too large for this scene (reduce --h)") +
+  if (br.outcome != Outcome::ok) {
+    const std::string smaller = is_step_controlled(*br.method) ? "the tolerance is too loose for this scene (reduce --tol"
+                                                               : "the step is too large for this scene (reduce --h";
+    throw Error("body '" + body.name + "' (" + std::string(br.method->name) + "): " + br.reason + "; " +
+                (br.outcome == Outcome::collision ? "a time-transformed method (ttl-*) or a smaller --h can follow it"
+                 : br.outcome == Outcome::inaccurate ? smaller + ", or raise --max-energy-error if that error will do)"
+                                                     : smaller + ")") +
                 "; no output written");
+  }
   if (o.with_reference) {
     const State ref = reference_state(body, scene.centres, br.result.t_end);
     br.err_R = (br.result.final.R - ref.R).norm();

@@ -128,7 +128,7 @@ StressRow run_case(const StressCase& c, const MethodInfo& m, double max_seconds)
     }
     if (const auto e = estimate_work(m, body, c.scene.centres, spec)) check_budget(*e, max_seconds, true);
     const RunResult r = run(m, body, c.scene.centres, spec);
-    const Health h = assess(r);
+    const Health h = assess(r, checks_for(m, c.scene.centres));
     row.status = h.status;
     row.reason = h.why;
     row.max_rel_dE = r.invariants ? r.invariants->max_rel_dE : std::nan("");
@@ -156,7 +156,8 @@ std::vector<StressRow> run_stress(bool quick, const std::function<void(const Str
 void write_stress(std::ostream& csv, std::ostream& md, const std::vector<StressRow>& rows) {
   csv << "case,method,status,max_rel_dE,steps,wall_s,reason\n"
       << "# bodypoint study stress, revision " << git_revision() << "\n"
-      << "# status: ok | refused (not run, reason) | diverged | collision (flagged, reason); max_rel_dE only for runs\n";
+      << "# status: ok | refused (not run, reason) | diverged | unresolved | inaccurate | collision (flagged, reason; "
+         "docs/physics.md, Resolution and accuracy flags); max_rel_dE only for runs\n";
   for (const StressRow& r : rows) {
     csv << CsvLine().quoted(r.case_name).text(r.method).text(r.status).num(r.max_rel_dE).count(r.steps)
                .num(r.wall_s).quoted(r.reason).str()

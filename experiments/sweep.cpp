@@ -353,6 +353,7 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
     job.spec.axes.push_back(Axis{f.param, {f.value}});
   }
   job.spec.h = st.h;
+  job.spec.max_energy_error = energy_bound(st);
   bool sweeps_h = false;
   for (const Axis& a : job.spec.axes) sweeps_h = sweeps_h || a.param == "h";
   if (vm.count("t-end")) {

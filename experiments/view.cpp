@@ -179,9 +179,18 @@ TrackJson body_json(const Body& body, const std::vector<Centre>& centres, const 
   if (d.non_finite_at())
     throw Error(who + ": the state became non-finite at t = " + fmt(*d.non_finite_at()) + "; no page written");
   if (d.seen() < 2) throw Error(who + ": the run produced no trajectory (fewer than two states); no page written");
-  if (const Health h = assess(br.result); h.status != "ok") throw Error(who + ": " + h.why + "; no page written");
+  // A diverged run has nothing to show; an unresolved, inaccurate or colliding one is drawn with its
+  // flag in the header (a comparison of a poor method with a good one is what view is for).
+  if (br.outcome != Outcome::ok && br.outcome != Outcome::unresolved && br.outcome != Outcome::inaccurate &&
+      br.outcome != Outcome::collision)
+    throw Error(who + ": " + br.reason + "; no page written");
+  if (br.outcome != Outcome::ok)
+    std::cerr << "bodypoint: warning: " << who << " is " << outcome_name(br.outcome) << ": " << br.reason
+              << "; drawn with that flag\n";
   const std::vector<Frame> f = d.frames(frames);
-  std::string out = "{\"name\": " + json_string(body.name, true) + ", \"steps\": " + std::to_string(br.result.steps) +
+  std::string out = "{\"name\": " + json_string(body.name, true) + ", \"status\": " +
+                    json_string(std::string(outcome_name(br.outcome)), true) + ", \"reason\": " +
+                    json_string(br.reason, true) + ", \"steps\": " + std::to_string(br.result.steps) +
                     ", \"force_evals\": " + std::to_string(br.result.force_evals) + ", \"invariants\": {";
   if (br.result.invariants) {
     const InvariantStats& inv = *br.result.invariants;

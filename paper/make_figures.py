@@ -139,7 +139,7 @@ def appendix_figure(res, figs, listing):
         ax.set_xticks([])
         ax.set_yticks([])
         label = f"P1.{row['figure']}"
-        if row["status"] != "ok":
+        if not row["file"]:
             ax.text(0.5, 0.5, "D <= 0:\nnot run", ha="center", va="center", fontsize=6, transform=ax.transAxes)
         else:
             traj = read_csv(os.path.join(res, "appendix1", row["file"]))
@@ -151,6 +151,8 @@ def appendix_figure(res, figs, listing):
             ax.plot([0], [0], "k.", markersize=3)
             if len(ok) < len(xs):
                 label += " (leaves)"
+            if row["status"] != "ok":
+                label += f" ({row['status']})"
         ax.set_title(label, fontsize=6, pad=2)
     save(fig, os.path.join(figs, "fig_appendix1.pdf"), listing,
          "thesis appendix 1 (fig. P1.1-P1.30): trajectories in the (x, y) plane, thesis-euler, h = 1e-4")

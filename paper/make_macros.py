@@ -337,12 +337,17 @@ def by_tol(res, out, M):
             f.write(" & ".join(latex_cell(row[i]) for i in keep) + " \\\\\n")
 
 
+# The statuses of a run that ended with numbers bodypoint does not vouch for (docs/physics.md,
+# "Resolution and accuracy flags").
+FLAGGED = ("diverged", "unresolved", "inaccurate", "collision")
+
+
 def stress(res, out, M):
     rows, _ = read_csv(os.path.join(res, "stress.csv"))
     M.add("StressRuns", count(len(rows)))
     for status, name in [("ok", "StressOk"), ("refused", "StressRefused")]:
         M.add(name, count(sum(1 for r in rows if r["status"] == status)))
-    M.add("StressFlagged", count(sum(1 for r in rows if r["status"] in ("diverged", "collision"))))
+    M.add("StressFlagged", count(sum(1 for r in rows if r["status"] in FLAGGED)))
     cases, methods = [], []
     for r in rows:
         if r["case"] not in cases:
@@ -362,18 +367,19 @@ def stress(res, out, M):
                 elif r["status"] == "ok":
                     cells.append(f"${sci(num(r['max_rel_dE']), 1)}$")
                 else:
-                    cells.append({"refused": "ref.", "diverged": "\\textbf{div.}", "collision": "\\textbf{col.}"}[r["status"]])
+                    cells.append({"refused": "ref.", "diverged": "\\textbf{div.}", "unresolved": "\\textbf{unres.}",
+                                  "inaccurate": "\\textbf{inacc.}", "collision": "\\textbf{col.}"}[r["status"]])
             label = c.replace("_", "\\_").replace("|K1|", "$|K_1|$")
             f.write(f"{label} & " + " & ".join(cells) + " \\\\\n")
         f.write("\\midrule\n")
         for title, statuses in [("ended normally", ("ok",)), ("refused with a reason", ("refused",)),
-                                ("flagged (div., col.)", ("diverged", "collision"))]:
+                                ("flagged", FLAGGED)]:
             n = [sum(1 for c in cases if cell.get((c, m)) and cell[(c, m)]["status"] in statuses) for m in methods]
             f.write(f"\\emph{{{title}}} & " + " & ".join(str(k) for k in n) + " \\\\\n")
     M.add("StressMethodCount", str(len(methods)), math_mode=False)  # a column count, used in the preamble
     M.add("StressCases", count(len(cases)))
     for m in methods:
-        M.add(f"StressFlagged{camel(m)}", count(sum(1 for r in rows if r["method"] == m and r["status"] in ("diverged", "collision"))))
+        M.add(f"StressFlagged{camel(m)}", count(sum(1 for r in rows if r["method"] == m and r["status"] in FLAGGED)))
     far = [num(r["max_rel_dE"]) for r in rows if r["status"] == "ok" and r["method"] in ("lp-y4", "logh-y4", "ttl-y4")
            and (r["case"].startswith("L=") or r["case"].startswith("|K1|"))]
     if far:
@@ -387,10 +393,23 @@ def stress(res, out, M):
 def appendix(res, M):
     rows, _ = read_csv(os.path.join(res, "appendix1", "index.csv"))
     M.add("AppendixSets", count(len(rows)))
-    M.add("AppendixRun", count(sum(1 for r in rows if r["status"] == "ok")))
-    M.add("AppendixSkipped", count(sum(1 for r in rows if r["status"] != "ok")))
+    M.add("AppendixRun", count(sum(1 for r in rows if r["file"])))
+    M.add("AppendixSkipped", count(sum(1 for r in rows if not r["file"])))
+    flagged = [r for r in rows if r["file"] and r["status"] != "ok"]
+    M.add("AppendixFlagged", count(len(flagged)))
+    # By status: how many, and which sets where they are few.
+    parts = []
+    for status in FLAGGED:
+        sets = [f"P1.{r['figure']}" for r in flagged if r["status"] == status]
+        if sets:
+            parts.append(f"{len(sets)} {status}" + (f" ({', '.join(sets)})" if len(sets) <= 3 else ""))
+    if flagged:
+        dE = [num(r["max_rel_dE"]) for r in flagged if r["status"] == "inaccurate"]
+        if dE:
+            parts.append(f"energy deviations of the inaccurate ones from ${sci(min(dE))}$ to ${sci(max(dE))}$")
+    M.add("AppendixFlaggedSets", "; ".join(parts) or "none", math_mode=False)
     for r in rows:
-        if r["status"] == "ok" and r["figure"] == "3":
+        if r["file"] and r["figure"] == "3":
             traj, _ = read_csv(os.path.join(res, "appendix1", r["file"]))
             last = traj[-1]
             M.add("AppendixPThreeFinalR", sci(math.hypot(num(last["Rx"]), num(last["Ry"]))))

@@ -24,8 +24,16 @@ std::string_view outcome_name(Outcome o) {
     case Outcome::collision: return "collision";
     case Outcome::refused: return "refused";
     case Outcome::failed: return "failed";
+    case Outcome::unresolved: return "unresolved";
+    case Outcome::inaccurate: return "inaccurate";
   }
   return "?";
+}
+
+Outcome outcome_of(const Health& h) {
+  for (Outcome o : {Outcome::ok, Outcome::diverged, Outcome::collision, Outcome::unresolved, Outcome::inaccurate})
+    if (h.status == outcome_name(o)) return o;
+  throw Error("assess() gave an unknown status '" + h.status + "'");
 }
 
 long BodyResult::total_force_evals() const {
@@ -71,10 +79,9 @@ RunSpec run_spec(const MethodInfo& method, const Advance& how, const Options& op
 namespace {
 
 /// The outcome of a finished run, from its health (run.hpp, assess).
-void judge(BodyResult& r) {
-  const Health h = assess(r.run);
-  if (h.status == "ok") return;
-  r.outcome = h.status == "collision" ? Outcome::collision : Outcome::diverged;
+void judge(BodyResult& r, const std::vector<Centre>& centres, const Options& options) {
+  const Health h = assess(r.run, checks_for(*r.method, centres, options.max_energy_error));
+  r.outcome = outcome_of(h);
   r.reason = h.why;
 }
 
@@ -280,9 +287,7 @@ BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& cen
     r.events.erase(std::next(stop), r.events.end());  // nothing after the stop happened
     const InvariantStats last = cut_at(r.run, r.events.back(), body, centres);
     watching.finish(&r.events.back(), last.max_rel_dE, last.max_rel_dK2sq, last.max_abs_dK2Q);
-    r.outcome = Outcome::ok;
-    r.reason.clear();
-    judge(r);
+    judge(r, centres, options);
     return r;
   }
   const bool own_steps = std::holds_alternative<FixedSteps>(how) || std::holds_alternative<ControlledSteps>(how);
@@ -338,7 +343,7 @@ BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& cen
     r.reason = e.what();
     return r;
   }
-  judge(r);
+  judge(r, centres, options);
   return r;
 }
 

@@ -35,19 +35,21 @@ SweepRow unrun_row(SweepRow row, Outcome outcome, std::string why) {
 }
 
 /// The row of a finished run, judged by assess().
-SweepRow run_row(SweepRow row, RunResult result) {
-  const Health h = assess(result);
+SweepRow run_row(SweepRow row, RunResult result, const SweepSpec& spec, const std::vector<Centre>& centres) {
+  const Health h = assess(result, checks_for(*row.method, centres, spec.max_energy_error));
   row.result = std::move(result);
-  row.outcome = h.status == "ok" ? Outcome::ok : h.status == "collision" ? Outcome::collision : Outcome::diverged;
+  row.outcome = outcome_of(h);
   row.reason = h.why;
   return row;
 }
 
 /// The row of a run with its encounter (SweepSpec::scattering): integrate_body with every centre's
 /// closest approach as events, then scattering() of the run.
-SweepRow encounter_row(SweepRow row, const MethodInfo& method, const Scene& scene, const RunSpec& spec) {
+SweepRow encounter_row(SweepRow row, const MethodInfo& method, const Scene& scene, const RunSpec& spec,
+                       double max_energy_error) {
   const Body& body = scene.bodies.front();
   Options options;
+  options.max_energy_error = max_energy_error;
   options.track_invariants = spec.track_invariants;
   options.omega_c = spec.omega_c;
   options.events = closest_approaches(scene.centres.size());
@@ -127,6 +129,7 @@ std::string point_label(const SweepSpec& spec, const std::vector<double>& point)
 
 void validate_sweep(const SweepSpec& spec) {
   if (spec.methods.empty()) throw Error("the method list is empty");
+  if (!(spec.max_energy_error > 0.0)) throw Error("the bound on the energy error must be a number > 0 (inf: no bound)");
   if (spec.axes.empty()) throw Error("the sweep has no varied parameter");
   for (const Axis& a : spec.axes)
     if (a.values.empty()) throw Error("the sweep has no values of " + a.param);
@@ -155,6 +158,7 @@ std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vect
   const MethodInfo& method = *spec.methods[unit.front() % M];
   std::vector<SweepRow> rows;
   std::vector<batch::Member> members;
+  std::vector<std::vector<Centre>> centres;
   for (std::size_t i : unit) {
     SweepRow row;
     row.task = i;
@@ -163,22 +167,24 @@ std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vect
     rows.push_back(std::move(row));
     const Scene scene = thesis_scene(point_params(spec, rows.back().point));
     members.push_back({scene.bodies.front().p, scene.bodies.front().s0, scene.centres.front().A});
+    centres.push_back(scene.centres);
   }
   if (unit.size() > 1) {  // a batch: one method, one step (plan_units), lanes that accept it
     auto results = batch::run(method, members, point_spec(spec, rows.front().point));
-    for (std::size_t k = 0; k < unit.size(); ++k) rows[k] = run_row(std::move(rows[k]), std::move(results[k]));
+    for (std::size_t k = 0; k < unit.size(); ++k)
+      rows[k] = run_row(std::move(rows[k]), std::move(results[k]), spec, centres[k]);
     return rows;
   }
   SweepRow& row = rows.front();
   const Scene scene = thesis_scene(point_params(spec, row.point));
   if (spec.scattering) {
-    row = encounter_row(std::move(row), method, scene, point_spec(spec, row.point));
+    row = encounter_row(std::move(row), method, scene, point_spec(spec, row.point), spec.max_energy_error);
     return rows;
   }
   try {
     // The run first: an argument list that also moved `row` may move it before reading row.point.
     RunResult result = run(method, scene.bodies.front(), scene.centres, point_spec(spec, row.point));
-    row = run_row(std::move(row), std::move(result));
+    row = run_row(std::move(row), std::move(result), spec, scene.centres);
   } catch (const std::exception& e) {  // run() throws the method's refusal, or why the run stopped
     const bool refused = !refusal(method, scene.bodies.front(), scene.centres).empty();
     row = unrun_row(std::move(row), refused ? Outcome::refused : Outcome::failed, e.what());

@@ -16,6 +16,12 @@
 
 namespace bodypoint {
 
+/// Cosine of the angle between a and b (1 when either is zero: no direction to turn).
+inline double turn_cos(const Vec3& a, const Vec3& b) {
+  const double q = a.squaredNorm() * b.squaredNorm();
+  return q > 0.0 ? a.dot(b) / std::sqrt(q) : 1.0;
+}
+
 struct OriginCentre {
   double A = 0.0;
   /// K2Q = R x K1 + K2 is a first integral only for a single centre (taken as the origin).
@@ -31,6 +37,11 @@ struct OriginCentre {
   /// Distance to the nearest attracting centre (infinite when none attracts).
   [[nodiscard]] double nearest_attracting(const Vec3& R) const {
     return A > 0.0 ? R.norm() : std::numeric_limits<double>::infinity();
+  }
+  /// Cosine of the angle through which the direction to the centre turned from `from` to `to`
+  /// (1 when the centre exerts no force).
+  [[nodiscard]] double min_turn_cos(const Vec3& from, const Vec3& to) const {
+    return A != 0.0 ? turn_cos(from, to) : 1.0;
   }
 
   /// F and Pi in one pass (one force evaluation).
@@ -79,6 +90,13 @@ struct CentreList {
     for (const Centre& k : centres)
       if (k.A > 0.0) r = std::min(r, (R - k.c).norm());
     return r;
+  }
+  /// The smallest cosine of the angles through which the directions to the centres (A != 0) turned.
+  [[nodiscard]] double min_turn_cos(const Vec3& from, const Vec3& to) const {
+    double c = 1.0;
+    for (const Centre& k : centres)
+      if (k.A != 0.0) c = std::min(c, turn_cos(from - k.c, to - k.c));
+    return c;
   }
   void force_potential(const Vec3& R, Vec3& F, double& P) const {
     F.setZero();

@@ -51,6 +51,11 @@ struct InvariantStats {
   /// without an attracting centre): a fall onto a centre shows as min/start ~ 0.
   double min_r_attracting = std::numeric_limits<double>::infinity();
   double r0_attracting = std::numeric_limits<double>::infinity();
+  /// Resolution (docs/physics.md "Resolution"): the largest angle the spin turned through about K1 in
+  /// one step, Omega_so dt with Omega_so = |B| |K1|/D at the step's end, and the cosine of the largest
+  /// angle through which the direction to a centre (A != 0) turned in one step (1: none turned).
+  double max_spin_angle = 0.0;
+  double min_turn_cos = 1.0;
 };
 
 inline double relative_deviation(double x, double x0) {
@@ -58,12 +63,14 @@ inline double relative_deviation(double x, double x0) {
   return scale > 0.0 ? std::abs(x - x0) / scale : std::abs(x - x0);
 }
 
-/// Tracks the deviations of every integral the field has; one call per observed state.
+/// Tracks the deviations of every integral the field has; one call per observed state, `step` for
+/// the state that ends a step (it also measures the step's resolution), `update` for any other.
 template <class Field>
 class InvariantMonitor {
  public:
   InvariantMonitor(const BodyPoint& p, const Field& f, const State& s0)
-      : p_(p), f_(f), c_(angular_momentum_point(f)) {
+      : p_(p), f_(f), c_(angular_momentum_point(f)), spin_rate_per_K1_(std::abs(p.B) * (1.0 / p.D())),
+        prev_R_(s0.R) {
     E0_ = energy(p_, f_, s0);
     K2sq0_ = proper_momentum_sq(p_, s0);
     if (c_) K2Q0_ = total_angular_momentum(p_, s0, *c_);
@@ -83,6 +90,18 @@ class InvariantMonitor {
     stats_.min_r_attracting = std::min(stats_.min_r_attracting, f_.nearest_attracting(s.R));
   }
 
+  /// The state s that ends a step of physical length dt: update(s) and the step's spin and orbital
+  /// angles (the batch monitor, batch_w.cpp, does the same arithmetic).
+  void step(const State& s, double dt) {
+    update(s);
+    if (spin_rate_per_K1_ > 0.0) {
+      const double angle = spin_rate_per_K1_ * (p_.m * s.v + p_.B * s.w).norm() * dt;
+      stats_.max_spin_angle = max_keeping_nan(stats_.max_spin_angle, angle);
+    }
+    stats_.min_turn_cos = std::min(stats_.min_turn_cos, f_.min_turn_cos(prev_R_, s.R));
+    prev_R_ = s.R;
+  }
+
   /// max that propagates NaN: std::max(x, NaN) is x, which would report a run full of NaN as clean.
   static double max_keeping_nan(double so_far, double x) {
     if (std::isnan(so_far) || std::isnan(x)) return std::numeric_limits<double>::quiet_NaN();
@@ -100,6 +119,8 @@ class InvariantMonitor {
   const Field& f_;
   std::optional<Vec3> c_;
   double E0_ = 0.0, K2sq0_ = 0.0;
+  double spin_rate_per_K1_;  ///< |B|/D: Omega_so = |B| |K1|/D
+  Vec3 prev_R_;              ///< where the last step started
   Vec3 K2Q0_ = Vec3::Zero();
   InvariantStats stats_;
   double last_rel_dE_ = 0.0, last_rel_dK2sq_ = 0.0, last_abs_dK2Q_ = 0.0;

@@ -154,23 +154,52 @@ namespace {
 constexpr double kMinStepTolerance = 1e-15;
 }  // namespace
 
-Health assess(const RunResult& r) {
+Checks checks_for(const MethodInfo& m, const std::vector<Centre>& centres, double max_energy_error) {
+  if (!(max_energy_error > 0.0))
+    throw Error("the bound on the energy error must be a number > 0 (infinity: no bound), got " +
+                detail::short_number(max_energy_error));
+  Checks c;
+  c.max_energy_error = max_energy_error;
+  c.energy_is_integral = !non_coulomb(centres);
+  c.orbit_exact = m.family == Family::KeplerSplit || m.family == Family::Regularised;
+  const bool free_flight = std::all_of(centres.begin(), centres.end(), [](const Centre& k) { return k.A == 0.0; });
+  // The exact splittings' drift rotates the spin exactly; without a force nothing else acts on it.
+  c.spin_exact = free_flight && (m.family == Family::LiePoisson || m.family == Family::KeplerSplit ||
+                                 m.family == Family::TimeTransformed);
+  return c;
+}
+
+Health assess(const RunResult& r, const Checks& checks) {
   const State& f = r.final;
   const bool finite = f.R.allFinite() && f.v.allFinite() && f.w.allFinite();
   const InvariantStats* inv = r.invariants ? &*r.invariants : nullptr;
   const bool fell = inv && inv->min_r_attracting < kCollisionFraction * inv->r0_attracting;
-  std::string why;
+  const bool energy = inv && checks.energy_is_integral;
+  std::string status = "diverged", why;
   if (!finite) why = "the state became non-finite (NaN/inf)";
   else if (inv && !(std::isfinite(inv->max_rel_dE) && std::isfinite(inv->max_rel_dK2sq) && std::isfinite(inv->max_abs_dK2Q)))
     why = "an invariant became non-finite";
-  else if (inv && inv->max_rel_dE > kDivergedEnergy)
+  else if (energy && inv->max_rel_dE > kDivergedEnergy)
     why = "the relative energy error reached " + detail::short_number(inv->max_rel_dE) + " (above 1)";
+  else if (inv && !checks.spin_exact && inv->max_spin_angle > kMaxSpinAngle) {
+    status = "unresolved";
+    why = "a step turned the spin by " + detail::short_number(inv->max_spin_angle) +
+          " rad about K1 (more than pi: the spin-orbit rotation is not resolved)";
+  } else if (inv && !checks.orbit_exact && inv->min_turn_cos < std::cos(kMaxTurnAngle)) {
+    status = "unresolved";
+    why = "a step turned the direction to a centre by " + detail::short_number(std::acos(std::max(-1.0, inv->min_turn_cos))) +
+          " rad (more than pi/2: the encounter is not resolved)";
+  } else if (energy && inv->max_rel_dE > checks.max_energy_error) {
+    status = "inaccurate";
+    why = "the relative energy error reached " + detail::short_number(inv->max_rel_dE) + " (above the bound " +
+          detail::short_number(checks.max_energy_error) + ")";
+  }
   if (why.empty()) return {"ok", ""};
   if (fell)
     return {"collision", why + " after a fall onto an attracting centre (closest approach " +
                              detail::short_number(inv->min_r_attracting) + " from a start at " +
                              detail::short_number(inv->r0_attracting) + ")"};
-  return {"diverged", why};
+  return {status, why};
 }
 
 std::string refusal(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres) {

@@ -151,18 +151,45 @@ inline bool is_time_transformed(const MethodInfo& m) {
 /// True for every method whose physical step varies (step-size-controlled or time-transformed).
 inline bool has_variable_step(const MethodInfo& m) { return is_step_controlled(m) || is_time_transformed(m); }
 
-/// Whether a run stayed in the regime its numbers mean something in: "ok"; "diverged" (a non-finite
-/// state or invariant, or a relative energy error above kDivergedEnergy); "collision" (diverged after
-/// coming closer to an attracting centre than kCollisionFraction of its starting distance).
+/// Whether a run stayed in the regime its numbers mean something in (docs/physics.md "Resolution and
+/// accuracy flags"), in order of precedence:
+///   diverged    a non-finite state or invariant, or a relative energy error above kDivergedEnergy;
+///   unresolved  a step turned the spin about K1 by more than kMaxSpinAngle, or the direction to a
+///               centre by more than kMaxTurnAngle: the step cannot resolve the scene's time scales;
+///   inaccurate  a relative energy error above the stated bound Checks::max_energy_error (default
+///               kDefaultMaxEnergyError);
+/// and "collision" instead of any of them after coming closer to an attracting centre than
+/// kCollisionFraction of the starting distance (the fall is the cause).
 struct Health {
-  std::string status;  ///< ok, diverged or collision
+  std::string status;  ///< ok, diverged, unresolved, inaccurate or collision
   std::string why;     ///< one line for a message, empty when ok
 };
 /// An energy error larger than the energy itself: the numbers no longer describe the motion.
 constexpr double kDivergedEnergy = 1.0;
+/// The default bound on the relative energy error of a run called ok: a run whose energy is 1% off
+/// has lost its trajectory long before (lp-y4 at h = 50 on table 3.1: 4e-2 in energy, 77% in R).
+constexpr double kDefaultMaxEnergyError = 1e-2;
+/// A step that turns the spin by more than half a turn about K1 aliases the rotation (sampling at
+/// fewer than two points per turn cannot tell it from a slower one, or from one the other way).
+constexpr double kMaxSpinAngle = 3.14159265358979323846;
+/// A step that turns the direction to a centre by more than a right angle: the force at the step's
+/// two ends has no component along each other, so no step of this size samples the encounter.
+constexpr double kMaxTurnAngle = 3.14159265358979323846 / 2.0;
 /// Closer than this fraction of the starting distance to an attracting centre is a fall onto it.
 constexpr double kCollisionFraction = 1e-6;
-Health assess(const RunResult& r);
+
+/// What assess() holds a run to; checks_for() sets the method's and the scene's part.
+struct Checks {
+  double max_energy_error = kDefaultMaxEnergyError;  ///< > 0; infinity: no accuracy flag
+  bool energy_is_integral = true;  ///< false under the thesis code's force law: E is not conserved there
+  bool orbit_exact = false;        ///< the method's stages solve the motion about the centre exactly
+  bool spin_exact = false;         ///< free flight, solved exactly by the method's drift (any spin angle)
+};
+/// The checks for runs of `m` on a scene with these centres, with the bound max_energy_error (> 0,
+/// not NaN; infinity turns the accuracy flag off).
+Checks checks_for(const MethodInfo& m, const std::vector<Centre>& centres,
+                  double max_energy_error = kDefaultMaxEnergyError);
+Health assess(const RunResult& r, const Checks& checks = {});
 
 /// The three ways of advancing time, one driver each: fixed steps h, time i h (the composition engine
 /// and Odeint's fixed-step loop, under one observer: run_support.hpp); fixed fictitious steps ds to

@@ -191,12 +191,14 @@ Event event_from(const std::string& text) {
 
 py::dict integrate_py(const Scene& scene, const std::string& method, std::optional<double> h,
                       std::optional<long> steps, std::optional<double> t_end, std::optional<double> tol,
-                      bool invariants, double omega_c, const std::vector<std::string>& event_names) {
+                      bool invariants, double omega_c, const std::vector<std::string>& event_names,
+                      double max_energy_error) {
   const MethodInfo* m = method == "auto" ? nullptr : &method_or_throw(method);
   const Advance how = advance_for(m, h, steps, t_end, tol);
   Options o;
   o.track_invariants = invariants;
   o.omega_c = omega_c;
+  o.max_energy_error = max_energy_error;
   for (const std::string& e : event_names) o.events.push_back(event_from(e));
   Result r;
   {
@@ -266,8 +268,9 @@ py::list trajectory_py(const Scene& scene, const std::string& method, double ste
 /// A sweep or grid of the thesis's scene as columns (sweep.hpp).
 py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>& axes,
                   const std::vector<std::string>& methods, const py::dict& base, double h, long steps, double t_end,
-                  double tol, unsigned threads) {
+                  double tol, unsigned threads, double max_energy_error) {
   SweepSpec s;
+  s.max_energy_error = max_energy_error;
   for (const auto& [param, values] : axes) s.axes.push_back({param, values});
   for (const std::string& m : methods) s.methods.push_back(&method_or_throw(m));
   for (const auto& [k, v] : base) scene_field(s.base, k.cast<std::string>()) = v.cast<double>();
@@ -400,11 +403,13 @@ PYBIND11_MODULE(_bodypoint, mod) {
     }
     return l;
   });
+  mod.attr("DEFAULT_MAX_ENERGY_ERROR") = kDefaultMaxEnergyError;
   mod.def("_integrate", &integrate_py, py::arg("scene"), py::arg("method"), py::arg("h"), py::arg("steps"),
-          py::arg("t_end"), py::arg("tol"), py::arg("invariants"), py::arg("omega_c"), py::arg("events"));
+          py::arg("t_end"), py::arg("tol"), py::arg("invariants"), py::arg("omega_c"), py::arg("events"),
+          py::arg("max_energy_error"));
   mod.def("_trajectory", &trajectory_py, py::arg("scene"), py::arg("method"), py::arg("step"), py::arg("times"),
           py::arg("omega_c"));
   mod.def("_sweep", &sweep_py, py::arg("axes"), py::arg("methods"), py::arg("base"), py::arg("h"), py::arg("steps"),
-          py::arg("t_end"), py::arg("tol"), py::arg("threads"));
+          py::arg("t_end"), py::arg("tol"), py::arg("threads"), py::arg("max_energy_error"));
   mod.def("_encounter", &encounter_py, py::arg("scene"), py::arg("method"), py::arg("tol"), py::arg("t_end"));
 }

@@ -66,7 +66,9 @@ TEST(Cli, EveryMethodRunsAndReportsItsInvariants) {
     // at h = 0.01 that is e^12 by t = 50, so they get the thesis's own step.
     const Scene thesis = thesis_scene(SceneParams{});
     const std::string extra = refusal(m, thesis.bodies.front(), thesis.centres).empty() ? "" : " --B 0";
-    const std::string step = m.family == Family::Thesis ? "1e-4" : "0.01";
+    // At that step thesis-euler's energy is 17% off, beyond the default accuracy bound: this test is
+    // about running and reporting, so it lifts the bound.
+    const std::string step = m.family == Family::Thesis ? "1e-4 --max-energy-error inf" : "0.01";
     const Result r = run_cli("simulate --json --h " + step + " --t-end 50 --method " + std::string(m.name) + extra);
     ASSERT_EQ(r.code, 0) << m.name << ": " << r.err;
     for (const char* key : {"max_rel_dE", "max_rel_dK2sq", "max_abs_dK2Q", "force_evals", "wall_s"})

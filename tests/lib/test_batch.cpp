@@ -29,6 +29,8 @@ void expect_same(const RunResult& batch, const RunResult& scalar, const std::str
   EXPECT_TRUE(same_bits(a.max_rel_dK2sq, b.max_rel_dK2sq)) << what;
   EXPECT_TRUE(same_bits(a.max_abs_dK2Q, b.max_abs_dK2Q)) << what;
   EXPECT_TRUE(same_bits(a.min_r_attracting, b.min_r_attracting)) << what;
+  EXPECT_TRUE(same_bits(a.max_spin_angle, b.max_spin_angle)) << what << ": " << a.max_spin_angle << " vs " << b.max_spin_angle;
+  EXPECT_TRUE(same_bits(a.min_turn_cos, b.min_turn_cos)) << what << ": " << a.min_turn_cos << " vs " << b.min_turn_cos;
   EXPECT_EQ(batch.force_evals, scalar.force_evals) << what;
   EXPECT_EQ(assess(batch).status, assess(scalar).status) << what;
 }

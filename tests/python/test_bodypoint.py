@@ -103,6 +103,22 @@ def test_grid_is_every_combination_last_axis_fastest():
     assert set(cols["outcome"]) == {"ok"}
 
 
+def test_flags_and_the_energy_bound_equal_the_command_line():
+    # A step that turns the spin by 5e9 rad (issue #24) is unresolved; the thesis's Euler at its own
+    # step is 17% off in energy: inaccurate by the default bound, ok without one, as on the command line.
+    stiff = bp.integrate(bp.thesis_scene(B=0.9999999999995), "lp-verlet", h=1e-3, t_end=20)
+    assert stiff["outcome"] == "unresolved" and "turned the spin" in stiff["reason"]
+    scene = bp.thesis_scene()
+    assert bp.integrate(scene, "thesis-euler", h=1e-4, steps=500000)["outcome"] == "inaccurate"
+    free = bp.integrate(scene, "thesis-euler", h=1e-4, steps=500000, max_energy_error=float("inf"))
+    assert free["outcome"] == "ok"
+    want = json.loads(cli("simulate", "--method", "thesis-euler", "--h", "1e-4", "--steps", "500000", "--json",
+                          "--max-energy-error", "inf"))
+    assert free["bodies"][0]["invariants"]["max_rel_dE"] == want["max_rel_dE"]
+    cols = bp.sweep({"h": [1e-4]}, "thesis-euler", t_end=50, max_energy_error=bp._core.DEFAULT_MAX_ENERGY_ERROR)
+    assert list(cols["outcome"]) == ["inaccurate"]
+
+
 def test_rutherford_deflection_for_a_material_point():
     A, m = -2.0, 1.0
     for b in (0.1, 1.0, 10.0):

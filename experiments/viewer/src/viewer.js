@@ -51,7 +51,9 @@ data.runs.forEach((run, k) => {
     const i = b.invariants || {};
     let s = `${esc(b.name)}: max|dE/E| ${fmt(i.max_rel_dE)}, max|dK2²|/K2² ${fmt(i.max_rel_dK2sq)}`;
     if (i.max_abs_dK2Q !== undefined) s += `, max|dK2Q| ${fmt(i.max_abs_dK2Q)}`;
-    return s + `, r_min ${fmt(b.closest.r)} at t=${fmt(b.closest.t)}`;
+    s += `, r_min ${fmt(b.closest.r)} at t=${fmt(b.closest.t)}`;
+    if (b.status && b.status !== 'ok') s += ` <b class="flag">${esc(b.status)}</b>: ${esc(b.reason)}`;
+    return s;
   });
   headerHtml += `<span class="run"><span class="swatch" style="background:${hex(RUN_COLOURS[k])}"></span>` +
     `<b>${esc(run.method)}</b> ${esc(run.step)} &nbsp; ${inv.join('; ')}</span><br>`;

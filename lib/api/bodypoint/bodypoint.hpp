@@ -93,17 +93,24 @@ struct Options {
   double omega_c = -1.0;
   /// Located along the run (BodyResult::events); the run then observes every step (or every dt_out).
   std::vector<Event> events;
+  /// A run whose relative energy error exceeds this bound ends Outcome::inaccurate (> 0; infinity: no
+  /// bound). Not applied where E is not conserved (the thesis code's force law).
+  double max_energy_error = kDefaultMaxEnergyError;
 };
 
 /// How one body's run ended.
 enum class Outcome {
   ok,         ///< the run reached its end in the regime its numbers mean something in
   diverged,   ///< a non-finite state or invariant, or an energy error above kDivergedEnergy
-  collision,  ///< diverged after falling onto an attracting centre
+  collision,  ///< diverged, unresolved or inaccurate after falling onto an attracting centre
   refused,    ///< the method does not apply to this scene (not run; reason says why)
   failed,     ///< started but stopped: a budget, a time transformation that broke down, an accuracy out of reach
+  unresolved,  ///< a step turned the spin by more than pi or the direction to a centre by more than pi/2
+  inaccurate,  ///< the energy error exceeded Options::max_energy_error (but not 1)
 };
 std::string_view outcome_name(Outcome o);
+/// The outcome assess() (run.hpp) gives a finished run.
+Outcome outcome_of(const Health& h);
 
 /// What the accuracy mode did to deliver its tolerance (Accuracy).
 struct AccuracyReport {

@@ -58,6 +58,7 @@ struct SweepSpec {
   /// Also locate each run's closest approaches and report the encounter (SweepRow::scattering): each
   /// task then runs alone through integrate_body (no vector lanes), the same run with an observer.
   bool scattering = false;
+  double max_energy_error = kDefaultMaxEnergyError;  ///< Options::max_energy_error of every run
 };
 
 /// Number of (grid point, method) tasks; Error above 1e9.
@@ -83,8 +84,8 @@ struct SweepRow {
   std::size_t task = 0;
   std::vector<double> point;
   const MethodInfo* method = nullptr;
-  /// ok, diverged or collision (assess()), refused (the method does not take the scene) or failed
-  /// (the run stopped: a budget, a broken time transformation).
+  /// ok, diverged, unresolved, inaccurate or collision (assess()), refused (the method does not take
+  /// the scene) or failed (the run stopped: a budget, a broken time transformation).
   Outcome outcome = Outcome::ok;
   std::string reason;  ///< one line; empty when ok
   RunResult result;    ///< final state NaN when refused or failed

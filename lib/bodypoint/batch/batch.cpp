@@ -118,6 +118,8 @@ std::vector<RunResult> run(const MethodInfo& method, const std::vector<Member>& 
     st.has_K2Q = true;
     st.min_r_attracting = o[12];
     st.r0_attracting = o[13];
+    st.max_spin_angle = o[14];
+    st.min_turn_cos = o[15];
     r.invariants = st;
   }
   return results;

@@ -59,29 +59,42 @@ struct Physical {
 /// InvariantMonitor's arithmetic (invariants.hpp) for one centre at the origin.
 class Monitor {
  public:
-  Monitor(const Params& p, const Physical& s0) : p_(p) {
+  Monitor(const Params& p, const Physical& s0, double h) : p_(p), h_(h), prev_R_(s0.R) {
     E0_ = energy(s0);
     K2sq0_ = squared_norm(K2(s0));
     K2Q0_ = K2Q(s0);
     r0_ = min_r_ = nearest(s0.R);
-    max_dE_ = max_dK2sq_ = max_dK2Q_ = splat(0.0);
+    max_dE_ = max_dK2sq_ = max_dK2Q_ = max_spin_ = splat(0.0);
+    min_cos_ = splat(1.0);
+    spin_rate_per_K1_ = vabs(p.B) * (1.0 / (p.m * p.J - p.B * p.B));
   }
 
-  void update(const Physical& s) {
+  /// The state that ends a step of h: InvariantMonitor::step's arithmetic.
+  void step(const Physical& s) {
     max_dE_ = max_keeping_nan(max_dE_, relative_deviation(energy(s), E0_));
     max_dK2sq_ = max_keeping_nan(max_dK2sq_, relative_deviation(squared_norm(K2(s)), K2sq0_));
     max_dK2Q_ = max_keeping_nan(max_dK2Q_, vsqrt(squared_norm(K2Q(s) - K2Q0_)));
     const Lane r = nearest(s.R);
     min_r_ = r < min_r_ ? r : min_r_;  // std::min(so_far, r)
+    const Lane angle = spin_rate_per_K1_ * vsqrt(squared_norm(p_.m * s.v + p_.B * s.w)) * h_;
+    max_spin_ = max_keeping_nan(max_spin_, angle);
+    const Lane q = squared_norm(prev_R_) * squared_norm(s.R);
+    const Lane c = q > 0.0 ? dot(prev_R_, s.R) / vsqrt(q) : splat(1.0);  // turn_cos (field.hpp)
+    const Lane turned = p_.A != 0.0 ? c : splat(1.0);
+    min_cos_ = turned < min_cos_ ? turned : min_cos_;
+    prev_R_ = s.R;
   }
 
-  /// max |dE|/|E0|, max |dK2^2|/K2^2_0, max |dK2Q|, closest and first distance to the centre.
+  /// max |dE|/|E0|, max |dK2^2|/K2^2_0, max |dK2Q|, closest and first distance to the centre, largest
+  /// spin angle of a step, smallest cosine of a step's turn about the centre.
   void stats(std::size_t i, double* out) const {
     out[0] = max_dE_[i];
     out[1] = max_dK2sq_[i];
     out[2] = max_dK2Q_[i];
     out[3] = min_r_[i];
     out[4] = r0_[i];
+    out[5] = max_spin_[i];
+    out[6] = min_cos_[i];
   }
 
  private:
@@ -105,8 +118,9 @@ class Monitor {
   }
 
   Params p_;
-  Lane E0_, K2sq0_, r0_, min_r_, max_dE_, max_dK2sq_, max_dK2Q_;
-  V3 K2Q0_;
+  double h_;
+  Lane E0_, K2sq0_, r0_, min_r_, max_dE_, max_dK2sq_, max_dK2Q_, max_spin_, min_cos_, spin_rate_per_K1_;
+  V3 K2Q0_, prev_R_;
 };
 
 /// The engine's observer: the physical state of every step, to the monitor.
@@ -117,7 +131,7 @@ struct Observer {
   Monitor& monitor;
   template <class X>
   void operator()(long, const X& x) {
-    monitor.update(kernel.to_physical(x));
+    monitor.step(kernel.to_physical(x));
   }
 };
 
@@ -234,7 +248,7 @@ void report(const Physical& f, const Monitor& monitor, std::size_t count, double
 /// Runs `Seq` with kernel K on the lanes; returns the force evaluations.
 template <const auto& Seq, class K>
 long run_splitting(K kernel, const Physical& s0, double h, long steps, std::size_t count, double* out) {
-  Monitor monitor(kernel.p, s0);
+  Monitor monitor(kernel.p, s0, h);
   Observer<K> obs{kernel, monitor};
   typename K::state_type x = kernel.initial_state(s0);
   sp::integrate<Seq>(kernel, x, h, steps, obs);
@@ -272,7 +286,7 @@ Ode stage(const Ode& x, int n, const double* a, const Ode* const* k) {
 long run_rk4(const Params& p, const Physical& s0, double h, long steps, std::size_t count, double* out) {
   const Lane D = p.m * p.J - p.B * p.B;
   const Rhs f{p.J / D, p.B * p.B / D, p.B / D, p.m * p.B / D, p};
-  Monitor monitor(p, s0);
+  Monitor monitor(p, s0, h);
   Ode x{s0.R, s0.v, s0.w};
   // odeint's runge_kutta4 tableau (a = 1/2; 0, 1/2; 0, 0, 1; b = 1/6, 1/3, 1/3, 1/6), each times h.
   const double a2[1] = {0.5 * h}, a3[2] = {0.0 * h, 0.5 * h}, a4[3] = {0.0 * h, 0.0 * h, 1.0 * h};
@@ -287,7 +301,7 @@ long run_rk4(const Params& p, const Physical& s0, double h, long steps, std::siz
     const Ode k4 = f(stage(x, 3, a4, k));
     k[3] = &k4;
     x = stage(x, 4, b, k);
-    monitor.update({x.R, x.v, x.w});
+    monitor.step({x.R, x.v, x.w});
   }
   report({x.R, x.v, x.w}, monitor, count, out);
   return 4 * steps;

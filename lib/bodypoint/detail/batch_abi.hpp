@@ -10,8 +10,9 @@ namespace bodypoint::batch::abi {
 /// One member in: m, B, J, A, R (3), v (3), w (3).
 inline constexpr std::size_t kIn = 13;
 /// One member out: R, v, w at the end (9), max |dE|/|E0|, max |dK2^2|/K2^2_0, max |dK2Q|, closest
-/// distance to the centre, distance at the start.
-inline constexpr std::size_t kOut = 14;
+/// distance to the centre, distance at the start, largest spin angle of a step, smallest cosine of a
+/// step's turn about the centre.
+inline constexpr std::size_t kOut = 16;
 
 /// splitting::drift_functions(x) as {S1, C1, S3}, built for the baseline (batch.cpp).
 void scalar_drift_functions(double x, double* out);

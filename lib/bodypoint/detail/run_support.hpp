@@ -64,18 +64,17 @@ class Monitor {
     if (sink_) (*sink_)(Sample{0, 0.0, s0, 0.0, 0.0, 0.0});
   }
 
+  /// Fixed steps: step i ends at time i h and was h long.
   template <class X>
   void operator()(long i, const X& x) {
-    observe(i, static_cast<double>(i) * spec_.h, x, i == spec_.steps);
+    stepped(i, static_cast<double>(i) * spec_.h, spec_.h, x, i == spec_.steps);
   }
 
   /// For methods with their own time grid: step i ends at time t; `last` marks the final state.
   template <class X>
   void observe(long i, double t, const X& x, bool last) {
-    const State s = to_physical_(x);
-    inv_.update(s);
-    if (sink_ && spec_.dt_out <= 0.0 && (i % spec_.every == 0 || last))
-      (*sink_)(Sample{i, t, s, inv_.last_rel_dE(), inv_.last_rel_dK2sq(), inv_.last_abs_dK2Q()});
+    stepped(i, t, t - t_, x, last);
+    t_ = t;
   }
 
   /// With spec.dt_out > 0: a state at a requested output time t (made by a side step).
@@ -88,7 +87,16 @@ class Monitor {
   [[nodiscard]] const InvariantStats& stats() const { return inv_.stats(); }
 
  private:
+  template <class X>
+  void stepped(long i, double t, double dt, const X& x, bool last) {
+    const State s = to_physical_(x);
+    inv_.step(s, dt);
+    if (sink_ && spec_.dt_out <= 0.0 && (i % spec_.every == 0 || last))
+      (*sink_)(Sample{i, t, s, inv_.last_rel_dE(), inv_.last_rel_dK2sq(), inv_.last_abs_dK2Q()});
+  }
+
   InvariantMonitor<Field> inv_;
+  double t_ = 0.0;  ///< observe(): where the last step ended
   const RunSpec& spec_;
   const SampleSink* sink_;
   ToPhysical to_physical_;
