@@ -9,6 +9,7 @@
 #include <cstring>
 #include <exception>
 #include <iostream>
+#include <new>
 #include <string>
 #include <string_view>
 
@@ -92,6 +93,10 @@ int main(int argc, char** argv) {
     if (cmd == "view") return bodypoint::cli::cmd_view(argc - 1, argv + 1);
     std::cerr << "bodypoint: error: unknown command '" << cmd << "' (simulate, methods, work-precision, sweep, merge, timing, study, view)\n";
     return 2;
+  } catch (const std::bad_alloc&) {  // its what() is "std::bad_alloc"
+    if (bodypoint::cli::launcher_rank() == 0)
+      std::cerr << "bodypoint: error: out of memory: the request needs more memory than this process may have "
+                   "(fewer points, frames, rows or threads)\n";
   } catch (const std::exception& e) {  // bodypoint::Error, boost::program_options::error and the rest
     if (bodypoint::cli::launcher_rank() == 0) std::cerr << "bodypoint: error: " << one_line(e.what()) << "\n";
   }

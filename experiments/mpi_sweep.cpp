@@ -45,7 +45,8 @@ std::vector<std::string> run_sweep_mpi(const MpiSession&, const SweepSpec&, cons
 
 namespace {
 
-constexpr int kTagRow = 1;   // rank r -> 0: "" (ready) or "<index>\t<row>\n" per task of a finished unit
+constexpr int kTagRow = 1;   // rank r -> 0: "" (ready), "<index>\t<row>\n" per task of a finished unit, or
+                             // "!<reason>" when the unit failed (rank 0 reports it and ends the sweep)
 constexpr int kTagTask = 2;  // 0 -> rank r: the task indices of the next unit, or none (no more)
 /// The coordinator polls for messages this often while rank 0's threads compute: short against a
 /// task (milliseconds to seconds), long enough to leave the core to the computing threads.
@@ -113,6 +114,8 @@ void coordinate(const MpiSession& mpi, Board& board) {
     std::string msg(static_cast<std::size_t>(len), '\0');
     MPI_Recv(msg.data(), len, MPI_CHAR, st.MPI_SOURCE, kTagRow, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
     try {
+      if (!msg.empty() && msg.front() == '!')
+        throw Error("rank " + std::to_string(st.MPI_SOURCE) + ": " + msg.substr(1));
       for (std::size_t from = 0, end; (end = msg.find('\n', from)) != std::string::npos; from = end + 1) {
         const std::size_t tab = msg.find('\t', from);
         board.finish(std::stoul(msg.substr(from, tab - from)), msg.substr(tab + 1, end - tab - 1));
@@ -140,9 +143,13 @@ void serve(const SweepSpec& spec) {
     MPI_Recv(next.data(), count, MPI_LONG, 0, kTagTask, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
     if (next.empty()) return;
     const std::vector<std::size_t> unit(next.begin(), next.end());
-    const std::vector<std::string> rows = run_sweep_unit(spec, unit);
     msg.clear();
-    for (std::size_t k = 0; k < unit.size(); ++k) msg += std::to_string(unit[k]) + "\t" + rows[k] + "\n";
+    try {
+      const std::vector<std::string> rows = run_sweep_unit(spec, unit);
+      for (std::size_t k = 0; k < unit.size(); ++k) msg += std::to_string(unit[k]) + "\t" + rows[k] + "\n";
+    } catch (const std::exception& e) {  // this rank's error, for rank 0 to report: it alone prints
+      msg = std::string("!") + e.what();
+    }
   }
 }
 

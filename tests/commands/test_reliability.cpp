@@ -394,6 +394,27 @@ TEST(Reliability, AWritePastTheFileSizeLimitFailsWithItsReason) {
   fs::remove_all(dir);
 }
 
+TEST(Reliability, OutOfMemoryIsOneLineWithItsReason) {
+#ifdef __SANITIZE_ADDRESS__
+  GTEST_SKIP() << "AddressSanitizer reserves more address space than the limit below allows";
+#endif
+  const fs::path dir = test::temp_path("bp_rel_oom");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  // 1e6 grid points x every method: the rows alone need more than the 400 MB of address space allowed.
+  const std::string limited = "ulimit -v 400000; exec '" + std::string(BODYPOINT_BIN) +
+                              "' sweep --param d --log --from 1 --to 10 --points 1000000 --methods all --steps 10 "
+                              "--out '" + (dir / "s.csv").string() + "' 2>'" + (dir / "err.txt").string() + "'";
+  const int rc = std::system(("bash -c \"" + limited + "\" >/dev/null").c_str());
+  EXPECT_TRUE(WIFEXITED(rc) && WEXITSTATUS(rc) == 2) << rc;
+  const std::string err = read(dir / "err.txt");
+  EXPECT_NE(err.find("bodypoint: error: out of memory"), std::string::npos) << err;
+  EXPECT_EQ(err.find("bad_alloc"), std::string::npos) << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  EXPECT_FALSE(fs::exists(dir / "s.csv"));
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace bodypoint
 
