@@ -81,6 +81,7 @@ def pdf(build):
     for title in SECTIONS:
         if not re.search(r"\\contentsline \{section\}\{\\numberline \{\d+\}" + re.escape(title) + r"\}", aux):
             failures.append(f"missing section: {title}")
+    failures += repeated_pairs(build)
     pages = re.search(r"Output written on bodypoint\.pdf \((\d+) pages", log)
     if failures:
         print("\n".join(failures))
@@ -88,6 +89,20 @@ def pdf(build):
     print(f"{build}/bodypoint.pdf: {pages.group(1) if pages else '?'} pages, {len(SECTIONS)} sections, "
           f"no undefined reference or citation, no overfull box above {MAX_OVERFULL_PT} pt")
     return 0
+
+
+def repeated_pairs(build):
+    """Generated sentences that name one thing twice: "\\A\\ and \\B" in the text where both macros
+    expand to the same words ("lp-verlet-dkd and lp-verlet-dkd"); equal numbers are measurements."""
+    with open(f"{build}/generated/macros.tex") as f:
+        defs = dict(re.findall(r"\\newcommand\{\\([A-Za-z]+)\}\{(.*)\}$", f.read(), re.M))
+    with open(f"{build}/bodypoint.tex") as f:
+        body = body_of(f.read())
+    found = []
+    for a, b in re.findall(r"\\([A-Za-z]+)\\?\s+and\s+\\([A-Za-z]+)", body):
+        if a in defs and b in defs and defs[a] == defs[b] and not defs[a].startswith("\\ensuremath"):
+            found.append(f"text: \\{a} and \\{b} both read '{defs[a]}'")
+    return found
 
 
 def main():

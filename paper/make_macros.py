@@ -272,6 +272,12 @@ def speedup_table(res, out, M):
             M.add(f"Best{key}", tt(best) if best != "-" else "none", math_mode=False)
             M.add(f"BestPeer{key}", tt(peer) if peer != "-" else "none", math_mode=False)
     M.add("NumSpeedupRows", count(len(body)))
+    # The pairs the text names together: one name once when both targets have the same.
+    for first, second, name in [("BestCloseSeven", "BestCloseTen", "BestClosePair"),
+                                ("BestPeerCloseSeven", "BestPeerCloseTen", "BestPeerClosePair"),
+                                ("BestThesisSeven", "BestLongSeven", "BestThesisLongPair")]:
+        a, b = M.defs.get(first, "none"), M.defs.get(second, "none")
+        M.add(name, f"{a} for both" if a == b else f"{a} and {b}", math_mode=False)
 
 
 
