@@ -29,6 +29,23 @@ py="${PYTHON:-/usr/bin/python3}"  # Debian's python3 with python3-matplotlib
 start=$(date +%s)
 mkdir -p "$results"
 
+# The machine and the software every timing of this build ran on (paper: "Reproducing this document").
+builddir="${BODYPOINT_BUILD_DIR:-build}"
+cache_value() { sed -n "s/^$1:[A-Z]*=//p" "$builddir/CMakeCache.txt" | head -1; }
+header_value() { sed -n "s/^#define $2 *\(.*\)$/\1/p" "$1" 2>/dev/null | head -1; }
+cxx=$(cache_value CMAKE_CXX_COMPILER)
+eigen=/usr/include/eigen3/Eigen/src/Core/util/Macros.h
+{
+  echo "cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1)"
+  echo "cores=$(nproc)"
+  echo "compiler=$("$cxx" --version | head -1)"
+  echo "flags=$(cache_value CMAKE_CXX_FLAGS) $(cache_value CMAKE_CXX_FLAGS_RELEASE) ($(cache_value CMAKE_BUILD_TYPE))"
+  echo "boost=$(header_value /usr/include/boost/version.hpp BOOST_LIB_VERSION | tr -d '"' | tr _ .)"
+  echo "eigen=$(header_value $eigen EIGEN_WORLD_VERSION).$(header_value $eigen EIGEN_MAJOR_VERSION).$(header_value $eigen EIGEN_MINOR_VERSION)"
+  echo "gsl=$(gsl-config --version 2>/dev/null || echo none)"
+  echo "kernel=$(uname -sr)"
+} > "$results/platform.txt"
+
 q=()
 [ $mode = quick ] && q=(--quick)
 # --resume: an interrupted build continues its sweeps from their journals (rows of this same build).

@@ -514,6 +514,24 @@ def scattering(res, M):
     M.add("ScatDelayZeroMax", sci(max(delays0), 2))
 
 
+def latex_text(text):
+    """Plain text (a CPU's or a compiler's name) safe inside a LaTeX paragraph."""
+    for a, b in [("\\", "\\textbackslash{}"), ("&", "\\&"), ("%", "\\%"), ("$", "\\$"), ("#", "\\#"),
+                 ("_", "\\_"), ("{", "\\{"), ("}", "\\}"), ("~", "\\textasciitilde{}"), ("^", "\\textasciicircum{}")]:
+        text = text.replace(a, b)
+    return text
+
+
+def platform(res, M):
+    """The machine and software of this build's timings (paper/build.sh writes platform.txt)."""
+    with open(os.path.join(res, "platform.txt")) as f:
+        info = dict(line.rstrip("\n").split("=", 1) for line in f if "=" in line)
+    for key, name in [("cpu", "PlatformCpu"), ("cores", "PlatformCores"), ("compiler", "PlatformCompiler"),
+                      ("flags", "PlatformFlags"), ("boost", "PlatformBoost"), ("eigen", "PlatformEigen"),
+                      ("gsl", "PlatformGsl"), ("kernel", "PlatformKernel")]:
+        M.add(name, latex_text(info.get(key, "").strip() or "unknown"), math_mode=False)
+
+
 def main():
     if len(sys.argv) != 4:
         sys.exit("usage: make_macros.py RESULTS_DIR OUT_DIR MODE")
@@ -524,6 +542,7 @@ def main():
     _, header = read_csv(os.path.join(res, "d_sweep.csv"))
     M.add("Revision", f"\\texttt{{{revision_of(header)}}}", math_mode=False)
     M.add("BuildMode", mode, math_mode=False)
+    platform(res, M)
     errata(res, M)
     sweeps(res, M)
     methods_table(res, out, M)
