@@ -73,25 +73,57 @@ def save(fig, path, listing, what):
     listing.append((os.path.basename(path), what))
 
 
-def sweep_panel(ax, rows, param, column, methods, title, legend=True):
+# Distinct colours for the highlighted curves of a panel; the rest grey. The thesis's seven keep one
+# colour each in every panel, so that a method is the same line across panels.
+PANEL_COLOURS = ["tab:blue", "tab:red", "tab:green", "tab:orange", "tab:purple", "tab:brown"]
+SEVEN_COLOURS = {"rk4": "tab:red", "ab4": "tab:orange", "thesis-euler": "tab:blue", "thesis-verlet": "tab:cyan",
+                 "thesis-ruth3": "tab:green", "thesis-fr4": "tab:olive", "thesis-y6": "tab:purple"}
+
+
+def median(values):
+    v = sorted(x for x in values if math.isfinite(x))
+    return v[len(v) // 2] if v else float("inf")
+
+
+def best_first(rows, column, methods):
+    """methods ordered by the median of their capped deviations, smallest first."""
     groups = by_method(rows)
-    cmap = plt.get_cmap("tab20")
-    for i, m in enumerate(methods):
-        rs = groups.get(m)
-        if not rs:
-            continue
-        xs = [num(r[param]) for r in rs]
-        ys = [capped(num(r[column])) for r in rs]
-        ax.plot(xs, ys, label=m, color=cmap(i % 20), linewidth=0.9,
-                linestyle="--" if m.startswith("thesis-") else "-")
+    return sorted((m for m in methods if m in groups), key=lambda m: median(capped(num(r[column])) for r in groups[m]))
+
+
+def sweep_panel(ax, rows, param, column, families, title):
+    """One panel: for each (methods, k, label) of `families`, its k best methods (smallest median
+    deviation) in colour and named, the others thin and grey under one legend entry."""
+    groups = by_method(rows)
+    colour = iter(PANEL_COLOURS)
+    for methods, k, other_label in families:
+        ranked = best_first(rows, column, methods)
+        for i, m in enumerate(ranked):
+            xs = [num(r[param]) for r in groups[m]]
+            ys = [capped(num(r[column])) for r in groups[m]]
+            if i < k:
+                ax.plot(xs, ys, label=m, color=SEVEN_COLOURS.get(m) or next(colour), linewidth=1.1,
+                        linestyle="--" if m.startswith("thesis-") else "-", zorder=3)
+            else:
+                ax.plot(xs, ys, color="0.65", linewidth=0.5, zorder=2,
+                        label=f"{other_label} ({len(ranked) - k})" if i == k else None)
     ax.set_yscale("log")
     if param == "h":
         ax.set_xscale("log")
     ax.axhline(DIVERGED, color="grey", linewidth=0.4)
     ax.set_xlabel(param)
     ax.set_title(title)
-    if legend:  # below the panel, so that no curve is hidden
-        ax.legend(ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.28), frameon=False)
+    # Below the panel, one column, so that no curve is hidden and no label runs into the next panel's.
+    ax.legend(ncol=1, loc="upper center", bbox_to_anchor=(0.5, -0.22), frameon=False)
+
+
+def thesis_families(rows):
+    """The thesis's seven as two families: RK4 and AB4 both named, the best two drift/kick schemes."""
+    return [(["rk4", "ab4"], 2, "other"), ([m for m in THESIS_SEVEN if m.startswith("thesis-")], 2, "other drift/kick")]
+
+
+def lie_family(rows):
+    return [(sorted({r["method"] for r in rows if r["method"].startswith("lp-")}), 4, "other exact splittings")]
 
 
 def sweep_figures(res, figs, listing):
@@ -99,19 +131,17 @@ def sweep_figures(res, figs, listing):
     for param, tfig in thesis_figs.items():
         rows = read_csv(os.path.join(res, f"{param}_sweep.csv"))
         published = read_csv(os.path.join(res, f"published_{param}_sweep.csv"))
-        lp = sorted({r["method"] for r in rows if r["method"].startswith("lp-")})
-        fig, axes = plt.subplots(1, 3, figsize=(WIDE, 2.7), sharey=True)
-        sweep_panel(axes[0], published, param, "max_rel_dE", THESIS_SEVEN, "as published: code's force law")
-        sweep_panel(axes[1], rows, param, "max_rel_dE", THESIS_SEVEN, "the same seven, corrected", legend=False)
-        sweep_panel(axes[2], rows, param, "max_rel_dE", lp, "exact Lie-Poisson, corrected")
+        fig, axes = plt.subplots(1, 3, figsize=(WIDE, 2.9), sharey=True)
+        sweep_panel(axes[0], published, param, "max_rel_dE", thesis_families(published), "as published: code's force law")
+        sweep_panel(axes[1], rows, param, "max_rel_dE", thesis_families(rows), "the same seven, corrected")
+        sweep_panel(axes[2], rows, param, "max_rel_dE", lie_family(rows), "exact Lie-Poisson, corrected")
         axes[0].set_ylabel("max relative energy deviation")
         save(fig, os.path.join(figs, f"fig_sweep_{param}.pdf"), listing,
              f"thesis fig. {tfig}: max relative energy deviation against {param}")
     rows = read_csv(os.path.join(res, "h_sweep.csv"))
-    lp = sorted({r["method"] for r in rows if r["method"].startswith("lp-")})
-    fig, axes = plt.subplots(1, 2, figsize=(WIDE * 2 / 3, 2.9), sharey=True)
-    sweep_panel(axes[0], rows, "h", "max_rel_dK2sq", THESIS_SEVEN, "thesis's seven")
-    sweep_panel(axes[1], rows, "h", "max_rel_dK2sq", lp, "exact Lie-Poisson")
+    fig, axes = plt.subplots(1, 2, figsize=(WIDE * 2 / 3, 3.1), sharey=True)
+    sweep_panel(axes[0], rows, "h", "max_rel_dK2sq", thesis_families(rows), "thesis's seven")
+    sweep_panel(axes[1], rows, "h", "max_rel_dK2sq", lie_family(rows), "exact Lie-Poisson")
     axes[0].set_ylabel("max relative deviation of |K2|^2")
     save(fig, os.path.join(figs, "fig_k2sq_h.pdf"), listing, "thesis fig. 4.8-4.9: |K2|^2 deviation against h")
 
