@@ -164,12 +164,15 @@ def timing_figure(res, figs, listing):
 
 def appendix_figure(res, figs, listing):
     index = read_csv(os.path.join(res, "appendix1", "index.csv"))
-    fig, axes = plt.subplots(5, 6, figsize=(WIDE, 5.6))
+    # Six rows of five, a full page: each panel with its own ticks (the sets span very different scales).
+    fig, axes = plt.subplots(6, 5, figsize=(WIDE, 8.6))
     for ax, row in zip(axes.flat, index):
-        ax.set_xticks([])
-        ax.set_yticks([])
+        ax.tick_params(labelsize=5, length=2, pad=1)
+        ax.locator_params(nbins=3)
         label = f"P1.{row['figure']}"
         if not row["file"]:
+            ax.set_xticks([])
+            ax.set_yticks([])
             ax.text(0.5, 0.5, "D <= 0:\nnot run", ha="center", va="center", fontsize=6, transform=ax.transAxes)
         else:
             traj = read_csv(os.path.join(res, "appendix1", row["file"]))
@@ -184,6 +187,9 @@ def appendix_figure(res, figs, listing):
             if row["status"] != "ok":
                 label += f" ({row['status']})"
         ax.set_title(label, fontsize=6, pad=2)
+    fig.supxlabel("x", fontsize=7)
+    fig.supylabel("y", fontsize=7)
+    fig.tight_layout(pad=0.4, h_pad=0.6, w_pad=0.4)
     save(fig, os.path.join(figs, "fig_appendix1.pdf"), listing,
          "thesis appendix 1 (fig. P1.1-P1.30): trajectories in the (x, y) plane, thesis-euler, h = 1e-4")
 
