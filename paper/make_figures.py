@@ -204,11 +204,31 @@ def pareto(points):
     return front
 
 
+def place_labels(ax, labels, fontsize=5):
+    """Annotates each (x, y, text, colour) beside its point, moving a label down in steps of a line
+    until its box overlaps no label placed before it (labels of neighbouring fronts collided)."""
+    ax.autoscale_view()
+    to_pt = 72.0 / ax.figure.dpi
+    char_w, line_h = 0.55 * fontsize, 1.25 * fontsize  # points
+    placed = []  # boxes (x0, y0, x1, y1) in points
+    for x, y, text, colour in labels:
+        px, py = (v * to_pt for v in ax.transData.transform((x, y)))
+        dy = 3.0
+        for _ in range(12):
+            box = (px + 3.0, py + dy, px + 3.0 + char_w * len(text), py + dy + line_h)
+            if not any(box[0] < b[2] and b[0] < box[2] and box[1] < b[3] and b[1] < box[3] for b in placed):
+                break
+            dy -= line_h
+        placed.append(box)
+        ax.annotate(text, (x, y), fontsize=fontsize, color=colour, xytext=(3, dy), textcoords="offset points")
+
+
 def work_precision_figures(res, figs, listing):
     rows = read_csv(os.path.join(res, "work_precision.csv"))
     scenes = scenes_of(rows)
     for scene in scenes:
         fig, ax = plt.subplots(figsize=(WIDE / 2, 2.8))
+        labels = []  # (time, error, text, colour) of the methods named on the fronts
         for fam, colour in FAMILIES:
             pts = [(num(r["wall_s"]) * 1e3, num(r["err_rel"]), r["method"]) for r in rows
                    if r["scene"] == scene and family(r["method"]) == fam]
@@ -225,13 +245,14 @@ def work_precision_figures(res, figs, listing):
             for lab in sorted(counts, key=lambda k: -counts[k])[:3]:
                 mine = [p for p in front if p[2] == lab]
                 t, e, _ = mine[len(mine) // 2]  # the middle of its stretch: labels of one front spread out
-                ax.annotate(lab, (t, e), fontsize=5, color=colour, xytext=(3, 3), textcoords="offset points")
+                labels.append((t, e, lab, colour))
         ax.set_xscale("log")
         ax.set_yscale("log")
+        place_labels(ax, labels)
         ax.set_xlabel("run time [ms]")
         ax.set_ylabel("final-position error |dR|/|R|")
         ax.set_title(f"scene {scene}: Pareto front per family")
-        ax.legend(loc="upper right")
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=3, frameon=False)  # off the labels
         save(fig, os.path.join(figs, f"fig_wp_{scene}.pdf"), listing, f"work-precision on scene {scene}")
 
 
