@@ -179,11 +179,10 @@ TrackJson body_json(const Body& body, const std::vector<Centre>& centres, const 
   if (d.non_finite_at())
     throw Error(who + ": the state became non-finite at t = " + fmt(*d.non_finite_at()) + "; no page written");
   if (d.seen() < 2) throw Error(who + ": the run produced no trajectory (fewer than two states); no page written");
-  // A diverged run has nothing to show; an unresolved, inaccurate or colliding one is drawn with its
-  // flag in the header (a comparison of a poor method with a good one is what view is for).
-  if (br.outcome != Outcome::ok && br.outcome != Outcome::unresolved && br.outcome != Outcome::inaccurate &&
-      br.outcome != Outcome::collision)
-    throw Error(who + ": " + br.reason + "; no page written");
+  // A diverged run has nothing to show (run_body threw for a refused or failed one); an unresolved,
+  // inaccurate or colliding one is drawn with its flag in the header (a comparison of a poor method
+  // with a good one is what view is for).
+  if (br.outcome == Outcome::diverged) throw Error(who + ": " + br.reason + "; no page written");
   if (br.outcome != Outcome::ok)
     std::cerr << "bodypoint: warning: " << who << " is " << outcome_name(br.outcome) << ": " << br.reason
               << "; drawn with that flag\n";
