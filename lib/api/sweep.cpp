@@ -129,7 +129,7 @@ std::string point_label(const SweepSpec& spec, const std::vector<double>& point)
 
 void validate_sweep(const SweepSpec& spec) {
   if (spec.methods.empty()) throw Error("the method list is empty");
-  if (!(spec.max_energy_error > 0.0)) throw Error("the bound on the energy error must be a number > 0 (inf: no bound)");
+  check_energy_bound(spec.max_energy_error);
   if (spec.axes.empty()) throw Error("the sweep has no varied parameter");
   for (const Axis& a : spec.axes)
     if (a.values.empty()) throw Error("the sweep has no values of " + a.param);

@@ -154,10 +154,14 @@ namespace {
 constexpr double kMinStepTolerance = 1e-15;
 }  // namespace
 
-Checks checks_for(const MethodInfo& m, const std::vector<Centre>& centres, double max_energy_error) {
+void check_energy_bound(double max_energy_error) {
   if (!(max_energy_error > 0.0))
     throw Error("the bound on the energy error must be a number > 0 (infinity: no bound), got " +
                 detail::short_number(max_energy_error));
+}
+
+Checks checks_for(const MethodInfo& m, const std::vector<Centre>& centres, double max_energy_error) {
+  check_energy_bound(max_energy_error);
   Checks c;
   c.max_energy_error = max_energy_error;
   c.energy_is_integral = !non_coulomb(centres);

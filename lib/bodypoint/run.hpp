@@ -185,8 +185,11 @@ struct Checks {
   bool orbit_exact = false;        ///< the method's stages solve the motion about the centre exactly
   bool spin_exact = false;         ///< free flight, solved exactly by the method's drift (any spin angle)
 };
-/// The checks for runs of `m` on a scene with these centres, with the bound max_energy_error (> 0,
-/// not NaN; infinity turns the accuracy flag off).
+/// Throws Error unless max_energy_error is a bound assess() can hold a run to: > 0, not NaN
+/// (infinity turns the accuracy flag off).
+void check_energy_bound(double max_energy_error);
+/// The checks for runs of `m` on a scene with these centres, with the bound max_energy_error
+/// (check_energy_bound).
 Checks checks_for(const MethodInfo& m, const std::vector<Centre>& centres,
                   double max_energy_error = kDefaultMaxEnergyError);
 Health assess(const RunResult& r, const Checks& checks = {});
