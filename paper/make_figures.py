@@ -117,7 +117,7 @@ def sweep_panel(ax, rows, param, column, families, title):
     ax.legend(ncol=1, loc="upper center", bbox_to_anchor=(0.5, -0.22), frameon=False)
 
 
-def thesis_families(rows):
+def thesis_families():
     """The thesis's seven as two families: RK4 and AB4 both named, the best two drift/kick schemes."""
     return [(["rk4", "ab4"], 2, "other"), ([m for m in THESIS_SEVEN if m.startswith("thesis-")], 2, "other drift/kick")]
 
@@ -132,15 +132,15 @@ def sweep_figures(res, figs, listing):
         rows = read_csv(os.path.join(res, f"{param}_sweep.csv"))
         published = read_csv(os.path.join(res, f"published_{param}_sweep.csv"))
         fig, axes = plt.subplots(1, 3, figsize=(WIDE, 2.9), sharey=True)
-        sweep_panel(axes[0], published, param, "max_rel_dE", thesis_families(published), "as published: code's force law")
-        sweep_panel(axes[1], rows, param, "max_rel_dE", thesis_families(rows), "the same seven, corrected")
+        sweep_panel(axes[0], published, param, "max_rel_dE", thesis_families(), "as published: code's force law")
+        sweep_panel(axes[1], rows, param, "max_rel_dE", thesis_families(), "the same seven, corrected")
         sweep_panel(axes[2], rows, param, "max_rel_dE", lie_family(rows), "exact Lie-Poisson, corrected")
         axes[0].set_ylabel("max relative energy deviation")
         save(fig, os.path.join(figs, f"fig_sweep_{param}.pdf"), listing,
              f"thesis fig. {tfig}: max relative energy deviation against {param}")
     rows = read_csv(os.path.join(res, "h_sweep.csv"))
     fig, axes = plt.subplots(1, 2, figsize=(WIDE * 2 / 3, 3.1), sharey=True)
-    sweep_panel(axes[0], rows, "h", "max_rel_dK2sq", thesis_families(rows), "thesis's seven")
+    sweep_panel(axes[0], rows, "h", "max_rel_dK2sq", thesis_families(), "thesis's seven")
     sweep_panel(axes[1], rows, "h", "max_rel_dK2sq", lie_family(rows), "exact Lie-Poisson")
     axes[0].set_ylabel("max relative deviation of |K2|^2")
     save(fig, os.path.join(figs, "fig_k2sq_h.pdf"), listing, "thesis fig. 4.8-4.9: |K2|^2 deviation against h")
