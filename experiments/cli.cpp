@@ -40,8 +40,9 @@ void add_scene_options(po::options_description& desc, SceneOptions& o) {
       ("force-law", po::value<std::string>()->default_value("coulomb")->notifier([&p](const std::string& v) {
          p.law = parse_force_law(v);
        }),
-       "coulomb (the model); thesis-code (the thesis's published code: F ~ R/|R|^1.5 and its third-kick slip, "
-       "to regenerate its figures as published); thesis-code-force (that force law alone)")
+       "coulomb (the model); thesis-code (the thesis's published code: F ~ R/|R|^1.5, its third-kick slip and "
+       "its loop, n - 1 steps of n asked, to regenerate its figures as published); thesis-code-force (that force "
+       "law alone)")
       ("b", po::value(&o.b), "the scene by its impact parameter b (of the incoming asymptote): d is solved for it "
        "(docs/physics.md, Scattering)")
       ("v-inf", po::value(&o.v_inf), "the scene by its speed at infinity (B != 0: the guiding centre's): K1 is solved for it")
@@ -94,7 +95,9 @@ void apply_step_options(const po::variables_map& vm, const StepOptions& o, RunSp
     if (!std::isfinite(o.t_end) || o.t_end <= 0.0) throw Error("--t-end must be a finite number > 0");
     t_end = o.t_end;
   }
-  const RunSpec r = resolve_steps(o.h, o.steps, t_end, spec.tol);
+  // --force-law thesis-code counts steps as the thesis's code did (n - 1 of n asked; run.hpp).
+  const ForceLaw law = vm.count("force-law") ? parse_force_law(vm["force-law"].as<std::string>()) : ForceLaw::coulomb;
+  const RunSpec r = resolve_steps(o.h, o.steps, t_end, spec.tol, law);
   spec.h = r.h;
   spec.steps = r.steps;
   spec.t_end = r.t_end;

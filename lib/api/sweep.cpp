@@ -97,12 +97,14 @@ SceneParams point_params(const SweepSpec& spec, const std::vector<double>& point
   return std::isnan(b) && std::isnan(v_inf) ? p : with_asymptotic_data(p, b, v_inf);
 }
 
-RunSpec fixed_run_spec(double h, long steps, double t_end, double tol) {
+RunSpec fixed_run_spec(double h, long steps, double t_end, double tol, ForceLaw law) {
   if (!(std::isfinite(h) && h > 0.0)) throw Error("step size h must be a finite number > 0, got " + fmt(h));
   RunSpec rs;
   rs.h = h;
   rs.steps = steps;
-  if (t_end > 0.0) {
+  if (law == ForceLaw::thesis_code) {
+    rs.steps = thesis_code_steps(h, steps, t_end).steps;
+  } else if (t_end > 0.0) {
     const FixedSteps f = fixed_steps_to(t_end, h);
     rs.h = f.h;
     rs.steps = f.steps;
@@ -115,7 +117,7 @@ RunSpec fixed_run_spec(double h, long steps, double t_end, double tol) {
 }
 
 RunSpec point_spec(const SweepSpec& spec, const std::vector<double>& point) {
-  return fixed_run_spec(point_h(spec, point), spec.steps, spec.t_end, spec.tol);
+  return fixed_run_spec(point_h(spec, point), spec.steps, spec.t_end, spec.tol, spec.base.law);
 }
 
 std::string point_label(const SweepSpec& spec, const std::vector<double>& point) {

@@ -240,6 +240,19 @@ FixedSteps fixed_steps_to(double t_end, double h_max) {
   return {t_end / static_cast<double>(steps), steps};
 }
 
+FixedSteps thesis_code_steps(double h, long steps, double t_end) {
+  if (!(std::isfinite(h) && h > 0.0)) throw Error("step size h must be a finite number > 0");
+  double n = static_cast<double>(steps);
+  if (t_end > 0.0) {
+    if (!std::isfinite(t_end)) throw Error("end time must be a finite number > 0");
+    n = std::trunc(t_end / h);
+  }
+  if (!(n <= 1e13)) throw Error("end time / step size asks for more than 1e13 steps");
+  if (n < 2.0)
+    throw Error("the thesis's code takes n - 1 steps of n asked (n = " + detail::short_number(n) + "): no step; ask for n >= 2");
+  return {h, static_cast<long>(n) - 1};
+}
+
 RunResult run(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
               const RunSpec& spec, const SampleSink* sink) {
   validate(Scene{centres, {body}});

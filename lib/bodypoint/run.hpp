@@ -227,6 +227,12 @@ using Advance = std::variant<FixedSteps, FictitiousSteps, ControlledSteps, Accur
 /// within 1e-12 of a whole number counts as that number). Throws Error beyond 1e13 steps.
 FixedSteps fixed_steps_to(double t_end, double h_max);
 
+/// The thesis's published code asked for n steps of h (with t_end > 0: n = (int)(t_end / h), Java's
+/// truncation) runs `i = 1; do { step; i++; } while (i < n);`: n - 1 steps of exactly h. Under
+/// ForceLaw::thesis_code the commands and sweeps count steps so, to regenerate its figures as printed.
+/// Throws Error when that leaves no step (n < 2) or asks for more than 1e13.
+FixedSteps thesis_code_steps(double h, long steps, double t_end);
+
 /// How `m` advances time under `spec` (never Accuracy, which chooses its own spec), every number of it checked (h > 0 and finite, every >= 1;
 /// steps >= 1 or an end time; tol in [1e-15, inf)): the one place a run specification is validated.
 Advance advance_of(const MethodInfo& m, const RunSpec& spec);

@@ -10,6 +10,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -151,7 +152,7 @@ py::dict body_result(const Body& body, const BodyResult& r, const std::vector<Ev
 
 /// The Advance the keywords ask for, by the method's kind (the command line's rules, cli.hpp).
 Advance advance_for(const MethodInfo* m, std::optional<double> h, std::optional<long> steps,
-                    std::optional<double> t_end, std::optional<double> tol) {
+                    std::optional<double> t_end, std::optional<double> tol, bool code_loop) {
   if (!m || (tol && !is_step_controlled(*m))) {
     if (!tol) throw Error("method 'auto' needs tol (the accuracy to deliver)");
     if (!t_end) throw Error("the accuracy mode (tol) needs t_end");
@@ -166,6 +167,8 @@ Advance advance_for(const MethodInfo* m, std::optional<double> h, std::optional<
     return ControlledSteps{std::min(step, end), end, tol.value_or(RunSpec{}.tol)};
   }
   if (is_time_transformed(*m)) return FictitiousSteps{step, t_end.value_or(0.0), t_end ? 0 : steps.value_or(RunSpec{}.steps), 0.0};
+  // A scene of the thesis's code counts its steps as that code did (n - 1 of n; run.hpp).
+  if (code_loop) return thesis_code_steps(step, steps.value_or(RunSpec{}.steps), t_end.value_or(0.0));
   if (t_end) return fixed_steps_to(*t_end, step);
   return FixedSteps{step, steps.value_or(RunSpec{}.steps)};
 }
@@ -194,7 +197,9 @@ py::dict integrate_py(const Scene& scene, const std::string& method, std::option
                       bool invariants, double omega_c, const std::vector<std::string>& event_names,
                       double max_energy_error) {
   const MethodInfo* m = method == "auto" ? nullptr : &method_or_throw(method);
-  const Advance how = advance_for(m, h, steps, t_end, tol);
+  const bool code_loop = std::any_of(scene.centres.begin(), scene.centres.end(),
+                                     [](const Centre& c) { return c.law == ForceLaw::thesis_code; });
+  const Advance how = advance_for(m, h, steps, t_end, tol, code_loop);
   Options o;
   o.track_invariants = invariants;
   o.omega_c = omega_c;

@@ -56,6 +56,21 @@ TEST(Cli, Rk4OnTheDefaultSceneMeetsTheFoundationTarget) {
   EXPECT_EQ(json_num(r.out, "force_evals"), 200000);
 }
 
+TEST(Cli, TheThesisCodesLawCountsStepsAsItsLoopDid) {
+  const Result code = run_cli("simulate --method thesis-euler --force-law thesis-code --h 1e-3 --steps 100 --json");
+  ASSERT_EQ(code.code, 0) << code.err;
+  EXPECT_EQ(json_num(code.out, "steps"), 99);
+  const Result by_time = run_cli("simulate --method rk4 --force-law thesis-code --h 0.3 --t-end 1 --json");
+  ASSERT_EQ(by_time.code, 0) << by_time.err;
+  EXPECT_EQ(json_num(by_time.out, "steps"), 2);  // (int)(1 / 0.3) - 1 steps of exactly 0.3
+  const Result model = run_cli("simulate --method thesis-euler --force-law thesis-code-force --h 1e-3 --steps 100 --json");
+  ASSERT_EQ(model.code, 0) << model.err;
+  EXPECT_EQ(json_num(model.out, "steps"), 100);
+  const Result none = run_cli("simulate --method thesis-euler --force-law thesis-code --h 1e-3 --steps 1");
+  EXPECT_NE(none.code, 0);
+  EXPECT_NE(none.err.find("n - 1 steps"), std::string::npos) << none.err;
+}
+
 TEST(Cli, EveryMethodRunsAndReportsItsInvariants) {
   const Result list = run_cli("methods");
   ASSERT_EQ(list.code, 0);

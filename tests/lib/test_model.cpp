@@ -5,6 +5,7 @@
 #include "bodypoint/rhs.hpp"
 #include "bodypoint/run.hpp"
 #include "bodypoint/scene_file.hpp"
+#include "bodypoint/sweep.hpp"
 #include "common.hpp"
 
 #include <gtest/gtest.h>
@@ -145,6 +146,21 @@ TEST(ForceLaw, SlipMovesOnlyThirdKickSchemesAndOnlyUnderTheCodeLaw) {
   // Ruth 3, Forest-Ruth 4 and Yoshida 6 take the slip: their results move.
   for (const char* m : {"thesis-ruth3", "thesis-fr4", "thesis-y6"})
     EXPECT_NE(final_R(m, force_only), final_R(m, code)) << m;
+}
+
+// The code's loop (SymplecticEulerForSystem.java and the others: i = 1; do { ...; i++; } while (i < n)):
+// n - 1 steps of exactly h, n = (int)(T / h) when a time is given (IntegrateStepTest).
+TEST(ForceLaw, TheCodesLoopTakesOneStepFewerThanAsked) {
+  EXPECT_EQ(thesis_code_steps(1e-4, 250000, 0.0).steps, 249999);
+  EXPECT_EQ(thesis_code_steps(1e-4, 0, 25.0).steps, 249999);
+  EXPECT_EQ(thesis_code_steps(0.3, 0, 1.0).steps, 2);  // (int)(1/0.3) = 3, truncated, not rounded up
+  EXPECT_EQ(thesis_code_steps(0.3, 0, 1.0).h, 0.3);    // h is never adjusted to land on T
+  EXPECT_THROW((void)thesis_code_steps(1e-3, 1, 0.0), Error) << "n = 1 takes no step";
+  EXPECT_THROW((void)thesis_code_steps(0.0, 10, 0.0), Error);
+  // The sweeps' run specification counts so under the code's law only.
+  EXPECT_EQ(fixed_run_spec(1e-4, 250000, 0.0, 1e-10, ForceLaw::thesis_code).steps, 249999);
+  EXPECT_EQ(fixed_run_spec(1e-4, 250000, 0.0, 1e-10, ForceLaw::thesis_code_force).steps, 250000);
+  EXPECT_EQ(fixed_run_spec(1e-4, 250000, 0.0, 1e-10).steps, 250000);
 }
 
 TEST(ForceLaw, TimeTransformedMethodsAndTolRefuseTheCodeLaw) {

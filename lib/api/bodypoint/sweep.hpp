@@ -68,9 +68,10 @@ std::vector<double> grid_point(const SweepSpec& spec, std::size_t p);
 /// The scene parameters at a grid point.
 SceneParams point_params(const SweepSpec& spec, const std::vector<double>& point);
 /// A sweep task's run specification: `steps` steps of h, or with t_end > 0 the steps of at most h that
-/// land on t_end (fixed_steps_to); tol for step-size-controlled methods; invariants tracked. Error for
-/// an h that is not a finite number > 0 or fewer than one step.
-RunSpec fixed_run_spec(double h, long steps, double t_end, double tol);
+/// land on t_end (fixed_steps_to); under ForceLaw::thesis_code the code's count instead
+/// (thesis_code_steps: n - 1 steps of exactly h); tol for step-size-controlled methods; invariants
+/// tracked. Error for an h that is not a finite number > 0 or fewer than one step.
+RunSpec fixed_run_spec(double h, long steps, double t_end, double tol, ForceLaw law = ForceLaw::coulomb);
 /// The run specification at a grid point: fixed_run_spec with the point's h.
 RunSpec point_spec(const SweepSpec& spec, const std::vector<double>& point);
 /// "d = 5, L = 100": a grid point for messages.
