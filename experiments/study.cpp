@@ -25,6 +25,8 @@
 #include "sweep.hpp"
 #include "timing.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <map>
@@ -55,7 +57,8 @@ void write_sweep(const StudyContext& c, const std::string& name, SweepSpec spec,
     spec.base.law = ForceLaw::thesis_code;
     spec.methods = parse_methods("thesis-euler,thesis-verlet,thesis-ruth3,thesis-fr4,thesis-y6,rk4,ab4");
     file = "published_" + name;
-    note += "; as published: the thesis code's force law F = -A R/|R|^1.5 and third-kick slip";
+    note += "; as published: A = -0.5, the thesis code's force law F = -A R/|R|^1.5, third-kick slip and loop (n - 1 "
+            "steps of n)";
   }
   const std::string path = (c.dir / file).string(), command = "bodypoint study" + std::string(c.quick ? " --quick" : "") + " (" + note + ")";
   AtomicFile f(path);
@@ -201,14 +204,78 @@ void study_orders(const StudyContext& c) {
   std::cerr << "wrote " << (c.dir / "orders.csv").string() << "\n";
 }
 
-/// Chapter 4's sweeps as the thesis's code computed them, beside the corrected ones.
+/// The d that puts the start at R0 = (-L, y, 0) (thesis_momenta: y = d - Kz/K1).
+double harness_d(const SceneParams& p, double y) { return y + p.start.Kz / p.start.K1; }
+
+/// The parameters of the thesis code's harnesses (its repository's ru/axothy/mechanics/tests:
+/// AimingDistanceTest, FullDistanceTest, IntegrateStepTest, KxTest), which differ from table 3.1:
+/// A = -0.5 and, except in KxTest, the literal start v0 = (7.058, 0, 6.86), w0 = (-2.941, 0, -9.8)
+/// (table 3.1's velocities rounded) with R0 = (-L, y, 0). In the thesis's terms (model.hpp,
+/// thesis_momenta) that start is K1 = 4.9993, Kx = 1.9996, Kz = 4.998 and d = y + Kz/K1.
+SceneParams harness_params(bool rounded_start) {
+  SceneParams p;
+  p.A = -0.5;
+  p.law = ForceLaw::thesis_code;
+  if (rounded_start) {
+    const BodyPoint bp{p.m, p.B, p.J};
+    const Momenta k = to_momenta(bp, State{Vec3(-200.0, 49.0, 0.0), Vec3(7.058, 0.0, 6.86), Vec3(-2.941, 0.0, -9.8)});
+    // K1 = m v + B w has no z-component in exact arithmetic (6.86 - 0.7 x 9.8); a rounding of it is dropped.
+    constexpr double kRoundingOfZero = 1e-12;
+    if (std::abs(k.K1.z()) > kRoundingOfZero || k.K1.y() != 0.0 || k.K2.y() != 0.0)
+      throw Error("the harnesses' start is not of the thesis's form");
+    p.start.K1 = k.K1.x();
+    p.start.Kx = k.K2.x();
+    p.start.Kz = -k.K2.z();
+  }
+  p.start.d = harness_d(p, 49.0);
+  return p;
+}
+
+/// Chapter 4's sweeps as the thesis's code computed them, with its harnesses' parameters, force law,
+/// slip and loop (n - 1 steps), beside the corrected ones (table 3.1 and the model).
 void study_published(const StudyContext& c) {
-  StudyContext p = c;
-  p.published = true;
-  study_d(p);
-  study_L(p);
-  study_h(p);
-  study_Kx(p);
+  StudyContext pc = c;
+  pc.published = true;
+  const std::string harness = "the thesis code's harness ";
+  {  // AimingDistanceTest: d = 5, 6, ..., 199 and R0 = (-200, d - 1, 0).
+    SweepSpec s = thesis_sweep("d");
+    s.base = harness_params(true);
+    for (double d : linear_range(5, 199, c.quick ? 38 : 1)) s.axes[0].values.push_back(harness_d(s.base, d - 1.0));
+    write_sweep(pc, "d_sweep.csv", s, harness + "AimingDistanceTest (fig. 4.1-4.2): R0 = (-200, d' - 1, 0), d' = 5..199");
+  }
+  {  // FullDistanceTest: R0 = (-L, 49, 0); its loop is commented out at L = 1500, the text gives 5..1000 step 5.
+    SweepSpec s = thesis_sweep("L");
+    s.base = harness_params(true);
+    s.axes[0].values = c.quick ? linear_range(5, 1000, 199) : linear_range(5, 1000, 5);
+    write_sweep(pc, "L_sweep.csv", s, harness + "FullDistanceTest (fig. 4.3-4.4): R0 = (-L, 49, 0), L = 5..1000 step 5 (the text's range)");
+  }
+  {  // IntegrateStepTest: h = 1e-4 halved while h > 5e-6, n = (int)(25/h); the coarse steps of fig. 4.5 are
+     // not in the harness, so the corrected sweep's log-spaced ones are added.
+    SweepSpec s = thesis_sweep("h");
+    s.base = harness_params(true);
+    s.steps = 0;
+    s.t_end = 25;
+    std::vector<double>& hs = s.axes[0].values;
+    hs = c.quick ? log_range(1e-4, 0.5, 7) : log_range(1e-4, 0.5, 25);
+    const int halvings = c.quick ? 1 : 4;  // 5e-5 (quick); 5e-5, 2.5e-5, 1.25e-5, 6.25e-6 (as the harness)
+    for (int k = 1; k <= halvings; ++k) hs.push_back(0.0001 / std::ldexp(1.0, k));
+    std::sort(hs.begin(), hs.end());
+    write_sweep(pc, "h_sweep.csv", s,
+                harness + "IntegrateStepTest (fig. 4.5-4.9): R0 = (-200, 49, 0), h = 1e-4 / 2^k while h > 5e-6 and the "
+                          "corrected sweep's log-spaced h up to 0.5, n = (int)(25/h)");
+  }
+  {  // KxTest: table 3.1's K1 = Kz = 5 exactly, R0 = (-200, 49, 0), Kx = -10 then Kx += 0.1 while Kx < 10.1.
+    SweepSpec s = thesis_sweep("Kx");
+    s.base = harness_params(false);
+    std::vector<double> kx;
+    double x = -10;
+    do {
+      kx.push_back(x);
+      x = x + 0.1;
+    } while (x < 10.1);
+    for (std::size_t i = 0; i < kx.size(); i += c.quick ? 50 : 1) s.axes[0].values.push_back(kx[i]);
+    write_sweep(pc, "Kx_sweep.csv", s, harness + "KxTest (fig. 4.10-4.11): R0 = (-200, 49, 0), Kx = -10, -9.9, ..., 10.1 accumulated as it did");
+  }
 }
 
 void study_appendix(const StudyContext& c) {

@@ -57,11 +57,11 @@ std::vector<double> log_range(double from, double to, long points) {
   return v;
 }
 
-RunSpec resolve_steps(double h, long steps, double t_end, double tol) {
+RunSpec resolve_steps(double h, long steps, double t_end, double tol, ForceLaw law) {
   // The command's words for the two ways a step option can be wrong; the rest is the library's.
   if (!std::isfinite(h) || h <= 0.0) throw Error("--h must be a finite number > 0, got " + fmt(h));
   if (!(t_end > 0.0) && steps < 1) throw Error("--steps must be >= 1");
-  return fixed_run_spec(h, steps, t_end, tol);
+  return fixed_run_spec(h, steps, t_end, tol, law);
 }
 
 unsigned thread_count(long requested) {
@@ -144,6 +144,7 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
   std::string fixed = "# fixed: " + describe(spec.base) + (grid ? " (the varied ones excepted)" : " (the varied one excepted)");
   if (!sweeps_h) fixed += " h=" + fmt(spec.h);
   fixed += spec.t_end > 0 ? " t_end=" + fmt(spec.t_end) : " steps=" + std::to_string(spec.steps);
+  if (spec.base.law == ForceLaw::thesis_code) fixed += " (the code's loop: n - 1 steps of exactly h)";
   // The column names come first, the description after them as comments (numpy's
   // genfromtxt(names=True, comments="#") takes the first line for the names; pandas' read_csv(comment="#")
   // the first line that is not a comment).
@@ -162,8 +163,10 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
               " max_rel_dK2sq = max_i |K2^2_i-K2^2_0|/K2^2_0; max_abs_dK2Q = max_i |K2Q_i-K2Q_0|;"
               " Rx,Ry,Rz = final position; force_evals; wall_s = step-loop time (runs share the cores; a batch of"
               " trajectories run in vector lanes shares its time equally);"
-              " status = ok | diverged (non-finite, or energy error above 1) | collision (diverged after a fall onto"
-              " an attracting centre) | refused (not run); reason = why, when not ok" +
+              " status = ok | diverged (non-finite, or energy error above 1) | unresolved (a step turned the spin by"
+              " more than pi or the direction to a centre by more than pi/2) | inaccurate (energy error above"
+              " max_energy_error = " + fmt(spec.max_energy_error) + ") | collision (diverged after a fall onto an"
+              " attracting centre) | refused (not run); reason = why, when not ok" +
               std::string(spec.scattering
                               ? "; r_min,t_min = the closest approach to any centre (located on the method's steps);"
                                 " deflection, out_of_plane = angles between the incoming and outgoing asymptotes (rad);"

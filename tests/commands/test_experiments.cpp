@@ -133,6 +133,9 @@ std::map<std::string, double> key_values(const fs::path& path) {
   return out;
 }
 
+// The published study's start is the harnesses' literal one, converted to momenta and back: a few roundings.
+constexpr double kHarnessStartTol = 1e-13;
+
 TEST(Study, QuickRecipesWriteEveryCsv) {
   const fs::path dir = test::temp_path("bp_study");
   fs::remove_all(dir);
@@ -190,7 +193,33 @@ TEST(Study, QuickRecipesWriteEveryCsv) {
     std::stringstream ps;
     ps << p.rdbuf();
     EXPECT_NE(ps.str().find("force-law=thesis-code"), std::string::npos) << f;
+    EXPECT_NE(ps.str().find("A=-0.5 "), std::string::npos) << f << ": the harnesses' A, not table 3.1's";
+    for (const auto& row : csv_rows(ps.str())) {  // the loop: n - 1 of the 250000 steps (one evaluation each)
+      if (row.size() > 8 && row[1] == "thesis-euler" && std::string(f) != "published_h_sweep.csv") {
+        EXPECT_EQ(row[8], "249999") << f;
+      }
+    }
   }
+  // The harnesses' rounded start, v0 = (7.058, 0, 6.86) and w0 = (-2.941, 0, -9.8), and R0 = (-200, d' - 1, 0):
+  // the d sweep's scene (its header's K1, Kx, Kz) at its first value, d' = 5, starts there.
+  std::ifstream pd(dir / "published_d_sweep.csv");
+  std::stringstream pds;
+  pds << pd.rdbuf();
+  const std::string text = pds.str();
+  auto header_value = [&text](const std::string& key) {
+    const std::size_t at = text.find(" " + key + "=", text.find("# fixed:"));
+    return std::stod(text.substr(at + key.size() + 2));
+  };
+  SceneParams harness;
+  harness.A = -0.5;
+  harness.start.K1 = header_value("K1");
+  harness.start.Kx = header_value("Kx");
+  harness.start.Kz = header_value("Kz");
+  harness.start.d = std::stod(csv_rows(text).at(0).at(0));
+  const State s0 = thesis_scene(harness).bodies.front().s0;
+  EXPECT_LT((s0.v - Vec3(7.058, 0, 6.86)).norm(), kHarnessStartTol);
+  EXPECT_LT((s0.w - Vec3(-2.941, 0, -9.8)).norm(), kHarnessStartTol);
+  EXPECT_LT((s0.R - Vec3(-200, 4, 0)).norm(), kHarnessStartTol);
   fs::remove_all(dir);
 }
 
