@@ -15,8 +15,11 @@ import sys
 # Inputs, not measurements, that the text may type: the thesis's scene parameters (table 3.1: d = 10,
 # L = 200, B = 0.7; the sweeps' d = 50, T = hn = 25, n = 250000, t = 50; appendix set P1.2's J = 0.2;
 # the close scene's Kz = 0.1, d = 0.05, t = 80; the convergence scenes' L = 20, t = 30).
-# The scattering study's couplings B = 0.2, 0.5, 0.7, 0.9 are inputs too.
-ALLOWED = {"10", "200", "0.7", "50", "25", "250000", "0.2", "0.1", "0.05", "80", "20", "30", "0.5", "0.9"}
+# The scattering study's couplings B = 0.2, 0.5, 0.7, 0.9 are inputs too, and so are the thesis code's
+# harnesses' literal settings: v0 = (7.058, 0, 6.86), w0 = (-2.941, 0, -9.8), d' up to 199, Kx = -10, -9.9,
+# ..., 10.1.
+ALLOWED = {"10", "200", "0.7", "50", "25", "250000", "0.2", "0.1", "0.05", "80", "20", "30", "0.5", "0.9",
+           "7.058", "6.86", "2.941", "9.8", "199", "9.9", "10.1"}
 # Powers of ten are step sizes, targets and tolerances the reader or a recipe chooses (h = 10^{-4},
 # targets 10^{-7}, the reference's tolerance 10^{-18}), never results.
 POWER_OF_TEN = re.compile(r"10\^\{?-?\d+\}?")
@@ -82,6 +85,7 @@ def pdf(build):
         if not re.search(r"\\contentsline \{section\}\{\\numberline \{\d+\}" + re.escape(title) + r"\}", aux):
             failures.append(f"missing section: {title}")
     failures += repeated_pairs(build)
+    failures += claims_without_verdict(build)
     pages = re.search(r"Output written on bodypoint\.pdf \((\d+) pages", log)
     if failures:
         print("\n".join(failures))
@@ -102,6 +106,22 @@ def repeated_pairs(build):
     for a, b in re.findall(r"\\([A-Za-z]+)\\?\s+and\s+\\([A-Za-z]+)", body):
         if a in defs and b in defs and defs[a] == defs[b] and not defs[a].startswith("\\ensuremath"):
             found.append(f"text: \\{a} and \\{b} both read '{defs[a]}'")
+    return found
+
+
+def claims_without_verdict(build):
+    """The table of the thesis's claims: each row must carry a verdict in both columns (as published,
+    corrected) that starts with yes, partly or no; "--" means a CSV it reads had no data for it."""
+    try:
+        with open(f"{build}/generated/tab_claims.tex") as f:
+            rows = [line for line in f if line.strip()]
+    except OSError as e:
+        return [f"no table of claims: {e}"]
+    found = [] if rows else ["the table of claims is empty"]
+    for line in rows:
+        cells = [c.strip() for c in line.rstrip().rstrip("\\").split(" & ")]
+        if len(cells) != 5 or not all(re.match(r"(yes|partly|no)\b", c) for c in cells[3:]):
+            found.append(f"claim without a verdict: {line.strip()[:100]}")
     return found
 
 
