@@ -127,38 +127,44 @@ def lie_family(rows):
 
 
 def sweep_figures(res, figs, listing):
-    thesis_figs = {"d": "4.1-4.2", "L": "4.3-4.4", "h": "4.5-4.7", "Kx": "4.10-4.11"}
-    for param, tfig in thesis_figs.items():
+    # Each thesis figure with what it plotted: the energy against d, L and h, |K2|^2 against h and Kx.
+    thesis_figs = [("d", "max_rel_dE", "4.1-4.2", "fig_sweep_d"), ("L", "max_rel_dE", "4.3-4.4", "fig_sweep_L"),
+                   ("h", "max_rel_dE", "4.5-4.7", "fig_sweep_h"), ("h", "max_rel_dK2sq", "4.8-4.9", "fig_k2sq_h"),
+                   ("Kx", "max_rel_dK2sq", "4.10-4.11", "fig_sweep_Kx")]
+    for param, column, tfig, name in thesis_figs:
         rows = read_csv(os.path.join(res, f"{param}_sweep.csv"))
         published = read_csv(os.path.join(res, f"published_{param}_sweep.csv"))
         fig, axes = plt.subplots(1, 3, figsize=(WIDE, 2.9), sharey=True)
-        sweep_panel(axes[0], published, param, "max_rel_dE", thesis_families(), "as published: code's force law")
-        sweep_panel(axes[1], rows, param, "max_rel_dE", thesis_families(), "the same seven, corrected")
-        sweep_panel(axes[2], rows, param, "max_rel_dE", lie_family(rows), "exact Lie-Poisson, corrected")
-        axes[0].set_ylabel("max relative energy deviation")
-        save(fig, os.path.join(figs, f"fig_sweep_{param}.pdf"), listing,
-             f"thesis fig. {tfig}: max relative energy deviation against {param}")
-    rows = read_csv(os.path.join(res, "h_sweep.csv"))
-    fig, axes = plt.subplots(1, 2, figsize=(WIDE * 2 / 3, 3.1), sharey=True)
-    sweep_panel(axes[0], rows, "h", "max_rel_dK2sq", thesis_families(), "thesis's seven")
-    sweep_panel(axes[1], rows, "h", "max_rel_dK2sq", lie_family(rows), "exact Lie-Poisson")
-    axes[0].set_ylabel("max relative deviation of |K2|^2")
-    save(fig, os.path.join(figs, "fig_k2sq_h.pdf"), listing, "thesis fig. 4.8-4.9: |K2|^2 deviation against h")
+        sweep_panel(axes[0], published, param, column, thesis_families(), "as published (code, harness)")
+        sweep_panel(axes[1], rows, param, column, thesis_families(), "the same seven, corrected")
+        sweep_panel(axes[2], rows, param, column, lie_family(rows), "exact Lie-Poisson, corrected")
+        what = "energy" if column == "max_rel_dE" else "$|K_2|^2$"
+        axes[0].set_ylabel(f"max relative deviation of {what}")
+        save(fig, os.path.join(figs, f"{name}.pdf"), listing, f"thesis fig. {tfig}: max relative {what} deviation against {param}")
 
 
 def timing_figure(res, figs, listing):
+    """Two panels of at most five named lines: the thesis's seven (the four its claims name in colour)
+    and four exact splittings of rising order."""
     rows = read_csv(os.path.join(res, "timing.csv"))
     groups = by_method(rows)
-    shown = THESIS_SEVEN + ["lp-verlet", "lp-y4", "lp-kl6", "lp-kl8"]
-    fig, ax = plt.subplots(figsize=(WIDE / 2, 2.6))
-    cmap = plt.get_cmap("tab20")
-    for i, m in enumerate(shown):
-        rs = groups.get(m, [])
-        ax.plot([num(r["n"]) for r in rs], [num(r["median_s"]) * 1e3 for r in rs], label=m, color=cmap(i),
-                linewidth=0.9, linestyle="--" if m.startswith("thesis-") else "-")
-    ax.set_xlabel("number of steps n")
-    ax.set_ylabel("median run time [ms]")
-    ax.legend(ncol=2)
+    panels = [("thesis's seven", ["thesis-euler", "thesis-fr4", "thesis-y6", "rk4", "ab4"], ["thesis-verlet", "thesis-ruth3"]),
+              ("exact Lie-Poisson", ["lp-verlet", "lp-y4", "lp-kl6", "lp-kl8"], [])]
+    fig, axes = plt.subplots(1, 2, figsize=(WIDE * 2 / 3, 2.9), sharey=True)
+    for ax, (title, named, grey) in zip(axes, panels):
+        colour = iter(PANEL_COLOURS)
+        for m in grey + named:
+            rs = groups.get(m, [])
+            xs, ys = [num(r["n"]) for r in rs], [num(r["median_s"]) * 1e3 for r in rs]
+            if m in grey:
+                ax.plot(xs, ys, color="0.65", linewidth=0.5, label=f"other drift/kick ({len(grey)})" if m == grey[0] else None)
+            else:
+                ax.plot(xs, ys, label=m, color=SEVEN_COLOURS.get(m) or next(colour), linewidth=1.0,
+                        linestyle="--" if m.startswith("thesis-") else "-")
+        ax.set_xlabel("number of steps n")
+        ax.set_title(title)
+        ax.legend(ncol=1, loc="upper center", bbox_to_anchor=(0.5, -0.22), frameon=False)
+    axes[0].set_ylabel("median run time [ms]")
     save(fig, os.path.join(figs, "fig_timing.pdf"), listing, "thesis fig. 4.12-4.13: run time against n")
 
 
@@ -316,44 +322,53 @@ def map_figure(res, figs, listing):
 
 def scattering_figure(res, figs, listing):
     """bodypoint study --name scattering: the deflection function theta(b), the differential cross-section
-    against theta, and the closest approach r_min(b), one line per series; Rutherford's for B = 0 in grey,
-    rainbows (theta(b) extremal, the study's column) as open circles."""
+    against theta, and the closest approach r_min(b), one line per series, the material point's and the
+    spinning bodies' in two rows; Rutherford's in grey, rainbows (theta(b) extremal) as open circles."""
     path = os.path.join(res, "scattering.csv")
     if not os.path.exists(path):
         return
     rows = read_csv(path)
     series = list(dict.fromkeys(r["series"] for r in rows))
-    fig, axes = plt.subplots(1, 3, figsize=(WIDE, 2.3))
+    # Two rows of at most six lines: the material point (B = 0, by two methods) against Rutherford, then
+    # the spinning bodies (couplings and spin orientations) with Rutherford's curve as the reference.
+    material = [n for n in series if n == "B=0" or n.startswith("B=0 ")]
+    groups = [("material point", material), ("spinning body", [n for n in series if n not in material])]
+    fig, grid = plt.subplots(2, 3, figsize=(WIDE, 4.8))
     cmap = plt.get_cmap("tab10")
-    for i, name in enumerate(series):
-        rs = [r for r in rows if r["series"] == name and r["failure"] == "" and num(r["theta"]) > 0]
-        if not rs:
-            continue
-        style = dict(color=cmap(i % 10), linewidth=0.9, label=name)
-        b = [num(r["b"]) for r in rs]
-        axes[0].plot(b, [num(r["theta"]) for r in rs], **style)
-        rb = [r for r in rs if r["rainbow"] == "1"]
-        axes[0].plot([num(r["b"]) for r in rb], [num(r["theta"]) for r in rb], "o", markersize=4,
-                     markerfacecolor="none", color=cmap(i % 10))
-        ds = [r for r in rs if num(r["dsigma_domega"]) > 0]
-        axes[1].plot([num(r["theta"]) for r in ds], [num(r["dsigma_domega"]) for r in ds], **style)
-        axes[2].plot(b, [num(r["r_min"]) for r in rs], **style)
-        if name == "B=0":
-            axes[0].plot(b, [num(r["theta_rutherford"]) for r in rs], color="grey", linewidth=2.5, alpha=0.35,
-                         label="Rutherford", zorder=0)
-            rr = [r for r in ds if num(r["dsigma_rutherford"]) > 0]
-            axes[1].plot([num(r["theta"]) for r in rr], [num(r["dsigma_rutherford"]) for r in rr], color="grey",
-                         linewidth=2.5, alpha=0.35, zorder=0)
-    for ax, (xl, yl) in zip(axes, [("impact parameter b", "deflection theta (rad)"),
-                                   ("deflection theta (rad)", "dsigma/dOmega"),
-                                   ("impact parameter b", "closest approach r_min")]):
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel(xl)
-        ax.set_ylabel(yl)
+    reference = [r for r in rows if r["series"] == "B=0" and r["failure"] == "" and num(r["theta"]) > 0]
+    for axes, (title, names) in zip(grid, groups):
+        for ax in axes:
+            ax.set_title(title)
+        rb_ = [num(r["b"]) for r in reference]
+        axes[0].plot(rb_, [num(r["theta_rutherford"]) for r in reference], color="grey", linewidth=2.5, alpha=0.35,
+                     label="Rutherford", zorder=0)
+        rr = [r for r in reference if num(r["dsigma_rutherford"]) > 0]
+        axes[1].plot([num(r["theta"]) for r in rr], [num(r["dsigma_rutherford"]) for r in rr], color="grey",
+                     linewidth=2.5, alpha=0.35, zorder=0)
+        for i, name in enumerate(names):
+            rs = [r for r in rows if r["series"] == name and r["failure"] == "" and num(r["theta"]) > 0]
+            if not rs:
+                continue
+            dashed = i > 0 and title == "material point"  # the second method on the same curve
+            style = dict(color=cmap(i % 10), linewidth=0.9, label=name, linestyle="--" if dashed else "-")
+            b = [num(r["b"]) for r in rs]
+            axes[0].plot(b, [num(r["theta"]) for r in rs], **style)
+            rb = [r for r in rs if r["rainbow"] == "1"]
+            axes[0].plot([num(r["b"]) for r in rb], [num(r["theta"]) for r in rb], "o", markersize=4,
+                         markerfacecolor="none", color=cmap(i % 10))
+            ds = [r for r in rs if num(r["dsigma_domega"]) > 0]
+            axes[1].plot([num(r["theta"]) for r in ds], [num(r["dsigma_domega"]) for r in ds], **style)
+            axes[2].plot(b, [num(r["r_min"]) for r in rs], **style)
+        for ax, (xl, yl) in zip(axes, [("impact parameter b", "deflection theta (rad)"),
+                                       ("deflection theta (rad)", "dsigma/dOmega"),
+                                       ("impact parameter b", "closest approach r_min")]):
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            ax.set_xlabel(xl)
+            ax.set_ylabel(yl)
+        handles, labels = axes[0].get_legend_handles_labels()  # Rutherford with the series
+        axes[2].legend(handles, labels, loc="upper left", frameon=False)
     fig.tight_layout()
-    handles, labels = axes[0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="upper center", ncol=5, bbox_to_anchor=(0.5, 0.0), frameon=False)
     save(fig, os.path.join(figs, "fig_scattering.pdf"), listing,
          "scattering: deflection function, differential cross-section and closest approach per series")
 
