@@ -404,6 +404,6 @@ std::string closest_word(std::string_view word, const std::vector<std::string>& 
   return best;
 }
 
-const char* git_revision() { return BODYPOINT_GIT_REVISION; }
+// git_revision() is generated at build time (cmake/revision.cmake).
 
 }  // namespace bodypoint
