@@ -62,6 +62,14 @@ constexpr int kMaxStalls = 3;
 constexpr double kStallFactor = 2.0;
 /// Budget of force evaluations (or KS steps) over all runs of one search.
 constexpr double kMaxEvals = 2e9;
+/// Below this tolerance a run about to be delivered is repeated once with its roundings changed (the
+/// step moved by a relative 1e-9, or one fixed step more: the truncation error moves by far less than
+/// tol) and the two must agree within kAccept tol. An encounter amplifies round-off: on B = 0.9, b = 1
+/// runs differ by ~4e-12 whatever the step, and a pair at the answer's step and twice it can agree
+/// with C h^p by chance (estimate 1.9e-14 for a true error of 3.8e-12 at tol 1e-13). Richardson
+/// cannot tell that floor from truncation; two runs that differ only in rounding measure it.
+constexpr double kProbeBelowTol = 1e-11;
+constexpr double kProbeShift = 1e-9;
 /// Refinements before the search gives up.
 constexpr int kMaxLevels = 48;
 /// Differences at or below this relative size are at the round-off level of a run of 1e3..1e6 steps.
@@ -251,7 +259,17 @@ class Search {
       // carried over from the coarser runs predicted, within kAgree.
       bool smooth = estimate_ <= kAgree * expected && estimate_ >= expected / kAgree;
       if (rungs.size() >= 3) smooth = observed_order(rungs[rungs.size() - 3], a, b) >= p_ - kOrderSlack;
-      if (estimate_ <= kAccept * tol_ && (smooth || d <= kRoundOff)) return std::move(rungs.back());
+      if (estimate_ <= kAccept * tol_ && (smooth || d <= kRoundOff)) {
+        if (tol_ < kProbeBelowTol) {
+          const double floor = rounding_floor(rungs.back(), h_c);
+          if (floor > kAccept * tol_)
+            throw Error("tol " + fmt_tol() + " is out of reach of " + std::string(m_.name) +
+                        " on this scene: runs that differ only in rounding differ by " + fmt_number(floor) +
+                        " (round-off amplified by the scene)");
+          estimate_ = last_estimate_ = std::max(estimate_, floor);
+        }
+        return std::move(rungs.back());
+      }
       // A search whose estimates stop falling (round-off, or resonances that refinement does not
       // remove) says so instead of spending its whole budget.
       if (estimate_ < best_bound / kStallFactor) {
@@ -268,6 +286,14 @@ class Search {
     }
     throw Error("tol " + fmt_tol() + ": " + std::string(m_.name) + " did not reach it in " +
                 std::to_string(kMaxLevels) + " refinements");
+  }
+
+  /// What the run `l` and a repeat of it with other roundings differ by (kProbeBelowTol): the repeat
+  /// moves a fictitious step by kProbeShift, or takes one fixed step more.
+  double rounding_floor(const Level& l, double h_c) {
+    const double h = is_time_transformed(m_) ? l.h * (1.0 - kProbeShift) : t_end_ / static_cast<double>(l.steps + 1);
+    const Level probe = run_at(h, h_c, false);
+    return state_distance(l.run.final, probe.run.final);
   }
 
   /// The order q with which x(h) = x* + C h^q fits three runs at steps h1 > h2 > h3: the root of
