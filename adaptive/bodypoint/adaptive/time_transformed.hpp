@@ -69,7 +69,8 @@ struct LogHKernel {
   splitting::LiePoissonKernel<Field, Spin> lp;  ///< the physical-time exact drift and kick
   double c = 0.0;  ///< constant added to Pi and to E - T: the physical step is at most ds/c
 
-  LogHKernel(const BodyPoint& p, const Field& f, double c_ = 0.0) : lp(p, f), c(c_) {}
+  LogHKernel(const BodyPoint& p, const Field& f, double c_ = 0.0)
+      : lp(p, f), c(c_), inv_d_(1.0 / p.D()) {}
 
   [[nodiscard]] TimeState initial_state(const State& s0) const {
     TimeState x;
@@ -97,11 +98,14 @@ struct LogHKernel {
     const double tau = ds / (P + c);
     const Vec3 delta = tau * F;
     const BodyPoint& p = lp.p;
-    x.g -= (p.J * (x.q.K1.dot(delta) + 0.5 * delta.squaredNorm()) - p.B * x.q.K2.dot(delta)) / p.D();
+    x.g -= (p.J * (x.q.K1.dot(delta) + 0.5 * delta.squaredNorm()) - p.B * x.q.K2.dot(delta)) * inv_d_;
     lp.apply_kick(x.q, tau, F);
   }
 
   [[nodiscard]] State to_physical(const TimeState& x) const { return lp.to_physical(x.q); }
+
+ private:
+  double inv_d_;  ///< 1/D: the kick's change of T without a division per stage
 };
 
 template <class Field, bool Spin>
@@ -112,7 +116,8 @@ struct TtlKernel {
   splitting::LiePoissonKernel<Field, Spin> lp;
   double c = 0.0;  ///< constant added to Omega: the physical step is at most ds/c
 
-  TtlKernel(const BodyPoint& p, const Field& f, double c_ = 0.0) : lp(p, f), c(c_) {}
+  TtlKernel(const BodyPoint& p, const Field& f, double c_ = 0.0)
+      : lp(p, f), c(c_), inv_d_(1.0 / p.D()) {}
 
   [[nodiscard]] TimeState initial_state(const State& s0) const {
     TimeState x;
@@ -136,17 +141,16 @@ struct TtlKernel {
     double Omega;
     lp.field.force_omega(x.q.R, F, Omega, grad);
     const double dtp = ds / (Omega + c);
-    const Vec3 v_before = velocity(x);
+    // The mean of v = (J K1 - B K2)/D before and after the kick: v at K1 + dtp F / 2 (v is linear in K1).
+    const Vec3 v_mean = (lp.p.J * (x.q.K1 + (0.5 * dtp) * F) - lp.p.B * x.q.K2) * inv_d_;
     lp.apply_kick(x.q, dtp, F);
-    x.W += dtp * grad.dot(0.5 * (v_before + velocity(x)));
+    x.W += dtp * grad.dot(v_mean);
   }
 
   [[nodiscard]] State to_physical(const TimeState& x) const { return lp.to_physical(x.q); }
 
  private:
-  [[nodiscard]] Vec3 velocity(const TimeState& x) const {
-    return (lp.p.J * x.q.K1 - lp.p.B * x.q.K2) / lp.p.D();
-  }
+  double inv_d_;  ///< 1/D: velocities without a division per component
 };
 
 }  // namespace bodypoint::adaptive
