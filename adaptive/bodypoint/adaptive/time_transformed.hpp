@@ -41,6 +41,7 @@
 
 #include <cmath>
 #include <string>
+#include <type_traits>
 
 namespace bodypoint::adaptive {
 
@@ -92,14 +93,23 @@ struct LogHKernel {
 
   void kick(TimeState& x, double ds) {
     ++lp.evals;
-    Vec3 F;
-    double P;
-    lp.field.force_potential(x.q.R, F, P);
-    const double tau = ds / (P + c);
-    const Vec3 delta = tau * F;
+    Vec3 delta;  // the kick's change of K1, ds F/(Pi + c)
+    if constexpr (std::is_same_v<Field, OriginCentre>) {
+      // One centre: ds F/(Pi + c) = ds (-A) R / (r^2 (c r - A)), one division where F, Pi and their
+      // quotient take two (the kick is on the step's critical path, see drift_functions).
+      const double A = lp.field.A;
+      const double r2 = x.q.R.squaredNorm();
+      const double r = std::sqrt(r2);
+      delta = (-A * ds / (r2 * (c * r - A))) * x.q.R;
+    } else {
+      Vec3 F;
+      double P;
+      lp.field.force_potential(x.q.R, F, P);
+      delta = (ds / (P + c)) * F;
+    }
     const BodyPoint& p = lp.p;
     x.g -= (p.J * (x.q.K1.dot(delta) + 0.5 * delta.squaredNorm()) - p.B * x.q.K2.dot(delta)) * inv_d_;
-    lp.apply_kick(x.q, tau, F);
+    splitting::compensated_add(x.q.K1, x.q.K1_err, delta);
   }
 
   [[nodiscard]] State to_physical(const TimeState& x) const { return lp.to_physical(x.q); }
