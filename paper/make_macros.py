@@ -523,11 +523,18 @@ def by_tol(res, out, M):
     M.add("PeerMet", count(sum(1 for r in peers if r["met"] == "yes")))
     M.add("NumByTolScenes", count(len({r["scene"] for r in auto})))
     head, body = md_table(os.path.join(res, "by_tol_summary.md"))
-    keep = [0, 1, 2, 3, 5, 7, 12, 13, 14]  # scene, TOL, auto, ds, delivered, time, peer best case, time, ratio
-    ratios = {}
+    # scene, TOL, auto, ds, delivered, time, peer best case, time, ratio, ratio of the delivered run alone
+    keep = [0, 1, 2, 3, 5, 7, 12, 13, 14, 16]
+    ratios, alone = {}, {}
     for row in body:  # auto against the peer's best case, per scene (a "-": no peer delivers TOL)
         if row[14].endswith("x"):
             ratios.setdefault(row[0], []).append(num(row[14].rstrip("x")))
+        if row[16].endswith("x"):
+            alone.setdefault(row[0], []).append(num(row[16].rstrip("x")))
+    spinning_alone = [r for scene, rs in alone.items() if scene != "material" for r in rs]
+    if spinning_alone:
+        M.add("AutoAloneSpinLow", sci(min(spinning_alone)))
+        M.add("AutoAloneSpinHigh", sci(max(spinning_alone)))
     spinning = [r for scene, rs in ratios.items() if scene != "material" for r in rs]
     if spinning:
         M.add("AutoVsPeerSpinLow", sci(min(spinning)))
