@@ -13,7 +13,6 @@ Prints two tables:
 Usage (from the repository, after the build):
     PYTHONPATH=build/python /usr/bin/python3 bench/far_field.py [build/bin/bodypoint]
 """
-import math
 import os
 import subprocess
 import sys

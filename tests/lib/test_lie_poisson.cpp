@@ -102,7 +102,7 @@ void expect_close_to_series(double x) {
   EXPECT_NEAR(f.S3, static_cast<double>(s3), kDriftFunctionsTol * std::abs(static_cast<double>(s3))) << "x = " << x;
 }
 
-// Every branch (4 and 6 terms by Horner and Estrin, 9 by Estrin, the closed form) and both sides of
+// Every branch (4 terms by Horner, 6 and 9 by Estrin, the closed form) and both sides of
 // each boundary: the drift's rotation is only as exact as these three functions.
 TEST(LiePoisson, DriftFunctionsMatchTheirSeriesInEveryBranch) {
   for (double x : {0.0, 1e-12, 1e-6, 5e-4, 0.000999, 0.001, 0.001001, 0.01, 0.05, 0.0999, 0.1, 0.1001, 0.3, 0.6,
