@@ -7,8 +7,9 @@ Prints two tables:
    turns the spin by. The error is smooth in h below pi per step and jumps at pi, 2 pi, 4 pi: a step
    longer than the spin period lands between resonances, and the error stops being the C h^p that
    Richardson's estimate assumes.
-2. Where the accuracy mode's delivered run spends its steps on the close scene (Kz = 0.1, d = 0.05,
-   t = 80): the share of steps taken farther than r from the centre.
+2. Where the steps go on the close scene (Kz = 0.1, d = 0.05, t = 80): the share of steps taken farther
+   than r from the centre and the spin angle per step beyond r = 50, for the accuracy mode's delivered
+   run and for the peers GSL rk8pd and Boost.Odeint rkf78 with their tolerance set to TOL.
 
 Usage (from the repository, after the build):
     PYTHONPATH=build/python /usr/bin/python3 bench/far_field.py [build/bin/bodypoint]
@@ -51,22 +52,42 @@ def resonances():
         print(f"| {h:g} | {spin_rate * h:.2f} | " + " | ".join(cells) + " |")
 
 
+PEERS = ["gsl-rk8pd", "odeint-rkf78"]
+
+
 def far_share(binary):
-    print("\nclose scene (Kz = 0.1, d = 0.05, t = 80), --tol: share of the delivered run's steps beyond r")
-    print("| TOL | method, ds | steps | " + " | ".join(f"r > {r}" for r in RADII) + " |")
-    print("|---|---|---|" + "---|" * len(RADII))
+    """Where the steps go on the close scene: auto's delivered run at each TOL and the peers with their
+    tolerance set to TOL. Everyone spends most steps far from the centre; there the spin angle per step
+    (Omega_so dt) says how finely each resolves the helix."""
+    spin_rate = 0.7 * 5.0 / (1.0 - 0.7 ** 2)  # table 3.1's B, K1, m, J
+    print("\nclose scene (Kz = 0.1, d = 0.05, t = 80): where the steps go; auto's delivered run (--tol) and the"
+          " peers at tolerance TOL")
+    print("| TOL | method | steps | force evals (delivered run) | " + " | ".join(f"r > {r}" for r in RADII)
+          + " | spin angle per step beyond r = 50 [rad] |")
+    print("|---|---|---|---|" + "---|" * len(RADII) + "---|")
     with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "traj.csv")
         for tol in TOLS:
-            out = os.path.join(tmp, "traj.csv")
-            run = subprocess.run([binary, "simulate", "--tol", tol, "--Kz", "0.1", "--d", "0.05", "--t-end",
-                                  str(T_END), "--out", out], check=True, capture_output=True, text=True)
-            chosen = next(line.split()[0:2] for line in run.stdout.splitlines() if "method=" in line and "ds=" in line)
-            d = np.genfromtxt(out, delimiter=",", names=True, comments="#")
-            r = np.sqrt(d["Rx"] ** 2 + d["Ry"] ** 2 + d["Rz"] ** 2)
-            n = len(r) - 1
-            shares = [np.sum((r[1:] > r0) & (r[:-1] > r0)) / n for r0 in RADII]
-            print(f"| {tol} | {chosen[0].split('=')[1]}, {float(chosen[1].split('=')[1]):.3g} | {n} | "
-                  + " | ".join(f"{s:.2f}" for s in shares) + " |")
+            for method in ["auto"] + PEERS:
+                args = [binary, "simulate", "--tol", tol, "--Kz", "0.1", "--d", "0.05", "--t-end", str(T_END),
+                        "--out", out]
+                if method != "auto":
+                    args += ["--method", method]
+                run = subprocess.run(args, check=True, capture_output=True, text=True)
+                label = method
+                if method == "auto":
+                    chosen = next(line.split()[0:2] for line in run.stdout.splitlines()
+                                  if "method=" in line and "ds=" in line)
+                    label = f"auto: {chosen[0].split('=')[1]}, ds {float(chosen[1].split('=')[1]):.3g}"
+                evals = next(line.split("=")[1].split(",")[0].strip() for line in run.stdout.splitlines()
+                             if line.strip().startswith("force evaluations ="))
+                d = np.genfromtxt(out, delimiter=",", names=True, comments="#")
+                r = np.sqrt(d["Rx"] ** 2 + d["Ry"] ** 2 + d["Rz"] ** 2)
+                n = len(r) - 1
+                beyond = [(r[1:] > r0) & (r[:-1] > r0) for r0 in RADII]
+                angle = spin_rate * np.mean(np.diff(d["t"])[beyond[-1]])
+                print(f"| {tol} | {label} | {n} | {evals} | " + " | ".join(f"{np.sum(b) / n:.2f}" for b in beyond)
+                      + f" | {angle:.2f} |")
 
 
 if __name__ == "__main__":
