@@ -62,13 +62,12 @@ constexpr int kMaxStalls = 3;
 constexpr double kStallFactor = 2.0;
 /// Budget of force evaluations (or KS steps) over all runs of one search.
 constexpr double kMaxEvals = 2e9;
-/// Below this tolerance a run about to be delivered is repeated once with its roundings changed (the
-/// step moved by a relative 1e-9, or one fixed step more: the truncation error moves by far less than
-/// tol) and the two must agree within kAccept tol. An encounter amplifies round-off: on B = 0.9, b = 1
-/// runs differ by ~4e-12 whatever the step, and a pair at the answer's step and twice it can agree
-/// with C h^p by chance (estimate 1.9e-14 for a true error of 3.8e-12 at tol 1e-13). Richardson
-/// cannot tell that floor from truncation; two runs that differ only in rounding measure it.
-constexpr double kProbeBelowTol = 1e-11;
+/// Below kProbeBelowTol (tolerance.hpp) a run about to be delivered is repeated once with its roundings
+/// changed (the step moved by a relative kProbeShift, or one fixed step more: the truncation error moves
+/// by far less than tol) and the two must agree within kAccept tol. An encounter amplifies round-off: on
+/// B = 0.9, b = 1 runs differ by ~4e-12 whatever the step, and a pair at the answer's step and twice it
+/// can agree with C h^p by chance (estimate 1.9e-14 for a true error of 3.8e-12 at tol 1e-13).
+/// Richardson cannot tell that floor from truncation; two runs that differ only in rounding measure it.
 constexpr double kProbeShift = 1e-9;
 /// Refinements before the search gives up.
 constexpr int kMaxLevels = 48;

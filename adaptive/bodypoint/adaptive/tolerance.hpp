@@ -27,6 +27,11 @@ namespace bodypoint::adaptive {
 /// delivered, nor estimated, in double precision.
 inline constexpr double kMinTolerance = 1e-13;
 
+/// Below this tolerance a run about to be delivered is repeated once with its roundings changed and
+/// the two must agree within tol (tolerance.cpp): an encounter amplifies round-off, which Richardson's
+/// estimate cannot tell from truncation. The search then costs one delivered run more.
+inline constexpr double kProbeBelowTol = 1e-11;
+
 /// Why the accuracy mode refuses a scene with a centre that does not follow Coulomb's law.
 inline constexpr std::string_view kNeedsCoulomb =
     "the accuracy mode (tol) assumes Coulomb's law (its error model and time transformations do); run the thesis "
