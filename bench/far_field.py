@@ -12,11 +12,14 @@ Prints two tables:
    run and for the peers GSL rk8pd and Boost.Odeint rkf78 with their tolerance set to TOL.
 
 Usage (from the repository, after the build):
-    PYTHONPATH=build/python /usr/bin/python3 bench/far_field.py [build/bin/bodypoint]
+    PYTHONPATH=build/python /usr/bin/python3 bench/far_field.py [build/bin/bodypoint] [--out-dir DIR]
+With --out-dir, the two tables are also written (atomically) to DIR/far_field_resonances.csv and
+DIR/far_field_share.csv, which paper/build.sh hands to the paper.
 """
+import argparse
+import csv
 import os
 import subprocess
-import sys
 import tempfile
 
 import numpy as np
@@ -34,6 +37,16 @@ def distance(b, ref):
                np.linalg.norm(b["v"] - ref["v"]) / np.linalg.norm(ref["v"]))
 
 
+def write_csv(path, header, rows):
+    """header and rows to path through a temporary file in the same folder, renamed into place."""
+    tmp = path + ".tmp"
+    with open(tmp, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(header)
+        w.writerows(rows)
+    os.replace(tmp, path)
+
+
 def resonances():
     m, B, J, K1 = 1.0, 0.7, 1.0, 5.0  # the thesis's table 3.1, stated so that Omega_so is this scene's
     scene = bp.thesis_scene(m=m, B=B, J=J, K1=K1, Kz=0.1, d=50.0)
@@ -42,14 +55,18 @@ def resonances():
     print(f"far pass (Kz = 0.1, d = 50, t = {T_END:g}): error against odeint-rkf78 at tol 1e-15")
     print("| h | spin angle per step [rad] | " + " | ".join(f"{m} error | {m} force evals" for m in METHODS) + " |")
     print("|---|---|" + "---|---|" * len(METHODS))
+    rows = []
     for h in STEPS:
         cells = []
         for m in METHODS:
             # The resolution check flags steps above pi of spin (docs/physics.md); here the run is
             # wanted as it is, to measure the error there, so no invariants and hence no flags.
             r = bp.integrate(scene, m, h=h, t_end=T_END, invariants=False)["bodies"][0]
-            cells += [f"{distance(r, ref):.2e}", str(r["force_evals"])]
+            err = distance(r, ref)
+            cells += [f"{err:.2e}", str(r["force_evals"])]
+            rows.append([m, repr(h), repr(spin_rate * h), repr(err), r["force_evals"]])
         print(f"| {h:g} | {spin_rate * h:.2f} | " + " | ".join(cells) + " |")
+    return rows
 
 
 PEERS = ["gsl-rk8pd", "odeint-rkf78"]
@@ -65,6 +82,7 @@ def far_share(binary):
     print("| TOL | method | steps | force evals (delivered run) | " + " | ".join(f"r > {r}" for r in RADII)
           + " | spin angle per step beyond r = 50 [rad] |")
     print("|---|---|---|---|" + "---|" * len(RADII) + "---|")
+    rows = []
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "traj.csv")
         for tol in TOLS:
@@ -86,10 +104,28 @@ def far_share(binary):
                 n = len(r) - 1
                 beyond = [(r[1:] > r0) & (r[:-1] > r0) for r0 in RADII]
                 angle = spin_rate * np.mean(np.diff(d["t"])[beyond[-1]])
-                print(f"| {tol} | {label} | {n} | {evals} | " + " | ".join(f"{np.sum(b) / n:.2f}" for b in beyond)
+                shares = [np.sum(b) / n for b in beyond]
+                print(f"| {tol} | {label} | {n} | {evals} | " + " | ".join(f"{x:.2f}" for x in shares)
                       + f" | {angle:.2f} |")
+                rows.append([tol, label.split(":")[0], label.split(":")[-1].split(",")[0].strip(), n, evals,
+                             *[repr(x) for x in shares], repr(angle)])
+    return rows
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("binary", nargs="?", default="build/bin/bodypoint")
+    parser.add_argument("--out-dir", help="also write far_field_resonances.csv and far_field_share.csv here")
+    args = parser.parse_args()
+    res = resonances()
+    share = far_share(args.binary)
+    if args.out_dir:
+        write_csv(os.path.join(args.out_dir, "far_field_resonances.csv"),
+                  ["method", "h", "spin_angle", "err", "force_evals"], res)
+        write_csv(os.path.join(args.out_dir, "far_field_share.csv"),
+                  ["tol", "who", "method", "steps", "force_evals"] + [f"share_beyond_{r}" for r in RADII]
+                  + [f"spin_angle_beyond_{RADII[-1]}"], share)
 
 
 if __name__ == "__main__":
-    resonances()
-    far_share(sys.argv[1] if len(sys.argv) > 1 else "build/bin/bodypoint")
+    main()

@@ -6,7 +6,8 @@
 #   paper/build.sh --quick    the same recipes, scenes and sections on coarse grids into paper/results-quick/
 #
 # Steps: bodypoint study (d, L, h, Kx sweeps, timing, force evaluations, appendix 1, errata, the sweeps
-# as published, stress, the (d, L) map, scattering), bodypoint work-precision (ladders and --by-tol), bench_steps
+# as published, stress, the (d, L) map, scattering), bodypoint work-precision (ladders and --by-tol),
+# bench/far_field.py (where the steps go, the far field's resonances), bench_steps
 # (cost per step), bench_batch (sweep throughput per core),
 # make_figures.py (vector PDF), make_macros.py (LaTeX macros and tables), latexmk.
 # BODYPOINT_NO_SETUP=1 skips scripts/setup.sh and BODYPOINT_BUILD_DIR names the build tree (default
@@ -71,6 +72,10 @@ $bin work-precision "${wp[@]}" --out "$results/work_precision.csv" --summary "$r
   > "$results/work_precision_summary.txt"
 $bin work-precision --by-tol "${by_tol[@]}" --out "$results/by_tol.csv" --summary "$results/by_tol_summary.md" \
   > "$results/by_tol_summary.txt"
+# Where a spinning body's steps go on the close scene (auto and the peers), and the far field's
+# resonances against the spin angle per step (the Python module, from the build tree).
+PYTHONPATH="${BODYPOINT_BUILD_DIR:-build}/python" "$py" bench/far_field.py "$bin" --out-dir "$results" \
+  > "$results/far_field.md"
 # Cost per step of every method on the thesis scene (medians with repetitions in the full build).
 "$bindir/bench_steps" --benchmark_filter='BM_Step/.*/thesis' "${bench[@]}" --benchmark_format=csv \
   > "$results/bench_steps.csv.tmp" 2>/dev/null

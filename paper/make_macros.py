@@ -523,14 +523,26 @@ def by_tol(res, out, M):
     M.add("PeerMet", count(sum(1 for r in peers if r["met"] == "yes")))
     M.add("NumByTolScenes", count(len({r["scene"] for r in auto})))
     head, body = md_table(os.path.join(res, "by_tol_summary.md"))
-    # scene, TOL, auto, ds, delivered, time, peer best case, time, ratio, ratio of the delivered run alone
-    keep = [0, 1, 2, 3, 5, 7, 12, 13, 14, 16]
+    # scene, TOL, auto, delivered, time; the fastest peer at tolerance TOL that met it, time, ratio; the
+    # peer's best case, time, ratio; ratio of the delivered run alone
+    keep = [0, 1, 2, 5, 7, 8, 9, 10, 12, 13, 14, 16]
     ratios, alone = {}, {}
     for row in body:  # auto against the peer's best case, per scene (a "-": no peer delivers TOL)
         if row[14].endswith("x"):
             ratios.setdefault(row[0], []).append(num(row[14].rstrip("x")))
         if row[16].endswith("x"):
             alone.setdefault(row[0], []).append(num(row[16].rstrip("x")))
+    spinning_peers = [r for r in peers if r["scene"] != "material"]
+    M.add("PeerSpinRuns", count(len(spinning_peers)))
+    M.add("PeerSpinMet", count(sum(1 for r in spinning_peers if r["met"] == "yes")))
+    # Against the fastest peer asked for TOL that delivered it, on the spinning scenes: a clause of the
+    # text, empty where no such peer run exists.
+    at_tol = [num(row[10].rstrip("x")) for row in body if row[0] != "material" and row[10].endswith("x")]
+    clause = ""
+    if at_tol:
+        clause = (f"; against the fastest of those that did, \\cmd{{auto}} is ${sci(min(at_tol))}$ to "
+                  f"${sci(max(at_tol))}$ times as fast")
+    M.add("AutoVsPeerAtTolSpin", clause, math_mode=False)
     spinning_alone = [r for scene, rs in alone.items() if scene != "material" for r in rs]
     if spinning_alone:
         M.add("AutoAloneSpinLow", sci(min(spinning_alone)))
@@ -545,6 +557,46 @@ def by_tol(res, out, M):
     with open(os.path.join(out, "tab_by_tol.tex"), "w") as f:
         for row in body:
             f.write(" & ".join(latex_cell(row[i]) for i in keep) + " \\\\\n")
+
+
+def far_field(res, out, M):
+    """Where the steps go on the close scene (bench/far_field.py): auto's delivered run and the peers at
+    tolerance TOL; and the far pass's error against the spin angle per step (its resonances)."""
+    rows, _ = read_csv(os.path.join(res, "far_field_share.csv"))
+    auto = [r for r in rows if r["who"] == "auto"]
+    peers = [r for r in rows if r["who"] != "auto"]
+    for name, group in [("FarAuto", auto), ("FarPeer", peers)]:
+        for radius in ("5", "50"):
+            shares = [100 * num(r[f"share_beyond_{radius}"]) for r in group]
+            word = "Five" if radius == "5" else "Fifty"
+            M.add(f"{name}Share{word}Low", f"{min(shares):.0f}")
+            M.add(f"{name}Share{word}High", f"{max(shares):.0f}")
+
+    def per_radian(r):  # force evaluations per radian of spin beyond r = 50
+        return num(r["force_evals"]) / num(r["steps"]) / num(r["spin_angle_beyond_50"])
+
+    ratios = []
+    with open(os.path.join(out, "tab_far_field.tex"), "w") as f:
+        for r in rows:
+            best_peer = min((p for p in peers if p["tol"] == r["tol"]), key=per_radian)
+            if r["who"] == "auto":
+                ratios.append(per_radian(best_peer) / per_radian(r))
+            cells = [sci(num(r["tol"]), 1), tt(r["method"]), count(int(r["steps"])), count(int(r["force_evals"])),
+                     f"{100 * num(r['share_beyond_5']):.0f}", f"{100 * num(r['share_beyond_50']):.0f}",
+                     sci(num(r["spin_angle_beyond_50"])), sci(per_radian(r))]
+            f.write(" & ".join(f"${c}$" if "times" in c else c for c in cells) + " \\\\\n")
+    M.add("FarPerRadianLow", sci(min(ratios)))
+    M.add("FarPerRadianHigh", sci(max(ratios)))
+    res_rows, _ = read_csv(os.path.join(res, "far_field_resonances.csv"))
+    kl6 = {round(num(r["spin_angle"]), 2): num(r["err"]) for r in res_rows if r["method"] == "lp-kl6"}
+
+    def nearest(angle):
+        return kl6[min(kl6, key=lambda a: abs(a - angle))]
+
+    M.add("FarSmoothAngle", sci(max(a for a in kl6 if a < 2.8)))
+    M.add("FarSmoothErr", sci(nearest(2.75)))
+    M.add("FarPiErr", sci(nearest(math.pi)))
+    M.add("FarTwoPiErr", sci(nearest(2 * math.pi)))
 
 
 # The statuses of a run that ended with numbers bodypoint does not vouch for (docs/physics.md,
@@ -756,6 +808,7 @@ def main():
     speedup_table(res, out, M)
     close_table(res, out, M)
     by_tol(res, out, M)
+    far_field(res, out, M)
     stress(res, out, M)
     appendix(res, M)
     ensembles(res, M)
