@@ -9,12 +9,12 @@ the force evaluations of all searches and of their delivered runs. docs/develope
 measured") quotes it for the search's geometry as it is and for the variants that were tried.
 
 Usage (from the repository, after the build; about a minute on 2 cores):
-    /usr/bin/python3 bench/estimate_grid.py [build/bin/bodypoint]
+    /usr/bin/python3 bench/estimate_grid.py [build/bin/bodypoint] [--tols 1e-4,1e-7,1e-10]
 """
+import argparse
 import itertools
 import json
 import subprocess
-import sys
 from concurrent.futures import ThreadPoolExecutor
 
 D = [0.02, 0.1, 0.5, 1, 3, 8, 15, 30]
@@ -37,10 +37,10 @@ def one(binary, tol, scene):
     return json.loads(run.stdout)
 
 
-def main(binary):
+def main(binary, tols):
     scenes = [["--d", str(d), "--Kz", str(kz), "--B", str(b), "--Kx", str(kx)]
               for d, kz, b, kx in itertools.product(D, KZ, B, KX)]
-    jobs = [(tol, s) for s in scenes for tol in TOLS]
+    jobs = [(tol, s) for s in scenes for tol in tols]
     with ThreadPoolExecutor(2) as pool:
         results = list(pool.map(lambda j: one(binary, *j), jobs))
     refused = missed = under = over = 0
@@ -58,11 +58,15 @@ def main(binary):
             under += est < err / FACTOR
             over += est > FACTOR * err
             worst = max(worst, err / est)
-    print(f"{len(jobs)} runs ({len(scenes)} scenes x TOL {', '.join(TOLS)}, t = {T_END}): refused {refused}, "
+    print(f"{len(jobs)} runs ({len(scenes)} scenes x TOL {', '.join(tols)}, t = {T_END}): refused {refused}, "
           f"missed TOL {missed}, estimate below error/{FACTOR:g} {under}, above {FACTOR:g} x error {over}, "
           f"worst error/estimate {worst:.2f}; force evaluations: searches {search}, delivered runs {delivered} "
           f"({search / delivered:.2f}x)")
 
 
 if __name__ == "__main__":
-    main(sys.argv[1] if len(sys.argv) > 1 else "build/bin/bodypoint")
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("binary", nargs="?", default="build/bin/bodypoint")
+    parser.add_argument("--tols", default=",".join(TOLS), help="comma-separated requested tolerances")
+    args = parser.parse_args()
+    main(args.binary, args.tols.split(","))

@@ -27,10 +27,12 @@ namespace bodypoint::adaptive {
 /// delivered, nor estimated, in double precision.
 inline constexpr double kMinTolerance = 1e-13;
 
-/// Below this tolerance a run about to be delivered is repeated once with its roundings changed and
-/// the two must agree within tol (tolerance.cpp): an encounter amplifies round-off, which Richardson's
-/// estimate cannot tell from truncation. The search then costs one delivered run more.
+/// Below this tolerance a run about to be delivered is repeated kProbeRuns times with its roundings
+/// changed, and what they differ by is added to the estimate (tolerance.cpp): an encounter amplifies
+/// round-off, which Richardson's estimate cannot tell from truncation. The search then costs that many
+/// delivered runs more.
 inline constexpr double kProbeBelowTol = 1e-11;
+inline constexpr int kProbeRuns = 2;
 
 /// Why the accuracy mode refuses a scene with a centre that does not follow Coulomb's law.
 inline constexpr std::string_view kNeedsCoulomb =
