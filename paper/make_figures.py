@@ -5,7 +5,8 @@ usage: make_figures.py [--only scattering] RESULTS_DIR FIGURES_DIR
 
 Reads (all written by paper/build.sh through `bodypoint study`, `bodypoint work-precision`):
   {d,L,h,Kx}_sweep.csv and published_{d,L,h,Kx}_sweep.csv, timing.csv, appendix1/index.csv and
-  appendix1/P1.*.csv, work_precision.csv, by_tol.csv, and dL_map.csv and scattering.csv when present
+  appendix1/P1.*.csv, work_precision.csv, by_tol.csv, far_field_resonances.csv (bench/far_field.py), and
+  dL_map.csv and scattering.csv when present
 Writes fig_*.pdf and figures.md (which thesis figure each one stands for). Nothing here computes
 physics: it only draws what the drivers measured.
 """
@@ -284,6 +285,26 @@ def by_tol_figure(res, figs, listing):
     save(fig, os.path.join(figs, "fig_by_tol.pdf"), listing, "delivered error against requested TOL")
 
 
+def far_field_figure(res, figs, listing):
+    """The far pass's error against the spin angle per step (bench/far_field.py), with the half and
+    whole turns of the spin marked: where a step longer than the cap meets its resonances."""
+    rows = read_csv(os.path.join(res, "far_field_resonances.csv"))
+    fig, ax = plt.subplots(figsize=(WIDE / 2, 2.4))
+    for method, colour in zip(dict.fromkeys(r["method"] for r in rows), PANEL_COLOURS):
+        rs = [r for r in rows if r["method"] == method]
+        ax.plot([num(r["spin_angle"]) for r in rs], [capped(num(r["err"])) for r in rs], ".-", color=colour,
+                label=method, markersize=3, linewidth=0.8)
+    for k, label in [(1, r"$\pi$"), (2, r"$2\pi$"), (4, r"$4\pi$")]:
+        ax.axvline(k * math.pi, color="grey", linewidth=0.5, linestyle=":")
+        ax.annotate(label, (k * math.pi, 1.0), xycoords=("data", "axes fraction"), ha="center", va="bottom",
+                    fontsize=7)
+    ax.set_yscale("log")
+    ax.set_xlabel("spin angle per step [rad]")
+    ax.set_ylabel("relative error at t = 80")
+    ax.legend(loc="lower right")
+    save(fig, os.path.join(figs, "fig_far_field.pdf"), listing, "far pass: error against the spin angle per step")
+
+
 def map_figure(res, figs, listing):
     """The (d, L) stability map (bodypoint study --name dL-map): one heat map of log10 max relative
     energy deviation per fixed-step method; cells whose run is not ok (diverged, collision) in black."""
@@ -395,6 +416,7 @@ def main():
     appendix_figure(res, figs, listing)
     work_precision_figures(res, figs, listing)
     by_tol_figure(res, figs, listing)
+    far_field_figure(res, figs, listing)
     map_figure(res, figs, listing)
     scattering_figure(res, figs, listing)
     with open(os.path.join(figs, "figures.md"), "w") as f:
