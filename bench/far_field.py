@@ -47,10 +47,13 @@ def write_csv(path, header, rows):
     os.replace(tmp, path)
 
 
+# The thesis's table 3.1, stated so that Omega_so is these scenes' (the far pass and the close scene).
+M, B, J, K1 = 1.0, 0.7, 1.0, 5.0
+SPIN_RATE = abs(B) * K1 / (M * J - B ** 2)
+
+
 def resonances():
-    m, B, J, K1 = 1.0, 0.7, 1.0, 5.0  # the thesis's table 3.1, stated so that Omega_so is this scene's
-    scene = bp.thesis_scene(m=m, B=B, J=J, K1=K1, Kz=0.1, d=50.0)
-    spin_rate = abs(B) * K1 / (m * J - B ** 2)
+    scene = bp.thesis_scene(m=M, B=B, J=J, K1=K1, Kz=0.1, d=50.0)
     ref = bp.integrate(scene, "odeint-rkf78", tol=1e-15, t_end=T_END, h=1e-3)["bodies"][0]
     print(f"far pass (Kz = 0.1, d = 50, t = {T_END:g}): error against odeint-rkf78 at tol 1e-15")
     print("| h | spin angle per step [rad] | " + " | ".join(f"{m} error | {m} force evals" for m in METHODS) + " |")
@@ -64,8 +67,8 @@ def resonances():
             r = bp.integrate(scene, m, h=h, t_end=T_END, invariants=False)["bodies"][0]
             err = distance(r, ref)
             cells += [f"{err:.2e}", str(r["force_evals"])]
-            rows.append([m, repr(h), repr(spin_rate * h), repr(err), r["force_evals"]])
-        print(f"| {h:g} | {spin_rate * h:.2f} | " + " | ".join(cells) + " |")
+            rows.append([m, repr(h), repr(SPIN_RATE * h), repr(err), r["force_evals"]])
+        print(f"| {h:g} | {SPIN_RATE * h:.2f} | " + " | ".join(cells) + " |")
     return rows
 
 
@@ -76,7 +79,6 @@ def far_share(binary):
     """Where the steps go on the close scene: auto's delivered run at each TOL and the peers with their
     tolerance set to TOL. Everyone spends most steps far from the centre; there the spin angle per step
     (Omega_so dt) says how finely each resolves the helix."""
-    spin_rate = 0.7 * 5.0 / (1.0 - 0.7 ** 2)  # table 3.1's B, K1, m, J
     print("\nclose scene (Kz = 0.1, d = 0.05, t = 80): where the steps go; auto's delivered run (--tol) and the"
           " peers at tolerance TOL")
     print("| TOL | method | steps | force evals (delivered run) | " + " | ".join(f"r > {r}" for r in RADII)
@@ -92,23 +94,23 @@ def far_share(binary):
                 if method != "auto":
                     args += ["--method", method]
                 run = subprocess.run(args, check=True, capture_output=True, text=True)
-                label = method
+                chosen, label = method, method
                 if method == "auto":
-                    chosen = next(line.split()[0:2] for line in run.stdout.splitlines()
+                    fields = next(line.split()[0:2] for line in run.stdout.splitlines()
                                   if "method=" in line and "ds=" in line)
-                    label = f"auto: {chosen[0].split('=')[1]}, ds {float(chosen[1].split('=')[1]):.3g}"
+                    chosen = fields[0].split("=")[1]
+                    label = f"auto: {chosen}, ds {float(fields[1].split('=')[1]):.3g}"
                 evals = next(line.split("=")[1].split(",")[0].strip() for line in run.stdout.splitlines()
                              if line.strip().startswith("force evaluations ="))
                 d = np.genfromtxt(out, delimiter=",", names=True, comments="#")
                 r = np.sqrt(d["Rx"] ** 2 + d["Ry"] ** 2 + d["Rz"] ** 2)
                 n = len(r) - 1
                 beyond = [(r[1:] > r0) & (r[:-1] > r0) for r0 in RADII]
-                angle = spin_rate * np.mean(np.diff(d["t"])[beyond[-1]])
+                angle = SPIN_RATE * np.mean(np.diff(d["t"])[beyond[-1]])
                 shares = [np.sum(b) / n for b in beyond]
                 print(f"| {tol} | {label} | {n} | {evals} | " + " | ".join(f"{x:.2f}" for x in shares)
                       + f" | {angle:.2f} |")
-                rows.append([tol, label.split(":")[0], label.split(":")[-1].split(",")[0].strip(), n, evals,
-                             *[repr(x) for x in shares], repr(angle)])
+                rows.append([tol, method, chosen, n, evals, *[repr(x) for x in shares], repr(angle)])
     return rows
 
 

@@ -71,7 +71,7 @@ struct FilteredKick {
   void drift(sp::LieState& x, double tau) const { lp.drift(x, tau); }
   void kick(sp::LieState& x, double tau) const {
     const Vec3 F = lp.field.force(x.R);
-    const double BD = kBody.B / kBody.D(), k = x.K1.norm();
+    const double BD = lp.p.B / lp.p.D(), k = x.K1.norm();
     const Vec3 e = x.K1 / k;
     const Vec3 Fp = F - F.dot(e) * e, P = e.cross(Fp);
     // Exact minus impulse response of the step's end, per component of F across K1 (file comment),
