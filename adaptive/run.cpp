@@ -1,12 +1,12 @@
 // bodypoint: the time-transformed (logh-*, ttl-*) and regularised (ks) methods, run by one driver
 // (FictitiousLoop) that each of them plugs a Stepper into.
 //
-// A run takes fixed fictitious steps ds = spec.h. With spec.t_end > 0 it stops at exactly t_end:
+// A run takes fixed fictitious steps ds (FictitiousSteps). Run to an end time, it stops at exactly t_end:
 // the fictitious step that would pass t_end is undone, and the last step ds' in (0, ds) is solved
 // so that the physical time it advances is the remaining time (the advance grows monotonically with
 // ds'; a safeguarded secant iteration, a few steps). The last step is thus a step of the same scheme,
 // which keeps its properties (for logH on a material point: the exact Kepler orbit). Otherwise it
-// takes spec.steps fictitious steps. With a sink and spec.dt_out > 0, states at t = k dt_out are
+// takes the number of fictitious steps asked for. With a sink and dt_out > 0, states at t = k dt_out are
 // made by side steps from the state before the crossing step (one step of the same table in physical
 // time; for ks the exact advance), without touching the main integration.
 #include "bodypoint/adaptive/methods.hpp"
@@ -62,27 +62,9 @@ constexpr double kMaxSpinAngle = 2.0;
 
 }  // namespace
 
-// The time-step function dt/ds = 1/(Pi + c) (logH) or 1/(sum |A_i|/r_i + c) (TTL) is the
-// Preto-Tremaine (1999, sec. 2) family with f = g = ln(. + c) and the Mikkola-Aarseth (2002, eq. 4)
-// Omega with an additive constant: both stay separable, symplectic and time-symmetric in the extended
-// phase space for any fixed c >= 0, and the physical step is bounded by ds/c. The scene has two time
-// scales: the encounter, where dt = ds r/|A| advances the orbit by the angle v dt/r = ds v/|A| per
-// step, and the spin-orbit precession of K2 about K1 at Omega_so = |B| |K1|/D (docs/physics.md), which
-// does not slow down far away while the step set by Pi alone grows like r. Far from every centre
-// the spin angle per step is Omega_so ds/c; c = sum|A| Omega_so/(k v0) makes it k times the orbital
-// angle per step in the encounter. k = 16 was measured (logh-kl8 on the close and thesis scenes,
-// c from 0 to 2: the error at equal force evaluations is smallest for c in 0.05..0.2; k = 16 gives
-// 0.12 and 0.09). For large ds that alone lets the far-field step dt = ds/c turn the spin by more
-// than pi per step, where the compositions meet resonances: logh-mcl8 on the thesis scene loses 40x
-// in accuracy between ds = 0.040 and 0.045 (spin angle 3.2 -> 3.5 rad per step), logh-kl8 on the
-// close scene 48x between ds = 0.113 and 0.124 (6.5 -> 7.1 rad). So c is also at least
-// Omega_so ds/kMaxSpinAngle: no step turns the spin by more than 2 rad. 3 rad was tried: logh-bm4 on
-// the two-centres scene meets a knee there (3.8x for 8% in ds). With 2 rad the error is smooth in ds
-// (logh-kl8, close scene: 2.1x for a 10% larger ds, the 2.14x of order 8), and the --tol search's
-// error estimates, which assume that smoothness, agree with the true error to 0.14..6.3x on the
-// close, thesis and two-centres scenes (27 tolerances), against up to 43x without the bound. As ds -> 0 the first term rules, so a
-// ladder of ds converges to one fixed time transformation. A material point (B = 0) has no spin time
-// scale: c = 0 keeps logH's exact Kepler orbit.
+// c = max(sum|A| Omega_so / (k v0), Omega_so ds / kMaxSpinAngle): far from every centre a step turns the
+// spin by k times the orbital angle per step at closest approach, and never by more than 2 rad
+// (docs/physics.md, "The time-step constant c", gives the rule's reasons and measurements).
 double automatic_omega_c(const Body& body, const std::vector<Centre>& centres, double ds) {
   const BodyPoint& p = body.p;
   if (p.B == 0.0) return 0.0;
@@ -138,8 +120,8 @@ TimeState step_to_time(K& k, const TimeState& from, double ds, double target, do
   return x;
 }
 
-/// The one driver of every method that takes fixed fictitious steps ds = spec.h: spec.steps of them,
-/// or as many as reach spec.t_end, the last one solved to land on it exactly. A Stepper holds the
+/// The one driver of every method that takes fixed fictitious steps ds: a number of them, or as many
+/// as reach an end time, the last one solved to land on it exactly. A Stepper holds the
 /// kernel and says, for its state type X:
 ///   StepAdvance step(X& x, double ds)       one fictitious step; returns the new time and the physical step
 ///   double time(const X& x)             the physical time of x
@@ -159,15 +141,15 @@ class FictitiousLoop {
  public:
   using X = typename Stepper::X;
 
-  FictitiousLoop(Stepper& s, const RunSpec& spec) : s_(s), spec_(spec), next_out_(spec.dt_out) {}
+  FictitiousLoop(Stepper& s, const FictitiousSteps& spec) : s_(s), spec_(spec), next_out_(spec.dt_out) {}
 
   /// Runs from x; returns the final state and leaves the statistics in stats(). The loop keeps its
   /// step, end time and statistics in locals (members read through `this` every step cost 3-8%).
   template <class Obs>
   X run(X x, Obs& obs) {
-    const bool to_time = spec_.t_end > 0.0;
-    const long cap = to_time ? kMaxFictitiousSteps : spec_.steps;
-    const double h = spec_.h, t_end = to_time ? spec_.t_end : 0.0;
+    const bool to_time = spec_.t_end() > 0.0;
+    const long cap = to_time ? kMaxFictitiousSteps : spec_.steps();
+    const double h = spec_.ds, t_end = spec_.t_end();
     StepStats st;
     double t_over = 0.0;  // the time the step that would pass t_end reaches
     while (st.steps < cap) {
@@ -201,47 +183,47 @@ class FictitiousLoop {
   void finish(X& x, double t_over, long cap, Obs& obs, StepStats& st) {
     if (st.steps >= cap) throw Error("more than 2e9 fictitious steps before t_end; increase the fictitious step ds");
     const X prev = x;
-    const double rest = spec_.t_end - s_.time(x);
+    const double t_end = spec_.t_end(), rest = t_end - s_.time(x);
     if (rest > 0.0) {
-      s_.land(x, spec_.t_end, t_over);
+      s_.land(x, t_end, t_over);
       st.add(rest);
     }
-    s_.set_time(x, spec_.t_end);
+    s_.set_time(x, t_end);
     if constexpr (Obs::active) {
-      outputs_until(obs, prev, spec_.t_end, st.steps);
-      obs.observe(st.steps, spec_.t_end, x, true);
-      if (obs.wants_times() && static_cast<double>(n_out_ - 1) * spec_.dt_out < spec_.t_end)
-        obs.emit(st.steps, spec_.t_end, s_.physical(x));
+      // Output times before t_end from the step before it; t_end itself is the landed state.
+      outputs_until(obs, prev, t_end, st.steps, true);
+      obs.observe(st.steps, t_end, x, true);
+      if (obs.wants_times()) obs.emit(st.steps, t_end, s_.physical(x));
     }
   }
 
-  /// States at the requested output times in (time(prev), t_upto]; output times are n dt_out, not a
-  /// running sum.
+  /// States at the requested output times in (time(prev), t_upto] (`before`: in (time(prev), t_upto));
+  /// output times are n dt_out, not a running sum.
   template <class Obs>
-  void outputs_until(Obs& obs, const X& prev, double t_upto, long steps) {
+  void outputs_until(Obs& obs, const X& prev, double t_upto, long steps, bool before = false) {
     if (!obs.wants_times()) return;
-    while (next_out_ <= t_upto) {
+    while (before ? next_out_ < t_upto : next_out_ <= t_upto) {
       obs.emit(steps, next_out_, s_.at(prev, next_out_));
       next_out_ = static_cast<double>(++n_out_) * spec_.dt_out;
     }
   }
 
   Stepper& s_;
-  const RunSpec& spec_;
+  const FictitiousSteps& spec_;
   StepStats st_;
   long n_out_ = 1;
   double next_out_;
 };
 
-/// Runs a Stepper through FictitiousLoop with the observer the spec asks for (invariants, samples).
+/// Runs a Stepper through FictitiousLoop with the observer the options ask for (invariants, samples).
 template <class Stepper, class Field>
-RunResult run_fictitious(Stepper& s, typename Stepper::X x0, const Body& body, const Field& field, const RunSpec& spec,
-                         const SampleSink* sink) {
+RunResult run_fictitious(Stepper& s, typename Stepper::X x0, const Body& body, const Field& field,
+                         const FictitiousSteps& spec, const RunOptions& options) {
   using X = typename Stepper::X;
   FictitiousLoop<Stepper> loop(s, spec);
   double t_reached = 0.0;
   auto to_physical = [&s](const X& x) { return s.physical(x); };
-  RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
+  RunResult r = observe(body.p, field, body.s0, options, detail::grid_of(spec), to_physical, [&](auto& obs) {
     const X x = loop.run(x0, obs);
     t_reached = s.time(x);
     return s.physical(x);
@@ -286,13 +268,14 @@ struct TransformedStepper {
 };
 
 template <template <class, bool> class Kernel, const auto& Seq>
-RunResult run_time_transformed(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
-                               const SampleSink* sink) {
+RunResult run_time_transformed(const Body& body, const std::vector<Centre>& centres, const Advance& how,
+                               const RunOptions& options) {
+  const auto& spec = std::get<FictitiousSteps>(how);
   return dispatch(body, centres, [&](const auto& field, auto spin) {
     using K = Kernel<std::decay_t<decltype(field)>, decltype(spin)::value>;
-    K k(body.p, field, spec.omega_c >= 0.0 ? spec.omega_c : automatic_omega_c(body, centres, spec.h));
-    TransformedStepper<K, Seq> stepper{k, spec.h};
-    RunResult r = run_fictitious(stepper, k.initial_state(body.s0), body, field, spec, sink);
+    K k(body.p, field, options.omega_c >= 0.0 ? options.omega_c : automatic_omega_c(body, centres, spec.ds));
+    TransformedStepper<K, Seq> stepper{k, spec.ds};
+    RunResult r = run_fictitious(stepper, k.initial_state(body.s0), body, field, spec, options);
     r.force_evals = k.lp.evals;
     return r;
   });
@@ -347,11 +330,11 @@ struct KsStepper {
   static State physical(const X& x) { return x.first.state(); }
 };
 
-RunResult run_ks(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec, const SampleSink* sink) {
+RunResult run_ks(const Body& body, const std::vector<Centre>& centres, const Advance& how, const RunOptions& options) {
   CentreList field{centres};  // for the invariants (K2Q about c)
   KsStepper stepper;
   RunResult r = run_fictitious(stepper, KsStepper::X{KsMotion(body.p, centres.front(), body.s0), 0.0}, body, field,
-                               spec, sink);
+                               std::get<FictitiousSteps>(how), options);
   r.force_evals = 0;  // the regularised flow is exact: no force evaluations
   return r;
 }

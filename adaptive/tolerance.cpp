@@ -114,21 +114,14 @@ double spin_orbit_period(const Body& b) {
   return rate > 0.0 ? 2.0 * M_PI / rate : std::numeric_limits<double>::infinity();
 }
 
-/// base with the step h: ds and t_end for time-transformed methods, otherwise n = ceil(t_end/h)
-/// steps of t_end/n.
-RunSpec step_spec(const MethodInfo& m, double h, double t_end, RunSpec s) {
-  if (is_time_transformed(m)) {
-    s.h = h;
-    s.steps = 0;
-    s.t_end = t_end;
-    return s;
-  }
+/// The way of advancing time at step h: fictitious steps ds = h to t_end for time-transformed methods,
+/// otherwise n = ceil(t_end/h) fixed steps of t_end/n.
+Advance step_advance(const MethodInfo& m, double h, double t_end, double dt_out) {
+  if (is_time_transformed(m)) return FictitiousSteps{h, EndTime{t_end}, dt_out};
   const double n = std::ceil(t_end / h * (1.0 - 1e-12));
   if (!(n <= 1e12)) throw SearchLimit("tol: the step the search needs (" + std::to_string(h) + ") is too small");
-  s.steps = std::max(1L, static_cast<long>(n));
-  s.h = t_end / static_cast<double>(s.steps);
-  s.t_end = 0.0;
-  return s;
+  const long steps = std::max(1L, static_cast<long>(n));
+  return FixedSteps{t_end / static_cast<double>(steps), steps, dt_out};
 }
 
 /// The first, coarse step of the ladder.
@@ -149,9 +142,10 @@ double initial_step(const MethodInfo& m, const Body& b, const std::vector<Centre
 
 class Search {
  public:
-  Search(const MethodInfo& m, const Body& b, const std::vector<Centre>& c, double tol, double t_end,
-         const Delivery& delivery)
-      : m_(m), b_(b), c_(c), tol_(tol), t_end_(t_end), p_(effective_order(m, b)), delivery_(delivery) {}
+  Search(const MethodInfo& m, const Body& b, const std::vector<Centre>& c, const Accuracy& a,
+         const RunOptions& delivery)
+      : m_(m), b_(b), c_(c), tol_(a.tol), t_end_(a.t_end), dt_out_(a.dt_out), p_(effective_order(m, b)),
+        delivery_(delivery) {}
 
   ToleranceResult search() {
     Level best = p_ > 0 ? ladder() : exact_flow();
@@ -164,8 +158,10 @@ class Search {
     out.runs = runs_;
     out.total_force_evals = total_evals_;
     out.total_wall_s = total_wall_;
+    // The delivered run is over: a sink's Flow::stop ends its samples, not the run.
     if (delivery_.sink)
-      for (const KeptSample& k : best.samples) (*delivery_.sink)(k.sample());
+      for (const KeptSample& k : best.samples)
+        if ((*delivery_.sink)(k.sample()) == Flow::stop) break;
     return out;
   }
 
@@ -175,29 +171,35 @@ class Search {
   /// runs compared by Richardson must share it to be one method). A run that may be delivered
   /// carries the observers the caller asked for, its samples kept aside.
   Level run_at(double h, double h_c, bool may_deliver) {
-    RunSpec s = step_spec(m_, h, t_end_, RunSpec{});
-    s.omega_c = automatic_omega_c(b_, c_, h_c);
+    const bool samples = may_deliver && delivery_.sink;
+    const Advance how = step_advance(m_, h, t_end_, samples ? dt_out_ : 0.0);
+    RunOptions o;
+    o.omega_c = automatic_omega_c(b_, c_, h_c);
+    o.track_invariants = may_deliver && delivery_.track_invariants;
     Level l;
     SampleSink keep;
     if (may_deliver) {
-      s.track_invariants = delivery_.track_invariants;
-      s.every = delivery_.every;
-      s.dt_out = delivery_.sink ? delivery_.dt_out : 0.0;
-      if (delivery_.sink)
+      o.every = delivery_.every;
+      if (samples) {
         keep = [&l](const Sample& x) { l.samples.push_back(KeptSample::of(x)); };
+        o.sink = &keep;
+      }
     }
-    const double expected = expected_evals(s);
+    const double expected = expected_evals(how);
     if (spent_evals_ + expected > kMaxEvals)
       throw SearchLimit("tol " + fmt_tol() + " is out of reach of " + std::string(m_.name) +
                         " within 2e9 force evaluations (last estimate " + fmt_number(last_estimate_) + ")");
-    // The scene and the method's acceptance of it were checked once (run_to_tolerance); each run's
-    // specification is checked here, and the method runs without run()'s checks of the scene.
-    (void)advance_of(m_, s);
-    l.run = m_.run(b_, c_, s, keep ? &keep : nullptr);
+    // The scene, the request and the method's acceptance of the scene were checked once; each step
+    // the search makes is valid by construction, and the method runs without run()'s checks.
+    l.run = m_.run(b_, c_, how, o);
     if (!(l.run.final.R.allFinite() && l.run.final.v.allFinite())) throw Error("the state became non-finite");
-    l.h = s.h;
-    l.steps = s.steps;
-    l.omega_c = s.omega_c;
+    if (const auto* fixed = std::get_if<FixedSteps>(&how)) {
+      l.h = fixed->h;
+      l.steps = fixed->steps;
+    } else {
+      l.h = h;
+    }
+    l.omega_c = o.omega_c;
     spent_evals_ += static_cast<double>(std::max(l.run.force_evals, l.run.steps));
     total_wall_ += l.run.wall_s;
     total_evals_ += l.run.force_evals;
@@ -237,22 +239,7 @@ class Search {
     double best_bound = std::numeric_limits<double>::infinity();
     int stalled = 0;
     for (int k = 0; k < kMaxLevels; ++k) {
-      // Once a round-off floor was measured (below kProbeBelowTol), the truncation aims at what it leaves.
-      const double aim = kTarget * std::max(tol_ - std::max(floor_, 0.0) / kAccept, kMinAimShare * tol_);
-      const double predicted = rungs.back().h * std::pow(aim / std::max(estimate_, kRoundOff), 1.0 / p_);
-      double expected = kTarget * tol_;  // what the model C h^p says the new run's error is
-      if (automatic_omega_c(b_, c_, kCompanionRatio * predicted) < kNewConstantGain * rungs.back().omega_c) {
-        // Far finer than the ladder so far: a new ladder whose constant c is that of the companion's
-        // step, so that the answer does not pay for the coarse runs' larger c in the far field.
-        h_c = kCompanionRatio * predicted;
-        rungs.clear();
-        rungs.push_back(run_at(h_c, h_c, false));
-        rungs.push_back(run_at(predicted, h_c, true));
-      } else {
-        const double h = std::min(predicted, rungs.back().h / kMinRefinement);
-        expected = estimate_ * std::pow(h / rungs.back().h, p_);
-        rungs.push_back(run_at(h, h_c, true));
-      }
+      const double expected = refine(rungs, h_c);
       Level& a = rungs[rungs.size() - 2];
       const Level& b = rungs.back();
       a.samples = {};  // only the newest run can still be delivered: its predecessors' samples go
@@ -267,22 +254,7 @@ class Search {
       // carried over from the coarser runs predicted, within kAgree.
       bool smooth = estimate_ <= kAgree * expected && estimate_ >= expected / kAgree;
       if (rungs.size() >= 3) smooth = observed_order(rungs[rungs.size() - 3], a, b) >= p_ - kOrderSlack;
-      if (estimate_ + std::max(floor_, 0.0) <= kAccept * tol_ && (smooth || d <= kRoundOff)) {
-        if (tol_ >= kProbeBelowTol) return std::move(rungs.back());
-        // Measured on the run that may be delivered: a floor measured on another run is another draw
-        // of the round-off (reused from a coarser run, 2 of 256 scenes at tol 1e-12 missed it).
-        floor_ = rounding_floor(rungs.back(), h_c);
-        if (floor_ > kAccept * tol_)
-          throw Error("tol " + fmt_tol() + " is out of reach of " + std::string(m_.name) +
-                      " on this scene: runs that differ only in rounding differ by " + fmt_number(floor_) +
-                      " (round-off amplified by the scene)");
-        // Truncation and round-off add up in the delivered run: its estimate is their sum. Where the
-        // sum is above what may be delivered, a finer run lowers the truncation part.
-        if (estimate_ + floor_ <= kAccept * tol_) {
-          estimate_ = last_estimate_ = estimate_ + floor_;
-          return std::move(rungs.back());
-        }
-      }
+      if (deliverable(rungs.back(), h_c, smooth || d <= kRoundOff)) return std::move(rungs.back());
       // A search whose estimates stop falling (round-off, or resonances that refinement does not
       // remove) says so instead of spending its whole budget.
       if (estimate_ < best_bound / kStallFactor) {
@@ -299,6 +271,48 @@ class Search {
     }
     throw Error("tol " + fmt_tol() + ": " + std::string(m_.name) + " did not reach it in " +
                 std::to_string(kMaxLevels) + " refinements");
+  }
+
+  /// Adds the ladder's next run, at the step the estimate predicts for what TOL leaves to truncation;
+  /// far finer than the ladder so far, it starts a new ladder (h_c changes). Returns the error the
+  /// model C h^p expects of the new run.
+  double refine(std::vector<Level>& rungs, double& h_c) {
+    // Once a round-off floor was measured (below kProbeBelowTol), the truncation aims at what it leaves.
+    const double aim = kTarget * std::max(tol_ - std::max(floor_, 0.0) / kAccept, kMinAimShare * tol_);
+    const double predicted = rungs.back().h * std::pow(aim / std::max(estimate_, kRoundOff), 1.0 / p_);
+    if (automatic_omega_c(b_, c_, kCompanionRatio * predicted) < kNewConstantGain * rungs.back().omega_c) {
+      // Far finer than the ladder so far: a new ladder whose constant c is that of the companion's
+      // step, so that the answer does not pay for the coarse runs' larger c in the far field.
+      h_c = kCompanionRatio * predicted;
+      rungs.clear();
+      rungs.push_back(run_at(h_c, h_c, false));
+      rungs.push_back(run_at(predicted, h_c, true));
+      return kTarget * tol_;
+    }
+    const double h = std::min(predicted, rungs.back().h / kMinRefinement);
+    const double expected = estimate_ * std::pow(h / rungs.back().h, p_);
+    rungs.push_back(run_at(h, h_c, true));
+    return expected;
+  }
+
+  /// Whether the newest run `l` may be delivered: its estimate (and the round-off floor measured so far)
+  /// within TOL, and the estimate `trusted`. Below kProbeBelowTol the round-off is probed on `l` itself
+  /// and added to the estimate; round-off alone above TOL throws.
+  bool deliverable(const Level& l, double h_c, bool trusted) {
+    if (!(estimate_ + std::max(floor_, 0.0) <= kAccept * tol_ && trusted)) return false;
+    if (tol_ >= kProbeBelowTol) return true;
+    // Measured on the run that may be delivered: a floor measured on another run is another draw
+    // of the round-off (reused from a coarser run, 2 of 256 scenes at tol 1e-12 missed it).
+    floor_ = rounding_floor(l, h_c);
+    if (floor_ > kAccept * tol_)
+      throw Error("tol " + fmt_tol() + " is out of reach of " + std::string(m_.name) +
+                  " on this scene: runs that differ only in rounding differ by " + fmt_number(floor_) +
+                  " (round-off amplified by the scene)");
+    // Truncation and round-off add up in the delivered run: its estimate is their sum. Where the
+    // sum is above what may be delivered, a finer run lowers the truncation part.
+    if (estimate_ + floor_ > kAccept * tol_) return false;
+    estimate_ = last_estimate_ = estimate_ + floor_;
+    return true;
   }
 
   /// The most that the run `l` and its kProbeRuns repeats with other roundings differ by (kProbeBelowTol):
@@ -351,8 +365,9 @@ class Search {
     return a;
   }
 
-  [[nodiscard]] double expected_evals(const RunSpec& s) const {
-    if (!is_time_transformed(m_)) return static_cast<double>(s.steps) * std::max(1, m_.evals_per_step);
+  [[nodiscard]] double expected_evals(const Advance& how) const {
+    if (const auto* fixed = std::get_if<FixedSteps>(&how))
+      return static_cast<double>(fixed->steps) * std::max(1, m_.evals_per_step);
     return 0.0;  // unknown in advance; the budget is checked against what was spent
   }
   [[nodiscard]] std::string fmt_tol() const { return fmt_number(tol_); }
@@ -366,9 +381,9 @@ class Search {
   const MethodInfo& m_;
   const Body& b_;
   const std::vector<Centre>& c_;
-  double tol_, t_end_;
+  double tol_, t_end_, dt_out_;
   int p_;
-  Delivery delivery_;
+  RunOptions delivery_;
   double estimate_ = 0.0, last_estimate_ = std::numeric_limits<double>::quiet_NaN();
   double floor_ = -1.0;  ///< the round-off floor last measured (below kProbeBelowTol), -1 before
   double spent_evals_ = 0.0, total_wall_ = 0.0;
@@ -387,28 +402,36 @@ double state_distance(const State& a, const State& b) {
 }
 
 void check_tolerance(double tol) {
-  if (!std::isfinite(tol) || !(tol > 0.0)) throw Error("tol must be a finite number > 0");
+  require_positive(tol, "the tolerance tol");
   if (tol < kMinTolerance)
     throw Error("tol below 1e-13 cannot be delivered in double precision (the round-off of a run is "
                 "1e-15..1e-13 relative)");
   if (!(tol < 1.0)) throw Error("tol must be below 1 (it is a relative error of the final state)");
 }
 
-ToleranceResult run_to_tolerance(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
-                                 double tol, double t_end, const Delivery& delivery) {
-  check_tolerance(tol);
-  if (!(std::isfinite(t_end) && t_end > 0.0)) throw Error("the accuracy mode needs an end time t_end that is a finite number > 0");
+void check_searchable(const MethodInfo& method) {
   if (is_step_controlled(method))
     throw Error(std::string(method.name) + " controls its own step: give it a tolerance per step, not the accuracy mode's "
                 "search (which is for fixed-step and time-transformed methods)");
   if (method.order == 0 && method.family != Family::Regularised)
     throw Error(std::string(method.name) + " has no fixed order for the error estimate");
+}
+
+ToleranceResult run_to_tolerance(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
+                                 const Accuracy& accuracy, const RunOptions& delivery) {
+  check_tolerance(accuracy.tol);
+  check(Advance(accuracy));
+  check(delivery);
+  check_searchable(method);
   validate(Scene{centres, {body}});
-  if (non_coulomb(centres))
-    throw Error(std::string(kNeedsCoulomb));
+  if (non_coulomb(centres)) throw Error(std::string(kNeedsCoulomb));
   if (const std::string why = refusal(method, body, centres); !why.empty()) throw Error(why);
-  if (delivery.every < 1) throw Error("every must be >= 1");
-  return Search(method, body, centres, tol, t_end, delivery).search();
+  return search_step(method, body, centres, accuracy, delivery);
+}
+
+ToleranceResult search_step(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
+                            const Accuracy& accuracy, const RunOptions& delivery) {
+  return Search(method, body, centres, accuracy, delivery).search();
 }
 
 }  // namespace bodypoint::adaptive

@@ -30,21 +30,14 @@ std::vector<Scene> members() {
   return v;
 }
 
-RunSpec spec() {
-  RunSpec s;
-  s.h = 1e-4;
-  s.steps = kSteps;
-  s.t_end = 1e-4 * kSteps;
-  s.track_invariants = true;
-  return s;
-}
+FixedSteps spec() { return {1e-4, kSteps}; }
 
 void BM_SweepScalar(benchmark::State& st, const std::string& method) {
   const MethodInfo& m = method_or_throw(method);
   const auto scenes = members();
-  const RunSpec rs = spec();
+  const FixedSteps rs = spec();
   for (auto _ : st)
-    for (const Scene& s : scenes) benchmark::DoNotOptimize(run(m, s.bodies[0], s.centres, rs));
+    for (const Scene& s : scenes) benchmark::DoNotOptimize(run(m, s.bodies[0], s.centres, rs, RunOptions{}));
   st.SetItemsProcessed(st.iterations() * static_cast<long>(kMembers) * kSteps);
 }
 
@@ -52,7 +45,7 @@ void BM_SweepBatch(benchmark::State& st, const std::string& method, std::size_t 
   const MethodInfo& m = method_or_throw(method);
   std::vector<batch::Member> all;
   for (const Scene& s : members()) all.push_back({s.bodies[0].p, s.bodies[0].s0, s.centres[0].A});
-  const RunSpec rs = spec();
+  const FixedSteps rs = spec();
   for (auto _ : st)
     for (std::size_t i = 0; i < all.size(); i += width) {
       const std::vector<batch::Member> lanes(all.begin() + static_cast<long>(i), all.begin() + static_cast<long>(i + width));

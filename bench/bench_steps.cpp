@@ -57,16 +57,18 @@ BENCHMARK(BM_ExactDrift<false>)->Name("BM_ExactDrift/material-point");
 void BM_MethodStep(benchmark::State& st, const std::string& method, const std::string& scene) {
   const NamedScene ns = named_scene(scene);
   const MethodInfo& m = method_or_throw(method);
-  RunSpec spec;
-  spec.h = 1e-3;
-  spec.steps = kSteps;
-  spec.t_end = 1e-3 * kSteps;
-  spec.tol = 1e-10;
+  // Every method to the same end time: kSteps steps of h, fictitious steps ds = h, or step-size control.
+  constexpr double h = 1e-3;
+  const Advance spec = is_step_controlled(m)  ? Advance(ControlledSteps{h, h * kSteps, 1e-10})
+                       : is_time_transformed(m) ? Advance(FictitiousSteps{h, EndTime{h * kSteps}})
+                                                : Advance(FixedSteps{h, kSteps});
+  RunOptions quiet;
+  quiet.track_invariants = false;
   long steps = 0, evals = 0;
   for (auto _ : st) {
     RunResult r;
     try {
-      r = run(m, ns.scene.bodies.front(), ns.scene.centres, spec);
+      r = run(m, ns.scene.bodies.front(), ns.scene.centres, spec, quiet);
     } catch (const Error& e) {  // a method that refuses the scene is reported, not fatal for the rest
       st.SkipWithError(e.what());
       return;

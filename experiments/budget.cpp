@@ -1,5 +1,6 @@
 #include "budget.hpp"
 
+#include "bodypoint/bodypoint.hpp"
 #include "bodypoint/io.hpp"
 
 #include <chrono>
@@ -7,6 +8,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <limits>
+#include <utility>
+#include <variant>
 #include <unistd.h>
 
 namespace bodypoint::cli {
@@ -37,35 +41,35 @@ std::string duration(double s) {
 }  // namespace
 
 std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
-                                          const RunSpec& spec) {
-  if (is_step_controlled(m)) return std::nullopt;
+                                          const Advance& how, const RunOptions& options) {
+  const auto* fixed = std::get_if<FixedSteps>(&how);
+  const auto* fictitious = std::get_if<FictitiousSteps>(&how);
+  if (!fixed && !fictitious) return std::nullopt;
   // A calibration without an end time can run away (ks's physical step grows with r): no estimate
   // then; the run's own checks still bound it.
   auto calibrate = [&](long steps) -> std::optional<RunResult> {
-    RunSpec cal = spec;
-    cal.steps = steps;
-    cal.t_end = 0.0;
-    cal.every = 1;
-    cal.dt_out = 0.0;
-    try {
-      return run(m, body, centres, cal);
-    } catch (const Error&) {
-      return std::nullopt;
-    }
+    Options cal;
+    cal.track_invariants = options.track_invariants;
+    cal.omega_c = options.omega_c;
+    cal.max_energy_error = std::numeric_limits<double>::infinity();
+    const Advance a = fixed ? Advance(FixedSteps{fixed->h, steps}) : Advance(FictitiousSteps{fictitious->ds, StepCount{steps}});
+    BodyResult r = integrate_body(body, centres, &m, a, cal);
+    if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return std::nullopt;
+    return std::move(r.run);
   };
-  double steps = static_cast<double>(spec.steps);
-  if (is_time_transformed(m) && spec.t_end > 0.0) {
+  const double t_end = fictitious ? fictitious->t_end() : 0.0;
+  double steps = static_cast<double>(fixed ? fixed->steps : fictitious->steps());
+  if (t_end > 0.0) {
     // How much physical time do kProbeSteps fictitious steps cover? A run shorter than the probe, or
     // than kCalibrateAbove steps at the probe's rate, is not calibrated further.
     const auto probe = calibrate(kProbeSteps);
-    if (!probe || probe->t_end >= spec.t_end) return std::nullopt;
-    steps = probe->t_end > 0.0 ? kProbeSteps * spec.t_end / probe->t_end : HUGE_VAL;
+    if (!probe || probe->t_end >= t_end) return std::nullopt;
+    steps = probe->t_end > 0.0 ? kProbeSteps * t_end / probe->t_end : HUGE_VAL;
   }
   if (steps <= static_cast<double>(kCalibrateAbove)) return std::nullopt;
   const auto r = calibrate(kCalibrationSteps);
   if (!r) return std::nullopt;
-  if (is_time_transformed(m) && spec.t_end > 0.0)
-    steps = r->t_end > 0.0 ? kCalibrationSteps * spec.t_end / r->t_end : HUGE_VAL;
+  if (t_end > 0.0) steps = r->t_end > 0.0 ? kCalibrationSteps * t_end / r->t_end : HUGE_VAL;
   return WorkEstimate{steps, r->wall_s * steps / kCalibrationSteps};
 }
 

@@ -21,8 +21,9 @@ struct WorkEstimate {
 
 /// The estimate for a run that may be long, or nothing when the run is short (or adaptive: those are
 /// bounded by their own step cap).
+/// `options` are the run's (the calibration observes as it will).
 std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
-                                          const RunSpec& spec);
+                                          const Advance& how, const RunOptions& options);
 
 /// Throws Error when the estimate exceeds max_seconds; prints it on stderr when it exceeds
 /// kAnnounceSeconds and `quiet` is false.

@@ -9,6 +9,8 @@
 // estimate's companion run and the delivered run), so its error estimate is paid for in full.
 #include "by_tol.hpp"
 
+#include "cli.hpp"
+
 #include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
@@ -62,7 +64,7 @@ TolRow measure_auto(const NamedScene& ns, const State& ref, double tol, long rep
   std::vector<double> times, delivered;
   adaptive::ToleranceResult r;
   for (long k = 0; k < repeats; ++k) {
-    r = adaptive::run_to_tolerance(m, body, ns.scene.centres, tol, ns.t_end);
+    r = adaptive::run_to_tolerance(m, body, ns.scene.centres, Accuracy{tol, ns.t_end}, unobserved());
     times.push_back(r.total_wall_s);
     delivered.push_back(r.result.wall_s);
   }
@@ -84,15 +86,11 @@ TolRow measure_peer(const NamedScene& ns, const std::string& name, const State& 
   row.scene = ns.name;
   row.method = name;
   row.tol = tol;
-  RunSpec spec;
-  spec.tol = tol;
-  spec.t_end = ns.t_end;
-  spec.h = 1e-3;
-  spec.steps = 1;
+  const ControlledSteps how{1e-3, ns.t_end, tol};
   std::vector<double> times;
   RunResult r;
   for (long k = 0; k < repeats; ++k) {
-    r = run(method_or_throw(name), body, ns.scene.centres, spec);
+    r = run_or_throw(method_or_throw(name), body, ns.scene.centres, how, unobserved());
     times.push_back(r.wall_s);
   }
   row.err = adaptive::state_distance(r.final, ref);

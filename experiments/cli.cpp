@@ -1,3 +1,4 @@
+#include "process.hpp"
 #include "cli.hpp"
 
 #include "bodypoint/io.hpp"
@@ -67,7 +68,9 @@ Scene make_scene(const po::variables_map& vm, const SceneOptions& o) {
     for (const std::string& k : keys)
       if (vm.count(k) && !vm[k].defaulted())
         throw Error("--" + k + " cannot be combined with --scene (set it in the scene file)");
-    return read_scene_file(o.scene_file);
+    Scene scene = read_scene_file(o.scene_file);
+    register_input(o.scene_file);  // no output of this run may replace it
+    return scene;
   }
   return thesis_scene(scene_params(vm, o));
 }
@@ -88,19 +91,20 @@ double energy_bound(const StepOptions& o) {
   return o.max_energy_error;
 }
 
-void apply_step_options(const po::variables_map& vm, const StepOptions& o, RunSpec& spec) {
-  double t_end = 0.0;
-  if (vm.count("t-end")) {
-    if (!vm["steps"].defaulted()) throw Error("give --steps or --t-end, not both");
-    if (!std::isfinite(o.t_end) || o.t_end <= 0.0) throw Error("--t-end must be a finite number > 0");
-    t_end = o.t_end;
-  }
+StepRequest step_request(const po::variables_map& vm, const StepOptions& o, const MethodInfo* method, double tol) {
+  StepRequest r;
+  if ((vm.count("tol") && !vm["tol"].defaulted()) || (method && is_step_controlled(*method))) r.tol = tol;
+  // A step given is passed on (the accuracy mode refuses it); a default one only where a step is used.
+  if (!vm["h"].defaulted() || !searches(method, r)) r.h = o.h;
+  if (!vm["steps"].defaulted()) r.steps = o.steps;
+  if (vm.count("t-end")) r.t_end = o.t_end;
   // --force-law thesis-code counts steps as the thesis's code did (n - 1 of n asked; run.hpp).
-  const ForceLaw law = vm.count("force-law") ? parse_force_law(vm["force-law"].as<std::string>()) : ForceLaw::coulomb;
-  const RunSpec r = resolve_steps(o.h, o.steps, t_end, spec.tol, law);
-  spec.h = r.h;
-  spec.steps = r.steps;
-  spec.t_end = r.t_end;
+  r.code_loop = vm.count("force-law") && parse_force_law(vm["force-law"].as<std::string>()) == ForceLaw::thesis_code;
+  if (!r.t_end && !r.steps) {
+    if (searches(method, r)) r.t_end = kDefaultStep * static_cast<double>(kDefaultSteps);
+    else r.steps = kDefaultSteps;
+  }
+  return r;
 }
 
 std::string describe(const SceneParams& p) {

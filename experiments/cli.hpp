@@ -34,30 +34,37 @@ Scene make_scene(const po::variables_map& vm, const SceneOptions& o);
 
 /// Step options: --h and --steps or --t-end.
 struct StepOptions {
-  double h = RunSpec{}.h;  // the defaults of every run are RunSpec's (run.hpp)
-  long steps = RunSpec{}.steps;
+  double h = kDefaultStep;  // the defaults of every run are the library's (bodypoint.hpp)
+  long steps = kDefaultSteps;
   double t_end = 0.0;
   double max_energy_error = kDefaultMaxEnergyError;  ///< the accuracy flag's bound (Options)
 };
 void add_step_options(po::options_description& desc, StepOptions& o);
 /// o.max_energy_error, checked: a number > 0 (inf: no bound); Error otherwise.
 double energy_bound(const StepOptions& o);
-/// Fills spec.h and spec.steps. With --t-end T: steps = ceil(T/h), h = T/steps (hits T exactly).
-void apply_step_options(const po::variables_map& vm, const StepOptions& o, RunSpec& spec);
+/// The library's step request from --h, --steps, --t-end and --tol as given (defaulted ones left out),
+/// with the command line's defaults: no end given, --steps 500000 (or with --tol, t_end = 50, the
+/// thesis's h n); --force-law thesis-code counts steps as the thesis's code did.
+StepRequest step_request(const po::variables_map& vm, const StepOptions& o, const MethodInfo* method, double tol);
 
-/// What --method, --tol and the step options ask for: a method (nullptr: auto) run with spec, or,
-/// with search, the step search of adaptive/tolerance.hpp to spec.t_end.
+/// What --method, --tol and the step options ask for: a method (nullptr: auto) and the way it
+/// advances (Accuracy when --tol chooses the step), with the run's options.
 struct RunPlan {
   const MethodInfo* method = nullptr;
   bool automatic = false;  ///< --method auto, or --tol without --method
   bool search = false;     ///< --tol chooses the step (any method but odeint-*/gsl-*)
   double tol = 0.0;
-  RunSpec spec;
-  double max_energy_error = kDefaultMaxEnergyError;  ///< Options::max_energy_error of the run
+  Advance how = FixedSteps{kDefaultStep, kDefaultSteps};
+  Options options;  ///< invariants, every, omega_c and the energy bound; events and sink are per run
 };
-/// Validates the step options against the method; throws Error with the reason (plan.cpp).
+/// The method, the way of advancing time and the energy bound from the options; throws Error with
+/// the reason (plan.cpp).
 RunPlan plan_run(const po::variables_map& vm, const StepOptions& st, const std::string& method_name,
                  bool method_defaulted, double tol);
+/// plan.how's step: h, the fictitious step ds, or a controlled method's first trial step (0: search).
+double planned_step(const RunPlan& plan);
+/// plan.how's end time: t_end, or the end of its steps (fictitious steps: 0, not known in advance).
+double planned_end(const RunPlan& plan);
 
 /// What one body's run used: the method (auto may choose per body) and, with --tol, the search.
 struct BodyRun {
@@ -73,11 +80,22 @@ struct BodyRun {
   long event_force_evals = 0;
   long total_force_evals = 0;  ///< the run, the accuracy search and the events (BodyResult::total_force_evals)
 };
-/// Runs one body as planned through the library (plan.cpp; integrate_body; spec may add invariants, output
-/// steps and a sink to plan.spec). A method that refuses the scene or a run that fails throws Error
-/// with the library's reason; diverged and collision are left to the caller (outcome, reason).
-BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
+/// Runs one body as planned through the library (integrate_body with `how`, plan.options, the sink
+/// and the events). A method that refuses the scene or a run that fails throws Error with the
+/// library's reason; diverged and collision are left to the caller (outcome, reason).
+BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre>& centres, const Advance& how,
                  const SampleSink* sink, const std::vector<Event>& events = {});
+
+/// One run of a study through the public API (integrate_body): its RunResult, whatever its outcome's
+/// flag; a refused or failed run throws Error with the library's reason.
+RunResult run_or_throw(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres, const Advance& how,
+                       const Options& options);
+/// Options that observe nothing (no invariants, no samples): the fastest run, for timings and errors.
+inline Options unobserved() {
+  Options o;
+  o.track_invariants = false;
+  return o;
+}
 
 /// An event from its command-line form: closest, closest:K (centre K), r=V, r:K=V, x=V, y=V, z=V or
 /// plane=nx,ny,nz,V (normal.R = V); Error naming the forms otherwise.

@@ -12,6 +12,8 @@
 //   5. the code's third-kick index slip (ForceLaw::thesis_code against thesis_code_force).
 #include "errata.hpp"
 
+#include "cli.hpp"
+
 #include "bodypoint/invariants.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
@@ -102,11 +104,10 @@ void half_B_erratum(Writer& w, const Scene& sc) {
     max_printed = std::max(max_printed, relative_deviation(printed(s.s), P0));
     max_true = std::max(max_true, relative_deviation(energy(b.p, field, s.s), E0));
   };
-  RunSpec rs;
-  rs.h = 1e-3;
-  rs.steps = static_cast<long>(kT / rs.h);
-  rs.track_invariants = true;
-  (void)run(method_or_throw("lp-kl8"), b, sc.centres, rs, &sink);
+  Options o;
+  o.sink = &sink;
+  constexpr double h = 1e-3;
+  (void)run_or_throw(method_or_throw("lp-kl8"), b, sc.centres, FixedSteps{h, static_cast<long>(kT / h)}, o);
   w.row("ErrHalfBEnergy", max_printed, "eq. 4.1 as printed (B/2 v.w): max relative change along an lp-kl8 run, h = 1e-3, T = 25");
   w.row("ErrFullBEnergy", max_true, "eq. 4.1 corrected (B v.w): the same run");
 }
@@ -116,11 +117,7 @@ double deflection_degrees(const State& s0, const State& s1) {
 }
 
 RunResult thesis_run(const std::string& method, const Scene& sc) {
-  RunSpec rs;
-  rs.h = kH;
-  rs.steps = kSteps;
-  rs.track_invariants = true;
-  return run(method_or_throw(method), sc.bodies.front(), sc.centres, rs);
+  return run_or_throw(method_or_throw(method), sc.bodies.front(), sc.centres, FixedSteps{kH, kSteps}, Options{});
 }
 
 void force_law_erratum(Writer& w, const Scene& coulomb, const Scene& code) {
@@ -137,10 +134,8 @@ void force_law_erratum(Writer& w, const Scene& coulomb, const Scene& code) {
 }
 
 double final_error(const std::string& method, const Scene& sc, double h, const State& ref) {
-  RunSpec rs;
-  rs.h = h;
-  rs.steps = static_cast<long>(std::lround(kT / h));
-  return (run(method_or_throw(method), sc.bodies.front(), sc.centres, rs).final.R - ref.R).norm();
+  const FixedSteps how{h, static_cast<long>(std::lround(kT / h))};
+  return (run_or_throw(method_or_throw(method), sc.bodies.front(), sc.centres, how, unobserved()).final.R - ref.R).norm();
 }
 
 /// Order from the final-position errors at h and h/2.

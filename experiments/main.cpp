@@ -1,4 +1,5 @@
 // bodypoint: command-line entry point. Every failure ends in one line on stderr and exit code 2.
+#include "process.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/model.hpp"
 #include "cli.hpp"
@@ -81,7 +82,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   const std::string cmd = argv[1];
-  bodypoint::install_signal_cleanup();
+  bodypoint::cli::install_signal_cleanup();
   try {
     if (cmd == "simulate") return bodypoint::cli::cmd_simulate(argc - 1, argv + 1);
     if (cmd == "methods") return bodypoint::cli::cmd_methods(argc - 1, argv + 1);

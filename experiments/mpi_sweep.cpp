@@ -1,4 +1,5 @@
 // A sweep across MPI processes (mpi_sweep.hpp): rank 0 coordinates and computes, the others compute.
+#include "process.hpp"
 #include "mpi_sweep.hpp"
 
 #include "bodypoint/detail/threads.hpp"

@@ -10,6 +10,8 @@
 // are measured on the encounter only (first order: their orbit ladder would need 1e8 steps).
 #include "orders.hpp"
 
+#include "cli.hpp"
+
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
 #include "bodypoint/order_fit.hpp"
@@ -46,18 +48,17 @@ Probe probe(const NamedScene& ns) {
 }
 
 double error_at(const MethodInfo& m, const Probe& p, double h) {
-  RunSpec rs;
+  Options o = unobserved();
+  Advance how;
   if (is_time_transformed(m)) {
-    rs.h = h;  // the fictitious step; the run ends exactly at t_end
-    rs.t_end = p.t_end;
-    rs.steps = 1;
-    rs.omega_c = 0.0;
+    how = FictitiousSteps{h, EndTime{p.t_end}};  // the fictitious step; the run ends exactly at t_end
+    o.omega_c = 0.0;
   } else {
-    rs.steps = std::max(1L, std::lround(p.t_end / h));
-    rs.h = p.t_end / static_cast<double>(rs.steps);
+    const long steps = std::max(1L, std::lround(p.t_end / h));
+    how = FixedSteps{p.t_end / static_cast<double>(steps), steps};
   }
   try {
-    const RunResult r = run(m, p.scene.bodies.front(), p.scene.centres, rs);
+    const RunResult r = run_or_throw(m, p.scene.bodies.front(), p.scene.centres, how, o);
     return (r.final.R - p.ref.R).norm() / p.ref.R.norm();
   } catch (const Error&) {
     return std::numeric_limits<double>::infinity();  // a step too large for this encounter (logH's E - T + c <= 0)

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <exception>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <variant>
 
@@ -20,55 +21,36 @@ RunPlan plan_run(const po::variables_map& vm, const StepOptions& st, const std::
   plan.automatic = method_name == "auto" || (tol_given && method_defaulted);
   if (plan.automatic && !tol_given) throw Error("--method auto needs --tol (the accuracy to deliver)");
   plan.method = plan.automatic ? nullptr : &method_or_throw(method_name);
-  plan.search = plan.automatic || (tol_given && !is_step_controlled(*plan.method));
   plan.tol = tol;
-  plan.max_energy_error = energy_bound(st);
-  RunSpec& spec = plan.spec;
-  spec.tol = tol;
-  if (plan.search) {
-    adaptive::check_tolerance(tol);
-    if (!vm["h"].defaulted() || !vm["steps"].defaulted())
-      throw Error("--tol chooses the step: give --t-end, not --h or --steps");
-    spec.t_end = vm.count("t-end") ? st.t_end : st.h * static_cast<double>(st.steps);
-    if (!(std::isfinite(spec.t_end) && spec.t_end > 0.0)) throw Error("--t-end must be a finite number > 0");
-  } else if (is_time_transformed(*plan.method)) {
-    // --h is the fictitious step ds (never adjusted); --t-end runs to exactly that time, otherwise
-    // --steps fictitious steps are taken.
-    if (!std::isfinite(st.h) || st.h <= 0.0) throw Error("--h must be a finite number > 0");
-    if (vm.count("t-end") && !vm["steps"].defaulted()) throw Error("give --steps or --t-end, not both");
-    if (vm.count("t-end") && !(std::isfinite(st.t_end) && st.t_end > 0.0))
-      throw Error("--t-end must be a finite number > 0");
-    if (!vm.count("t-end") && st.steps < 1) throw Error("--steps must be >= 1");
-    spec.h = st.h;
-    spec.t_end = vm.count("t-end") ? st.t_end : 0.0;
-    spec.steps = vm.count("t-end") ? 0 : st.steps;
-  } else if (is_step_controlled(*plan.method)) {
-    // The method chooses its steps: --h is only the first trial step, --t-end (or h steps) the end.
-    if (!std::isfinite(st.h) || st.h <= 0.0) throw Error("--h must be a finite number > 0");
-    if (vm.count("t-end") && !vm["steps"].defaulted()) throw Error("give --steps or --t-end, not both");
-    if (!vm.count("t-end") && st.steps < 1) throw Error("--steps must be >= 1");
-    spec.t_end = vm.count("t-end") ? st.t_end : st.h * static_cast<double>(st.steps);
-    if (!(std::isfinite(spec.t_end) && spec.t_end > 0.0)) throw Error("--t-end must be a finite number > 0");
-    spec.h = std::min(st.h, spec.t_end);
-    spec.steps = 1;
-  } else {
-    apply_step_options(vm, st, spec);
-  }
+  plan.how = advance_for(plan.method, step_request(vm, st, plan.method, tol));
+  plan.search = std::holds_alternative<Accuracy>(plan.how);
+  plan.options.max_energy_error = energy_bound(st);
   return plan;
 }
 
-BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
+double planned_step(const RunPlan& plan) {
+  if (const auto* f = std::get_if<FixedSteps>(&plan.how)) return f->h;
+  if (const auto* f = std::get_if<FictitiousSteps>(&plan.how)) return f->ds;
+  if (const auto* c = std::get_if<ControlledSteps>(&plan.how)) return c->h0;
+  return 0.0;
+}
+
+double planned_end(const RunPlan& plan) {
+  return std::visit(
+      [](const auto& a) -> double {
+        using A = std::decay_t<decltype(a)>;
+        if constexpr (std::is_same_v<A, FixedSteps>) return a.h * static_cast<double>(a.steps);
+        else if constexpr (std::is_same_v<A, FictitiousSteps>) return a.t_end();
+        else return a.t_end;
+      },
+      plan.how);
+}
+
+BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre>& centres, const Advance& how,
                  const SampleSink* sink, const std::vector<Event>& events) {
-  Options options;
+  Options options = plan.options;
   options.events = events;
-  options.track_invariants = spec.track_invariants;
   options.sink = sink;
-  options.every = spec.every;
-  options.omega_c = spec.omega_c;
-  options.max_energy_error = plan.max_energy_error;
-  Advance how = plan.search ? Advance(Accuracy{plan.tol, spec.t_end, spec.dt_out}) : advance_of(*plan.method, spec);
-  if (auto* fixed = std::get_if<FixedSteps>(&how)) fixed->dt_out = spec.dt_out;
-  if (auto* controlled = std::get_if<ControlledSteps>(&how)) controlled->dt_out = spec.dt_out;
   BodyResult r = integrate_body(body, centres, plan.method, how, options);
   if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) throw Error(r.reason);
   BodyRun b;
@@ -82,6 +64,13 @@ BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre
   b.event_force_evals = r.event_force_evals;
   b.total_force_evals = r.total_force_evals();
   return b;
+}
+
+RunResult run_or_throw(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres, const Advance& how,
+                       const Options& options) {
+  BodyResult r = integrate_body(body, centres, &m, how, options);
+  if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) throw Error(r.reason);
+  return std::move(r.run);
 }
 
 namespace {

@@ -1,4 +1,5 @@
 // Rows files: the journal of a running sweep and the output of a shard (format in rows_file.hpp).
+#include "process.hpp"
 #include "rows_file.hpp"
 
 #include "bodypoint/io.hpp"

@@ -9,6 +9,7 @@
 // cross-section dsigma/dOmega = b/sin(theta) |db/dtheta| from neighbouring b (centred differences),
 // rainbows (where dtheta/db changes sign), and for B = 0 the largest relative difference from
 // Rutherford's tan(theta/2) = |A|/(m v_inf^2 b) and its cross-section (|A|/(2 m v_inf^2))^2/sin^4(theta/2).
+#include "process.hpp"
 #include "scattering_study.hpp"
 
 #include "bodypoint/bodypoint.hpp"
@@ -105,20 +106,89 @@ double rutherford(double A, double mu, double v_inf, double b) { return 2.0 * st
 
 }  // namespace
 
-void write_scattering_study(const std::filesystem::path& dir, bool quick, unsigned threads) {
-  const std::vector<double> bs = log_range(1e-3, 1e3, quick ? 13 : 61);
-  const std::vector<Series> all = series();
+namespace {
+
+/// Every (series, b) point, on `threads` threads.
+std::vector<Point> run_points(const std::vector<Series>& all, const std::vector<double>& bs, unsigned threads) {
   std::vector<Point> points(all.size() * bs.size());
   std::atomic<std::size_t> next{0};
   auto worker = [&] {
     for (std::size_t i; (i = next++) < points.size();) points[i] = run_point(all[i / bs.size()], bs[i % bs.size()]);
   };
   {
-    const detail::WorkerThreads pool(std::max(1u, threads) - 1, worker);
+    const detail::WorkerThreads pool(std::max(1u, threads) - 1, worker);  // joined before points is read
     worker();
   }
+  return points;
+}
 
+/// What a series' summary row gathers from its points.
+struct SeriesTotals {
+  double max_rel = 0.0, max_oop = 0.0, min_r = Point::kNaN, first_rainbow = Point::kNaN;
+  long evals = 0, rainbows = 0, failed = 0;
+};
+
+/// One series' n points as rows of scattering.csv; returns what its summary row needs.
+SeriesTotals write_series_rows(std::ostream& os, const Series& s, const Point* row, std::size_t n) {
   const double A = SceneParams{}.A, m = SceneParams{}.m;
+  SeriesTotals t;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Point& p = row[i];
+    t.evals += p.force_evals;
+    const bool ok = p.failure.empty() && std::isfinite(p.sc.deflection);
+    t.failed += ok ? 0 : 1;
+    const double th_r = ok && s.B == 0.0 ? rutherford(A, m, p.sc.v_inf, p.sc.b) : Point::kNaN;
+    const double rel = ok && s.B == 0.0 ? std::abs(p.sc.deflection / th_r - 1.0) : Point::kNaN;
+    if (rel > t.max_rel) t.max_rel = rel;
+    if (ok) t.max_oop = std::max(t.max_oop, std::abs(p.sc.out_of_plane));
+    if (ok && !(p.r_min >= t.min_r)) t.min_r = p.r_min;
+    // dsigma/dOmega = b/sin(theta) |db/dtheta| from the neighbours (centred differences)
+    double dsigma = Point::kNaN, dsigma_r = Point::kNaN;
+    bool rainbow = false;
+    if (ok && i > 0 && i + 1 < n && row[i - 1].failure.empty() && row[i + 1].failure.empty()) {
+      const double dtheta_db = (row[i + 1].sc.deflection - row[i - 1].sc.deflection) / (row[i + 1].sc.b - row[i - 1].sc.b);
+      dsigma = p.sc.b / std::sin(p.sc.deflection) / std::abs(dtheta_db);
+      if (s.B == 0.0) {
+        const double a = std::abs(A) / (2.0 * m * p.sc.v_inf * p.sc.v_inf);
+        dsigma_r = a * a / std::pow(std::sin(0.5 * th_r), 4);
+      }
+      // a rainbow between i-1 and i+1: theta(b) has an extremum at i
+      const double left = p.sc.deflection - row[i - 1].sc.deflection, right = row[i + 1].sc.deflection - p.sc.deflection;
+      if (left * right < 0.0) {
+        rainbow = true;
+        ++t.rainbows;
+        if (!std::isfinite(t.first_rainbow)) t.first_rainbow = p.sc.b;
+      }
+    }
+    CsvLine line;
+    line.quoted(s.name).num(s.B).num(s.Kx).num(s.Kz).num(ok ? p.sc.b : p.b_target).num(p.d).num(p.sc.v_inf).num(p.sc.deflection);
+    line.num_if(s.B == 0.0 && ok, th_r).num_if(s.B == 0.0 && ok, rel).num(p.sc.out_of_plane).num_if(std::isfinite(dsigma), dsigma);
+    line.num_if(std::isfinite(dsigma_r), dsigma_r).count(rainbow ? 1 : 0).num(p.r_min).num(p.t_min).num(p.r_end).num(p.sc.spin_turn).num(p.sc.K1_turn);
+    line.num(p.sc.time_delay).quoted(p.sc.asymptotes).text(p.method).num(p.tol).count(p.force_evals).quoted(p.failure);
+    os << line.str() << "\n";
+  }
+  return t;
+}
+
+/// One series' row of scattering_summary.csv.
+void write_series_summary(std::ostream& ss, const Series& s, const Point& first, std::size_t n, const SeriesTotals& t) {
+  const double A = SceneParams{}.A, m = SceneParams{}.m;
+  CsvLine line;
+  line.quoted(s.name).num(s.B).num(s.Kx).num(s.Kz).count(static_cast<long>(n)).count(t.failed);
+  line.num_if(s.B == 0.0, t.max_rel).num(first.sc.deflection);
+  // a material point of mass m with the same momentum at infinity and impact parameter
+  const double p_inf = first.sc.in ? first.sc.in->p_inf : Point::kNaN;
+  line.num(rutherford(A, m, p_inf / m, first.sc.b)).num(t.max_oop).count(t.rainbows);
+  line.num_if(std::isfinite(t.first_rainbow), t.first_rainbow).num(t.min_r).count(t.evals);
+  ss << line.str() << "\n";
+}
+
+}  // namespace
+
+void write_scattering_study(const std::filesystem::path& dir, bool quick, unsigned threads) {
+  const std::vector<double> bs = log_range(1e-3, 1e3, quick ? 13 : 61);
+  const std::vector<Series> all = series();
+  const std::vector<Point> points = run_points(all, bs, threads);
   AtomicFile csv((dir / "scattering.csv").string()), summary((dir / "scattering_summary.csv").string());
   std::ostream& os = csv.stream();
   os << "series,B,Kx,Kz,b,d,v_inf,theta,theta_rutherford,rel_diff_rutherford,out_of_plane,dsigma_domega,"
@@ -134,55 +204,9 @@ void write_scattering_study(const std::filesystem::path& dir, bool quick, unsign
      << "# bodypoint study --name scattering" << (quick ? " --quick" : "") << ", revision " << git_revision()
      << ": one row per series; rainbows where dtheta/db changes sign (b of the extremum between grid points)\n";
   for (std::size_t si = 0; si < all.size(); ++si) {
-    const Series& s = all[si];
     const Point* row = &points[si * bs.size()];
-    const std::size_t n = bs.size();
-    double max_rel = 0.0, max_oop = 0.0, min_r = Point::kNaN, first_rainbow = Point::kNaN;
-    long evals = 0, rainbows = 0, failed = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      const Point& p = row[i];
-      evals += p.force_evals;
-      const bool ok = p.failure.empty() && std::isfinite(p.sc.deflection);
-      failed += ok ? 0 : 1;
-      const double th_r = ok && s.B == 0.0 ? rutherford(A, m, p.sc.v_inf, p.sc.b) : Point::kNaN;
-      const double rel = ok && s.B == 0.0 ? std::abs(p.sc.deflection / th_r - 1.0) : Point::kNaN;
-      if (rel > max_rel) max_rel = rel;
-      if (ok) max_oop = std::max(max_oop, std::abs(p.sc.out_of_plane));
-      if (ok && !(p.r_min >= min_r)) min_r = p.r_min;
-      // dsigma/dOmega = b/sin(theta) |db/dtheta| from the neighbours (centred differences)
-      double dsigma = Point::kNaN, dsigma_r = Point::kNaN;
-      bool rainbow = false;
-      if (ok && i > 0 && i + 1 < n && row[i - 1].failure.empty() && row[i + 1].failure.empty()) {
-        const double dtheta_db = (row[i + 1].sc.deflection - row[i - 1].sc.deflection) / (row[i + 1].sc.b - row[i - 1].sc.b);
-        dsigma = p.sc.b / std::sin(p.sc.deflection) / std::abs(dtheta_db);
-        if (s.B == 0.0) {
-          const double a = std::abs(A) / (2.0 * m * p.sc.v_inf * p.sc.v_inf);
-          dsigma_r = a * a / std::pow(std::sin(0.5 * th_r), 4);
-        }
-        // a rainbow between i-1 and i+1: theta(b) has an extremum at i
-        const double left = p.sc.deflection - row[i - 1].sc.deflection, right = row[i + 1].sc.deflection - p.sc.deflection;
-        if (left * right < 0.0) {
-          rainbow = true;
-          ++rainbows;
-          if (!std::isfinite(first_rainbow)) first_rainbow = p.sc.b;
-        }
-      }
-      CsvLine line;
-      line.quoted(s.name).num(s.B).num(s.Kx).num(s.Kz).num(ok ? p.sc.b : p.b_target).num(p.d).num(p.sc.v_inf).num(p.sc.deflection);
-      line.num_if(s.B == 0.0 && ok, th_r).num_if(s.B == 0.0 && ok, rel).num(p.sc.out_of_plane).num_if(std::isfinite(dsigma), dsigma);
-      line.num_if(std::isfinite(dsigma_r), dsigma_r).count(rainbow ? 1 : 0).num(p.r_min).num(p.t_min).num(p.r_end).num(p.sc.spin_turn).num(p.sc.K1_turn);
-      line.num(p.sc.time_delay).quoted(p.sc.asymptotes).text(p.method).num(p.tol).count(p.force_evals).quoted(p.failure);
-      os << line.str() << "\n";
-    }
-    const Point& first = row[0];
-    CsvLine line;
-    line.quoted(s.name).num(s.B).num(s.Kx).num(s.Kz).count(static_cast<long>(n)).count(failed);
-    line.num_if(s.B == 0.0, max_rel).num(first.sc.deflection);
-    // a material point of mass m with the same momentum at infinity and impact parameter
-    const double p_inf = first.sc.in ? first.sc.in->p_inf : Point::kNaN;
-    line.num(rutherford(A, m, p_inf / m, first.sc.b)).num(max_oop).count(rainbows);
-    line.num_if(std::isfinite(first_rainbow), first_rainbow).num(min_r).count(evals);
-    ss << line.str() << "\n";
+    const SeriesTotals t = write_series_rows(os, all[si], row, bs.size());
+    write_series_summary(ss, all[si], row[0], bs.size(), t);
   }
   csv.commit();
   summary.commit();

@@ -1,6 +1,6 @@
 // `bodypoint simulate`: one method on one scene; readable summary, --json, or a trajectory CSV.
+#include "process.hpp"
 #include "bodypoint/adaptive/tolerance.hpp"
-#include "bodypoint/batch.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
 #include "bodypoint/observables.hpp"
@@ -147,7 +147,7 @@ struct SimulateOptions {
   std::string method_name = "lp-y4";
   std::string out;
   long every = 1;
-  double tol = RunSpec{}.tol, dt_out = 0.0, omega_c = RunSpec{}.omega_c;
+  double tol = kDefaultStepTolerance, dt_out = 0.0, omega_c = -1.0;
   bool json = false, no_invariants = false, with_reference = false, dry_run = false, quiet = false, scattering = false;
   std::vector<std::string> event_text, stop_text;
   std::vector<Event> events;  ///< parsed from event_text, and the closest approaches --scattering adds
@@ -191,36 +191,41 @@ void add_simulate_options(po::options_description& desc, SimulateOptions& o) {
        "also report err_R = |R - R_ref| against Boost.Odeint rkf78 in long double at tolerance 1e-16");
 }
 
-/// The output options of the run specification, checked against the plan and the scene.
+/// The output options, checked against the plan and the scene, set in plan.how and plan.options.
 void apply_output_options(const po::variables_map& vm, const SimulateOptions& o, const Scene& scene, RunPlan& plan) {
-  RunSpec& spec = plan.spec;
   if (plan.search && vm.count("omega-c")) throw Error("--tol uses the automatic time-step constant: drop --omega-c");
   if (vm.count("omega-c")) {
     // Given, it is used: a constant c >= 0 for a time-transformed method (issue #24: -5, nan and a
     // fixed-step method's --omega-c were ignored).
-    if (!(std::isfinite(o.omega_c) && o.omega_c >= 0.0)) throw Error("--omega-c must be a finite number >= 0");
+    require_non_negative(o.omega_c, "the time-step constant omega_c");
     if (plan.method && (!is_time_transformed(*plan.method) || plan.method->family == Family::Regularised))
       throw Error("--omega-c is the time-step constant of the time-transformed methods (logh-*, ttl-*); " +
                   plan.method->name + " does not take it");
   }
   if (vm.count("dt-out")) {
-    if (!(o.dt_out > 0.0) || !std::isfinite(o.dt_out)) throw Error("--dt-out must be a finite number > 0");
+    require_positive(o.dt_out, "the output interval dt_out");
     if (!vm.count("out")) throw Error("--dt-out needs --out");
-    spec.dt_out = o.dt_out;
+    std::visit([&o](auto& a) { a.dt_out = o.dt_out; }, plan.how);
   }
   if (vm.count("observe") && !vm.count("out")) throw Error("--observe needs --out");
-  spec.every = o.every;
-  spec.omega_c = o.omega_c;
-  if (o.every < 1) throw Error("--every must be >= 1");
-  spec.track_invariants = !o.no_invariants;
-  if (!(o.max_seconds > 0.0)) throw Error("--max-seconds must be > 0");
+  plan.options.every = require_count(o.every, "every (write every k-th step)");
+  plan.options.omega_c = o.omega_c;
+  plan.options.track_invariants = !o.no_invariants;
+  require_positive(o.max_seconds, "the budget max_seconds");
   if (!(o.max_rows >= 1.0)) throw Error("--max-rows must be >= 1");
   if (vm.count("out") && !plan.search) {
     // Rows the output would get: one per dt-out, or per every-th step (fictitious steps to t_end are
     // not known in advance: the sink counts them and stops the run at the limit).
-    const double span = spec.t_end > 0.0 ? spec.t_end : spec.h * static_cast<double>(spec.steps);
-    const double rows = spec.dt_out > 0.0 ? span / spec.dt_out
-                        : spec.steps > 0 ? static_cast<double>(spec.steps) / static_cast<double>(spec.every) : 0.0;
+    const double span = planned_end(plan), dt_out = output_interval(plan.how);
+    const double steps = std::visit(
+        [](const auto& a) -> double {
+          using A = std::decay_t<decltype(a)>;
+          if constexpr (std::is_same_v<A, FixedSteps>) return static_cast<double>(a.steps);
+          else if constexpr (std::is_same_v<A, FictitiousSteps>) return static_cast<double>(a.steps());
+          else return 0.0;
+        },
+        plan.how);
+    const double rows = dt_out > 0.0 ? span / dt_out : steps / static_cast<double>(o.every);
     if (rows * static_cast<double>(scene.bodies.size()) > o.max_rows)
       throw Error("--out would get about " + fmt(std::ceil(rows)) + " rows per body, more than --max-rows " +
                   fmt(o.max_rows) + " (raise --every or --dt-out, or --max-rows)");
@@ -228,14 +233,22 @@ void apply_output_options(const po::variables_map& vm, const SimulateOptions& o,
 }
 
 void print_dry_run(const RunPlan& plan, const std::string& method_name, const Scene& scene) {
-  const RunSpec& spec = plan.spec;
   std::cout << "would run " << (plan.search ? method_name + " with --tol " + fmt(plan.tol) : std::string(plan.method->name))
             << " on " << scene.bodies.size() << " body-point(s) and " << scene.centres.size() << " centre(s): ";
-  if (plan.search) std::cout << "step search to t_end = " << fmt(spec.t_end);
-  else if (is_time_transformed(*plan.method)) std::cout << "ds = " << fmt(spec.h) << (spec.t_end > 0 ? " to t_end = " + fmt(spec.t_end) : " for " + std::to_string(spec.steps) + " fictitious steps");
-  else if (is_step_controlled(*plan.method)) std::cout << "tol = " << fmt(spec.tol) << " to t_end = " << fmt(spec.t_end);
-  else std::cout << spec.steps << " steps of h = " << fmt(spec.h);
+  if (const auto* a = std::get_if<Accuracy>(&plan.how)) std::cout << "step search to t_end = " << fmt(a->t_end);
+  else if (const auto* f = std::get_if<FictitiousSteps>(&plan.how))
+    std::cout << "ds = " << fmt(f->ds) << (f->t_end() > 0 ? " to t_end = " + fmt(f->t_end()) : " for " + std::to_string(f->steps()) + " fictitious steps");
+  else if (const auto* c = std::get_if<ControlledSteps>(&plan.how)) std::cout << "tol = " << fmt(c->tol) << " to t_end = " << fmt(c->t_end);
+  else if (const auto* x = std::get_if<FixedSteps>(&plan.how)) std::cout << x->steps << " steps of h = " << fmt(x->h);
   std::cout << "\n";
+}
+
+/// The header's steps= of a run: fixed steps, fictitious steps asked for (0: to an end time), and 1
+/// for a step-size-controlled run (one call of its controller to the end time).
+long header_steps(const Advance& how) {
+  if (const auto* f = std::get_if<FixedSteps>(&how)) return f->steps;
+  if (const auto* f = std::get_if<FictitiousSteps>(&how)) return f->steps();
+  return 1;
 }
 
 /// The trajectory file of --out: opened before computing (an unwritable path fails at once), its
@@ -251,9 +264,9 @@ class TrajectoryFile {
     writer_.header();
     std::ostream& os = file_.stream();
     os << "# bodypoint simulate, revision " << git_revision() << "\n# method=" << o.method_name;
-    if (plan.search) os << " tol=" << fmt(plan.tol) << " t_end=" << fmt(plan.spec.t_end);
-    else os << " h=" << fmt(plan.spec.h) << " steps=" << plan.spec.steps;
-    os << " every=" << plan.spec.every << " " << scene_header(vm, o.so) << "\n";
+    if (plan.search) os << " tol=" << fmt(plan.tol) << " t_end=" << fmt(planned_end(plan));
+    else os << " h=" << fmt(planned_step(plan)) << " steps=" << header_steps(plan.how);
+    os << " every=" << plan.options.every << " " << scene_header(vm, o.so) << "\n";
     writer_.help();
     // The body column holds each body's index in the scene (a number, for numpy); its name is here.
     os << "# body names:";
@@ -283,13 +296,13 @@ BodyRun simulate_body(const SimulateOptions& o, const RunPlan& plan, const Body&
                       const SampleSink* sink) {
   std::optional<WorkEstimate> estimate;
   if (!plan.search) {
-    estimate = estimate_work(*plan.method, body, scene.centres, plan.spec);
+    estimate = estimate_work(*plan.method, body, scene.centres, plan.how, plan.options);
     if (estimate) check_budget(*estimate, o.max_seconds, o.quiet || o.json);
   }
   BodyRun br;
   {
     const ProgressBar bar(estimate, progress_wanted(o.quiet));
-    br = run_body(plan, body, scene.centres, plan.spec, sink, o.events);
+    br = run_body(plan, body, scene.centres, plan.how, sink, o.events);
   }
   if (br.outcome != Outcome::ok) {
     const std::string smaller = is_step_controlled(*br.method) ? "the tolerance is too loose for this scene (reduce --tol"
@@ -311,9 +324,9 @@ BodyRun simulate_body(const SimulateOptions& o, const RunPlan& plan, const Body&
 void report_json(const std::vector<BodyRun>& runs, const Scene& scene, const RunPlan& plan, const SimulateOptions& o,
                  const std::vector<std::optional<Encounter>>& enc) {
   const BodyRun& r0 = runs.front();
-  const double h0 = r0.search ? r0.search->step : plan.spec.h;
+  const double h0 = r0.search ? r0.search->step : planned_step(plan);
   std::cout << "{\"method\": " << json_string(r0.method->name) << ", \"h\": " << json_number(h0)
-            << (is_step_controlled(*r0.method) ? ", \"tol\": " + json_number(plan.spec.tol) : std::string())
+            << (is_step_controlled(*r0.method) ? ", \"tol\": " + json_number(plan.tol) : std::string())
             << search_json(r0, plan.tol) << ", \"steps\": " << r0.result.steps
             << ", \"t_end\": " << json_number(r0.result.t_end) << ", " << json_body(r0.result, r0.err_R, r0.err_rel)
             << events_json(o.events, r0) << scattering_json(enc.front());
@@ -367,7 +380,7 @@ void report_text(const std::vector<BodyRun>& runs, const Scene& scene, const Run
   const BodyRun& r0 = runs.front();
   std::cout << "bodypoint simulate  method=" << (plan.search ? method_name : std::string(r0.method->name));
   if (plan.search) std::cout << "  tol=" << fmt(plan.tol);
-  else std::cout << (is_time_transformed(*r0.method) ? "  ds=" : "  h=") << fmt(plan.spec.h);
+  else std::cout << (is_time_transformed(*r0.method) ? "  ds=" : "  h=") << fmt(planned_step(plan));
   std::cout << "  steps=" << r0.result.steps << "  t_end=" << fmt(r0.result.t_end) << "\n"
             << "scene: " << header << "  (" << scene.centres.size() << " centre(s), " << scene.bodies.size()
             << " body-point(s))\n";
@@ -427,68 +440,6 @@ int cmd_simulate(int argc, char** argv) {
   }
   report_text(runs, scene, plan, o, enc, scene_header(vm, o.so));
   if (file) std::cout << "\ntrajectory written to " << o.out << "\n";
-  return 0;
-}
-
-namespace {
-
-/// The README's method table (between its `methods:begin` and `methods:end` markers; ctest
-/// ReadmeMethodTableIsGenerated keeps the two equal).
-void print_markdown_table() {
-  std::cout << "| method | family | order | stages | evals/step | description |\n|---|---|---|---|---|---|\n";
-  for (const MethodInfo& m : methods())
-    std::cout << "| `" << m.name << "` | " << family_name(m.family) << " | " << (m.order ? std::to_string(m.order) : "var")
-              << " | " << (is_step_controlled(m) ? "-" : std::to_string(m.stages)) << " | "
-              << (is_step_controlled(m) ? "adaptive" : std::to_string(m.evals_per_step)) << " | " << m.description << " |\n";
-}
-
-/// One row per method for scripts (paper/ reads the families from it): method, family (family_key),
-/// order (0: variable), stages, force evaluations per step, and how it advances time.
-void print_csv() {
-  std::cout << "method,family,order,stages,evals_per_step,advance\n";
-  for (const MethodInfo& m : methods()) {
-    CsvLine row;
-    row.text(m.name).text(std::string(family_key(m.family))).count(m.order).count(m.stages).count(m.evals_per_step);
-    row.text(is_step_controlled(m) ? "controlled" : is_time_transformed(m) ? "fictitious" : "fixed");
-    std::cout << row.str() << "\n";
-  }
-}
-
-void print_table() {
-  std::cout << std::left << std::setw(16) << "method" << std::setw(8) << "order" << std::setw(8)
-            << "stages" << std::setw(14) << "evals/step" << "description\n";
-  for (const MethodInfo& m : methods())
-    std::cout << std::left << std::setw(16) << m.name << std::setw(8)
-              << (m.order ? std::to_string(m.order) : "var") << std::setw(8)
-              << (is_step_controlled(m) ? "-" : std::to_string(m.stages)) << std::setw(14)
-              << (is_step_controlled(m) ? "adaptive" : std::to_string(m.evals_per_step)) << m.description << "\n";
-}
-
-}  // namespace
-
-int cmd_methods(int argc, char** argv) {
-  po::options_description desc("bodypoint methods");
-  bool markdown = false, csv = false;
-  desc.add_options()("markdown", po::bool_switch(&markdown), "print the table as Markdown (README's Methods section)")(
-      "csv", po::bool_switch(&csv), "print one CSV row per method (method, family, order, stages, evals_per_step, advance)");
-  po::variables_map vm;
-  if (!parse(argc, argv, desc, vm, "usage: bodypoint methods [--markdown | --csv]\nLists every integration method.")) return 0;
-  if (markdown && csv) throw Error("give --markdown or --csv, not both");
-  if (markdown) {
-    print_markdown_table();
-    return 0;
-  }
-  if (csv) {
-    print_csv();
-    return 0;
-  }
-  print_table();
-  const Scene probe = thesis_scene(SceneParams{});
-  std::string batched;
-  for (const MethodInfo& m : methods())
-    if (batch::accepts(m, probe.bodies.front(), probe.centres)) batched += (batched.empty() ? "" : ", ") + std::string(m.name);
-  std::cout << "\nsweeps run " << batched << " in batches of " << batch::width() << " vector lanes (" << batch::isa()
-            << "; one Coulomb centre at the origin, B != 0; the same bits as alone)\n";
   return 0;
 }
 

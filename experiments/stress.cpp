@@ -4,13 +4,16 @@
 // reported as a number that does not mean one.
 #include "stress.hpp"
 
+#include "bodypoint/bodypoint.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
 #include "budget.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
+#include <utility>
 
 namespace bodypoint::cli {
 namespace {
@@ -91,12 +94,18 @@ std::vector<StressCase> cases(bool quick) {
   return out;
 }
 
-/// One method of each family: the thesis's, Odeint's fixed and controlled steppers, GSL's, the exact
-/// splitting, the two time transformations and KS.
-std::vector<std::string> stress_methods() {
-  std::vector<std::string> m = {"thesis-verlet", "rk4", "odeint-dopri5", "lp-y4", "logh-y4", "ttl-y4", "ks"};
-  if (find_method("gsl-rk8pd")) m.insert(m.begin() + 3, "gsl-rk8pd");
-  return m;
+/// One method of each family and of each scene check within it (logH and TTL assume different
+/// scenes), from the catalogue: the family's first method of order 4, or its first method where it has
+/// none of order 4 (the step-size-controlled peers, ks).
+std::vector<const MethodInfo*> stress_methods() {
+  std::vector<const MethodInfo*> chosen;
+  const auto same_kind = [](const MethodInfo* a, const MethodInfo& b) { return a->family == b.family && a->check == b.check; };
+  for (const MethodInfo& m : methods()) {
+    const auto kind = std::find_if(chosen.begin(), chosen.end(), [&](const MethodInfo* c) { return same_kind(c, m); });
+    if (kind == chosen.end()) chosen.push_back(&m);
+    else if ((*kind)->order != 4 && m.order == 4) *kind = &m;
+  }
+  return chosen;
 }
 
 StressRow run_case(const StressCase& c, const MethodInfo& m, double max_seconds) {
@@ -104,38 +113,30 @@ StressRow run_case(const StressCase& c, const MethodInfo& m, double max_seconds)
   row.case_name = c.name;
   row.method = std::string(m.name);
   if (c.scene.bodies.empty()) {
-    row.status = "refused";
+    row.outcome = Outcome::refused;
     row.reason = c.name.substr(c.name.find('[') + 1);
     row.reason.pop_back();
     return row;
   }
   try {
     const Body& body = c.scene.bodies.front();
-    RunSpec spec;
-    spec.track_invariants = true;
-    spec.tol = 1e-10;
-    if (is_step_controlled(m)) {
-      spec.h = c.h;
-      spec.steps = 1;
-      spec.t_end = c.t_end;
-    } else if (is_time_transformed(m)) {
-      spec.h = c.h * 10;  // ds: one fictitious step covers ~10 fixed steps far from a centre
-      spec.t_end = c.t_end;
-      spec.steps = 0;
-    } else {
-      spec.h = c.h;
-      spec.steps = static_cast<long>(std::llround(c.t_end / c.h));
+    Advance how;
+    if (is_step_controlled(m)) how = ControlledSteps{c.h, c.t_end, kDefaultStepTolerance};
+    // ds: one fictitious step covers ~10 fixed steps far from a centre
+    else if (is_time_transformed(m)) how = FictitiousSteps{c.h * 10, EndTime{c.t_end}};
+    else how = FixedSteps{c.h, static_cast<long>(std::llround(c.t_end / c.h))};
+    const Options options;
+    if (const auto e = estimate_work(m, body, c.scene.centres, how, options)) check_budget(*e, max_seconds, true);
+    BodyResult r = integrate_body(body, c.scene.centres, &m, how, options);
+    row.outcome = r.outcome;
+    row.reason = std::move(r.reason);
+    if (r.outcome != Outcome::refused && r.outcome != Outcome::failed) {
+      row.max_rel_dE = r.run.invariants ? r.run.invariants->max_rel_dE : std::nan("");
+      row.steps = r.run.steps;
+      row.wall_s = r.run.wall_s;
     }
-    if (const auto e = estimate_work(m, body, c.scene.centres, spec)) check_budget(*e, max_seconds, true);
-    const RunResult r = run(m, body, c.scene.centres, spec);
-    const Health h = assess(r, checks_for(m, c.scene.centres));
-    row.status = h.status;
-    row.reason = h.why;
-    row.max_rel_dE = r.invariants ? r.invariants->max_rel_dE : std::nan("");
-    row.steps = r.steps;
-    row.wall_s = r.wall_s;
-  } catch (const Error& e) {
-    row.status = "refused";
+  } catch (const Error& e) {  // the scene or the step is not a valid request, or over the budget
+    row.outcome = Outcome::refused;
     row.reason = e.what();
   }
   return row;
@@ -146,8 +147,8 @@ StressRow run_case(const StressCase& c, const MethodInfo& m, double max_seconds)
 std::vector<StressRow> run_stress(bool quick, const std::function<void(const StressRow&)>& each) {
   std::vector<StressRow> rows;
   for (const StressCase& c : cases(quick))
-    for (const std::string& name : stress_methods()) {
-      rows.push_back(run_case(c, method_or_throw(name), quick ? kQuickStressMaxSeconds : kStressMaxSeconds));
+    for (const MethodInfo* m : stress_methods()) {
+      rows.push_back(run_case(c, *m, quick ? kQuickStressMaxSeconds : kStressMaxSeconds));
       if (each) each(rows.back());
     }
   return rows;
@@ -156,10 +157,10 @@ std::vector<StressRow> run_stress(bool quick, const std::function<void(const Str
 void write_stress(std::ostream& csv, std::ostream& md, const std::vector<StressRow>& rows) {
   csv << "case,method,status,max_rel_dE,steps,wall_s,reason\n"
       << "# bodypoint study stress, revision " << git_revision() << "\n"
-      << "# status: ok | refused (not run, reason) | diverged | unresolved | inaccurate | collision (flagged, reason; "
+      << "# status: ok | refused (not run, reason) | failed (started and stopped, reason) | diverged | unresolved | inaccurate | collision (flagged, reason; "
          "docs/physics.md, Resolution and accuracy flags); max_rel_dE only for runs\n";
   for (const StressRow& r : rows) {
-    csv << CsvLine().quoted(r.case_name).text(r.method).text(r.status).num(r.max_rel_dE).count(r.steps)
+    csv << CsvLine().quoted(r.case_name).text(r.method).text(std::string(outcome_name(r.outcome))).num(r.max_rel_dE).count(r.steps)
                .num(r.wall_s).quoted(r.reason).str()
         << '\n';
   }
@@ -168,12 +169,12 @@ void write_stress(std::ostream& csv, std::ostream& md, const std::vector<StressR
     std::ostringstream e, w;
     e << std::setprecision(2) << std::scientific << r.max_rel_dE;
     w << std::setprecision(3) << r.wall_s;
-    std::string outcome = r.status;
+    std::string outcome(outcome_name(r.outcome));
     if (!r.reason.empty()) outcome += ": " + r.reason.substr(0, 110) + (r.reason.size() > 110 ? "..." : "");
     std::replace(outcome.begin(), outcome.end(), '|', '/');
     md << "| " << r.case_name << " | " << r.method << " | " << outcome << " | "
-       << (r.status == "refused" ? "-" : e.str()) << " | " << (r.status == "refused" ? "-" : std::to_string(r.steps))
-       << " | " << (r.status == "refused" ? "-" : w.str()) << " |\n";
+       << (r.outcome == Outcome::refused ? "-" : e.str()) << " | " << (r.outcome == Outcome::refused ? "-" : std::to_string(r.steps))
+       << " | " << (r.outcome == Outcome::refused ? "-" : w.str()) << " |\n";
   }
 }
 

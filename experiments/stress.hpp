@@ -14,7 +14,8 @@ namespace bodypoint::cli {
 
 struct StressRow {
   std::string case_name, method;
-  std::string status = "refused", reason;
+  Outcome outcome = Outcome::refused;
+  std::string reason;
   double max_rel_dE = std::nan("");
   long steps = 0;
   double wall_s = 0.0;

@@ -13,6 +13,7 @@
 //   Kx = 2). Set P1.2 (J = 0.2) has D = mJ - B^2 = -0.29 < 0: its kinetic energy is not positive
 //   definite, so it is recorded as skipped instead of integrated. Sets P1.4 and P1.5 are printed
 //   with identical parameters; both are run.
+#include "process.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
 #include "bodypoint/observables.hpp"
@@ -155,12 +156,13 @@ void study_evals(const StudyContext& c) {
   material.B = 0.0;
   const Scene material_scene = thesis_scene(material);
   for (const MethodInfo& m : methods()) {
-    RunSpec rs;
-    rs.h = 1e-3;
-    rs.steps = 1000;
-    rs.t_end = is_step_controlled(m) ? 1.0 : 0.0;
+    constexpr double h = 1e-3;
+    constexpr long steps = 1000;
+    const Advance how = is_step_controlled(m)  ? Advance(ControlledSteps{h, 1.0, kDefaultStepTolerance})
+                        : is_time_transformed(m) ? Advance(FictitiousSteps{h, StepCount{steps}})
+                                                 : Advance(FixedSteps{h, steps});
     const Scene& sc = refusal(m, scene.bodies.front(), scene.centres).empty() ? scene : material_scene;
-    const RunResult r = run(m, sc.bodies.front(), sc.centres, rs);
+    const RunResult r = run_or_throw(m, sc.bodies.front(), sc.centres, how, unobserved());
     const auto printed = kThesisTable41.find(m.name);
     os << CsvLine().text(m.name).count(m.order).count(m.stages).count(m.evals_per_step)
               .num(static_cast<double>(r.force_evals) / static_cast<double>(r.steps))
@@ -310,17 +312,16 @@ void study_appendix(const StudyContext& c) {
     os << "# thesis appendix 1, fig. P1." << set.figure << "; thesis-euler h=1e-4 n=250000\n";
     const BodyPoint& bp = scene.bodies.front().p;
     SampleSink sink = [&writer, &bp](const Sample& s) { writer.row(0, s, bp); };
-    RunSpec rs;
-    rs.h = 1e-4;
-    rs.steps = steps;
-    rs.every = every;
-    rs.track_invariants = true;
-    const MethodInfo& euler = method_or_throw("thesis-euler");
-    const RunResult r = run(euler, scene.bodies.front(), scene.centres, rs, &sink);
+    Options o;
+    o.every = every;
+    o.sink = &sink;
+    const BodyResult br = integrate_body(scene.bodies.front(), scene.centres, &method_or_throw("thesis-euler"),
+                                         FixedSteps{1e-4, steps}, o);
+    if (br.outcome == Outcome::refused || br.outcome == Outcome::failed) throw Error(br.reason);
+    const RunResult& r = br.run;
     f.commit();
     // The thesis's run as it made it, written whatever its flags; the status says what they are.
-    const Health h = assess(r, checks_for(euler, scene.centres));
-    ix << row.text(h.status).text(name).num(r.invariants->max_rel_dE).num(r.invariants->max_rel_dK2sq).str() << '\n';
+    ix << row.text(std::string(outcome_name(br.outcome))).text(name).num(r.invariants->max_rel_dE).num(r.invariants->max_rel_dK2sq).str() << '\n';
   }
   index.commit();
   std::cerr << "wrote " << dir.string() << "/ (30 sets)\n";
@@ -330,13 +331,13 @@ void study_appendix(const StudyContext& c) {
 void study_stress(const StudyContext& c) {
   AtomicFile csv((c.dir / "stress.csv").string()), md((c.dir / "stress.md").string());
   const auto rows = run_stress(c.quick, [&](const StressRow& r) {
-    if (c.progress) std::cerr << "  " << r.case_name << " / " << r.method << ": " << r.status << "\n";
+    if (c.progress) std::cerr << "  " << r.case_name << " / " << r.method << ": " << outcome_name(r.outcome) << "\n";
   });
   write_stress(csv.stream(), md.stream(), rows);
   csv.commit();
   md.commit();
   std::size_t ok = 0, refused = 0, flagged = 0;
-  for (const StressRow& r : rows) (r.status == "ok" ? ok : r.status == "refused" ? refused : flagged)++;
+  for (const StressRow& r : rows) (r.outcome == Outcome::ok ? ok : r.outcome == Outcome::refused ? refused : flagged)++;
   std::cerr << "wrote " << (c.dir / "stress.csv").string() << " and stress.md: " << rows.size() << " runs, " << ok
             << " ok, " << refused << " refused with a reason, " << flagged << " flagged (diverged, unresolved, inaccurate or collided)\n";
 }

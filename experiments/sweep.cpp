@@ -1,4 +1,5 @@
 // `bodypoint sweep`: one scene or run parameter varied over a range, for a list of methods.
+#include "process.hpp"
 #include "sweep.hpp"
 
 #include "bodypoint/io.hpp"
@@ -55,13 +56,6 @@ std::vector<double> log_range(double from, double to, long points) {
   v.front() = from;
   v.back() = to;
   return v;
-}
-
-RunSpec resolve_steps(double h, long steps, double t_end, double tol, ForceLaw law) {
-  // The command's words for the two ways a step option can be wrong; the rest is the library's.
-  if (!std::isfinite(h) || h <= 0.0) throw Error("--h must be a finite number > 0, got " + fmt(h));
-  if (!(t_end > 0.0) && steps < 1) throw Error("--steps must be >= 1");
-  return fixed_run_spec(h, steps, t_end, tol, law);
 }
 
 unsigned thread_count(long requested) {
@@ -300,6 +294,38 @@ std::vector<Axis> parse_axes(const po::variables_map& vm, const std::vector<std:
   return {{param, linear_range(from, to, vm["step"].as<double>())}};
 }
 
+/// Fixed asymptotic data (--b, --v-inf): a one-value axis each, solved for at every grid point (a
+/// sweep over L keeps b, not d).
+void apply_fixed_data(const po::variables_map& vm, const SceneOptions& so, SweepSpec& spec) {
+  struct Fixed {
+    const char* option;
+    std::string param;
+    double value;
+  };
+  for (const Fixed& f : {Fixed{"b", "b", so.b}, Fixed{"v-inf", "v_inf", so.v_inf}}) {
+    if (!vm.count(f.option)) continue;
+    if (!(std::isfinite(f.value) && f.value > 0.0)) throw Error(std::string("--") + f.option + " must be a finite number > 0");
+    if (std::any_of(spec.axes.begin(), spec.axes.end(), [&f](const Axis& a) { return a.param == f.param; }))
+      throw Error(std::string("--") + f.option + " is fixed and varied at once");
+    spec.axes.push_back(Axis{f.param, {f.value}});
+  }
+}
+
+/// --h, --steps or --t-end, and the energy bound: every method of the sweep ends at one time.
+void apply_steps(const po::variables_map& vm, const StepOptions& st, SweepSpec& spec) {
+  spec.h = st.h;
+  spec.max_energy_error = energy_bound(st);
+  bool sweeps_h = false;
+  for (const Axis& a : spec.axes) sweeps_h = sweeps_h || a.param == "h";
+  if (vm.count("t-end")) {
+    if (!vm["steps"].defaulted()) throw Error("give --steps or --t-end, not both");
+    spec.t_end = require_positive(st.t_end, "the end time t_end");
+  } else {
+    spec.steps = st.steps;
+    if (sweeps_h) throw Error("sweeping h needs a fixed --t-end (the thesis's T = h n)");
+  }
+}
+
 SweepJob parse_sweep(int argc, char** argv, bool& help) {
   SceneOptions so;
   StepOptions st;
@@ -342,31 +368,8 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
   if (job.sharded && job.out.empty()) throw Error("--shard needs --out (the shard's rows file)");
   job.spec.methods = parse_methods(methods_arg);
   job.spec.base = so.params;
-  // Fixed asymptotic data are solved for at every grid point (a sweep over L keeps b, not d).
-  struct Fixed {
-    const char* option;
-    std::string param;
-    double value;
-  };
-  for (const Fixed& f : {Fixed{"b", "b", so.b}, Fixed{"v-inf", "v_inf", so.v_inf}}) {
-    if (!vm.count(f.option)) continue;
-    if (!(std::isfinite(f.value) && f.value > 0.0)) throw Error(std::string("--") + f.option + " must be a finite number > 0");
-    if (std::any_of(job.spec.axes.begin(), job.spec.axes.end(), [&f](const Axis& a) { return a.param == f.param; }))
-      throw Error(std::string("--") + f.option + " is fixed and varied at once");
-    job.spec.axes.push_back(Axis{f.param, {f.value}});
-  }
-  job.spec.h = st.h;
-  job.spec.max_energy_error = energy_bound(st);
-  bool sweeps_h = false;
-  for (const Axis& a : job.spec.axes) sweeps_h = sweeps_h || a.param == "h";
-  if (vm.count("t-end")) {
-    if (!vm["steps"].defaulted()) throw Error("give --steps or --t-end, not both");
-    job.spec.t_end = st.t_end;
-    if (!std::isfinite(job.spec.t_end) || job.spec.t_end <= 0.0) throw Error("--t-end must be a finite number > 0");
-  } else {
-    job.spec.steps = st.steps;
-    if (sweeps_h) throw Error("sweeping h needs a fixed --t-end (the thesis's T = h n)");
-  }
+  apply_fixed_data(vm, so, job.spec);
+  apply_steps(vm, st, job.spec);
   job.command = science_command(argc, argv);
   return job;
 }

@@ -40,10 +40,6 @@ struct SweepControl {
   bool simd = true;
 };
 
-/// Resolves (h, steps) exactly as `simulate` does: with t_end > 0, steps = ceil(t_end/h) and
-/// h = t_end/steps; under ForceLaw::thesis_code the code's n - 1 steps of h (fixed_run_spec).
-RunSpec resolve_steps(double h, long steps, double t_end, double tol, ForceLaw law = ForceLaw::coulomb);
-
 /// Runs the tasks of this shard that the journal does not hold yet, on control.threads threads, and
 /// returns every task's CSV row by task index (empty for tasks of other shards). A row's status is ok,
 /// diverged or collision (assess() in run.hpp), or refused (not run; the reason column says why).

@@ -1,6 +1,7 @@
 // `bodypoint timing`: run time against the number of steps n for each method (thesis fig. 4.12-4.13),
 // measured properly: warm-up runs, repeats, median and spread per point, one thread, and nothing
 // but the step loop inside the timed region (no invariants, no output).
+#include "process.hpp"
 #include "timing.hpp"
 
 #include "bodypoint/io.hpp"
@@ -29,16 +30,17 @@ std::vector<TimingRow> run_timing(const TimingSpec& spec, bool progress) {
   for (long n : spec.ns) {
     if (n < 1) throw Error("n must be >= 1, got " + std::to_string(n));
     for (const MethodInfo* m : spec.methods) {
-      RunSpec rs;
-      rs.h = spec.h;
-      rs.steps = n;
-      rs.t_end = spec.h * static_cast<double>(n);
-      rs.tol = spec.tol;
-      for (long w = 0; w < spec.warmup; ++w) run(*m, scene.bodies.front(), scene.centres, rs);
+      // Every method to the same end time h n: n steps of h, fictitious steps ds = h, or step-size control.
+      const double t_end = spec.h * static_cast<double>(n);
+      const Advance how = is_step_controlled(*m)  ? Advance(ControlledSteps{spec.h, t_end, spec.tol})
+                          : is_time_transformed(*m) ? Advance(FictitiousSteps{spec.h, EndTime{t_end}})
+                                                    : Advance(FixedSteps{spec.h, n});
+      const Options quiet = unobserved();
+      for (long w = 0; w < spec.warmup; ++w) run_or_throw(*m, scene.bodies.front(), scene.centres, how, quiet);
       std::vector<double> t;
       long evals = 0;
       for (long r = 0; r < spec.repeats; ++r) {
-        const RunResult res = run(*m, scene.bodies.front(), scene.centres, rs);
+        const RunResult res = run_or_throw(*m, scene.bodies.front(), scene.centres, how, quiet);
         t.push_back(res.wall_s);
         evals = res.force_evals;
       }

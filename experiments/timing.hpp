@@ -2,6 +2,7 @@
 #pragma once
 
 #include "bodypoint/model.hpp"
+#include "bodypoint/bodypoint.hpp"
 #include "bodypoint/run.hpp"
 
 #include <ostream>
@@ -14,8 +15,8 @@ struct TimingSpec {
   std::vector<long> ns;
   std::vector<const MethodInfo*> methods;
   SceneParams base;
-  double h = RunSpec{}.h;
-  double tol = RunSpec{}.tol;
+  double h = kDefaultStep;
+  double tol = kDefaultStepTolerance;
   long repeats = 5;
   long warmup = 1;
 };

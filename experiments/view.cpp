@@ -5,6 +5,7 @@
 // disk with no server and no network. Every step of a run is seen; at most `--frames` states per body
 // are kept, at equal arc length along the path, with the state closest to a centre always kept, so a
 // run of 10^6 steps still makes a page of a few MB.
+#include "process.hpp"
 #include "bodypoint/field.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/scattering.hpp"
@@ -166,15 +167,14 @@ std::string encounter_json(const Body& body, const std::vector<Centre>& centres,
   return out + "], \"deflection\": " + (std::isfinite(sc.deflection) ? json_number(sc.deflection) : "null") + "}";
 }
 
-TrackJson body_json(const Body& body, const std::vector<Centre>& centres, const RunPlan& plan, RunSpec spec,
+TrackJson body_json(const Body& body, const std::vector<Centre>& centres, RunPlan plan, const Advance& how,
                     std::size_t frames, const std::string& method_label) {
-  spec.track_invariants = true;  // the energy panel and the header show the deviations
-  spec.every = 1;
-  spec.dt_out = 0.0;
+  plan.options.track_invariants = true;  // the energy panel and the header show the deviations
+  plan.options.every = 1;
   Decimator d(centres, std::max<std::size_t>(8 * frames, 1 << 16));
   const SampleSink sink = [&d](const Sample& s) { d.add(s); };
   const std::vector<Event> closest = closest_approaches(centres.size());  // located for the marks
-  const BodyRun br = run_body(plan, body, centres, spec, &sink, closest);
+  const BodyRun br = run_body(plan, body, centres, how, &sink, closest);
   const std::string who = "body '" + body.name + "' with " + method_label;
   if (d.non_finite_at())
     throw Error(who + ": the state became non-finite at t = " + fmt(*d.non_finite_at()) + "; no page written");
@@ -218,29 +218,27 @@ TrackJson body_json(const Body& body, const std::vector<Centre>& centres, const 
 /// The step the run used, as the header shows it.
 std::string step_label(const RunPlan& plan) {
   if (plan.search) return "tol=" + fmt(plan.tol);
-  if (is_step_controlled(*plan.method)) return "tol=" + fmt(plan.spec.tol);
-  if (is_time_transformed(*plan.method)) return "ds=" + fmt(plan.spec.h);
-  return "h=" + fmt(plan.spec.h) + " steps=" + std::to_string(plan.spec.steps);
+  if (const auto* c = std::get_if<ControlledSteps>(&plan.how)) return "tol=" + fmt(c->tol);
+  if (const auto* f = std::get_if<FictitiousSteps>(&plan.how)) return "ds=" + fmt(f->ds);
+  const auto& f = std::get<FixedSteps>(plan.how);
+  return "h=" + fmt(f.h) + " steps=" + std::to_string(f.steps);
 }
 
-/// plan's spec made to end at time t_end (--compare follows the first run's end time).
-RunSpec ending_at(const RunPlan& plan, double t_end) {
-  RunSpec s = plan.spec;
-  if (plan.search || has_variable_step(*plan.method)) {
-    s.t_end = t_end;
-    s.steps = 0;
-  } else {
-    s.steps = std::max(1L, static_cast<long>(std::ceil(t_end / s.h * (1.0 - 1e-12))));
-    s.h = t_end / static_cast<double>(s.steps);
-  }
-  return s;
+/// plan's way of advancing made to end at time t_end (--compare follows the first run's end time).
+Advance ending_at(const RunPlan& plan, double t_end) {
+  Advance how = plan.how;
+  if (auto* a = std::get_if<Accuracy>(&how)) a->t_end = t_end;
+  else if (auto* f = std::get_if<FictitiousSteps>(&how)) f->end = EndTime{t_end};
+  else if (auto* c = std::get_if<ControlledSteps>(&how)) c->t_end = t_end;
+  else how = fixed_steps_to(t_end, std::get<FixedSteps>(how).h);
+  return how;
 }
 
 struct ViewOptions {
   SceneOptions so;
   StepOptions st;
   std::string method_name = "lp-y4", compare, out = "bodypoint-view.html";
-  double tol = RunSpec{}.tol, compare_h = 0.0, max_mb = 32.0;
+  double tol = kDefaultStepTolerance, compare_h = 0.0, max_mb = 32.0;
   long frames = 3000;
   bool dry_run = false;
 };
@@ -300,8 +298,8 @@ std::string page_json(const std::string& title, const std::string& scene_line, c
     json += (k ? ", " : "") + std::string("{\"method\": ") + json_string(labels[k], true) +
             ", \"step\": " + json_string(step_label(plans[k]), true) + ", \"bodies\": [";
     for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
-      const RunSpec spec = k == 0 ? plans[k].spec : ending_at(plans[k], t_end[b]);
-      const TrackJson tr = body_json(scene.bodies[b], scene.centres, plans[k], spec,
+      const Advance how = k == 0 ? plans[k].how : ending_at(plans[k], t_end[b]);
+      const TrackJson tr = body_json(scene.bodies[b], scene.centres, plans[k], how,
                                      static_cast<std::size_t>(frames), labels[k]);
       if (k == 0) t_end[b] = tr.t_end;
       json += (b ? ", " : "") + tr.json;

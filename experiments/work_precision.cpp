@@ -7,6 +7,7 @@
 // ladder of steps (halving h) or tolerances (dividing by 10) is run; each configuration is timed as
 // the median of several repeats with no invariant tracking and no output inside the timed region, and
 // run once more, untimed, to measure max_rel_dE.
+#include "process.hpp"
 #include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
@@ -52,34 +53,30 @@ struct Options {
 
 Row measure(const NamedScene& ns, const MethodInfo& m, const Body& body, const State& ref, double h,
             double tol, const Options& o) {
-  RunSpec spec;
-  spec.t_end = ns.t_end;
+  Advance how;
+  double step = h;  // the step of the row: h, or the fictitious step ds
   if (is_time_transformed(m)) {
-    spec.h = h;  // the fictitious step ds
-    spec.steps = 0;
+    how = FictitiousSteps{h, EndTime{ns.t_end}};
   } else if (is_step_controlled(m)) {
-    spec.tol = tol;
-    spec.h = 1e-3;
-    spec.steps = 1;
+    how = ControlledSteps{1e-3, ns.t_end, tol};
   } else {
-    spec.steps = std::max(1L, std::lround(ns.t_end / h));
-    spec.h = ns.t_end / static_cast<double>(spec.steps);
+    const long steps = std::max(1L, std::lround(ns.t_end / h));
+    step = ns.t_end / static_cast<double>(steps);
+    how = FixedSteps{step, steps};
   }
   std::vector<double> times;
   RunResult r;
   double total = 0;
   while ((long)times.size() < o.repeats || (total < o.min_timed_s && times.size() < 50)) {
-    r = run(m, body, ns.scene.centres, spec);
+    r = run_or_throw(m, body, ns.scene.centres, how, unobserved());
     times.push_back(r.wall_s);
     total += r.wall_s;
   }
-  RunSpec inv = spec;
-  inv.track_invariants = true;
-  const RunResult ri = run(m, body, ns.scene.centres, inv);
+  const RunResult ri = run_or_throw(m, body, ns.scene.centres, how, bodypoint::Options{});
   Row row;
   row.scene = ns.name;
   row.method = std::string(m.name);
-  row.h = is_step_controlled(m) ? 0.0 : spec.h;  // for time-transformed methods: ds
+  row.h = is_step_controlled(m) ? 0.0 : step;  // for time-transformed methods: ds
   row.tol = is_step_controlled(m) ? tol : 0.0;
   row.err_R = (r.final.R - ref.R).norm();
   if (!std::isfinite(row.err_R)) row.err_R = std::numeric_limits<double>::infinity();
@@ -144,10 +141,9 @@ State reference_of(const NamedScene& ns, std::ostringstream& refs) {
   const Body& body = ns.scene.bodies.front();
   const State ref = reference_state(body, ns.scene.centres, ns.t_end, 1e-18L);
   const State loose = reference_state(body, ns.scene.centres, ns.t_end, 1e-15L);
-  RunSpec cs;
-  cs.steps = std::lround(ns.t_end / splitting_check_step(ns.name));
-  cs.h = ns.t_end / static_cast<double>(cs.steps);
-  const State split = run(method_or_throw("lp-ss10"), body, ns.scene.centres, cs).final;
+  const long steps = std::lround(ns.t_end / splitting_check_step(ns.name));
+  const FixedSteps check_steps{ns.t_end / static_cast<double>(steps), steps};
+  const State split = run_or_throw(method_or_throw("lp-ss10"), body, ns.scene.centres, check_steps, unobserved()).final;
   const double ref_err = std::max((ref.R - loose.R).norm(), (ref.R - split.R).norm());
   std::ostringstream line;
   line << "reference " << ns.name << ": odeint rkf78 long double tol 1e-18, t_end " << fmt(ns.t_end)

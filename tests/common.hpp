@@ -14,6 +14,42 @@
 #include <utility>
 #include <vector>
 
+namespace bodypoint {
+
+/// The tests' shorthand for one run of the core: a step h (ds of time-transformed methods, a first
+/// trial step of controlled ones), a number of steps or an end time, a tolerance per step, and what
+/// to observe. flat_advance gives it the meaning run.hpp's Advance spells out, by the method's kind.
+struct FlatRun {
+  double h = 1e-4;
+  long steps = 500000;
+  double t_end = 0.0;  ///< time-transformed and controlled methods: the end time (0: steps h, or steps)
+  double tol = 1e-10;
+  double dt_out = 0.0;  ///< time-transformed methods with a sink: output times
+  double omega_c = -1.0;
+  bool track_invariants = false;
+  long every = 1;
+};
+inline Advance flat_advance(const MethodInfo& m, const FlatRun& f) {
+  if (is_time_transformed(m)) {
+    if (f.t_end > 0.0) return FictitiousSteps{f.h, EndTime{f.t_end}, f.dt_out};
+    return FictitiousSteps{f.h, StepCount{f.steps}, f.dt_out};
+  }
+  if (is_step_controlled(m))
+    return ControlledSteps{f.h, f.t_end == 0.0 ? f.h * static_cast<double>(f.steps) : f.t_end, f.tol};
+  return FixedSteps{f.h, f.steps};
+}
+inline RunResult run(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres, const FlatRun& f,
+                     const SampleSink* sink = nullptr) {
+  RunOptions o;
+  o.track_invariants = f.track_invariants;
+  o.sink = sink;
+  o.every = f.every;
+  o.omega_c = f.omega_c;
+  return bodypoint::run(m, body, centres, flat_advance(m, f), o);
+}
+
+}  // namespace bodypoint
+
 namespace bodypoint::test {
 
 /// Thesis table 3.1 with the given changes applied by the caller.

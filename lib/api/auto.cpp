@@ -1,6 +1,8 @@
 // bodypoint: `--method auto`, the method for a scene and a tolerance (methods.hpp).
 #include "bodypoint/methods.hpp"
 
+#include "choice.hpp"
+
 #include "bodypoint/adaptive/methods.hpp"
 #include "bodypoint/adaptive/tolerance.hpp"
 
@@ -39,6 +41,11 @@ double closest_approach(const Body& b, const Centre& c) {
 
 const MethodInfo& choose_method(const Body& body, const std::vector<Centre>& centres, double tol, std::string* why) {
   adaptive::check_tolerance(tol);
+  return detail::choose_method_for(body, centres, tol, why);
+}
+
+const MethodInfo& detail::choose_method_for(const Body& body, const std::vector<Centre>& centres, double tol,
+                                            std::string* why) {
   // The table by tolerance, measured (logh on the close, thesis and two-centres scenes, force
   // evaluations of the whole search): Yoshida 4 (3 stages) is cheapest down to 1e-5 (thesis 3,648
   // against 10,944 for Kahan-Li 6), Kahan-Li 6 down to 1e-10 (close 1e-9: 21,690 against 33,218 for

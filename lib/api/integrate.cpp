@@ -5,6 +5,7 @@
 #include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/field.hpp"
 #include "bodypoint/invariants.hpp"
+#include "choice.hpp"
 #include "events.hpp"
 
 #include <algorithm>
@@ -17,83 +18,23 @@
 
 namespace bodypoint {
 
-std::string_view outcome_name(Outcome o) {
-  switch (o) {
-    case Outcome::ok: return "ok";
-    case Outcome::diverged: return "diverged";
-    case Outcome::collision: return "collision";
-    case Outcome::refused: return "refused";
-    case Outcome::failed: return "failed";
-    case Outcome::unresolved: return "unresolved";
-    case Outcome::inaccurate: return "inaccurate";
-  }
-  return "?";
-}
-
-Outcome outcome_of(const Health& h) {
-  for (Outcome o : {Outcome::ok, Outcome::diverged, Outcome::collision, Outcome::unresolved, Outcome::inaccurate})
-    if (h.status == outcome_name(o)) return o;
-  throw Error("assess() gave an unknown status '" + h.status + "'");
-}
-
 long BodyResult::total_force_evals() const {
   return (accuracy ? accuracy->force_evals : run.force_evals) + event_force_evals;
-}
-
-RunSpec run_spec(const MethodInfo& method, const Advance& how, const Options& options) {
-  RunSpec s;
-  s.track_invariants = options.track_invariants;
-  s.every = options.every;
-  s.omega_c = options.omega_c;
-  std::visit(
-      [&](const auto& a) {
-        using A = std::decay_t<decltype(a)>;
-        if constexpr (std::is_same_v<A, FixedSteps>) {
-          if (is_step_controlled(method) || is_time_transformed(method))
-            throw Error(method.name + " does not take fixed steps (" +
-                        (is_time_transformed(method) ? "it takes FictitiousSteps)" : "it takes ControlledSteps)"));
-          s.h = a.h;
-          s.steps = a.steps;
-        } else if constexpr (std::is_same_v<A, FictitiousSteps>) {
-          if (!is_time_transformed(method)) throw Error(method.name + " does not take fictitious steps");
-          s.h = a.ds;
-          s.t_end = a.t_end;
-          s.steps = a.t_end > 0.0 ? 0 : a.steps;
-          s.dt_out = a.dt_out;
-        } else if constexpr (std::is_same_v<A, ControlledSteps>) {
-          if (!is_step_controlled(method))
-            throw Error(method.name + " does not control its step (give it FixedSteps, FictitiousSteps or Accuracy)");
-          s.h = a.h0;
-          s.t_end = a.t_end;
-          s.tol = a.tol;
-          s.steps = 1;
-        } else {
-          throw Error("the accuracy mode chooses its own step: it has no run specification");
-        }
-      },
-      how);
-  (void)advance_of(method, s);  // every number checked, in one place (run.cpp)
-  return s;
 }
 
 namespace {
 
 /// The outcome of a finished run, from its health (run.hpp, assess).
 void judge(BodyResult& r, const std::vector<Centre>& centres, const Options& options) {
-  const Health h = assess(r.run, checks_for(*r.method, centres, options.max_energy_error));
-  r.outcome = outcome_of(h);
-  r.reason = h.why;
+  Health h = assess(r.run, checks_for(*r.method, centres, options.max_energy_error));
+  r.outcome = h.outcome;
+  r.reason = std::move(h.why);
 }
 
 /// The accuracy mode: the step search, whose delivered run carries the observers.
 void run_accurately(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Accuracy& a,
                     const Options& options) {
-  adaptive::Delivery delivery;
-  delivery.track_invariants = options.track_invariants;
-  delivery.every = options.every;
-  delivery.dt_out = a.dt_out;
-  delivery.sink = options.sink;
-  adaptive::ToleranceResult t = adaptive::run_to_tolerance(*r.method, body, centres, a.tol, a.t_end, delivery);
+  adaptive::ToleranceResult t = adaptive::search_step(*r.method, body, centres, a, options);
   r.accuracy = AccuracyReport{a.tol, t.err_estimate, t.h, t.omega_c, t.runs, t.total_force_evals, t.total_wall_s};
   r.run = std::move(t.result);
 }
@@ -103,30 +44,29 @@ BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& cen
 
 /// The sink of a run with events: every observed state goes to the watch; the caller's sink gets the
 /// states it asked for (every `every`-th step and the last; with dt_out all of them). Once a stop
-/// event is bracketed no later state is passed on; with `stop_run` the run is ended there (StopRun).
+/// event is bracketed no later state is passed on; with `stop_run` the run is ended there (Flow::stop).
 class WatchingSink {
  public:
   WatchingSink(detail::EventWatch& watch, const Options& options, bool every_state, bool stop_run)
       : watch_(watch), events_(options.events), user_(options.sink), every_(every_state ? 1 : options.every),
         stop_run_(stop_run) {}
-  void operator()(const Sample& s) {
-    if (stopped_) return;
+  Flow operator()(const Sample& s) {
+    if (stopped_) return Flow::go;
     watch_.observe(s.t, s.s);
     for (; seen_ < watch_.brackets().size(); ++seen_)
       stopped_ = stopped_ || events_[watch_.brackets()[seen_].event].stop;
     if (stopped_) {
       pending_.reset();
       stop_step_ = s.step;
-      if (stop_run_) throw StopRun{s.step, s.t, s.s};
-      return;
+      return stop_run_ ? Flow::stop : Flow::go;
     }
-    if (!user_) return;
-    if (s.step % every_ == 0) {
-      (*user_)(s);
-      pending_.reset();
-    } else {
+    if (!user_) return Flow::go;
+    if (s.step % every_ != 0) {
       pending_ = KeptSample::of(s);
+      return Flow::go;
     }
+    pending_.reset();
+    return (*user_)(s);
   }
   /// The last state: the one the every-th rule skipped, or the stop event's (its deviations given).
   void finish(const EventHit* stop, double rel_dE, double rel_dK2sq, double abs_dK2Q) {
@@ -190,7 +130,7 @@ detail::Advancer advancer(const BodyResult& r, const Body& body, const std::vect
     sub.track_invariants = false;
     sub.omega_c = c;
     Advance a;
-    if (is_time_transformed(m)) a = FictitiousSteps{step, tau, 0, 0.0};
+    if (is_time_transformed(m)) a = FictitiousSteps{step, EndTime{tau}};
     else if (is_step_controlled(m)) a = ControlledSteps{std::min(step, tau), tau, tol};
     else a = fixed_steps_to(tau, step);  // one step of tau inside a step; steps <= h across output times
     const BodyResult x = integrate_valid_body(from, centres, &m, a, sub);
@@ -203,11 +143,6 @@ detail::Advancer advancer(const BodyResult& r, const Body& body, const std::vect
   };
 }
 
-/// The output interval of any way of advancing time (0: none).
-double output_interval(const Advance& how) {
-  return std::visit([](const auto& a) -> double { return a.dt_out; }, how);
-}
-
 /// The sink of a fixed-step or step-size-controlled run with output times: it observes every step and
 /// hands the caller the states at t = k dt_out, each from the step that contains it, taken again from
 /// that step's start for the shorter time (the run's own method and configuration: `advance`), then
@@ -217,24 +152,26 @@ class OutputTimesSink {
   OutputTimesSink(const Body& body, const std::vector<Centre>& centres, double dt_out, const SampleSink& user,
                   detail::Advancer advance)
       : field_{centres}, monitor_(body.p, field_, body.s0), dt_out_(dt_out), user_(user), advance_(std::move(advance)) {}
-  void operator()(const Sample& x) {
+  Flow operator()(const Sample& x) {
+    Flow flow = Flow::go;
     if (!prev_) {
-      emit(x);  // t = 0
+      flow = emit(x);  // t = 0
       next_ = 1;
     } else {
-      for (double t = next_time(); t <= x.t; t = next_time()) {
+      for (double t = next_time(); t <= x.t && flow == Flow::go; t = next_time()) {
         if (t == x.t) {
-          emit(x);
+          flow = emit(x);
         } else {
           const State s = advance_(prev_->s, t - prev_->t, evals_);
           monitor_.update(s);
-          user_(Sample{x.step, t, s, monitor_.last_rel_dE(), monitor_.last_rel_dK2sq(), monitor_.last_abs_dK2Q()});
+          flow = user_(Sample{x.step, t, s, monitor_.last_rel_dE(), monitor_.last_rel_dK2sq(), monitor_.last_abs_dK2Q()});
           last_t_ = t;
         }
         ++next_;
       }
     }
     prev_ = KeptSample::of(x);
+    return flow;
   }
   /// The last state, unless it was an output time.
   void finish() {
@@ -244,9 +181,9 @@ class OutputTimesSink {
 
  private:
   [[nodiscard]] double next_time() const { return static_cast<double>(next_) * dt_out_; }
-  void emit(const Sample& x) {
-    user_(x);
+  Flow emit(const Sample& x) {
     last_t_ = x.t;
+    return user_(x);
   }
   CentreList field_;
   InvariantMonitor<CentreList> monitor_;
@@ -258,86 +195,103 @@ class OutputTimesSink {
   std::optional<KeptSample> prev_;  ///< the last step's state, from which an output time inside the next is reached
 };
 
-/// integrate_body for a body and centres already validated.
+/// A run with events: every observed state goes through the watch; the run itself is the one asked
+/// for. A stop event ends a fixed-step, time-transformed or controlled run on the step that brackets
+/// it; the accuracy mode hands its delivered run's states on after its search, so its run is cut at
+/// the event afterwards.
+BodyResult run_with_events(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
+                           const Advance& how, const Options& options) {
+  const bool accuracy = std::holds_alternative<Accuracy>(how);
+  detail::EventWatch watch(options.events, centres);
+  WatchingSink watching(watch, options, output_interval(how) > 0.0, !accuracy);
+  const SampleSink sink = [&watching](const Sample& s) { return watching(s); };
+  Options inner = options;
+  inner.events.clear();
+  inner.sink = &sink;
+  inner.every = 1;
+  BodyResult r = integrate_valid_body(body, centres, method, how, inner);
+  if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return r;
+  r.events = detail::locate(watch, options.events, centres, advancer(r, body, centres, how, options),
+                            r.event_force_evals);
+  const auto stop = std::find_if(r.events.begin(), r.events.end(),
+                                 [&](const EventHit& h) { return options.events[h.event].stop; });
+  if (stop == r.events.end()) {
+    watching.finish(nullptr, 0.0, 0.0, 0.0);
+    return r;
+  }
+  r.events.erase(std::next(stop), r.events.end());  // nothing after the stop happened
+  const InvariantStats last = cut_at(r.run, r.events.back(), body, centres);
+  watching.finish(&r.events.back(), last.max_rel_dE, last.max_rel_dK2sq, last.max_abs_dK2Q);
+  judge(r, centres, options);
+  return r;
+}
+
+/// A fixed-step or controlled run with output times: it observes every step, and OutputTimesSink
+/// hands the caller the states at t = k dt_out.
+BodyResult run_with_output_times(const Body& body, const std::vector<Centre>& centres, const MethodInfo& method,
+                                 const Advance& how, const Options& options) {
+  BodyResult probe;
+  probe.method = &method;
+  OutputTimesSink outputs(body, centres, output_interval(how), *options.sink,
+                          advancer(probe, body, centres, how, options));
+  const SampleSink sink = [&outputs](const Sample& x) { return outputs(x); };
+  Options inner = options;
+  inner.sink = &sink;
+  inner.every = 1;
+  Advance plain = how;
+  std::visit([](auto& a) { a.dt_out = 0.0; }, plain);
+  BodyResult r = integrate_valid_body(body, centres, &method, plain, inner);
+  if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return r;
+  outputs.finish();
+  r.event_force_evals += outputs.evals();
+  return r;
+}
+
+/// The accuracy mode with output times for a fixed-step method: the delivered run's states are kept
+/// and handed on as a fixed-step run with output times hands them (OutputTimesSink), at the step the
+/// search chose.
+void run_accurately_at_output_times(BodyResult& r, const Body& body, const std::vector<Centre>& centres,
+                                    const Accuracy& a, const Options& options) {
+  std::vector<KeptSample> kept;
+  const SampleSink keep = [&kept](const Sample& x) { kept.push_back(KeptSample::of(x)); };
+  Options inner = options;
+  inner.sink = &keep;
+  inner.every = 1;
+  Accuracy plain = a;
+  plain.dt_out = 0.0;
+  run_accurately(r, body, centres, plain, inner);
+  OutputTimesSink outputs(body, centres, a.dt_out, *options.sink, advancer(r, body, centres, Advance(a), options));
+  bool stopped = false;
+  for (std::size_t i = 0; i < kept.size() && !stopped; ++i) stopped = outputs(kept[i].sample()) == Flow::stop;
+  if (!stopped) outputs.finish();
+  r.event_force_evals += outputs.evals();
+}
+
+/// integrate_body for a body, centres, `how` and options already checked.
 BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
                                 const Advance& how, const Options& options) {
-  if (!options.events.empty()) {
-    // Every observed state goes through the watch; the run itself is the one asked for.
-    const double dt_out = output_interval(how);
-    // The accuracy mode hands its delivered run's states on after its search: it cannot be stopped
-    // mid-run, only cut at the event afterwards.
-    const bool accuracy = std::holds_alternative<Accuracy>(how);
-    detail::EventWatch watch(options.events, centres);
-    WatchingSink watching(watch, options, dt_out > 0.0, !accuracy);
-    const SampleSink sink = [&watching](const Sample& s) { watching(s); };
-    Options inner = options;
-    inner.events.clear();
-    inner.sink = &sink;
-    inner.every = 1;
-    BodyResult r = integrate_valid_body(body, centres, method, how, inner);
-    if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return r;
-    r.events = detail::locate(watch, options.events, centres, advancer(r, body, centres, how, options),
-                              r.event_force_evals);
-    const auto stop = std::find_if(r.events.begin(), r.events.end(),
-                                   [&](const EventHit& h) { return options.events[h.event].stop; });
-    if (stop == r.events.end()) {
-      watching.finish(nullptr, 0.0, 0.0, 0.0);
-      return r;
-    }
-    r.events.erase(std::next(stop), r.events.end());  // nothing after the stop happened
-    const InvariantStats last = cut_at(r.run, r.events.back(), body, centres);
-    watching.finish(&r.events.back(), last.max_rel_dE, last.max_rel_dK2sq, last.max_abs_dK2Q);
-    judge(r, centres, options);
-    return r;
-  }
-  const bool own_steps = std::holds_alternative<FixedSteps>(how) || std::holds_alternative<ControlledSteps>(how);
-  if (const double dt_out = output_interval(how); own_steps && dt_out != 0.0 && !(std::isfinite(dt_out) && dt_out > 0.0))
-    throw Error("dt_out must be a finite number > 0 (or 0: no output times)");
-  if (options.sink && own_steps && output_interval(how) > 0.0) {
-    const double dt_out = output_interval(how);
-    if (!method) throw Error("only the accuracy mode chooses a method by itself; name one");
-    BodyResult probe;
-    probe.method = method;
-    OutputTimesSink outputs(body, centres, dt_out, *options.sink, advancer(probe, body, centres, how, options));
-    const SampleSink sink = [&outputs](const Sample& x) { outputs(x); };
-    Options inner = options;
-    inner.sink = &sink;
-    inner.every = 1;
-    Advance plain = how;
-    std::visit([](auto& a) { a.dt_out = 0.0; }, plain);
-    BodyResult r = integrate_valid_body(body, centres, method, plain, inner);
-    if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return r;
-    outputs.finish();
-    r.event_force_evals += outputs.evals();
-    return r;
-  }
-  BodyResult r;
+  if (!options.events.empty()) return run_with_events(body, centres, method, how, options);
   const auto* accuracy = std::get_if<Accuracy>(&how);
-  if (accuracy) {
-    adaptive::check_tolerance(accuracy->tol);
-    if (!(std::isfinite(accuracy->t_end) && accuracy->t_end > 0.0))
-      throw Error("the accuracy mode needs an end time t_end that is a finite number > 0");
-    if (options.every < 1) throw Error("every must be >= 1");
-    if (non_coulomb(centres)) {
-      r.method = method;
-      r.outcome = Outcome::refused;
-      r.reason = adaptive::kNeedsCoulomb;
-      return r;
-    }
-    r.method = method ? method : &choose_method(body, centres, accuracy->tol, &r.chosen);
-  } else {
-    if (!method) throw Error("only the accuracy mode chooses a method by itself; name one");
-    r.method = method;
+  if (!accuracy && options.sink && output_interval(how) > 0.0 && !is_time_transformed(*method))
+    return run_with_output_times(body, centres, *method, how, options);
+  BodyResult r;
+  r.method = method;
+  if (accuracy && non_coulomb(centres)) {
+    r.outcome = Outcome::refused;
+    r.reason = adaptive::kNeedsCoulomb;
+    return r;
   }
+  if (!method) r.method = &detail::choose_method_for(body, centres, accuracy->tol, &r.chosen);
   if (std::string why = refusal(*r.method, body, centres); !why.empty()) {
     r.outcome = Outcome::refused;
     r.reason = std::move(why);
     return r;
   }
-  const RunSpec spec = accuracy ? RunSpec{} : run_spec(*r.method, how, options);
   try {
-    if (accuracy) run_accurately(r, body, centres, *accuracy, options);
-    else r.run = r.method->run(body, centres, spec, options.sink);
+    if (accuracy && options.sink && accuracy->dt_out > 0.0 && !is_time_transformed(*r.method))
+      run_accurately_at_output_times(r, body, centres, *accuracy, options);
+    else if (accuracy) run_accurately(r, body, centres, *accuracy, options);
+    else r.run = r.method->run(body, centres, how, options);
   } catch (const Error& e) {
     r.outcome = Outcome::failed;
     r.reason = e.what();
@@ -347,18 +301,34 @@ BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& cen
   return r;
 }
 
+/// Every part of a request checked once, each with one message naming the quantity: the scene, the
+/// way of advancing time and whether the method takes it, the options and the events.
+void check_request(const Scene& scene, const MethodInfo* method, const Advance& how, const Options& options) {
+  validate(scene);
+  check(how);
+  if (const auto* accuracy = std::get_if<Accuracy>(&how)) {
+    adaptive::check_tolerance(accuracy->tol);
+    if (method) adaptive::check_searchable(*method);
+  } else if (!method) {
+    throw Error("only the accuracy mode chooses a method by itself; name one");
+  } else {
+    check_takes(*method, how);
+  }
+  check(options);
+  check_energy_bound(options.max_energy_error);
+  detail::validate_events(options.events, scene.centres);
+}
+
 }  // namespace
 
 BodyResult integrate_body(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
                           const Advance& how, const Options& options) {
-  validate(Scene{centres, {body}});
-  detail::validate_events(options.events, centres);
+  check_request(Scene{centres, {body}}, method, how, options);
   return integrate_valid_body(body, centres, method, how, options);
 }
 
 Result integrate(const Scene& scene, const MethodInfo* method, const Advance& how, const Options& options) {
-  validate(scene);
-  detail::validate_events(options.events, scene.centres);
+  check_request(scene, method, how, options);
   Result all;
   for (const Body& body : scene.bodies) {
     BodyResult b = integrate_valid_body(body, scene.centres, method, how, options);
@@ -380,12 +350,43 @@ Result integrate(const Scene& scene, std::string_view method, const Advance& how
   return integrate(scene, automatic ? nullptr : &method_or_throw(method), how, options);
 }
 
+bool searches(const MethodInfo* method, const StepRequest& request) {
+  return !method || (request.tol && !is_step_controlled(*method));
+}
+
+Advance advance_for(const MethodInfo* m, const StepRequest& r) {
+  if (r.t_end && r.steps) throw Error("give a number of steps or an end time t_end, not both");
+  if (searches(m, r)) {
+    if (!r.tol) throw Error("method auto needs the accuracy to deliver, tol");
+    if (r.h || r.steps) throw Error("the accuracy mode (tol) chooses the step: give the end time t_end, not h or steps");
+    if (!r.t_end) throw Error("the accuracy mode (tol) needs the end time t_end");
+    return Accuracy{*r.tol, *r.t_end, r.dt_out};
+  }
+  if (!r.t_end && !r.steps) throw Error("give an end time t_end or a number of steps");
+  const double h = require_positive(r.h.value_or(kDefaultStep), is_time_transformed(*m) ? "the fictitious step ds (h)" : "the step h");
+  if (is_step_controlled(*m)) {
+    const double end = r.t_end ? *r.t_end : h * static_cast<double>(require_count(*r.steps, "the number of steps"));
+    return ControlledSteps{std::min(h, end), end, r.tol.value_or(kDefaultStepTolerance), r.dt_out};
+  }
+  if (is_time_transformed(*m)) {
+    if (r.t_end) return FictitiousSteps{h, EndTime{*r.t_end}, r.dt_out};
+    return FictitiousSteps{h, StepCount{*r.steps}, r.dt_out};
+  }
+  FixedSteps f = r.code_loop ? thesis_code_steps(h, r.steps.value_or(0), r.t_end.value_or(0.0))
+                 : r.t_end   ? fixed_steps_to(*r.t_end, h)
+                             : FixedSteps{h, *r.steps};
+  f.dt_out = r.dt_out;
+  return f;
+}
+
 // --- Stepper ---
 
 Stepper::Stepper(const MethodInfo& method, Body body, std::vector<Centre> centres, double step, Options options)
     : method_(&method), body_(std::move(body)), centres_(std::move(centres)), step_(step), options_(options) {
   validate(Scene{centres_, {body_}});
-  if (!(std::isfinite(step_) && step_ > 0.0)) throw Error("the step must be a finite number > 0");
+  require_positive(step_, is_time_transformed(method) ? "the fictitious step ds"
+                          : is_step_controlled(method)  ? "the tolerance per step tol"
+                                                        : "the step h");
   // The time-step constant of a time-transformed method is fixed once, from the starting state, so
   // that every segment integrates the same transformed system.
   if (is_time_transformed(method) && options_.omega_c < 0.0)
@@ -400,7 +401,7 @@ Outcome Stepper::advance_to(double t) {
     throw Error("advance_to needs a finite time after the current one (" + std::to_string(t_) + ")");
   const double span = t - t_;
   Advance how;
-  if (is_time_transformed(*method_)) how = FictitiousSteps{step_, span, 0, 0.0};
+  if (is_time_transformed(*method_)) how = FictitiousSteps{step_, EndTime{span}};
   else if (is_step_controlled(*method_)) how = ControlledSteps{std::min(1e-3, span), span, step_};
   else how = fixed_steps_to(span, step_);
   // Samples carry absolute times (the segment's run starts at 0); a later segment's first sample is

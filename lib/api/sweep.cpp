@@ -36,24 +36,22 @@ SweepRow unrun_row(SweepRow row, Outcome outcome, std::string why) {
 
 /// The row of a finished run, judged by assess().
 SweepRow run_row(SweepRow row, RunResult result, const SweepSpec& spec, const std::vector<Centre>& centres) {
-  const Health h = assess(result, checks_for(*row.method, centres, spec.max_energy_error));
+  Health h = assess(result, checks_for(*row.method, centres, spec.max_energy_error));
   row.result = std::move(result);
-  row.outcome = outcome_of(h);
-  row.reason = h.why;
+  row.outcome = h.outcome;
+  row.reason = std::move(h.why);
   return row;
 }
 
 /// The row of a run with its encounter (SweepSpec::scattering): integrate_body with every centre's
 /// closest approach as events, then scattering() of the run.
-SweepRow encounter_row(SweepRow row, const MethodInfo& method, const Scene& scene, const RunSpec& spec,
+SweepRow encounter_row(SweepRow row, const MethodInfo& method, const Scene& scene, const Advance& how,
                        double max_energy_error) {
   const Body& body = scene.bodies.front();
   Options options;
   options.max_energy_error = max_energy_error;
-  options.track_invariants = spec.track_invariants;
-  options.omega_c = spec.omega_c;
   options.events = closest_approaches(scene.centres.size());
-  BodyResult r = integrate_body(body, scene.centres, &method, advance_of(method, spec), options);
+  BodyResult r = integrate_body(body, scene.centres, &method, how, options);
   if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return unrun_row(std::move(row), r.outcome, r.reason);
   if (const EventHit* nearest = nearest_approach(r.events, options.events)) {
     row.r_min = nearest->distance;
@@ -97,27 +95,19 @@ SceneParams point_params(const SweepSpec& spec, const std::vector<double>& point
   return std::isnan(b) && std::isnan(v_inf) ? p : with_asymptotic_data(p, b, v_inf);
 }
 
-RunSpec fixed_run_spec(double h, long steps, double t_end, double tol, ForceLaw law) {
-  if (!(std::isfinite(h) && h > 0.0)) throw Error("step size h must be a finite number > 0, got " + fmt(h));
-  RunSpec rs;
-  rs.h = h;
-  rs.steps = steps;
-  if (law == ForceLaw::thesis_code) {
-    rs.steps = thesis_code_steps(h, steps, t_end).steps;
-  } else if (t_end > 0.0) {
-    const FixedSteps f = fixed_steps_to(t_end, h);
-    rs.h = f.h;
-    rs.steps = f.steps;
-  }
-  if (rs.steps < 1) throw Error("the number of steps must be >= 1");
-  rs.t_end = rs.h * static_cast<double>(rs.steps);
-  rs.tol = tol;
-  rs.track_invariants = true;
-  return rs;
+FixedSteps sweep_steps(double h, long steps, double t_end, ForceLaw law) {
+  require_positive(h, "the step h");
+  if (law == ForceLaw::thesis_code) return thesis_code_steps(h, steps, t_end);
+  if (t_end > 0.0) return fixed_steps_to(t_end, h);
+  return {h, require_count(steps, "the number of steps")};
 }
 
-RunSpec point_spec(const SweepSpec& spec, const std::vector<double>& point) {
-  return fixed_run_spec(point_h(spec, point), spec.steps, spec.t_end, spec.tol, spec.base.law);
+Advance point_advance(const SweepSpec& spec, const MethodInfo& method, const std::vector<double>& point) {
+  const FixedSteps f = sweep_steps(point_h(spec, point), spec.steps, spec.t_end, spec.base.law);
+  const double t_end = f.h * static_cast<double>(f.steps);
+  if (is_time_transformed(method)) return FictitiousSteps{f.h, EndTime{t_end}};
+  if (is_step_controlled(method)) return ControlledSteps{f.h, t_end, spec.tol};
+  return f;
 }
 
 std::string point_label(const SweepSpec& spec, const std::vector<double>& point) {
@@ -139,16 +129,13 @@ void validate_sweep(const SweepSpec& spec) {
     for (const Axis& other : spec.axes)
       if ((a.param == "b" && other.param == "d") || (a.param == "v_inf" && other.param == "K1"))
         throw Error("the sweep varies " + a.param + " and " + other.param + ", which it solves for " + a.param);
-  // A step-size-controlled method's tolerance, checked once for the sweep (each row refused it before).
-  for (const MethodInfo* m : spec.methods)
-    if (is_step_controlled(*m) && !(std::isfinite(spec.tol) && spec.tol > 0.0))
-      throw Error("the tolerance tol of " + m->name + " must be a finite number > 0");
+  // Every point's scene and every method's way of advancing there, checked once for the sweep.
   const std::size_t points = task_count(spec) / spec.methods.size();
   for (std::size_t p = 0; p < points; ++p) {
     const std::vector<double> point = grid_point(spec, p);
     try {
       thesis_scene(point_params(spec, point));
-      point_spec(spec, point);
+      for (const MethodInfo* m : spec.methods) check(point_advance(spec, *m, point));
     } catch (const Error& e) {
       throw Error(point_label(spec, point) + ": " + e.what());
     }
@@ -172,7 +159,7 @@ std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vect
     centres.push_back(scene.centres);
   }
   if (unit.size() > 1) {  // a batch: one method, one step (plan_units), lanes that accept it
-    auto results = batch::run(method, members, point_spec(spec, rows.front().point));
+    auto results = batch::run(method, members, std::get<FixedSteps>(point_advance(spec, method, rows.front().point)));
     for (std::size_t k = 0; k < unit.size(); ++k)
       rows[k] = run_row(std::move(rows[k]), std::move(results[k]), spec, centres[k]);
     return rows;
@@ -180,17 +167,19 @@ std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vect
   SweepRow& row = rows.front();
   const Scene scene = thesis_scene(point_params(spec, row.point));
   if (spec.scattering) {
-    row = encounter_row(std::move(row), method, scene, point_spec(spec, row.point), spec.max_energy_error);
+    row = encounter_row(std::move(row), method, scene, point_advance(spec, method, row.point), spec.max_energy_error);
     return rows;
   }
-  try {
-    // The run first: an argument list that also moved `row` may move it before reading row.point.
-    RunResult result = run(method, scene.bodies.front(), scene.centres, point_spec(spec, row.point));
-    row = run_row(std::move(row), std::move(result), spec, scene.centres);
-  } catch (const std::exception& e) {  // run() throws the method's refusal, or why the run stopped
-    const bool refused = !refusal(method, scene.bodies.front(), scene.centres).empty();
-    row = unrun_row(std::move(row), refused ? Outcome::refused : Outcome::failed, e.what());
+  Options options;
+  options.max_energy_error = spec.max_energy_error;
+  BodyResult r = integrate_body(scene.bodies.front(), scene.centres, &method, point_advance(spec, method, row.point), options);
+  if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) {
+    row = unrun_row(std::move(row), r.outcome, std::move(r.reason));
+    return rows;
   }
+  row.result = std::move(r.run);
+  row.outcome = r.outcome;
+  row.reason = std::move(r.reason);
   return rows;
 }
 

@@ -34,10 +34,10 @@ struct Member {
 /// and B != 0.
 bool accepts(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres);
 
-/// Runs up to width() members (or, given, `lanes` of widths()) for spec.steps steps of spec.h with
+/// Runs up to width() members (or, given, `lanes` of widths()) for spec.steps fixed steps of spec.h with
 /// invariants tracked; one result per member, as `run` returns it (wall_s: the batch's time shared
 /// equally). Throws Error when the method has no batch kernel or there are too many members.
-std::vector<RunResult> run(const MethodInfo& method, const std::vector<Member>& members, const RunSpec& spec,
+std::vector<RunResult> run(const MethodInfo& method, const std::vector<Member>& members, const FixedSteps& spec,
                            std::size_t lanes = 0);
 
 }  // namespace bodypoint::batch

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "bodypoint/field.hpp"
+#include "bodypoint/invariant_stats.hpp"
 #include "bodypoint/model.hpp"
 
 #include <algorithm>
@@ -38,29 +39,6 @@ inline Vec3 total_angular_momentum(const BodyPoint& p, const State& s, const Vec
 
 inline double proper_momentum_sq(const BodyPoint& p, const State& s) {
   return (p.B * s.v + p.J * s.w).squaredNorm();
-}
-
-/// Maxima over a run of the thesis's metric |X_i - X_0|/|X_0| (absolute where X_0 = 0) and of
-/// |K2Q_i - K2Q_0|. `has_K2Q` is false in fields where K2Q is not an integral.
-struct InvariantStats {
-  double max_rel_dE = 0.0;
-  double max_rel_dK2sq = 0.0;
-  double max_abs_dK2Q = 0.0;
-  bool has_K2Q = false;
-  /// Closest observed distance to an attracting centre, and the distance at the start (both infinite
-  /// without an attracting centre): a fall onto a centre shows as min/start ~ 0.
-  double min_r_attracting = std::numeric_limits<double>::infinity();
-  double r0_attracting = std::numeric_limits<double>::infinity();
-  /// Resolution (docs/physics.md "Resolution"): the largest angle the spin turned through about K1 in
-  /// one step, Omega_so dt with Omega_so = |B| |K1|/D at the step's end, and the cosine of the largest
-  /// angle through which the direction to a centre (A != 0) turned in one step (1: none turned).
-  double max_spin_angle = 0.0;
-  double min_turn_cos = 1.0;
-};
-
-inline double relative_deviation(double x, double x0) {
-  const double scale = std::abs(x0);
-  return scale > 0.0 ? std::abs(x - x0) / scale : std::abs(x - x0);
 }
 
 /// Tracks the deviations of every integral the field has; one call per observed state, `step` for

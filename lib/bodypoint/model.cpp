@@ -23,6 +23,21 @@ void require_finite(const Vec3& x, const std::string& what) {
 
 }  // namespace
 
+double require_positive(double x, std::string_view what) {
+  if (!(std::isfinite(x) && x > 0.0)) throw Error(std::string(what) + " must be a finite number > 0, got " + num(x));
+  return x;
+}
+
+double require_non_negative(double x, std::string_view what) {
+  if (!(std::isfinite(x) && x >= 0.0)) throw Error(std::string(what) + " must be a finite number >= 0, got " + num(x));
+  return x;
+}
+
+long require_count(long n, std::string_view what) {
+  if (n < 1) throw Error(std::string(what) + " must be a whole number >= 1, got " + std::to_string(n));
+  return n;
+}
+
 void validate(const BodyPoint& p, const std::string& who) {
   require_finite(p.m, who + ": m");
   require_finite(p.B, who + ": B");

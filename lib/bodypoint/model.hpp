@@ -26,6 +26,13 @@ struct Error : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The one wording of a number's range, shared by every check of the library and the commands: each
+/// throws Error("<what> must be a finite number > 0, got <x>") (>= 0; a whole number >= 1) and
+/// returns x when it is in range.
+double require_positive(double x, std::string_view what);
+double require_non_negative(double x, std::string_view what);
+long require_count(long n, std::string_view what);
+
 /// D = m J - B^2 must exceed this multiple of m J (about 45 rounding errors of m J - B^2): below it
 /// the sign and size of D are not resolved in double precision.
 constexpr double kMinRelativeD = 1e-14;

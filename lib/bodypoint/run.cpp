@@ -40,8 +40,9 @@ bool reproduces_code(const std::vector<Centre>& centres) {
 }
 
 template <template <class, bool> class Kernel, const auto& Seq, sp::CodeSlip Slip = sp::CodeSlip::none>
-RunResult run_splitting(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
-                        const SampleSink* sink) {
+RunResult run_splitting(const Body& body, const std::vector<Centre>& centres, const Advance& how,
+                        const RunOptions& options) {
+  const auto& fixed = std::get<FixedSteps>(how);
   return dispatch(body, centres, [&](const auto& field, auto spin) {
     using Field = std::decay_t<decltype(field)>;
     using K = Kernel<Field, decltype(spin)::value>;
@@ -49,9 +50,9 @@ RunResult run_splitting(const Body& body, const std::vector<Centre>& centres, co
     if constexpr (Slip != sp::CodeSlip::none)
       if (reproduces_code(centres)) kernel.slip = Slip;
     auto to_physical = [&kernel](const typename K::state_type& x) { return kernel.to_physical(x); };
-    RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
+    RunResult r = observe(body.p, field, body.s0, options, detail::grid_of(fixed), to_physical, [&](auto& obs) {
       typename K::state_type x = kernel.initial_state(body.s0);
-      sp::integrate<Seq>(kernel, x, spec.h, spec.steps, obs);
+      sp::integrate<Seq>(kernel, x, fixed.h, fixed.steps, obs);
       return kernel.to_physical(x);
     });
     r.force_evals = kernel.evals;
@@ -96,11 +97,11 @@ std::string kepler_split_check(const MethodInfo& m, const Body& /*body*/, const 
 
 /// The Kepler split of table T: two parts for one centre, three (the other centres' kicks) for several.
 template <sp::TableType T>
-RunResult run_kepler_split(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
-                           const SampleSink* sink) {
+RunResult run_kepler_split(const Body& body, const std::vector<Centre>& centres, const Advance& how,
+                           const RunOptions& options) {
   static_assert(sp::is_dkd_composition(T::table), "the three-part Kepler split needs a DKD composition");
-  if (centres.size() == 1) return run_splitting<sp::KeplerSplitKernel, sp::ops_of<T>>(body, centres, spec, sink);
-  return run_splitting<sp::KeplerSplitKernel, sp::three_part_ops_of<T>>(body, centres, spec, sink);
+  if (centres.size() == 1) return run_splitting<sp::KeplerSplitKernel, sp::ops_of<T>>(body, centres, how, options);
+  return run_splitting<sp::KeplerSplitKernel, sp::three_part_ops_of<T>>(body, centres, how, options);
 }
 
 /// The row of a Kepler-split method from its entry in KeplerSplitTables (catalogue.hpp).
@@ -161,7 +162,6 @@ void check_energy_bound(double max_energy_error) {
 }
 
 Checks checks_for(const MethodInfo& m, const std::vector<Centre>& centres, double max_energy_error) {
-  check_energy_bound(max_energy_error);
   Checks c;
   c.max_energy_error = max_energy_error;
   c.energy_is_integral = !non_coulomb(centres);
@@ -179,61 +179,95 @@ Health assess(const RunResult& r, const Checks& checks) {
   const InvariantStats* inv = r.invariants ? &*r.invariants : nullptr;
   const bool fell = inv && inv->min_r_attracting < kCollisionFraction * inv->r0_attracting;
   const bool energy = inv && checks.energy_is_integral;
-  std::string status = "diverged", why;
+  Outcome outcome = Outcome::diverged;
+  std::string why;
   if (!finite) why = "the state became non-finite (NaN/inf)";
   else if (inv && !(std::isfinite(inv->max_rel_dE) && std::isfinite(inv->max_rel_dK2sq) && std::isfinite(inv->max_abs_dK2Q)))
     why = "an invariant became non-finite";
   else if (energy && inv->max_rel_dE > kDivergedEnergy)
     why = "the relative energy error reached " + detail::short_number(inv->max_rel_dE) + " (above 1)";
   else if (inv && !checks.spin_exact && inv->max_spin_angle > kMaxSpinAngle) {
-    status = "unresolved";
+    outcome = Outcome::unresolved;
     why = "a step turned the spin by " + detail::short_number(inv->max_spin_angle) +
           " rad about K1 (more than pi: the spin-orbit rotation is not resolved)";
   } else if (inv && !checks.orbit_exact && inv->min_turn_cos < std::cos(kMaxTurnAngle)) {
-    status = "unresolved";
+    outcome = Outcome::unresolved;
     why = "a step turned the direction to a centre by " + detail::short_number(std::acos(std::max(-1.0, inv->min_turn_cos))) +
           " rad (more than pi/2: the encounter is not resolved)";
   } else if (energy && inv->max_rel_dE > checks.max_energy_error) {
-    status = "inaccurate";
+    outcome = Outcome::inaccurate;
     why = "the relative energy error reached " + detail::short_number(inv->max_rel_dE) + " (above the bound " +
           detail::short_number(checks.max_energy_error) + ")";
   }
-  if (why.empty()) return {"ok", ""};
+  if (why.empty()) return {Outcome::ok, ""};
   if (fell)
-    return {"collision", why + " after a fall onto an attracting centre (closest approach " +
+    return {Outcome::collision, why + " after a fall onto an attracting centre (closest approach " +
                              detail::short_number(inv->min_r_attracting) + " from a start at " +
                              detail::short_number(inv->r0_attracting) + ")"};
-  return {status, why};
+  return {outcome, why};
 }
 
 std::string refusal(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres) {
   return m.check ? m.check(m, body, centres) : std::string();
 }
 
-Advance advance_of(const MethodInfo& m, const RunSpec& spec) {
-  if (!std::isfinite(spec.h) || spec.h <= 0.0)
-    throw Error("step size h must be a finite number > 0, got " + std::to_string(spec.h));
-  if (spec.every < 1) throw Error("every must be >= 1");
-  if (is_time_transformed(m)) {
-    if (spec.t_end < 0.0 || !std::isfinite(spec.t_end)) throw Error("end time must be a finite number >= 0");
-    if (spec.t_end == 0.0 && spec.steps < 1) throw Error("give a number of fictitious steps or an end time");
-    if (spec.dt_out < 0.0 || !std::isfinite(spec.dt_out)) throw Error("dt_out must be a finite number >= 0");
-    return FictitiousSteps{spec.h, spec.t_end, spec.t_end == 0.0 ? spec.steps : 0, spec.dt_out};
-  }
-  if (spec.steps < 1) throw Error("number of steps must be >= 1");
-  if (!is_step_controlled(m)) return FixedSteps{spec.h, spec.steps};
-  const double t_end = spec.t_end == 0.0 ? spec.h * static_cast<double>(spec.steps) : spec.t_end;
-  if (!std::isfinite(t_end) || t_end <= 0.0) throw Error("end time must be a finite number > 0");
-  if (!std::isfinite(spec.tol) || spec.tol <= 0.0) throw Error("the tolerance tol must be a finite number > 0");
-  if (spec.tol < kMinStepTolerance)
-    throw Error("tol " + detail::short_number(spec.tol) + " is below what double precision can deliver (a step's "
-                "rounding is ~1e-16 relative; the smallest tolerance taken is 1e-15)");
-  return ControlledSteps{spec.h, t_end, spec.tol};
+void check(const Advance& how) {
+  std::visit(
+      [](const auto& a) {
+        using A = std::decay_t<decltype(a)>;
+        if constexpr (std::is_same_v<A, FixedSteps>) {
+          require_positive(a.h, "the step h");
+          require_count(a.steps, "the number of steps");
+        } else if constexpr (std::is_same_v<A, FictitiousSteps>) {
+          require_positive(a.ds, "the fictitious step ds");
+          if (a.end.index() == 0) require_positive(a.t_end(), "the end time t_end");
+          else require_count(a.steps(), "the number of fictitious steps");
+        } else if constexpr (std::is_same_v<A, ControlledSteps>) {
+          require_positive(a.h0, "the first trial step h0");
+          require_positive(a.t_end, "the end time t_end");
+          require_positive(a.tol, "the tolerance per step tol");
+          if (a.tol < kMinStepTolerance)
+            throw Error("the tolerance per step tol " + detail::short_number(a.tol) + " is below what double "
+                        "precision can deliver (a step's rounding is ~1e-16 relative; the smallest taken is 1e-15)");
+        } else {
+          require_positive(a.t_end, "the end time t_end");
+        }
+        require_non_negative(a.dt_out, "the output interval dt_out");
+      },
+      how);
+}
+
+double output_interval(const Advance& how) {
+  return std::visit([](const auto& a) -> double { return a.dt_out; }, how);
+}
+
+void check(const RunOptions& options) {
+  require_count(options.every, "every (the sampling interval in steps)");
+  if (std::isnan(options.omega_c) || options.omega_c == std::numeric_limits<double>::infinity())
+    throw Error("the time-step constant omega_c must be a finite number >= 0 (< 0: chosen from the scene), got " +
+                detail::short_number(options.omega_c));
+}
+
+void check_takes(const MethodInfo& m, const Advance& how) {
+  const char* takes = is_time_transformed(m) ? "FictitiousSteps" : is_step_controlled(m) ? "ControlledSteps" : "FixedSteps";
+  const bool ok = std::visit(
+      [&m](const auto& a) {
+        using A = std::decay_t<decltype(a)>;
+        if constexpr (std::is_same_v<A, FixedSteps>) return !has_variable_step(m);
+        else if constexpr (std::is_same_v<A, FictitiousSteps>) return is_time_transformed(m);
+        else if constexpr (std::is_same_v<A, ControlledSteps>) return is_step_controlled(m);
+        else return false;
+      },
+      how);
+  if (ok) return;
+  if (std::holds_alternative<Accuracy>(how))
+    throw Error("the accuracy mode chooses its own step: its run of " + m.name + " takes " + takes);
+  throw Error(m.name + " takes " + takes + ", not the way of advancing time given");
 }
 
 FixedSteps fixed_steps_to(double t_end, double h_max) {
-  if (!(std::isfinite(h_max) && h_max > 0.0)) throw Error("step size h must be a finite number > 0");
-  if (!(std::isfinite(t_end) && t_end > 0.0)) throw Error("end time must be a finite number > 0");
+  require_positive(h_max, "the step h");
+  require_positive(t_end, "the end time t_end");
   const double n = std::ceil(t_end / h_max * (1.0 - 1e-12));
   if (!(n <= 1e13)) throw Error("end time / step size asks for more than 1e13 steps");
   const long steps = std::max(1L, static_cast<long>(n));
@@ -241,10 +275,10 @@ FixedSteps fixed_steps_to(double t_end, double h_max) {
 }
 
 FixedSteps thesis_code_steps(double h, long steps, double t_end) {
-  if (!(std::isfinite(h) && h > 0.0)) throw Error("step size h must be a finite number > 0");
+  require_positive(h, "the step h");
   double n = static_cast<double>(steps);
   if (t_end > 0.0) {
-    if (!std::isfinite(t_end)) throw Error("end time must be a finite number > 0");
+    require_positive(t_end, "the end time t_end");
     n = std::trunc(t_end / h);
   }
   if (!(n <= 1e13)) throw Error("end time / step size asks for more than 1e13 steps");
@@ -253,16 +287,27 @@ FixedSteps thesis_code_steps(double h, long steps, double t_end) {
   return {h, static_cast<long>(n) - 1};
 }
 
-RunResult run(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
-              const RunSpec& spec, const SampleSink* sink) {
+std::string_view outcome_name(Outcome o) {
+  switch (o) {
+    case Outcome::ok: return "ok";
+    case Outcome::diverged: return "diverged";
+    case Outcome::collision: return "collision";
+    case Outcome::refused: return "refused";
+    case Outcome::failed: return "failed";
+    case Outcome::unresolved: return "unresolved";
+    case Outcome::inaccurate: return "inaccurate";
+  }
+  return "?";
+}
+
+RunResult run(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres, const Advance& how,
+              const RunOptions& options) {
   validate(Scene{centres, {body}});
-  const Advance advance = advance_of(method, spec);
+  check(how);
+  check_takes(method, how);
+  check(options);
   if (const std::string why = refusal(method, body, centres); !why.empty()) throw Error(why);
-  // The driver reads the run specification with the end time the advance settled on (a
-  // step-size-controlled run without t_end runs to steps h).
-  RunSpec s = spec;
-  if (const auto* c = std::get_if<ControlledSteps>(&advance)) s.t_end = c->t_end;
-  return method.run(body, centres, s, sink);
+  return method.run(body, centres, how, options);
 }
 
 }  // namespace bodypoint

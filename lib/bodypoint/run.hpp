@@ -1,40 +1,27 @@
 // bodypoint: running one method on one body of a scene (the core layer's interface to every method).
 //
-// A method is a MethodInfo row: its family, order and cost, and the function that runs it. `run`
-// validates the inputs once and calls it. Fixed-step methods take `steps` steps of size h from t0 = 0
-// (time is t0 + i h, never a running sum); step-size-controlled methods run to t_end with --tol;
-// time-transformed methods (adaptive/) take fictitious steps ds = h. Invariants are tracked only when
-// asked for, and states are handed to a sink only when one is given: with neither, the step loop runs
-// with a null observer and stores nothing. This layer lists its own methods (core_methods); the
-// registry of every method is one layer up (bodypoint/methods.hpp).
+// A run is one method, one way of advancing time (Advance: fixed steps, fictitious steps, step-size
+// control, or an accuracy that searches one of those) and the observations asked for (RunOptions). The
+// Advance is checked once, where its alternatives are defined (check, check_takes); the method's driver
+// reads the alternative it takes and nothing else. Invariants are tracked only when asked for, and
+// states are handed to a sink only when one is given: with neither, the step loop runs with a null
+// observer and stores nothing. This layer lists its own methods (core_methods); the registry of every
+// method is one layer up (bodypoint/methods.hpp).
 #pragma once
 
-#include "bodypoint/invariants.hpp"
+#include "bodypoint/invariant_stats.hpp"
 #include "bodypoint/model.hpp"
 
 #include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <type_traits>
+#include <utility>
 #include <variant>
 #include <vector>
 
 namespace bodypoint {
-
-/// What a run is asked to do; its defaults are the defaults of every command (the thesis's h = 1e-4,
-/// n = 500000 of table 3.1, tol 1e-10).
-struct RunSpec {
-  double h = 1e-4;       ///< fixed step; for adaptive methods the first trial step
-  long steps = 500000;   ///< fixed-step methods: number of steps (t_end = steps h)
-  double t_end = 0.0;    ///< adaptive methods: end time (0: steps h)
-  double tol = 1e-10;    ///< adaptive methods: relative and absolute error tolerance per step
-  double dt_out = 0.0;   ///< time-transformed methods with a sink: sample at t = k dt_out (0: every-th step)
-  /// time-transformed methods: constant c added to the time-step function (logH: Pi + c, TTL:
-  /// sum |A_i|/r_i + c), so the physical step is at most ds/c; < 0: chosen from the scene
-  double omega_c = -1.0;
-  bool track_invariants = false;
-  long every = 1;  ///< hand every `every`-th state (and the last) to the sink
-};
 
 /// One observed state with the deviations of the integrals the field has.
 struct Sample {
@@ -52,14 +39,37 @@ struct KeptSample {
   static KeptSample of(const Sample& x) { return {x.step, x.t, x.s, x.rel_dE, x.rel_dK2sq, x.abs_dK2Q}; }
   [[nodiscard]] Sample sample() const { return {step, t, s, rel_dE, rel_dK2sq, abs_dK2Q}; }
 };
-using SampleSink = std::function<void(const Sample&)>;
-/// Thrown by a sink to end a run after the state it was just handed (an event that stops the run).
-/// The run returns what it has: that state as final, its step and time, the invariants up to it,
-/// the force evaluations made, stopped = true.
-struct StopRun {
-  long step;
-  double t;
-  State s;
+/// What a sink tells the run after a state: go on, or end the run at that state.
+enum class Flow { go, stop };
+
+/// Receives observed states. A callable returning Flow may end the run: after Flow::stop the run
+/// returns what it has, that state as final, its step and time, the invariants up to it and the force
+/// evaluations made, with RunResult::stopped set (the accuracy mode hands its delivered run's states on
+/// after its search: there Flow::stop ends the samples, not the run). A callable returning nothing
+/// always goes on.
+class SampleSink {
+ public:
+  SampleSink() = default;
+  template <class F>
+    requires(!std::is_same_v<std::decay_t<F>, SampleSink> && std::is_invocable_v<F&, const Sample&>)
+  SampleSink(F f)  // NOLINT(google-explicit-constructor): a lambda is a sink
+      : f_(wrap(std::move(f))) {}
+  Flow operator()(const Sample& s) const { return f_(s); }
+  explicit operator bool() const { return static_cast<bool>(f_); }
+
+ private:
+  template <class F>
+  static std::function<Flow(const Sample&)> wrap(F f) {
+    if constexpr (std::is_same_v<std::invoke_result_t<F&, const Sample&>, Flow>) {
+      return f;
+    } else {
+      return [g = std::move(f)](const Sample& s) mutable {
+        g(s);
+        return Flow::go;
+      };
+    }
+  }
+  std::function<Flow(const Sample&)> f_;
 };
 
 struct RunResult {
@@ -70,7 +80,7 @@ struct RunResult {
   double wall_s = 0.0;
   std::optional<InvariantStats> invariants;
   double min_step = 0.0, max_step = 0.0;  ///< smallest and largest accepted physical step
-  bool stopped = false;  ///< a sink ended the run early (StopRun): t_end is where
+  bool stopped = false;  ///< a sink ended the run early (Flow::stop): t_end is where
 };
 
 /// Thesis: the thesis's drift/kick schemes; LiePoisson: exact splittings; Odeint: fixed-step
@@ -110,6 +120,71 @@ constexpr std::string_view family_key(Family f) {
   return "?";
 }
 
+/// The three ways of advancing time, one driver each, and the accuracy mode that searches the step of
+/// one of them:
+///   FixedSteps       `steps` steps of h, time i h (the composition engine and Odeint's fixed-step loop
+///                    under one observer: run_support.hpp);
+///   FictitiousSteps  steps of ds in a fictitious time, to exactly an end time or a number of steps
+///                    (FictitiousLoop, adaptive/run.cpp: time-transformed and regularised methods);
+///   ControlledSteps  step-size control to exactly t_end at tolerance tol per step from a first trial
+///                    step h0 (controlled_loop, run_support.hpp: Boost.Odeint's and GSL's steppers).
+/// dt_out > 0 (with a sink) hands the sink the states at t = k dt_out and at the end instead of every
+/// `every`-th step's; fixed and controlled steps reach an output time inside a step by a shorter step of
+/// the same method from that step's start (integrate.cpp), fictitious steps inside their loop.
+struct FixedSteps {
+  double h;
+  long steps;
+  double dt_out = 0.0;
+};
+/// How a run of fictitious steps ends: at exactly this physical time, or after this many steps.
+struct EndTime {
+  double t;
+};
+struct StepCount {
+  long n;
+};
+struct FictitiousSteps {
+  double ds;
+  std::variant<EndTime, StepCount> end;
+  double dt_out = 0.0;
+  /// The end time (0 when the run counts steps) and the number of steps (0 when it runs to a time).
+  [[nodiscard]] double t_end() const { return end.index() == 0 ? std::get<EndTime>(end).t : 0.0; }
+  [[nodiscard]] long steps() const { return end.index() == 1 ? std::get<StepCount>(end).n : 0; }
+};
+struct ControlledSteps {
+  double h0, t_end, tol;
+  double dt_out = 0.0;
+};
+/// The accuracy mode: the final state's relative error max(|dR|/|R|, |dv|/|v|) at t_end is to be at
+/// most tol; the step (h, or ds) is searched with a Richardson error estimate (adaptive/tolerance.hpp).
+struct Accuracy {
+  double tol, t_end;
+  double dt_out = 0.0;  ///< with a sink: samples at t = k dt_out
+};
+using Advance = std::variant<FixedSteps, FictitiousSteps, ControlledSteps, Accuracy>;
+
+/// Every number of `how` checked, each with one message naming the quantity: steps and times finite
+/// and > 0, counts >= 1, dt_out >= 0, a tolerance per step in [1e-15, inf). The accuracy mode's
+/// tolerance is checked by adaptive::check_tolerance, one layer up.
+void check(const Advance& how);
+/// The output interval of any way of advancing time (0: none).
+double output_interval(const Advance& how);
+
+/// What a run asks for besides the way of advancing time; the API's Options add events and the bound
+/// on the energy error. By default the invariants are tracked and nothing else is kept.
+struct RunOptions {
+  bool track_invariants = true;
+  /// Receives the observed states (the first, every `every`-th and the last; with dt_out > 0 the states
+  /// at t = k dt_out and the last). nullptr: no samples.
+  const SampleSink* sink = nullptr;
+  long every = 1;
+  /// Time-transformed methods: the constant c of the time-step function (logH: Pi + c, TTL:
+  /// sum |A_i|/r_i + c), so the physical step is at most ds/c; < 0: chosen from the scene.
+  double omega_c = -1.0;
+};
+/// Throws Error unless every >= 1 and omega_c is finite (< 0: automatic).
+void check(const RunOptions& options);
+
 /// Why a method cannot run a (valid) scene, in one line; empty when it can. A family's assumptions:
 /// Coulomb's law and the sign of A for the time transformations, B = 0 and one centre for ks.
 struct MethodInfo;
@@ -122,7 +197,8 @@ struct MethodInfo {
   int stages;           ///< sub-steps (kicks) per step as written
   int evals_per_step;   ///< force evaluations per step in a long run without per-step output
   std::string description;
-  RunResult (*run)(const Body&, const std::vector<Centre>&, const RunSpec&, const SampleSink*);
+  /// The driver: takes the Advance alternative of its kind (never Accuracy), already checked.
+  RunResult (*run)(const Body&, const std::vector<Centre>&, const Advance&, const RunOptions&);
   SceneCheck check = nullptr;  ///< nullptr: runs every valid scene
 };
 
@@ -134,8 +210,8 @@ std::string refusal(const MethodInfo& m, const Body& body, const std::vector<Cen
 /// step-size-controlled peers (Odeint, GSL), the thesis's schemes and the exact Lie-Poisson splittings.
 const std::vector<MethodInfo>& core_methods();
 
-/// True for methods that choose their own steps from a tolerance per step (spec.tol, spec.t_end
-/// apply): Boost.Odeint's and GSL's controlled steppers.
+/// True for methods that choose their own steps from a tolerance per step (ControlledSteps):
+/// Boost.Odeint's and GSL's controlled steppers.
 inline bool is_step_controlled(const MethodInfo& m) {
   return m.family == Family::OdeintAdaptive || m.family == Family::Gsl;
 }
@@ -143,8 +219,7 @@ inline bool is_step_controlled(const MethodInfo& m) {
 inline bool is_peer(const MethodInfo& m) {
   return m.family == Family::Odeint || m.family == Family::OdeintAdaptive || m.family == Family::Gsl;
 }
-/// True for methods with a fixed fictitious step (time-transformed and regularised): spec.h is ds;
-/// with spec.t_end > 0 they run to exactly t_end, otherwise spec.steps fictitious steps.
+/// True for methods with a fixed fictitious step (FictitiousSteps): time-transformed and regularised.
 inline bool is_time_transformed(const MethodInfo& m) {
   return m.family == Family::TimeTransformed || m.family == Family::Regularised;
 }
@@ -160,9 +235,22 @@ inline bool has_variable_step(const MethodInfo& m) { return is_step_controlled(m
 ///               kDefaultMaxEnergyError);
 /// and "collision" instead of any of them after coming closer to an attracting centre than
 /// kCollisionFraction of the starting distance (the fall is the cause).
+/// How a run ended.
+enum class Outcome {
+  ok,          ///< the run reached its end in the regime its numbers mean something in
+  diverged,    ///< a non-finite state or invariant, or an energy error above kDivergedEnergy
+  collision,   ///< diverged, unresolved or inaccurate after falling onto an attracting centre
+  refused,     ///< the method does not apply to this scene (not run; the reason says why)
+  failed,      ///< started but stopped: a budget, a time transformation that broke down, an accuracy out of reach
+  unresolved,  ///< a step turned the spin by more than pi or the direction to a centre by more than pi/2
+  inaccurate,  ///< the energy error exceeded the bound asked for (but not 1)
+};
+/// The outcome as one word, for outputs (ok, diverged, collision, refused, failed, unresolved, inaccurate).
+std::string_view outcome_name(Outcome o);
+
 struct Health {
-  std::string status;  ///< ok, diverged, unresolved, inaccurate or collision
-  std::string why;     ///< one line for a message, empty when ok
+  Outcome outcome = Outcome::ok;  ///< ok, diverged, unresolved, inaccurate or collision
+  std::string why;                ///< one line for a message, empty when ok
 };
 /// An energy error larger than the energy itself: the numbers no longer describe the motion.
 constexpr double kDivergedEnergy = 1.0;
@@ -188,40 +276,11 @@ struct Checks {
 /// Throws Error unless max_energy_error is a bound assess() can hold a run to: > 0, not NaN
 /// (infinity turns the accuracy flag off).
 void check_energy_bound(double max_energy_error);
-/// The checks for runs of `m` on a scene with these centres, with the bound max_energy_error
-/// (check_energy_bound).
+/// The checks for runs of `m` on a scene with these centres, with the bound max_energy_error (as
+/// check_energy_bound takes it; the caller checks it once per run or sweep).
 Checks checks_for(const MethodInfo& m, const std::vector<Centre>& centres,
                   double max_energy_error = kDefaultMaxEnergyError);
 Health assess(const RunResult& r, const Checks& checks = {});
-
-/// The three ways of advancing time, one driver each: fixed steps h, time i h (the composition engine
-/// and Odeint's fixed-step loop, under one observer: run_support.hpp); fixed fictitious steps ds to
-/// exactly t_end, or `steps` of them when t_end = 0, with output times dt_out (FictitiousLoop,
-/// adaptive/run.cpp); step-size control to exactly t_end at tolerance tol from a first trial step h0
-/// (controlled_loop, run_support.hpp). dt_out > 0 (with a sink) hands the sink the states at
-/// t = k dt_out and at the end instead of every `every`-th step's; fixed and controlled steps reach an
-/// output time inside a step by a shorter step of the same method from that step's start (integrate.cpp).
-struct FixedSteps {
-  double h;
-  long steps;
-  double dt_out = 0.0;
-};
-struct FictitiousSteps {
-  double ds, t_end;
-  long steps;
-  double dt_out;
-};
-struct ControlledSteps {
-  double h0, t_end, tol;
-  double dt_out = 0.0;
-};
-/// The accuracy mode: the final state's relative error max(|dR|/|R|, |dv|/|v|) at t_end is to be at
-/// most tol; the step (h, or ds) is searched with a Richardson error estimate (adaptive/tolerance.hpp).
-struct Accuracy {
-  double tol, t_end;
-  double dt_out = 0.0;  ///< with a sink, when the method chosen is time-transformed: samples at t = k dt_out
-};
-using Advance = std::variant<FixedSteps, FictitiousSteps, ControlledSteps, Accuracy>;
 
 /// Fixed steps that land exactly on t_end: n = ceil(t_end / h_max) steps of t_end / n (a quotient
 /// within 1e-12 of a whole number counts as that number). Throws Error beyond 1e13 steps.
@@ -233,13 +292,15 @@ FixedSteps fixed_steps_to(double t_end, double h_max);
 /// Throws Error when that leaves no step (n < 2) or asks for more than 1e13.
 FixedSteps thesis_code_steps(double h, long steps, double t_end);
 
-/// How `m` advances time under `spec` (never Accuracy, which chooses its own spec), every number of it checked (h > 0 and finite, every >= 1;
-/// steps >= 1 or an end time; tol in [1e-15, inf)): the one place a run specification is validated.
-Advance advance_of(const MethodInfo& m, const RunSpec& spec);
+/// Throws Error unless `m` takes this way of advancing time (FixedSteps for fixed-step methods,
+/// FictitiousSteps for time-transformed ones, ControlledSteps for step-size-controlled ones; Accuracy
+/// for none: it searches the step of one of the others).
+void check_takes(const MethodInfo& m, const Advance& how);
 
-/// Validates the scene and the run specification (advance_of), asks the method whether it accepts
-/// the scene (refusal), and runs.
-RunResult run(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
-              const RunSpec& spec, const SampleSink* sink = nullptr);
+/// Checks the scene, `how` and `options` (check, check_takes), asks the method whether it accepts the
+/// scene (refusal, thrown as Error), and runs. The public API's integrate() (bodypoint.hpp) is what
+/// programs call; this is the core's entry for its own tests and benchmarks.
+RunResult run(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres, const Advance& how,
+              const RunOptions& options = {});
 
 }  // namespace bodypoint

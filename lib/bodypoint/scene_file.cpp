@@ -134,7 +134,6 @@ Scene read_scene_file(const std::string& path) {
     throw Error(path + ": the scene file is larger than 16 MB");
   std::ifstream in(path);
   if (!in) throw Error(path + ": cannot open scene file");
-  register_input(path);
   std::ostringstream ss;
   ss << in.rdbuf();
   return parse_scene(ss.str(), path);

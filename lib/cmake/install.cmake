@@ -16,6 +16,7 @@ install(FILES
           ${PROJECT_SOURCE_DIR}/lib/api/bodypoint/methods.hpp
           ${PROJECT_SOURCE_DIR}/lib/api/bodypoint/sweep.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/field.hpp
+          ${PROJECT_SOURCE_DIR}/lib/bodypoint/invariant_stats.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/invariants.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/model.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/run.hpp

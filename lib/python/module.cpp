@@ -150,27 +150,11 @@ py::dict body_result(const Body& body, const BodyResult& r, const std::vector<Ev
   return d;
 }
 
-/// The Advance the keywords ask for, by the method's kind (the command line's rules, cli.hpp).
-Advance advance_for(const MethodInfo* m, std::optional<double> h, std::optional<long> steps,
-                    std::optional<double> t_end, std::optional<double> tol, bool code_loop) {
-  if (!m || (tol && !is_step_controlled(*m))) {
-    if (!tol) throw Error("method 'auto' needs tol (the accuracy to deliver)");
-    if (!t_end) throw Error("the accuracy mode (tol) needs t_end");
-    if (h || steps) throw Error("tol chooses the step: give t_end, not h or steps");
-    return Accuracy{*tol, *t_end};
-  }
-  if (h && !(std::isfinite(*h) && *h > 0.0)) throw Error("h must be a finite number > 0");
-  const double step = h.value_or(RunSpec{}.h);
-  if (t_end && steps) throw Error("give steps or t_end, not both");
-  if (is_step_controlled(*m)) {
-    const double end = t_end ? *t_end : step * static_cast<double>(steps.value_or(RunSpec{}.steps));
-    return ControlledSteps{std::min(step, end), end, tol.value_or(RunSpec{}.tol)};
-  }
-  if (is_time_transformed(*m)) return FictitiousSteps{step, t_end.value_or(0.0), t_end ? 0 : steps.value_or(RunSpec{}.steps), 0.0};
-  // A scene of the thesis's code counts its steps as that code did (n - 1 of n; run.hpp).
-  if (code_loop) return thesis_code_steps(step, steps.value_or(RunSpec{}.steps), t_end.value_or(0.0));
-  if (t_end) return fixed_steps_to(*t_end, step);
-  return FixedSteps{step, steps.value_or(RunSpec{}.steps)};
+/// The Advance the keywords ask for: the library's one mapping (advance_for, bodypoint.hpp).
+Advance advance_of_keywords(const MethodInfo* m, std::optional<double> h, std::optional<long> steps,
+                            std::optional<double> t_end, std::optional<double> tol, bool code_loop) {
+  StepRequest request{h, steps, t_end, tol, 0.0, code_loop};
+  return advance_for(m, request);
 }
 
 Event event_from(const std::string& text) {
@@ -199,7 +183,7 @@ py::dict integrate_py(const Scene& scene, const std::string& method, std::option
   const MethodInfo* m = method == "auto" ? nullptr : &method_or_throw(method);
   const bool code_loop = std::any_of(scene.centres.begin(), scene.centres.end(),
                                      [](const Centre& c) { return c.law == ForceLaw::thesis_code; });
-  const Advance how = advance_for(m, h, steps, t_end, tol, code_loop);
+  const Advance how = advance_of_keywords(m, h, steps, t_end, tol, code_loop);
   Options o;
   o.track_invariants = invariants;
   o.omega_c = omega_c;

@@ -86,7 +86,7 @@ TEST(LogH, MaterialPointFollowsTheExactKeplerOrbitAtAnyStep) {
   const double mu = s.centres.front().A / b.p.m;
   for (const char* method : {"logh-verlet", "logh-y4", "logh-kl8"}) {
     for (double ds : {1e-3, 1e-2, 0.05}) {
-      RunSpec spec;
+      FlatRun spec;
       spec.h = ds;
       spec.t_end = 80.0;
       spec.track_invariants = true;
@@ -104,7 +104,7 @@ TEST(LogH, MaterialPointFollowsTheExactKeplerOrbitAtAnyStep) {
     }
   }
   // Control: the same encounter with a fixed-step splitting has an energy error that grows with h.
-  RunSpec f;
+  FlatRun f;
   f.steps = 8000;
   f.h = 0.01;
   f.track_invariants = true;
@@ -133,7 +133,7 @@ double ds_slope(const std::string& method, double ds0, bool trapped = false) {
   const double t_end = trapped ? 40.0 : 8.0;
   const State ref = reference_state(s.bodies.front(), s.centres, t_end, 1e-18L);
   return test::ladder_slope(method + (trapped ? " trap" : " encounter"), [&](int k) {
-    RunSpec spec;
+    FlatRun spec;
     spec.h = ds0 / std::pow(std::sqrt(2.0), k);
     spec.t_end = t_end;
     // The trap serves the 8th-order tables, whose asymptotic range is narrow: with the bounded step
@@ -209,7 +209,7 @@ TEST(TimeTransformed, StepShrinksNearTheCentreAndIsBoundedFarAway) {
   const NamedScene ns = named_scene("close");
   Body material = ns.scene.bodies.front();
   material.p.B = 0.0;
-  RunSpec spec;
+  FlatRun spec;
   spec.h = 0.005;
   spec.t_end = 80.0;
   for (const char* m : {"logh-y4", "ttl-y4"}) {
@@ -228,7 +228,7 @@ TEST(TimeTransformed, StepShrinksNearTheCentreAndIsBoundedFarAway) {
 
 TEST(TimeTransformed, OutputAtRequestedPhysicalTimes) {
   const NamedScene ns = named_scene("close");
-  RunSpec spec;
+  FlatRun spec;
   spec.h = 0.005;
   spec.t_end = 80.0;
   spec.dt_out = 2.5;
@@ -254,7 +254,7 @@ TEST(TimeTransformed, DenseOutputCostsOneStepPerOutputAtTheTrajectorysAccuracy) 
   const NamedScene ns = named_scene("close");
   const Body& b = ns.scene.bodies.front();
   auto outputs = [&](double ds, double dt_out, long* evals) {
-    RunSpec spec;
+    FlatRun spec;
     spec.h = ds;
     spec.t_end = 80.0;
     spec.dt_out = dt_out;
@@ -265,7 +265,7 @@ TEST(TimeTransformed, DenseOutputCostsOneStepPerOutputAtTheTrajectorysAccuracy) 
     return states;
   };
   long plain = 0, dense = 0;
-  RunSpec spec;
+  FlatRun spec;
   spec.h = 0.08;
   spec.t_end = 80.0;
   plain = run(method_or_throw("logh-kl8"), b, ns.scene.centres, spec).force_evals;
@@ -285,7 +285,7 @@ TEST(TimeTransformed, RefusalsNameAMethodThatWorks) {
   SceneParams sp;
   sp.A = 2.0;  // attracting
   const Scene s = thesis_scene(sp);
-  RunSpec spec;
+  FlatRun spec;
   spec.h = 0.01;
   spec.t_end = 10;
   try {
@@ -311,7 +311,7 @@ TEST(Ks, ReproducesTheRutherfordHyperbolaToRoundOffAtAnyStep) {
   const Body& b = s.bodies.front();
   const State exact = kepler_body_state(b, s.centres.front(), 80.0);
   for (double ds : {1e-3, 1e-2, 0.1, 1.0}) {
-    RunSpec spec;
+    FlatRun spec;
     spec.h = ds;
     spec.t_end = 80.0;
     const RunResult r = run(method_or_throw("ks"), b, s.centres, spec);
@@ -333,7 +333,7 @@ TEST(Ks, LongFictitiousStepsStayExact) {
   const Body& b = s.bodies.front();
   const State exact = kepler_body_state(b, s.centres.front(), 80.0);
   for (double ds : {0.05, 0.1, 0.3, 1.0, 2.0, 2.3, 3.0, 4.0, 6.0, 8.0}) {
-    RunSpec spec;
+    FlatRun spec;
     spec.h = ds;
     spec.t_end = 80.0;
     spec.dt_out = 10.0;
@@ -357,7 +357,7 @@ TEST(Ks, HeadOnCollisionWithAnAttractingCentreIsRegular) {
   sp.B = 0.0;
   sp.start = {0.0, 20.0, 1.0, 0.0, 0.0};  // d = 0, L = 20, K1 = 1, Kx = Kz = 0
   const Scene s = thesis_scene(sp);
-  RunSpec spec;
+  FlatRun spec;
   spec.h = 0.01;
   spec.t_end = 60.0;
   const RunResult r = run(method_or_throw("ks"), s.bodies.front(), s.centres, spec);
@@ -413,7 +413,7 @@ TEST(TimeTransformed, StressCasesFinishWithinTheirEnergyBounds) {
   for (const StressCase& c : cases) {
     Scene s = thesis_scene(c.sp);
     for (const Centre& e : c.extra) s.centres.push_back(e);
-    RunSpec spec;
+    FlatRun spec;
     spec.h = c.ds;
     spec.t_end = c.t_end;
     spec.track_invariants = true;
@@ -441,7 +441,7 @@ TEST(CloseEncounter, LogHReachesOneEMinusEightWithFarFewerEvaluations) {
   const NamedScene ns = named_scene("close");
   const Body& b = ns.scene.bodies.front();
   const State ref = reference_state(b, ns.scene.centres, 80.0, 1e-18L);
-  RunSpec spec;
+  FlatRun spec;
   spec.h = 0.08;
   spec.t_end = 80.0;
   spec.track_invariants = true;
@@ -452,7 +452,7 @@ TEST(CloseEncounter, LogHReachesOneEMinusEightWithFarFewerEvaluations) {
   // Every fixed-step Lie-Poisson method given 10x the force evaluations stays above 1e-8.
   for (const MethodInfo& m : methods()) {
     if (m.family != Family::LiePoisson) continue;
-    RunSpec f;
+    FlatRun f;
     f.steps = std::max(1L, 10 * lh.force_evals / std::max(1, m.evals_per_step));
     f.h = 80.0 / static_cast<double>(f.steps);
     const RunResult r = run(m, b, ns.scene.centres, f);
@@ -462,7 +462,7 @@ TEST(CloseEncounter, LogHReachesOneEMinusEightWithFarFewerEvaluations) {
   for (const char* m : {"odeint-dopri5", "odeint-rkf78", "odeint-bs"}) {
     bool reached = false;
     for (double tol = 1e-9; tol >= 1e-15; tol /= 10) {
-      RunSpec a;
+      FlatRun a;
       a.tol = tol;
       a.t_end = 80.0;
       const RunResult r = run(method_or_throw(m), b, ns.scene.centres, a);
@@ -490,7 +490,7 @@ TEST(Peers, GslRk8pdAgreesWithTheReference) {
     const NamedScene ns = named_scene(scene);
     const Body& b = ns.scene.bodies.front();
     const State ref = reference_state(b, ns.scene.centres, ns.t_end, 1e-18L);
-    RunSpec spec;
+    FlatRun spec;
     spec.tol = 1e-13;
     spec.t_end = ns.t_end;
     const RunResult r = run(method_or_throw("gsl-rk8pd"), b, ns.scene.centres, spec);
@@ -511,7 +511,7 @@ TEST(Methods, RefusalIsExactlyWhatRunRefuses) {
   code.law = ForceLaw::thesis_code;
   const std::vector<Scene> scenes = {thesis_scene(SceneParams{}), thesis_scene(attracting), thesis_scene(material),
                                      thesis_scene(code), named_scene("two-centres").scene};
-  RunSpec spec;
+  FlatRun spec;
   spec.h = 1e-3;
   spec.steps = 10;
   int refused = 0, accepted = 0;

@@ -24,6 +24,13 @@
 namespace bodypoint {
 namespace {
 
+/// The search's runs observe nothing beyond the final state (the accuracy mode's default observers).
+const RunOptions kUnobserved = [] {
+  RunOptions o;
+  o.track_invariants = false;
+  return o;
+}();
+
 // The estimate is an estimate of the delivered run's error: within this factor of it both ways (the
 // accuracy issue's requirement), where the error is measurable.
 constexpr double kEstimateFactor = 3.0;
@@ -104,7 +111,7 @@ std::vector<Case> cases() {
 /// (the step moved by k kRoundingShift, k = 1..kRoundingTwins).
 double rounding_spread(const MethodInfo& m, const Case& c, double h) {
   const Body& b = c.scene.bodies.front();
-  RunSpec spec;
+  FlatRun spec;
   spec.t_end = c.t_end;
   spec.steps = 0;
   spec.omega_c = adaptive::automatic_omega_c(b, c.scene.centres, h);
@@ -130,7 +137,7 @@ TEST(Tolerance, AutoDeliversTolWithAnHonestEstimate) {
       const MethodInfo& m = choose_method(b, c.scene.centres, tol, &why);
       adaptive::ToleranceResult r;
       try {
-        r = adaptive::run_to_tolerance(m, b, c.scene.centres, tol, c.t_end);
+        r = adaptive::run_to_tolerance(m, b, c.scene.centres, Accuracy{tol, c.t_end}, kUnobserved);
       } catch (const Error& e) {
         // Below the probe's threshold the scene's round-off may be above tol: a refusal that says so is
         // the right answer when it is true.
@@ -177,7 +184,7 @@ TEST(Tolerance, EveryFamilyAcceptsTol) {
   constexpr double tol = 1e-8;
   for (const char* name : {"lp-rkn6", "lp-kl8", "logh-y4", "logh-kl6", "ttl-bm4", "ttl-mcl8"}) {
     const adaptive::ToleranceResult r =
-        adaptive::run_to_tolerance(method_or_throw(name), b, ns.scene.centres, tol, ns.t_end);
+        adaptive::run_to_tolerance(method_or_throw(name), b, ns.scene.centres, Accuracy{tol, ns.t_end}, kUnobserved);
     EXPECT_LE(adaptive::state_distance(r.result.final, ref), tol) << name;
   }
 }
@@ -218,7 +225,7 @@ TEST(Tolerance, UnreachableOrInvalidTolIsRefused) {
   for (double tol : {0.0, -1e-6, std::nan(""), 1e-20, 2.0})
     EXPECT_THROW(adaptive::check_tolerance(tol), Error) << tol;
   // An adaptive peer controls its own step: the search refuses it.
-  EXPECT_THROW(adaptive::run_to_tolerance(method_or_throw("odeint-rkf78"), b, ns.scene.centres, 1e-8, 80.0), Error);
+  EXPECT_THROW(adaptive::run_to_tolerance(method_or_throw("odeint-rkf78"), b, ns.scene.centres, Accuracy{1e-8, 80.0}, kUnobserved), Error);
 }
 
 // A strongly coupled spinning body (B = 0.9) aimed at the centre (b = 1): runs of logh-kl8 at finer
@@ -239,7 +246,7 @@ TEST(Tolerance, ARefusalQuotesTheFloorItMet) {
   const MethodInfo& m = method_or_throw("logh-kl8");
   constexpr double kAsked = 1e-12, kLooser = 1e-11;
   try {
-    adaptive::run_to_tolerance(m, b, scene.centres, kAsked, t_end);
+    adaptive::run_to_tolerance(m, b, scene.centres, Accuracy{kAsked, t_end}, kUnobserved);
     ADD_FAILURE() << "tol " << kAsked << " was delivered; this scene's floor moved (choose another)";
   } catch (const Error& e) {
     const std::string why = e.what();
@@ -250,14 +257,14 @@ TEST(Tolerance, ARefusalQuotesTheFloorItMet) {
     EXPECT_GT(std::stod(why.substr(at + key.size())), kAsked) << why;
   }
   const State ref = reference_state(b, scene.centres, t_end, 1e-18L);
-  const adaptive::ToleranceResult r = adaptive::run_to_tolerance(m, b, scene.centres, kLooser, t_end);
+  const adaptive::ToleranceResult r = adaptive::run_to_tolerance(m, b, scene.centres, Accuracy{kLooser, t_end}, kUnobserved);
   EXPECT_LE(adaptive::state_distance(r.result.final, ref), kLooser);
   // Ten times tighter than the floor, a pair at the answer's step and twice it agreed with C h^p by
   // chance and was delivered 38x off (estimate 1.9e-14, error 3.8e-12) until runs differing only in
   // rounding were compared: now refused, or delivered within tol.
   constexpr double kBelowFloor = 1e-13;
   try {
-    const adaptive::ToleranceResult below = adaptive::run_to_tolerance(m, b, scene.centres, kBelowFloor, t_end);
+    const adaptive::ToleranceResult below = adaptive::run_to_tolerance(m, b, scene.centres, Accuracy{kBelowFloor, t_end}, kUnobserved);
     EXPECT_LE(adaptive::state_distance(below.result.final, ref), kBelowFloor) << "delivered below the floor";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("out of reach"), std::string::npos) << e.what();

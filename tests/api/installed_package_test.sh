@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # ctest InstalledPackageExamples: the library as a user outside the tree gets it.
-#  1. configure and build the library alone (no command line, tests or benchmarks: no
-#     Boost.program_options, MPI, Chromium or TeX asked for) and install it under a temporary prefix;
-#  2. build examples/ against that prefix with find_package(bodypoint);
+#  1. configure the library alone (no command line, tests or benchmarks): it must not ask for
+#     Boost.program_options, MPI, Chromium or TeX;
+#  2. install the library of this build (the same sources and flags; not compiled a second time) under a
+#     temporary prefix, and build examples/ against that prefix with find_package(bodypoint);
 #  3. run each example and check what it prints against the command line (same method, same
 #     numbers: bit for bit where the runs are the same) and against its own bounds.
-# usage: installed_package_test.sh SOURCE_DIR BODYPOINT_BIN PYTHON
+# usage: installed_package_test.sh SOURCE_DIR BUILD_DIR BODYPOINT_BIN PYTHON
 set -euo pipefail
-src=$1 bin=$2 python=$3
+src=$1 build=$2 bin=$3 python=$4
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 gen=()
@@ -18,8 +19,7 @@ cmake -S "$src" -B "$work/lib" "${gen[@]}" -DCMAKE_BUILD_TYPE=Release -DBODYPOIN
 if grep -qi "program_options" "$work/lib/CMakeCache.txt"; then
   echo "FAIL: the library-only configuration looked for Boost.program_options"; exit 1
 fi
-cmake --build "$work/lib" --parallel 2 >>"$work/lib.log"
-cmake --install "$work/lib" --prefix "$work/prefix" >>"$work/lib.log"
+cmake --install "$build" --prefix "$work/prefix" >>"$work/lib.log"
 test -f "$work/prefix/include/bodypoint/bodypoint.hpp"
 if [ -e "$work/prefix/include/bodypoint/detail" ]; then echo "FAIL: internal headers (detail/) installed"; exit 1; fi
 ls "$work"/prefix/lib*/cmake/bodypoint/bodypointConfigVersion.cmake >/dev/null

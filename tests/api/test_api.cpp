@@ -1,5 +1,5 @@
 // The public API (bodypoint.hpp) through the library: integrate() is run() for every way of advancing
-// time, outcomes are typed, run_spec() is where an Advance meets a method, and a Stepper continues a
+// time, outcomes are typed, check_takes() is where an Advance meets a method, and a Stepper continues a
 // run as one run of the same steps would.
 #include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/bodypoint.hpp"
@@ -12,6 +12,8 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <optional>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -44,14 +46,14 @@ TEST(Api, IntegrateIsRunForEveryWayOfAdvancingTime) {
   const std::vector<Case> cases = {
       {"lp-y4", FixedSteps{1e-2, 500}},
       {"rk4", FixedSteps{1e-2, 500}},
-      {"logh-kl6", FictitiousSteps{0.05, 5.0, 0, 0.0}},
+      {"logh-kl6", FictitiousSteps{0.05, EndTime{5.0}}},
       {"odeint-dopri5", ControlledSteps{1e-3, 5.0, 1e-9}},
   };
   for (const Case& c : cases) {
     const MethodInfo& m = method_or_throw(c.method);
     const Result r = integrate(s, c.method, c.how);
     ASSERT_EQ(r.outcome, Outcome::ok) << c.method << ": " << r.reason;
-    const RunResult direct = run(m, b, s.centres, run_spec(m, c.how));
+    const RunResult direct = run(m, b, s.centres, c.how);
     EXPECT_EQ(r.bodies.front().run.final.R, direct.final.R) << c.method;
     EXPECT_EQ(r.bodies.front().run.final.v, direct.final.v) << c.method;
     EXPECT_EQ(r.bodies.front().run.force_evals, direct.force_evals) << c.method;
@@ -74,7 +76,7 @@ TEST(Api, AccuracyModeDeliversTheSearchedRunWithItsReport) {
   const BodyResult& br = r.bodies.front();
   ASSERT_TRUE(br.accuracy.has_value());
   EXPECT_FALSE(br.chosen.empty());
-  const adaptive::ToleranceResult t = adaptive::run_to_tolerance(*br.method, b, s.centres, tol, t_end);
+  const adaptive::ToleranceResult t = adaptive::run_to_tolerance(*br.method, b, s.centres, Accuracy{tol, t_end}, quiet);
   EXPECT_EQ(br.run.final.R, t.result.final.R);
   EXPECT_LE(br.accuracy->err_estimate, tol);
   EXPECT_EQ(br.accuracy->force_evals, t.total_force_evals);
@@ -108,7 +110,7 @@ TEST(Api, AccuracyModeDeliversTheSearchedRunWithItsReport) {
 TEST(Api, OutcomesAreTyped) {
   // refused: ks is for a material point; the reason is the method's own.
   const Scene s = thesis();
-  const Result refused = integrate(s, "ks", FictitiousSteps{0.1, 1.0, 0, 0.0});
+  const Result refused = integrate(s, "ks", FictitiousSteps{0.1, EndTime{1.0}});
   EXPECT_EQ(refused.outcome, Outcome::refused);
   EXPECT_EQ(refused.bodies.front().reason, refusal(method_or_throw("ks"), s.bodies.front(), s.centres));
   EXPECT_NE(refused.reason.find(refused.bodies.front().reason), std::string::npos);
@@ -218,10 +220,10 @@ TEST(Api, InvalidRequestsThrowWithTheQuantityNamed) {
   EXPECT_THROW(integrate(s, "lp-y4", Accuracy{0.0, 10.0}), Error);
   EXPECT_THROW(integrate(s, "lp-y4", Accuracy{1e-6, -1.0}), Error);
   // An Advance the method does not take.
-  EXPECT_THROW(run_spec(method_or_throw("lp-y4"), ControlledSteps{1e-3, 1.0, 1e-8}), Error);
-  EXPECT_THROW(run_spec(method_or_throw("odeint-dopri5"), FixedSteps{1e-3, 10}), Error);
-  EXPECT_THROW(run_spec(method_or_throw("logh-y4"), FixedSteps{1e-3, 10}), Error);
-  EXPECT_THROW(run_spec(method_or_throw("lp-y4"), FictitiousSteps{0.1, 1.0, 0, 0.0}), Error);
+  EXPECT_THROW(check_takes(method_or_throw("lp-y4"), ControlledSteps{1e-3, 1.0, 1e-8}), Error);
+  EXPECT_THROW(check_takes(method_or_throw("odeint-dopri5"), FixedSteps{1e-3, 10}), Error);
+  EXPECT_THROW(check_takes(method_or_throw("logh-y4"), FixedSteps{1e-3, 10}), Error);
+  EXPECT_THROW(check_takes(method_or_throw("lp-y4"), FictitiousSteps{0.1, EndTime{1.0}}), Error);
   // A scene that breaks a rule: D = m J - B^2 <= 0.
   SceneParams singular;
   singular.B = 1.0;
@@ -235,7 +237,7 @@ TEST(Api, InvalidRequestsThrowWithTheQuantityNamed) {
       [&] { integrate(s, "odeint-dopri5", ControlledSteps{1e-3, 1.0, 1e-20}); },
       [&] { integrate(s, "lp-y4", Accuracy{1e-20, 1.0}); },
       [&] { integrate(s, "lp-y4", Accuracy{2.0, 1.0}); },
-      [&] { integrate(s, "logh-y4", FictitiousSteps{0.1, 1.0, 0, -1.0}); },
+      [&] { integrate(s, "logh-y4", FictitiousSteps{0.1, EndTime{1.0}, -1.0}); },
   };
   for (std::size_t i = 0; i < bad.size(); ++i) {
     try {
@@ -315,7 +317,7 @@ TEST(Api, EveryFamilyHandsOnStatesAtOutputTimes) {
       {"rk4", fixed_steps_to(kEnd, 0.001)},
       {"odeint-rkf78", ControlledSteps{1e-3, kEnd, 1e-12}},
       {"gsl-rk8pd", ControlledSteps{1e-3, kEnd, 1e-12}},
-      {"logh-kl8", FictitiousSteps{0.01, kEnd, 0, 0.0}},
+      {"logh-kl8", FictitiousSteps{0.01, EndTime{kEnd}}},
   };
   for (const auto& [name, plain] : runs) {
     if (!find_method(name)) continue;  // built without GSL
@@ -347,6 +349,159 @@ TEST(Api, EveryFamilyHandsOnStatesAtOutputTimes) {
   Options o;
   o.sink = &none;
   EXPECT_THROW(integrate(s, "lp-y4", bad, o), Error);
+}
+
+TEST(Api, ASinkThatSaysStopEndsTheRunAtThatState) {
+  const Scene s = thesis();
+  constexpr double kStopAt = 2.0;
+  struct Case {
+    const char* method;
+    Advance how;
+  };
+  const std::vector<Case> cases = {
+      {"lp-y4", FixedSteps{1e-2, 500}},
+      {"rk4", FixedSteps{1e-2, 500, 0.25}},  // output times: the sink sees states made between steps
+      {"logh-kl6", FictitiousSteps{0.05, EndTime{5.0}}},
+      {"logh-kl6", FictitiousSteps{0.05, EndTime{5.0}, 0.5}},
+      {"odeint-dopri5", ControlledSteps{1e-3, 5.0, 1e-9}},
+  };
+  for (const Case& c : cases) {
+    std::vector<KeptSample> seen;
+    const SampleSink stop = [&seen](const Sample& x) {
+      seen.push_back(KeptSample::of(x));
+      return x.t >= kStopAt ? Flow::stop : Flow::go;
+    };
+    Options o;
+    o.sink = &stop;
+    const Result r = integrate(s, c.method, c.how, o);
+    ASSERT_EQ(r.outcome, Outcome::ok) << c.method << ": " << r.reason;
+    const RunResult& run = r.bodies.front().run;
+    ASSERT_FALSE(seen.empty());
+    const KeptSample& last = seen.back();
+    EXPECT_GE(last.t, kStopAt) << c.method;
+    if (seen.size() > 1) {
+      EXPECT_LT(seen[seen.size() - 2].t, kStopAt) << c.method << ": no state after the stop";
+    }
+    EXPECT_TRUE(run.stopped) << c.method;
+    EXPECT_LT(run.t_end, 5.0) << c.method;
+    if (output_interval(c.how) > 0.0) continue;  // an output time is not a step's end: the run stops at its step
+    EXPECT_EQ(run.t_end, last.t) << c.method;
+    EXPECT_EQ(run.final.R, last.s.R) << c.method;
+  }
+  // A fixed-step run stopped after step k is the run of k steps, bit for bit.
+  long stopped_at = 0;
+  const SampleSink at_step = [&stopped_at](const Sample& x) {
+    stopped_at = x.step;
+    return x.step == 123 ? Flow::stop : Flow::go;
+  };
+  Options o;
+  o.sink = &at_step;
+  const Result cut = integrate(s, "lp-kl8", FixedSteps{1e-2, 500}, o);
+  const Result whole = integrate(s, "lp-kl8", FixedSteps{1e-2, 123});
+  EXPECT_EQ(stopped_at, 123);
+  EXPECT_EQ(cut.bodies.front().run.final.R, whole.bodies.front().run.final.R);
+  EXPECT_EQ(cut.bodies.front().run.steps, 123);
+}
+
+/// Each request throws Error with its fragment in the message.
+void expect_errors(const std::vector<std::pair<std::function<void()>, std::string>>& requests) {
+  for (const auto& [request, fragment] : requests) {
+    try {
+      request();
+      ADD_FAILURE() << "accepted; expected '" << fragment << "'";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+  }
+}
+
+/// A step request with the fields given (the rest absent).
+StepRequest request(std::optional<double> h, std::optional<long> steps = std::nullopt,
+                    std::optional<double> t_end = std::nullopt, std::optional<double> tol = std::nullopt) {
+  StepRequest r;
+  r.h = h;
+  r.steps = steps;
+  r.t_end = t_end;
+  r.tol = tol;
+  return r;
+}
+
+TEST(Api, AStepRequestMeansWhatTheMethodsKindMakesOfIt) {
+  const MethodInfo& fixed = method_or_throw("lp-y4");
+  const MethodInfo& transformed = method_or_throw("logh-y4");
+  const MethodInfo& controlled = method_or_throw("odeint-dopri5");
+  const auto f = std::get<FixedSteps>(advance_for(&fixed, request(0.03, std::nullopt, 1.0)));
+  EXPECT_EQ(f.steps, 34);  // ceil(1 / 0.03): the steps of at most h that land on t_end
+  EXPECT_DOUBLE_EQ(f.h * 34, 1.0);
+  EXPECT_EQ(std::get<FixedSteps>(advance_for(&fixed, request(0.03, 10))).steps, 10);
+  StepRequest code = request(1e-3, 10);
+  code.code_loop = true;
+  EXPECT_EQ(std::get<FixedSteps>(advance_for(&fixed, code)).steps, 9);  // the thesis code's n - 1
+  const auto to_time = std::get<FictitiousSteps>(advance_for(&transformed, request(0.1, std::nullopt, 5.0)));
+  EXPECT_EQ(to_time.ds, 0.1);
+  EXPECT_EQ(to_time.t_end(), 5.0);
+  EXPECT_EQ(to_time.steps(), 0);
+  const auto counted = std::get<FictitiousSteps>(advance_for(&transformed, request(0.1, 40)));
+  EXPECT_EQ(counted.steps(), 40);
+  EXPECT_EQ(counted.t_end(), 0.0);
+  const auto c = std::get<ControlledSteps>(advance_for(&controlled, request(0.5, std::nullopt, 0.2, 1e-9)));
+  EXPECT_EQ(c.h0, 0.2);  // the first trial step stays inside the run
+  EXPECT_EQ(c.t_end, 0.2);
+  EXPECT_EQ(c.tol, 1e-9);
+  EXPECT_EQ(std::get<ControlledSteps>(advance_for(&controlled, request(1e-3, std::nullopt, 2.0))).tol,
+            kDefaultStepTolerance);
+  const auto a = std::get<Accuracy>(advance_for(nullptr, request(std::nullopt, std::nullopt, 50.0, 1e-8)));
+  EXPECT_EQ(a.tol, 1e-8);
+  EXPECT_EQ(a.t_end, 50.0);
+  EXPECT_TRUE(std::holds_alternative<Accuracy>(advance_for(&fixed, request(std::nullopt, std::nullopt, 5.0, 1e-8))));
+  // Each way a request is incomplete or contradicts itself, named.
+  const std::vector<std::pair<std::function<void()>, std::string>> bad = {
+      {[&] { (void)advance_for(&fixed, request(0.1, 10, 1.0)); }, "not both"},
+      {[&] { (void)advance_for(&fixed, request(0.1)); }, "give an end time t_end or a number of steps"},
+      {[&] { (void)advance_for(&fixed, request(0.0, 10)); }, "the step h must be a finite number > 0, got 0"},
+      {[&] { (void)advance_for(&transformed, request(-1.0, 10)); }, "the fictitious step ds (h) must be"},
+      {[&] { (void)advance_for(nullptr, request(0.1, std::nullopt, 5.0, 1e-8)); }, "not h or steps"},
+      {[&] { (void)advance_for(nullptr, request(std::nullopt, std::nullopt, std::nullopt, 1e-8)); }, "needs the end time"},
+      {[&] { (void)advance_for(nullptr, request(std::nullopt, std::nullopt, 5.0)); }, "needs the accuracy to deliver"},
+  };
+  expect_errors(bad);
+}
+
+TEST(Api, EachQuantityHasOneMessage) {
+  const Scene s = thesis();
+  const std::vector<std::pair<std::function<void()>, std::string>> bad = {
+      {[&] { integrate(s, "lp-y4", FixedSteps{0.0, 10}); }, "the step h must be a finite number > 0, got 0"},
+      {[&] { integrate(s, "lp-y4", FixedSteps{0.1, 0}); }, "the number of steps must be a whole number >= 1, got 0"},
+      {[&] { integrate(s, "logh-y4", FictitiousSteps{0.1, StepCount{0}}); },
+       "the number of fictitious steps must be a whole number >= 1, got 0"},
+      {[&] { integrate(s, "logh-y4", FictitiousSteps{std::nan(""), EndTime{1.0}}); },
+       "the fictitious step ds must be a finite number > 0, got nan"},
+      {[&] { integrate(s, "logh-y4", FictitiousSteps{0.1, EndTime{-1.0}}); }, "the end time t_end must be a finite number > 0"},
+      {[&] { integrate(s, "odeint-dopri5", ControlledSteps{1e-3, 1.0, -1.0}); },
+       "the tolerance per step tol must be a finite number > 0"},
+      {[&] { integrate(s, "lp-y4", FixedSteps{0.1, 10, -1.0}); }, "the output interval dt_out must be a finite number >= 0"},
+      {[&] { integrate(s, "lp-y4", Accuracy{1e-8, std::nan("")}); }, "the end time t_end must be a finite number > 0"},
+      {[&] { integrate(s, "odeint-dopri5", Accuracy{1e-8, 1.0}); }, "controls its own step"},
+      {[&] { integrate(s, "lp-y4", FictitiousSteps{0.1, EndTime{1.0}}); }, "lp-y4 takes FixedSteps"},
+  };
+  expect_errors(bad);
+}
+
+TEST(Api, TheAccuracyModeHandsOnStatesAtOutputTimesForEveryMethod) {
+  // Issue #40: with a fixed-step method the accuracy mode handed on the state at t = 0 only.
+  const Scene s = thesis();
+  constexpr double kDtOut = 0.5, kEnd = 5.0;
+  for (const char* name : {"lp-y4", "lp-verlet", "rk4", "kep-y4", "ab4", "logh-y4", "auto"}) {
+    std::vector<KeptSample> seen;
+    const SampleSink keep = [&seen](const Sample& x) { seen.push_back(KeptSample::of(x)); };
+    Options o;
+    o.sink = &keep;
+    const Result r = integrate(s, name, Accuracy{1e-6, kEnd, kDtOut}, o);
+    ASSERT_EQ(r.outcome, Outcome::ok) << name << ": " << r.reason;
+    ASSERT_EQ(seen.size(), 11u) << name;
+    for (std::size_t k = 0; k < seen.size(); ++k) EXPECT_NEAR(seen[k].t, kDtOut * static_cast<double>(k), kTimeRoundOff) << name;
+    EXPECT_EQ(seen.back().s.R, r.bodies.front().run.final.R) << name;
+  }
 }
 
 TEST(Api, MultiBodyTotalsAreTheSumOfTheBodies) {
@@ -387,7 +542,7 @@ TEST(ApiSweep, RowsAreTypedAndEqualSingleRuns) {
       continue;
     }
     EXPECT_EQ(r.outcome, Outcome::ok) << r.method->name << " " << point_label(s, r.point) << ": " << r.reason;
-    const RunResult one = run(*r.method, scene.bodies.front(), scene.centres, point_spec(s, r.point));
+    const RunResult one = run(*r.method, scene.bodies.front(), scene.centres, point_advance(s, *r.method, r.point));
     EXPECT_EQ(r.result.final.R, one.final.R) << r.method->name << " " << point_label(s, r.point);
     EXPECT_EQ(r.result.force_evals, one.force_evals);
   }

@@ -51,8 +51,8 @@ std::vector<Case> every_family() {
       {"lp-y8", FixedSteps{2e-3, 4000}},                       // exact Lie-Poisson, fixed step
       {"thesis-y6", FixedSteps{1e-3, 8000}},                   // the thesis's drift/kick
       {"rk4", FixedSteps{1e-3, 8000}},                         // Boost.Odeint fixed step
-      {"logh-kl8", FictitiousSteps{0.02, 8.0, 0, 0.0}},        // time-transformed
-      {"ks", FictitiousSteps{0.01, 8.0, 0, 0.0}},              // regularised
+      {"logh-kl8", FictitiousSteps{0.02, EndTime{8.0}}},        // time-transformed
+      {"ks", FictitiousSteps{0.01, EndTime{8.0}}},              // regularised
       {"odeint-rkf78", ControlledSteps{1e-3, 8.0, 1e-14}},     // step-size control
       {"lp-kl8", Accuracy{1e-12, 8.0}},                        // the accuracy mode
   };
@@ -227,7 +227,7 @@ TEST(Scattering, MaterialPointTimeDelayIsKeplersAtEveryDistance) {
     const Body& body = s.bodies.front();
     Options o;
     o.events = {Event{Event::Kind::radius, 0, 1.25 * L, Vec3::UnitX(), true}};
-    const Result r = integrate(s, "ks", FictitiousSteps{0.02, 4.0 * L / p.start.K1, 0, 0.0}, o);
+    const Result r = integrate(s, "ks", FictitiousSteps{0.02, EndTime{4.0 * L / p.start.K1}}, o);
     ASSERT_EQ(r.outcome, Outcome::ok) << r.reason;
     ASSERT_TRUE(r.bodies.front().run.stopped);
     const RunResult& run = r.bodies.front().run;

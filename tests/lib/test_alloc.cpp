@@ -1,6 +1,7 @@
 // No heap allocation inside any step loop: a counting global operator new shows that the number of
 // allocations of a run does not depend on its number of steps, for every method, with and without
 // invariant tracking, with one centre and with several.
+#include "common.hpp"
 #include "bodypoint/methods.hpp"
 #include "bodypoint/run.hpp"
 #include "bodypoint/scenes.hpp"
@@ -27,7 +28,7 @@ namespace bodypoint {
 namespace {
 
 long allocations_of(const MethodInfo& m, const NamedScene& ns, long steps, bool track) {
-  RunSpec spec;
+  FlatRun spec;
   spec.h = 1e-3;
   spec.steps = steps;
   spec.t_end = 1e-3 * static_cast<double>(steps);

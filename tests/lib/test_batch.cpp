@@ -1,5 +1,6 @@
 // Batch kernels (issue #14): every lane computes the scalar run's bits, for every batch method and
 // every width this CPU runs; a diverging lane does not touch the others.
+#include "common.hpp"
 #include "bodypoint/batch.hpp"
 #include "bodypoint/methods.hpp"
 #include "bodypoint/run.hpp"
@@ -32,7 +33,7 @@ void expect_same(const RunResult& batch, const RunResult& scalar, const std::str
   EXPECT_TRUE(same_bits(a.max_spin_angle, b.max_spin_angle)) << what << ": " << a.max_spin_angle << " vs " << b.max_spin_angle;
   EXPECT_TRUE(same_bits(a.min_turn_cos, b.min_turn_cos)) << what << ": " << a.min_turn_cos << " vs " << b.min_turn_cos;
   EXPECT_EQ(batch.force_evals, scalar.force_evals) << what;
-  EXPECT_EQ(assess(batch).status, assess(scalar).status) << what;
+  EXPECT_EQ(assess(batch).outcome, assess(scalar).outcome) << what;
 }
 
 /// Eight different scenes of the thesis: d, L, Kx, A (both signs), B and J vary lane to lane.
@@ -51,8 +52,8 @@ std::vector<SceneParams> varied_scenes() {
   return v;
 }
 
-RunSpec spec_of(double h, long steps) {
-  RunSpec s;
+FlatRun spec_of(double h, long steps) {
+  FlatRun s;
   s.h = h;
   s.steps = steps;
   s.t_end = h * static_cast<double>(steps);
@@ -61,7 +62,7 @@ RunSpec spec_of(double h, long steps) {
 }
 
 TEST(Batch, EveryLaneEqualsTheScalarRunBitForBit) {
-  const RunSpec spec = spec_of(2e-3, 3000);
+  const FlatRun spec = spec_of(2e-3, 3000);
   const auto scenes = varied_scenes();
   int methods_run = 0;
   for (const MethodInfo& m : methods()) {
@@ -76,7 +77,7 @@ TEST(Batch, EveryLaneEqualsTheScalarRunBitForBit) {
         members.push_back({s.bodies[0].p, s.bodies[0].s0, s.centres[0].A});
         scalar.push_back(run(m, s.bodies[0], s.centres, spec));
       }
-      const auto lanes = batch::run(m, members, spec, width);
+      const auto lanes = batch::run(m, members, std::get<FixedSteps>(flat_advance(m, spec)), width);
       ASSERT_EQ(lanes.size(), members.size());
       for (std::size_t i = 0; i < lanes.size(); ++i)
         expect_same(lanes[i], scalar[i], std::string(m.name) + " width " + std::to_string(width) + " lane " + std::to_string(i));
@@ -91,7 +92,7 @@ TEST(Batch, EveryLaneEqualsTheScalarRunBitForBit) {
 TEST(Batch, ADivergingLaneLeavesTheOthersAlone) {
   // thesis-euler at h = 0.05 from d = 0.3 next to an attracting centre: the energy error explodes
   // (status diverged or collision); its neighbours are ordinary runs.
-  const RunSpec spec = spec_of(0.05, 2000);
+  const FlatRun spec = spec_of(0.05, 2000);
   const MethodInfo& m = method_or_throw("thesis-euler");
   SceneParams bad;
   bad.A = 3.0;
@@ -107,8 +108,8 @@ TEST(Batch, ADivergingLaneLeavesTheOthersAlone) {
       members.push_back({s.bodies[0].p, s.bodies[0].s0, s.centres[0].A});
       scalar.push_back(run(m, s.bodies[0], s.centres, spec));
     }
-    ASSERT_NE(assess(scalar[1]).status, "ok") << "the test needs a lane that fails";
-    const auto lanes = batch::run(m, members, spec, width);
+    ASSERT_NE(assess(scalar[1]).outcome, Outcome::ok) << "the test needs a lane that fails";
+    const auto lanes = batch::run(m, members, std::get<FixedSteps>(flat_advance(m, spec)), width);
     for (std::size_t i = 0; i < width; ++i) expect_same(lanes[i], scalar[i], "lane " + std::to_string(i));
   }
 }
@@ -125,9 +126,9 @@ TEST(Batch, ScenesWithoutABatchKernelAreDeclined) {
   code.law = ForceLaw::thesis_code;
   const Scene published = thesis_scene(code);
   EXPECT_FALSE(batch::accepts(method_or_throw("thesis-fr4"), published.bodies[0], published.centres));
-  EXPECT_THROW(batch::run(method_or_throw("ab4"), {{s.bodies[0].p, s.bodies[0].s0, -2.0}}, spec_of(1e-3, 10)), Error);
+  EXPECT_THROW(batch::run(method_or_throw("ab4"), {{s.bodies[0].p, s.bodies[0].s0, -2.0}}, FixedSteps{1e-3, 10}), Error);
   EXPECT_THROW(batch::run(method_or_throw("lp-y4"), std::vector<batch::Member>(batch::width() + 1, {s.bodies[0].p, s.bodies[0].s0, -2.0}),
-                          spec_of(1e-3, 10)), Error);
+                          FixedSteps{1e-3, 10}), Error);
 }
 
 }  // namespace

@@ -131,7 +131,7 @@ double measured_slope(const Case& c, double B) {
                              : reference_state(body, s.centres, kTEnd);
   const std::string label = c.method + (c.on_orbit ? " orbit" : " encounter") + (B == 0.0 ? " B=0" : " B=0.7");
   return test::ladder_slope(label, [&](int k) {
-    RunSpec spec;
+    FlatRun spec;
     spec.steps = std::lround(kTEnd / c.h0 * std::pow(std::sqrt(2.0), k));
     spec.h = kTEnd / static_cast<double>(spec.steps);
     const RunResult r = run(method_or_throw(c.method), body, s.centres, spec);

@@ -116,7 +116,7 @@ TEST(LiePoisson, OneStepOfAnySizeIsTheExactHelixWhenAIsZero) {
     const Body& b = s.bodies.front();
     for (const MethodInfo* m : lie_methods()) {
       for (double h : {0.1, 1.0, 10.0}) {
-        RunSpec spec;
+        FlatRun spec;
         spec.h = h;
         spec.steps = 1;
         const State got = run(*m, b, s.centres, spec).final;
@@ -134,7 +134,7 @@ TEST(LiePoisson, MaterialPointDoesNoSpinWork) {
   const Scene s = test::table31(0.0);
   Body b = s.bodies.front();
   b.s0.w = Vec3(0.3, -1.7, 2.9);
-  RunSpec spec;
+  FlatRun spec;
   spec.h = 0.01;
   spec.steps = 5000;
   for (const char* name : {"lp-y4", "lp-kl8", "thesis-y6", "kep-kl6"}) {
@@ -149,7 +149,7 @@ TEST(LiePoisson, InvariantsConservedToRoundOffAtEveryStep) {
   const double K2Q0 = total_angular_momentum(b.p, b.s0, Vec3::Zero()).norm();
   for (const MethodInfo* m : lie_methods()) {
     for (double h : {1e-4, 1e-3, 1e-2, 1e-1, 1.0}) {
-      RunSpec spec;
+      FlatRun spec;
       spec.h = h;
       spec.steps = std::min(kInvariantSteps, std::lround(100.0 / h));
       spec.track_invariants = true;
@@ -209,7 +209,7 @@ double trend(const std::vector<double>& x, const std::vector<double>& y) {
 /// Drift of |E - E0|/|E0| over a run: (fitted slope x duration) / max error.
 double energy_drift_fraction(const std::string& method, const Body& b, const std::vector<Centre>& cs,
                              double h, long n, double* max_err, double* r_max = nullptr) {
-  RunSpec spec;
+  FlatRun spec;
   spec.h = h;
   spec.steps = n;
   spec.every = n / 1000;
@@ -261,7 +261,7 @@ TEST(LiePoisson, SeveralCentresSumForcesAndKeepEnergyBounded) {
 
   Scene s = test::table31(0.7);
   s.centres.push_back({Vec3(40, 6, 0), -1.0});
-  RunSpec spec;
+  FlatRun spec;
   spec.h = 0.01;
   spec.steps = 8000;
   spec.track_invariants = true;
@@ -273,7 +273,7 @@ TEST(LiePoisson, SeveralCentresSumForcesAndKeepEnergyBounded) {
 
 TEST(LiePoisson, ForceEvaluationsPerStepAsAdvertised) {
   const Scene s = test::table31(0.7);
-  RunSpec spec;
+  FlatRun spec;
   spec.h = 0.1;
   spec.steps = 100;
   for (const MethodInfo& m : methods()) {
@@ -299,7 +299,7 @@ TEST(LiePoisson, RoundOffFloorNearOneEMinusFourteen) {
   const State ref = reference_state(s.bodies.front(), s.centres, 50.0, 1e-18L);
   double worst = 0;
   for (double h : {0.005, 0.01, 0.02}) {
-    RunSpec spec;
+    FlatRun spec;
     spec.steps = std::lround(50.0 / h);
     spec.h = 50.0 / static_cast<double>(spec.steps);
     const State got = run(method_or_throw("lp-kl8"), s.bodies.front(), s.centres, spec).final;
@@ -313,7 +313,7 @@ TEST(LiePoisson, RoundOffFloorNearOneEMinusFourteen) {
 TEST(LiePoisson, MaterialPointFollowsTheRutherfordHyperbola) {
   const Scene s = test::table31(0.0);
   const State exact = kepler_body_state(s.bodies.front(), s.centres.front(), 50.0);
-  RunSpec spec;
+  FlatRun spec;
   spec.h = 0.05;
   spec.steps = 1000;
   const State got = run(method_or_throw("lp-kl8"), s.bodies.front(), s.centres, spec).final;
@@ -331,7 +331,7 @@ TEST(LiePoisson, KeplerSplitIsExactForAMaterialPoint) {
   for (const MethodInfo& m : methods()) {
     if (m.family != Family::KeplerSplit) continue;
     for (double h : {0.1, 1.0, 5.0}) {
-      RunSpec spec;
+      FlatRun spec;
       spec.h = h;
       spec.steps = std::lround(50.0 / h);
       const State got = run(m, b, s.centres, spec).final;
@@ -355,7 +355,7 @@ TEST(LiePoisson, KeplerSplitOfSeveralCentresKeepsItsOrder) {
     EXPECT_EQ(refusal(m, b, ns.scene.centres), "") << name;
     double err[2] = {0.0, 0.0};
     for (int k = 0; k < 2; ++k) {
-      RunSpec spec;
+      FlatRun spec;
       spec.h = kThreePartCoarseStep / (1 << k);
       spec.steps = std::lround(ns.t_end / spec.h);
       spec.track_invariants = true;

@@ -136,7 +136,7 @@ TEST(ForceLaw, SlipMovesOnlyThirdKickSchemesAndOnlyUnderTheCodeLaw) {
   const Scene force_only = thesis_scene(sp);
   sp.law = ForceLaw::thesis_code;
   const Scene code = thesis_scene(sp);
-  RunSpec rs;
+  FlatRun rs;
   rs.h = 1e-3;
   rs.steps = 5000;
   auto final_R = [&](const char* m, const Scene& sc) { return run(method_or_throw(m), sc.bodies.front(), sc.centres, rs).final.R; };
@@ -158,16 +158,16 @@ TEST(ForceLaw, TheCodesLoopTakesOneStepFewerThanAsked) {
   EXPECT_THROW((void)thesis_code_steps(1e-3, 1, 0.0), Error) << "n = 1 takes no step";
   EXPECT_THROW((void)thesis_code_steps(0.0, 10, 0.0), Error);
   // The sweeps' run specification counts so under the code's law only.
-  EXPECT_EQ(fixed_run_spec(1e-4, 250000, 0.0, 1e-10, ForceLaw::thesis_code).steps, 249999);
-  EXPECT_EQ(fixed_run_spec(1e-4, 250000, 0.0, 1e-10, ForceLaw::thesis_code_force).steps, 250000);
-  EXPECT_EQ(fixed_run_spec(1e-4, 250000, 0.0, 1e-10).steps, 250000);
+  EXPECT_EQ(sweep_steps(1e-4, 250000, 0.0, ForceLaw::thesis_code).steps, 249999);
+  EXPECT_EQ(sweep_steps(1e-4, 250000, 0.0, ForceLaw::thesis_code_force).steps, 250000);
+  EXPECT_EQ(sweep_steps(1e-4, 250000, 0.0).steps, 250000);
 }
 
 TEST(ForceLaw, TimeTransformedMethodsAndTolRefuseTheCodeLaw) {
   SceneParams sp;
   sp.law = ForceLaw::thesis_code;
   const Scene sc = thesis_scene(sp);
-  RunSpec rs;
+  FlatRun rs;
   rs.h = 1e-2;
   rs.steps = 10;
   for (const char* m : {"logh-y4", "ttl-y4"})
@@ -204,16 +204,16 @@ TEST(Validation, RejectsBodyOnCentreAndEmptyScenes) {
   expect_error([&] { validate(s); }, "no Coulomb centre");
 }
 
-TEST(Validation, RejectsBadRunSpecAndUnknownMethod) {
+TEST(Validation, RejectsBadStepsAndUnknownMethod) {
   const Scene s = test::table31();
-  RunSpec spec;
+  FlatRun spec;
   spec.steps = 10;
   spec.h = 0.0;
-  expect_error([&] { run(method_or_throw("rk4"), s.bodies[0], s.centres, spec); }, "step size h");
+  expect_error([&] { run(method_or_throw("rk4"), s.bodies[0], s.centres, spec); }, "the step h");
   spec.h = -1e-3;
-  expect_error([&] { run(method_or_throw("rk4"), s.bodies[0], s.centres, spec); }, "step size h");
+  expect_error([&] { run(method_or_throw("rk4"), s.bodies[0], s.centres, spec); }, "the step h");
   spec.h = std::numeric_limits<double>::quiet_NaN();
-  expect_error([&] { run(method_or_throw("rk4"), s.bodies[0], s.centres, spec); }, "step size h");
+  expect_error([&] { run(method_or_throw("rk4"), s.bodies[0], s.centres, spec); }, "the step h");
   spec.h = 1e-3;
   spec.steps = 0;
   expect_error([&] { run(method_or_throw("rk4"), s.bodies[0], s.centres, spec); }, "steps");

@@ -8,7 +8,7 @@
 // Equations I, 2nd ed., Springer 1993, sec. II.4, "Richardson extrapolation" and its use for global
 // error estimation): in the asymptotic regime err(h) = C h^p, so two runs at h and h/r differ by
 // C h^p (1 - r^-p) and the finer one's error is their difference over r^p - 1. The run delivered is
-// the run reported: it carries the observers (Delivery), nothing is integrated again. See
+// the run reported: it carries the observers (RunOptions), nothing is integrated again. See
 // tolerance.cpp for the steps of the search.
 //
 // `--method auto` (which method for a scene and a tol) is one layer up: bodypoint/methods.hpp.
@@ -39,17 +39,8 @@ inline constexpr std::string_view kNeedsCoulomb =
     "the accuracy mode (tol) assumes Coulomb's law (its error model and time transformations do); run the thesis "
     "code's force law with a fixed step h";
 
-/// What the delivered run carries: invariants, samples (handed to the sink only for the delivered run,
-/// after the search), every k-th step or states at t = k dt_out.
-struct Delivery {
-  bool track_invariants = false;
-  long every = 1;
-  double dt_out = 0.0;
-  const SampleSink* sink = nullptr;
-};
-
 struct ToleranceResult {
-  RunResult result;        ///< the delivered run, with the invariants Delivery asked for
+  RunResult result;        ///< the delivered run, with the invariants and samples RunOptions asked for
   double h = 0.0;          ///< the step used: h, or ds for time-transformed methods
   long steps = 0;          ///< fixed-step methods: number of steps (time-transformed: 0)
   double omega_c = 0.0;    ///< time-transformed methods: the time-step constant c of the run
@@ -59,11 +50,20 @@ struct ToleranceResult {
   double total_wall_s = 0.0;   ///< step loops of all those runs (what a user waits for)
 };
 
-/// Validates tol (finite, >= kMinTolerance, < 1) and the method (fixed-step or time-transformed with
-/// a known order, or ks), then searches the step for a run from t = 0 to t_end. Throws Error with a
-/// one-line reason when tol cannot be met (round-off floor, a budget of force evaluations exceeded).
+/// Checks the scene, the accuracy asked for (check_tolerance; t_end and dt_out: check), the options and
+/// the method (fixed-step or time-transformed with a known order, or ks, accepting the scene), then
+/// searches the step for a run from t = 0 to accuracy.t_end (search_step). The delivered run carries
+/// `delivery`'s observers: its invariants, and its samples (every k-th step, or with dt_out the states
+/// at t = k dt_out), handed to the sink after the search. Throws Error with a one-line reason when tol
+/// cannot be met (round-off floor, a budget of force evaluations exceeded).
 ToleranceResult run_to_tolerance(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
-                                 double tol, double t_end, const Delivery& delivery = {});
+                                 const Accuracy& accuracy, const RunOptions& delivery = {});
+/// The search alone, for a request whose every part was checked already (integrate() checks each once).
+ToleranceResult search_step(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
+                            const Accuracy& accuracy, const RunOptions& delivery);
+/// Throws Error unless the accuracy mode can search `method`'s step: a fixed-step or time-transformed
+/// method with a known order, or ks.
+void check_searchable(const MethodInfo& method);
 
 /// Relative distance of two final states: max(|dR|/|R_b|, |dv|/|v_b|).
 double state_distance(const State& a, const State& b);

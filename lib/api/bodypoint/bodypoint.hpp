@@ -8,8 +8,9 @@
 // What it holds, from the ground up:
 //   - the model (model.hpp): a Scene is fixed Coulomb centres and independent body-points, each with
 //     its parameters m, B, J and initial state (R, v, w); thesis_scene() builds the thesis's set-up;
-//     read_scene_file() reads a TOML scene (scene_file.hpp). The physics and the meaning of every
-//     parameter are in docs/physics.md.
+//     read_scene_file() reads a TOML scene (scene_file.hpp); its first integrals (energy,
+//     kinetic_energy, ...: invariants.hpp). The physics and the meaning of every parameter are in
+//     docs/physics.md.
 //   - the catalogue (methods.hpp): every method, each a MethodInfo row with its family, order and
 //     cost; methods(), find_method(), and choose_method() for `auto`.
 //   - a way of advancing time, as a value (Advance): FixedSteps, FictitiousSteps (time-transformed
@@ -27,6 +28,7 @@
 // that happens to a valid request is reported in the Result, never thrown.
 #pragma once
 
+#include "bodypoint/invariants.hpp"
 #include "bodypoint/methods.hpp"
 #include "bodypoint/model.hpp"
 #include "bodypoint/run.hpp"
@@ -80,37 +82,15 @@ std::vector<Event> closest_approaches(std::size_t centres);
 /// a hit with a finite distance before one without. nullptr when there is none.
 const EventHit* nearest_approach(const std::vector<EventHit>& hits, const std::vector<Event>& events);
 
-/// What a run asks for besides the way of advancing time. By default the invariants are tracked
-/// and nothing else is kept: the step loop stores no trajectory.
-struct Options {
-  bool track_invariants = true;
-  /// Receives the observed states (the first, every `every`-th and the last; for FictitiousSteps with
-  /// dt_out > 0 the states at t = k dt_out). nullptr: no samples.
-  const SampleSink* sink = nullptr;
-  long every = 1;
-  /// Time-transformed methods: the constant c of the time-step function (physical step <= ds/c);
-  /// < 0: chosen from the scene (the spin-orbit rate).
-  double omega_c = -1.0;
+/// What a run asks for besides the way of advancing time and what it observes (RunOptions: invariants,
+/// samples, the time-step constant c): events to locate and the bound of the accuracy flag.
+struct Options : RunOptions {
   /// Located along the run (BodyResult::events); the run then observes every step (or every dt_out).
   std::vector<Event> events;
   /// A run whose relative energy error exceeds this bound ends Outcome::inaccurate (> 0; infinity: no
   /// bound). Not applied where E is not conserved (the thesis code's force law).
   double max_energy_error = kDefaultMaxEnergyError;
 };
-
-/// How one body's run ended.
-enum class Outcome {
-  ok,         ///< the run reached its end in the regime its numbers mean something in
-  diverged,   ///< a non-finite state or invariant, or an energy error above kDivergedEnergy
-  collision,  ///< diverged, unresolved or inaccurate after falling onto an attracting centre
-  refused,    ///< the method does not apply to this scene (not run; reason says why)
-  failed,     ///< started but stopped: a budget, a time transformation that broke down, an accuracy out of reach
-  unresolved,  ///< a step turned the spin by more than pi or the direction to a centre by more than pi/2
-  inaccurate,  ///< the energy error exceeded Options::max_energy_error (but not 1)
-};
-std::string_view outcome_name(Outcome o);
-/// The outcome assess() (run.hpp) gives a finished run.
-Outcome outcome_of(const Health& h);
 
 /// What the accuracy mode did to deliver its tolerance (Accuracy).
 struct AccuracyReport {
@@ -148,11 +128,34 @@ struct Result {
   double wall_s = 0.0;            ///< all bodies' step loops, searches included
 };
 
-/// The run specification of `method` under `how` (its step, end time, tolerance and outputs), checked:
-/// the one place where a way of advancing time meets a method. Throws Error for a number out of range
-/// or an Advance the method cannot take (FixedSteps for a step-size-controlled method, ...). Not for
-/// Accuracy, which chooses the step itself.
-RunSpec run_spec(const MethodInfo& method, const Advance& how, const Options& options = {});
+/// The defaults of a run asked for by step (the thesis's table 3.1: h = 1e-4, n = 500000) and of a
+/// step-size-controlled method's tolerance per step.
+inline constexpr double kDefaultStep = 1e-4;
+inline constexpr long kDefaultSteps = 500000;
+inline constexpr double kDefaultStepTolerance = 1e-10;
+
+/// A run asked for as the command line and the Python module take it, before the method's kind gives
+/// it a meaning (advance_for): a step, an end (an end time or a number of steps, not both), a tolerance.
+struct StepRequest {
+  std::optional<double> h = std::nullopt;      ///< the step h; ds of a time-transformed method; a controlled method's first trial step
+  std::optional<long> steps = std::nullopt;    ///< a number of steps (fictitious steps for time-transformed methods)
+  std::optional<double> t_end = std::nullopt;  ///< an end time, landed on exactly
+  /// A step-size-controlled method's tolerance per step (default kDefaultStepTolerance); for any other
+  /// method, or no method (auto), the accuracy to deliver: the step is then searched (Accuracy).
+  std::optional<double> tol = std::nullopt;
+  double dt_out = 0.0;          ///< output interval (0: none)
+  bool code_loop = false;       ///< count fixed steps as the thesis's code did (thesis_code_steps)
+};
+/// True when `request` asks the accuracy mode to choose the step of `method` (nullptr: auto).
+bool searches(const MethodInfo* method, const StepRequest& request);
+/// The one mapping from a step request to a way of advancing time, by the method's kind:
+///   accuracy (searches): Accuracy{tol, t_end}; h and steps are refused, t_end is needed;
+///   fixed-step: t_end given, the steps of at most h that land on it (fixed_steps_to); otherwise
+///     `steps` steps of h; under the thesis code's loop its count (thesis_code_steps);
+///   time-transformed: fictitious steps ds = h, to exactly t_end or `steps` of them;
+///   step-size-controlled: to t_end (or h steps), first trial step min(h, t_end), tolerance tol.
+/// h defaults to kDefaultStep; an end (t_end or steps) is required. Throws Error naming the quantity.
+Advance advance_for(const MethodInfo* method, const StepRequest& request);
 
 /// Integrates one body of a scene (the scene's centres act on it) with `method`; with Accuracy,
 /// `method` may be nullptr: chosen by choose_method.

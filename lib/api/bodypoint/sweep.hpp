@@ -51,10 +51,10 @@ struct SweepSpec {
   std::vector<Axis> axes;
   std::vector<const MethodInfo*> methods;
   SceneParams base;         ///< the fixed scene parameters (table 3.1 unless changed)
-  double h = RunSpec{}.h;   ///< fixed step (unless an axis varies h)
+  double h = kDefaultStep;  ///< fixed step (unless an axis varies h)
   long steps = 0;           ///< fixed number of steps, or 0 when t_end is fixed
   double t_end = 0;         ///< fixed end time (steps = ceil(t_end/h), h = t_end/steps), or 0
-  double tol = RunSpec{}.tol;  ///< step-size-controlled methods: tolerance per step
+  double tol = kDefaultStepTolerance;  ///< step-size-controlled methods: tolerance per step
   /// Also locate each run's closest approaches and report the encounter (SweepRow::scattering): each
   /// task then runs alone through integrate_body (no vector lanes), the same run with an observer.
   bool scattering = false;
@@ -67,13 +67,14 @@ std::size_t task_count(const SweepSpec& spec);
 std::vector<double> grid_point(const SweepSpec& spec, std::size_t p);
 /// The scene parameters at a grid point.
 SceneParams point_params(const SweepSpec& spec, const std::vector<double>& point);
-/// A sweep task's run specification: `steps` steps of h, or with t_end > 0 the steps of at most h that
-/// land on t_end (fixed_steps_to); under ForceLaw::thesis_code the code's count instead
-/// (thesis_code_steps: n - 1 steps of exactly h); tol for step-size-controlled methods; invariants
-/// tracked. Error for an h that is not a finite number > 0 or fewer than one step.
-RunSpec fixed_run_spec(double h, long steps, double t_end, double tol, ForceLaw law = ForceLaw::coulomb);
-/// The run specification at a grid point: fixed_run_spec with the point's h.
-RunSpec point_spec(const SweepSpec& spec, const std::vector<double>& point);
+/// A sweep task's fixed steps: `steps` steps of h, or with t_end > 0 the steps of at most h that land
+/// on t_end (fixed_steps_to); under ForceLaw::thesis_code the code's count instead (thesis_code_steps:
+/// n - 1 steps of exactly h). Error for an h that is not a finite number > 0 or fewer than one step.
+FixedSteps sweep_steps(double h, long steps, double t_end, ForceLaw law = ForceLaw::coulomb);
+/// How `method` advances at a grid point: every method of a sweep ends at the same time T = h n of the
+/// point's sweep_steps (h, n): fixed-step methods take those steps, time-transformed ones fictitious
+/// steps ds = h to T, step-size-controlled ones run to T from a first trial step h at tolerance tol.
+Advance point_advance(const SweepSpec& spec, const MethodInfo& method, const std::vector<double>& point);
 /// "d = 5, L = 100": a grid point for messages.
 std::string point_label(const SweepSpec& spec, const std::vector<double>& point);
 

@@ -85,7 +85,7 @@ bool accepts(const MethodInfo& method, const Body& body, const std::vector<Centr
          centres.front().c.isZero(0.0) && centres.front().law == ForceLaw::coulomb;
 }
 
-std::vector<RunResult> run(const MethodInfo& method, const std::vector<Member>& members, const RunSpec& spec,
+std::vector<RunResult> run(const MethodInfo& method, const std::vector<Member>& members, const FixedSteps& spec,
                            std::size_t width) {
   const Isa& isa = width == 0 ? isa_in_use() : unit(width);
   const std::string name(method.name);

@@ -52,22 +52,41 @@ inline bool time_advances(double t_before, double t) {
 }
 
 
+/// The time grid the observer needs: fixed steps h (step i ends at i h; the last is `steps`), and
+/// the output interval of a driver that makes its own output times (fictitious steps; 0: none).
+struct Grid {
+  double h = 0.0;
+  long steps = 0;
+  double dt_out = 0.0;
+};
+inline Grid grid_of(const FixedSteps& f) { return {f.h, f.steps, 0.0}; }
+inline Grid grid_of(const ControlledSteps&) { return {}; }
+inline Grid grid_of(const FictitiousSteps& f) { return {0.0, f.steps(), f.dt_out}; }
+
+/// Unwinds a step loop from its observer when the sink says Flow::stop; observe() catches it, so it
+/// never leaves a run.
+struct SinkStopped {
+  long step;
+  double t;
+  State s;
+};
+
 /// Observer that tracks the invariants at every step and hands every `every`-th state to a sink.
 template <class Field, class ToPhysical>
 class Monitor {
  public:
   static constexpr bool active = true;
 
-  Monitor(const BodyPoint& p, const Field& f, const State& s0, const RunSpec& spec,
-          const SampleSink* sink, ToPhysical to_physical)
-      : inv_(p, f, s0), spec_(spec), sink_(sink), to_physical_(std::move(to_physical)) {
-    if (sink_) (*sink_)(Sample{0, 0.0, s0, 0.0, 0.0, 0.0});
+  Monitor(const BodyPoint& p, const Field& f, const State& s0, const RunOptions& options, Grid grid,
+          ToPhysical to_physical)
+      : inv_(p, f, s0), grid_(grid), every_(options.every), sink_(options.sink), to_physical_(std::move(to_physical)) {
+    if (sink_ && (*sink_)(Sample{0, 0.0, s0, 0.0, 0.0, 0.0}) == Flow::stop) throw SinkStopped{0, 0.0, s0};
   }
 
   /// Fixed steps: step i ends at time i h and was h long.
   template <class X>
   void operator()(long i, const X& x) {
-    stepped(i, static_cast<double>(i) * spec_.h, spec_.h, x, i == spec_.steps);
+    stepped(i, static_cast<double>(i) * grid_.h, grid_.h, x, i == grid_.steps);
   }
 
   /// For methods with their own time grid: step i ends at time t; `last` marks the final state.
@@ -77,12 +96,12 @@ class Monitor {
     t_ = t;
   }
 
-  /// With spec.dt_out > 0: a state at a requested output time t (made by a side step).
+  /// With grid.dt_out > 0: a state at a requested output time t (made by a side step).
   void emit(long i, double t, const State& s) {
     inv_.update(s);
-    if (sink_) (*sink_)(Sample{i, t, s, inv_.last_rel_dE(), inv_.last_rel_dK2sq(), inv_.last_abs_dK2Q()});
+    hand(Sample{i, t, s, inv_.last_rel_dE(), inv_.last_rel_dK2sq(), inv_.last_abs_dK2Q()});
   }
-  [[nodiscard]] bool wants_times() const { return sink_ && spec_.dt_out > 0.0; }
+  [[nodiscard]] bool wants_times() const { return sink_ && grid_.dt_out > 0.0; }
 
   [[nodiscard]] const InvariantStats& stats() const { return inv_.stats(); }
 
@@ -91,13 +110,17 @@ class Monitor {
   void stepped(long i, double t, double dt, const X& x, bool last) {
     const State s = to_physical_(x);
     inv_.step(s, dt);
-    if (sink_ && spec_.dt_out <= 0.0 && (i % spec_.every == 0 || last))
-      (*sink_)(Sample{i, t, s, inv_.last_rel_dE(), inv_.last_rel_dK2sq(), inv_.last_abs_dK2Q()});
+    if (sink_ && grid_.dt_out <= 0.0 && (i % every_ == 0 || last))
+      hand(Sample{i, t, s, inv_.last_rel_dE(), inv_.last_rel_dK2sq(), inv_.last_abs_dK2Q()});
+  }
+  void hand(const Sample& x) const {
+    if (sink_ && (*sink_)(x) == Flow::stop) throw SinkStopped{x.step, x.t, x.s};
   }
 
   InvariantMonitor<Field> inv_;
   double t_ = 0.0;  ///< observe(): where the last step ended
-  const RunSpec& spec_;
+  Grid grid_;
+  long every_;
   const SampleSink* sink_;
   ToPhysical to_physical_;
 };
@@ -154,20 +177,20 @@ template <class Says, class X, class TryStep, class Observer>
   return x;
 }
 
-/// Runs `loop(observer)` with a null observer or a monitor, timing the loop only. A sink that throws
-/// StopRun ends the loop: the run ends at the state it was handed.
+/// Runs `loop(observer)` with a null observer or a monitor, timing the loop only. A sink that says
+/// Flow::stop ends the loop: the run ends at the state it was handed.
 template <class Field, class ToPhysical, class Loop>
-RunResult observe(const BodyPoint& p, const Field& field, const State& s0, const RunSpec& spec,
-                  const SampleSink* sink, ToPhysical to_physical, Loop&& loop) {
+RunResult observe(const BodyPoint& p, const Field& field, const State& s0, const RunOptions& options, Grid grid,
+                  ToPhysical to_physical, Loop&& loop) {
   RunResult r;
-  r.steps = spec.steps;
-  r.t_end = static_cast<double>(spec.steps) * spec.h;
-  if (spec.track_invariants || sink) {
-    Monitor<Field, ToPhysical> mon(p, field, s0, spec, sink, to_physical);
+  r.steps = grid.steps;
+  r.t_end = static_cast<double>(grid.steps) * grid.h;
+  if (options.track_invariants || options.sink) {
+    Monitor<Field, ToPhysical> mon(p, field, s0, options, grid, to_physical);
     const auto t0 = Clock::now();
     try {
       r.final = loop(mon);
-    } catch (const StopRun& stop) {
+    } catch (const SinkStopped& stop) {
       r.final = stop.s;
       r.steps = stop.step;
       r.t_end = stop.t;

@@ -52,7 +52,8 @@ struct GslSays {
 };
 
 RunResult run_gsl(const gsl_odeiv2_step_type* type, const Body& body, const std::vector<Centre>& centres,
-                  const RunSpec& spec, const SampleSink* sink) {
+                  const Advance& how, const RunOptions& options) {
+  const auto& spec = std::get<ControlledSteps>(how);
   gsl_set_error_handler_off();
   return dispatch(body, centres, [&](const auto& field, auto spin) {
     using Field = std::decay_t<decltype(field)>;
@@ -67,7 +68,7 @@ RunResult run_gsl(const gsl_odeiv2_step_type* type, const Body& body, const std:
     const double t_end = spec.t_end;
     detail::StepStats st;
     auto to_physical = [](const OdeState<double>& x) { return from_ode(x); };
-    RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
+    RunResult r = observe(body.p, field, body.s0, options, detail::grid_of(spec), to_physical, [&](auto& obs) {
       auto try_step = [&](OdeState<double>& x, double& t, double& dt) {  // evolve retries and lands on t_end
         const int status =
             gsl_odeiv2_evolve_apply(evolve.get(), control.get(), step.get(), &gsys, &t, t_end, &dt, x.data());
@@ -75,7 +76,7 @@ RunResult run_gsl(const gsl_odeiv2_step_type* type, const Body& body, const std:
           throw Error("gsl: step failed at t = " + std::to_string(t) + " (" + gsl_strerror(status) + ")");
         return true;
       };
-      return from_ode(detail::controlled_loop<GslSays>(to_ode(body.s0), spec.h, t_end, st, obs, try_step));
+      return from_ode(detail::controlled_loop<GslSays>(to_ode(body.s0), spec.h0, t_end, st, obs, try_step));
     });
     r.force_evals = evals;
     st.record(r, t_end);
@@ -85,10 +86,10 @@ RunResult run_gsl(const gsl_odeiv2_step_type* type, const Body& body, const std:
 
 }  // namespace
 
-RunResult run_gsl_rk8pd(const Body& b, const std::vector<Centre>& c, const RunSpec& s, const SampleSink* k) {
+RunResult run_gsl_rk8pd(const Body& b, const std::vector<Centre>& c, const Advance& s, const RunOptions& k) {
   return run_gsl(gsl_odeiv2_step_rk8pd, b, c, s, k);
 }
-RunResult run_gsl_rkf45(const Body& b, const std::vector<Centre>& c, const RunSpec& s, const SampleSink* k) {
+RunResult run_gsl_rkf45(const Body& b, const std::vector<Centre>& c, const Advance& s, const RunOptions& k) {
   return run_gsl(gsl_odeiv2_step_rkf45, b, c, s, k);
 }
 

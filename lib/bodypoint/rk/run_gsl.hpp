@@ -5,7 +5,7 @@
 
 namespace bodypoint {
 
-RunResult run_gsl_rk8pd(const Body&, const std::vector<Centre>&, const RunSpec&, const SampleSink*);
-RunResult run_gsl_rkf45(const Body&, const std::vector<Centre>&, const RunSpec&, const SampleSink*);
+RunResult run_gsl_rk8pd(const Body&, const std::vector<Centre>&, const Advance&, const RunOptions&);
+RunResult run_gsl_rkf45(const Body&, const std::vector<Centre>&, const Advance&, const RunOptions&);
 
 }  // namespace bodypoint

@@ -47,15 +47,16 @@ OdeState<double> fixed_step_loop(const System& sys, OdeState<double> x, double h
 }
 
 template <class Stepper>
-RunResult run_odeint(const Body& body, const std::vector<Centre>& centres, const RunSpec& spec,
-                     const SampleSink* sink) {
+RunResult run_odeint(const Body& body, const std::vector<Centre>& centres, const Advance& how,
+                     const RunOptions& options) {
+  const auto& fixed = std::get<FixedSteps>(how);
   return dispatch(body, centres, [&](const auto& field, auto spin) {
     using Field = std::decay_t<decltype(field)>;
     long evals = 0;
     EquationsOfMotion<Field, decltype(spin)::value> sys{body.p, field, &evals};
     auto to_physical = [](const OdeState<double>& x) { return from_ode(x); };
-    RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
-      return from_ode(fixed_step_loop<Stepper>(sys, to_ode(body.s0), spec.h, spec.steps, obs));
+    RunResult r = observe(body.p, field, body.s0, options, detail::grid_of(fixed), to_physical, [&](auto& obs) {
+      return from_ode(fixed_step_loop<Stepper>(sys, to_ode(body.s0), fixed.h, fixed.steps, obs));
     });
     r.force_evals = evals;
     return r;
@@ -78,11 +79,12 @@ struct OdeintSays {
   }
 };
 
-/// Step-size-controlled odeint stepper from t = 0 to spec.t_end, hitting t_end exactly (the last
+/// Step-size-controlled odeint stepper from t = 0 to t_end, hitting t_end exactly (the last
 /// trial step is cut to the remaining time). The observer sees every accepted step.
 template <class Controlled>
 RunResult run_odeint_adaptive(const Body& body, const std::vector<Centre>& centres,
-                              const RunSpec& spec, const SampleSink* sink) {
+                              const Advance& how, const RunOptions& options) {
+  const auto& spec = std::get<ControlledSteps>(how);
   return dispatch(body, centres, [&](const auto& field, auto spin) {
     using Field = std::decay_t<decltype(field)>;
     long evals = 0;
@@ -90,7 +92,7 @@ RunResult run_odeint_adaptive(const Body& body, const std::vector<Centre>& centr
     auto to_physical = [](const OdeState<double>& x) { return from_ode(x); };
     const double t_end = spec.t_end;
     detail::StepStats st;
-    RunResult r = observe(body.p, field, body.s0, spec, sink, to_physical, [&](auto& obs) {
+    RunResult r = observe(body.p, field, body.s0, options, detail::grid_of(spec), to_physical, [&](auto& obs) {
       Controlled stepper = rk::make_controlled<Controlled>(spec.tol);
       auto try_step = [&](OdeState<double>& x, double& t, double& dt) __attribute__((always_inline)) {
         const bool final_step = t + dt >= t_end;
@@ -99,7 +101,7 @@ RunResult run_odeint_adaptive(const Body& body, const std::vector<Centre>& centr
         if (final_step) t = t_end;  // exact end time, not t_before + dt rounded
         return true;
       };
-      return from_ode(detail::controlled_loop<OdeintSays>(to_ode(body.s0), spec.h, t_end, st, obs, try_step));
+      return from_ode(detail::controlled_loop<OdeintSays>(to_ode(body.s0), spec.h0, t_end, st, obs, try_step));
     });
     r.force_evals = evals;
     st.record(r, t_end);
@@ -109,19 +111,19 @@ RunResult run_odeint_adaptive(const Body& body, const std::vector<Centre>& centr
 
 }  // namespace
 
-RunResult run_odeint_rk4(const Body& b, const std::vector<Centre>& c, const RunSpec& s, const SampleSink* k) {
+RunResult run_odeint_rk4(const Body& b, const std::vector<Centre>& c, const Advance& s, const RunOptions& k) {
   return run_odeint<rk::Rk4>(b, c, s, k);
 }
-RunResult run_odeint_ab4(const Body& b, const std::vector<Centre>& c, const RunSpec& s, const SampleSink* k) {
+RunResult run_odeint_ab4(const Body& b, const std::vector<Centre>& c, const Advance& s, const RunOptions& k) {
   return run_odeint<rk::Ab4>(b, c, s, k);
 }
-RunResult run_odeint_dopri5(const Body& b, const std::vector<Centre>& c, const RunSpec& s, const SampleSink* k) {
+RunResult run_odeint_dopri5(const Body& b, const std::vector<Centre>& c, const Advance& s, const RunOptions& k) {
   return run_odeint_adaptive<rk::Dopri5>(b, c, s, k);
 }
-RunResult run_odeint_rkf78(const Body& b, const std::vector<Centre>& c, const RunSpec& s, const SampleSink* k) {
+RunResult run_odeint_rkf78(const Body& b, const std::vector<Centre>& c, const Advance& s, const RunOptions& k) {
   return run_odeint_adaptive<rk::Rkf78>(b, c, s, k);
 }
-RunResult run_odeint_bs(const Body& b, const std::vector<Centre>& c, const RunSpec& s, const SampleSink* k) {
+RunResult run_odeint_bs(const Body& b, const std::vector<Centre>& c, const Advance& s, const RunOptions& k) {
   return run_odeint_adaptive<rk::BulirschStoer>(b, c, s, k);
 }
 
