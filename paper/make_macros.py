@@ -611,7 +611,7 @@ FLAGGED = ("diverged", "unresolved", "inaccurate", "collision")
 def stress(res, out, M):
     rows, _ = read_csv(os.path.join(res, "stress.csv"))
     M.add("StressRuns", count(len(rows)))
-    for status, name in [("ok", "StressOk"), ("refused", "StressRefused")]:
+    for status, name in [("ok", "StressOk"), ("refused", "StressRefused"), ("failed", "StressFailed")]:
         M.add(name, count(sum(1 for r in rows if r["status"] == status)))
     M.add("StressFlagged", count(sum(1 for r in rows if r["status"] in FLAGGED)))
     cases, methods = [], []
@@ -633,13 +633,14 @@ def stress(res, out, M):
                 elif r["status"] == "ok":
                     cells.append(f"${sci(num(r['max_rel_dE']), 1)}$")
                 else:
-                    cells.append({"refused": "ref.", "diverged": "\\textbf{div.}", "unresolved": "\\textbf{unres.}",
-                                  "inaccurate": "\\textbf{inacc.}", "collision": "\\textbf{col.}"}[r["status"]])
+                    cells.append({"refused": "ref.", "failed": "stop.", "diverged": "\\textbf{div.}",
+                                  "unresolved": "\\textbf{unres.}", "inaccurate": "\\textbf{inacc.}",
+                                  "collision": "\\textbf{col.}"}[r["status"]])
             label = c.replace("_", "\\_").replace("|K1|", "$|K_1|$")
             f.write(f"{label} & " + " & ".join(cells) + " \\\\\n")
         f.write("\\midrule\n")
         for title, statuses in [("ended normally", ("ok",)), ("refused with a reason", ("refused",)),
-                                ("flagged", FLAGGED)]:
+                                ("stopped with a reason", ("failed",)), ("flagged", FLAGGED)]:
             n = [sum(1 for c in cases if cell.get((c, m)) and cell[(c, m)]["status"] in statuses) for m in methods]
             f.write(f"\\emph{{{title}}} & " + " & ".join(str(k) for k in n) + " \\\\\n")
     M.add("StressMethodCount", str(len(methods)), math_mode=False)  # a column count, used in the preamble
