@@ -2,6 +2,7 @@
 // (fictitious step ds = 0.01), printing its distance from the centre and its energy error after
 // each segment; each segment continues from where the previous one ended.
 #include <bodypoint/bodypoint.hpp>
+#include <bodypoint/invariants.hpp>
 
 #include <cmath>
 #include <cstdio>

@@ -2,7 +2,7 @@
 #include "process.hpp"
 #include "mpi_sweep.hpp"
 
-#include "bodypoint/detail/threads.hpp"
+#include "bodypoint/threads.hpp"
 #include "bodypoint/io.hpp"
 #include "rows_file.hpp"
 
@@ -189,7 +189,7 @@ std::vector<std::string> run_sweep_mpi(const MpiSession& mpi, const SweepSpec& s
     }
   };
   {
-    const detail::WorkerThreads pool(std::max(1u, control.threads), worker);  // none: the other ranks do it all
+    const WorkerThreads pool(std::max(1u, control.threads), worker);  // none: the other ranks do it all
     coordinate(mpi, board);
   }
   CooperativeInterrupt::check();

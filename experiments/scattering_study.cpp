@@ -13,7 +13,7 @@
 #include "scattering_study.hpp"
 
 #include "bodypoint/bodypoint.hpp"
-#include "bodypoint/detail/threads.hpp"
+#include "bodypoint/threads.hpp"
 #include "bodypoint/io.hpp"
 #include "sweep.hpp"
 
@@ -116,7 +116,7 @@ std::vector<Point> run_points(const std::vector<Series>& all, const std::vector<
     for (std::size_t i; (i = next++) < points.size();) points[i] = run_point(all[i / bs.size()], bs[i % bs.size()]);
   };
   {
-    const detail::WorkerThreads pool(std::max(1u, threads) - 1, worker);  // joined before points is read
+    const WorkerThreads pool(std::max(1u, threads) - 1, worker);  // joined before points is read
     worker();
   }
   return points;

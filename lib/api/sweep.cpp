@@ -2,7 +2,7 @@
 #include "bodypoint/sweep.hpp"
 
 #include "bodypoint/batch.hpp"
-#include "bodypoint/detail/threads.hpp"
+#include "bodypoint/threads.hpp"
 #include "bodypoint/io.hpp"
 
 #include <algorithm>
@@ -229,7 +229,7 @@ void run_sweep_tasks(const SweepSpec& spec, const std::vector<std::size_t>& todo
     }
   };
   {
-    const detail::WorkerThreads pool(static_cast<unsigned>(std::min<std::size_t>(runner.threads, units.size())) - 1, worker);
+    const WorkerThreads pool(static_cast<unsigned>(std::min<std::size_t>(runner.threads, units.size())) - 1, worker);
     worker();
   }
   if (error) std::rethrow_exception(error);

@@ -22,7 +22,22 @@ install(FILES
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/run.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/scattering.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/scene_file.hpp
+          ${PROJECT_SOURCE_DIR}/lib/bodypoint/scenes.hpp
+          ${PROJECT_SOURCE_DIR}/lib/bodypoint/observables.hpp
+          ${PROJECT_SOURCE_DIR}/lib/bodypoint/io.hpp
+          ${PROJECT_SOURCE_DIR}/lib/bodypoint/batch.hpp
+          ${PROJECT_SOURCE_DIR}/lib/bodypoint/threads.hpp
+          ${PROJECT_SOURCE_DIR}/lib/bodypoint/order_fit.hpp
+          # The independent references and the equations of motion as an ODE system (Boost.Odeint's
+          # headers are needed where a program includes these).
+          ${PROJECT_SOURCE_DIR}/lib/bodypoint/reference.hpp
+          ${PROJECT_SOURCE_DIR}/lib/bodypoint/rhs.hpp
+          ${PROJECT_SOURCE_DIR}/lib/bodypoint/kepler.hpp
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bodypoint)
+install(FILES
+          ${PROJECT_SOURCE_DIR}/adaptive/bodypoint/adaptive/tolerance.hpp
+          ${PROJECT_SOURCE_DIR}/adaptive/bodypoint/adaptive/methods.hpp
+        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bodypoint/adaptive)
 
 set(BODYPOINT_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/bodypoint)
 install(EXPORT bodypointTargets NAMESPACE bodypoint:: DESTINATION ${BODYPOINT_CMAKE_DIR})

@@ -9,8 +9,9 @@
 //   - the model (model.hpp): a Scene is fixed Coulomb centres and independent body-points, each with
 //     its parameters m, B, J and initial state (R, v, w); thesis_scene() builds the thesis's set-up;
 //     read_scene_file() reads a TOML scene (scene_file.hpp); its first integrals (energy,
-//     kinetic_energy, ...: invariants.hpp). The physics and the meaning of every parameter are in
-//     docs/physics.md.
+//     kinetic_energy, ...) are in <bodypoint/invariants.hpp>, included where needed so that a
+//     program's objects do not depend on the force kernel. The physics and the meaning of every
+//     parameter are in docs/physics.md.
 //   - the catalogue (methods.hpp): every method, each a MethodInfo row with its family, order and
 //     cost; methods(), find_method(), and choose_method() for `auto`.
 //   - a way of advancing time, as a value (Advance): FixedSteps, FictitiousSteps (time-transformed
@@ -28,7 +29,6 @@
 // that happens to a valid request is reported in the Result, never thrown.
 #pragma once
 
-#include "bodypoint/invariants.hpp"
 #include "bodypoint/methods.hpp"
 #include "bodypoint/model.hpp"
 #include "bodypoint/run.hpp"

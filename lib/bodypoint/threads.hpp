@@ -7,7 +7,7 @@
 #include <thread>
 #include <vector>
 
-namespace bodypoint::detail {
+namespace bodypoint {
 
 class WorkerThreads {
  public:
@@ -38,4 +38,4 @@ class WorkerThreads {
   std::vector<std::thread> pool_;
 };
 
-}  // namespace bodypoint::detail
+}  // namespace bodypoint
