@@ -339,14 +339,6 @@ RunResult run_ks(const Body& body, const std::vector<Centre>& centres, const Adv
   return r;
 }
 
-/// The tables the time-transformed families take: the symmetric drift-first compositions (their drift
-/// carries the time variable, so a step must be symmetric to stay time-reversible); DKD Strang is
-/// their "verlet".
-using LogHTables = sp::List<sp::Use<sp::StrangDkd, "verlet">, sp::Yoshida4, sp::BlanesMoan4, sp::Yoshida6,
-                            sp::KahanLi6, sp::Yoshida8, sp::McLachlan8, sp::KahanLi8, sp::SofroniouSpaletta10>;
-using TtlTables = sp::List<sp::Use<sp::StrangDkd, "verlet">, sp::Yoshida4, sp::BlanesMoan4, sp::Yoshida6,
-                           sp::KahanLi6, sp::McLachlan8, sp::KahanLi8>;
-
 /// The row of a time-transformed method: kernel family K (logH or TTL) times the entry's table.
 template <template <class, bool> class K, class E>
 MethodInfo transformed_row(std::string_view prefix, std::string_view family, SceneCheck check) {
@@ -360,10 +352,10 @@ MethodInfo transformed_row(std::string_view prefix, std::string_view family, Sce
 
 std::vector<MethodInfo> methods() {
   std::vector<MethodInfo> all;
-  sp::for_each(LogHTables{}, [&all]<class E>() {
+  sp::for_each(sp::TimeTransformedTables{}, [&all]<class E>() {
     all.push_back(transformed_row<LogHKernel, E>("logh-", "logH (repulsive scenes), ds = --h", &logh_check));
   });
-  sp::for_each(TtlTables{}, [&all]<class E>() {
+  sp::for_each(sp::TimeTransformedTables{}, [&all]<class E>() {
     all.push_back(transformed_row<TtlKernel, E>("ttl-", "TTL (any sign of A), ds = --h", &ttl_check));
   });
   all.push_back({"ks", Family::Regularised, 0, 0, 0,

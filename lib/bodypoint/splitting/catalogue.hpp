@@ -4,7 +4,8 @@
 // about it: a name tag, the order, the stage count (force evaluations per step when consecutive steps
 // share their boundary kicks, the count papers quote) and a citation. `AllTables` lists every table;
 // a family lists the tables it accepts (`LiePoissonTables`, `ThesisTables` here, the time-transformed
-// ones in adaptive/), each entry a table under its own tag or under a name the family gives it. The
+// ones too), each entry a table under its own tag or under a name the family gives it; the lists of the
+// Kepler split and the time transformations are AllTables filtered by what their kernels need. The
 // method registry, the SIMD batch kernels, `bodypoint methods` (and the README's table from it) and
 // the tests' method lists are generated from these lists, so adding a table is its header and one
 // entry in `AllTables`; a family is its kernel and one list.
@@ -24,6 +25,7 @@
 #include <cstddef>
 #include <string>
 #include <string_view>
+#include <type_traits>
 
 namespace bodypoint::splitting {
 
@@ -112,9 +114,68 @@ using AllTables = List<Euler, VerletKdk, StrangDkd, Ruth3, Yoshida4, BlanesMoan4
 /// The exact Lie-Poisson splitting (lp-*) takes every table.
 using LiePoissonTables = AllTables;
 
+// A family's list is AllTables filtered by what the family's kernel needs of a table (a predicate on
+// its coefficients), so that a table added to AllTables reaches every family it fits.
+
+namespace detail {
+template <template <class> class Keep, class L>
+struct Filter;
+template <template <class> class Keep>
+struct Filter<Keep, List<>> {
+  using type = List<>;
+};
+template <template <class> class Keep, class H, class... T>
+struct Filter<Keep, List<H, T...>> {
+  template <class... X>
+  static List<H, X...> prepend(List<X...>);
+  using rest = typename Filter<Keep, List<T...>>::type;
+  using type = std::conditional_t<Keep<H>::value, decltype(prepend(rest{})), rest>;
+};
+template <template <class> class F, class L>
+struct Map;
+template <template <class> class F, class... T>
+struct Map<F, List<T...>> {
+  using type = List<F<T>...>;
+};
+}  // namespace detail
+
+/// The entries of list L that Keep<T>::value accepts, in order; each renamed by F.
+template <template <class> class Keep, class L, template <class> class F>
+using filtered_t = typename detail::Map<F, typename detail::Filter<Keep, L>::type>::type;
+
+/// Coefficients equal within this many of their own roundings count as equal (a palindrome's mirrored
+/// coefficients are computed by different sums).
+inline constexpr double kMirrorUlps = 8.0;
+
+/// A symmetric step that starts and ends with a drift: the compositions a time transformation takes
+/// (its drift carries the time variable; a symmetric step keeps the method time-reversible).
+template <TableType T>
+constexpr bool is_symmetric_drift_first() {
+  constexpr const auto& s = ops_of<T>;
+  if (s.size == 0 || s.ops[0].part != Part::drift) return false;
+  for (std::size_t i = 0; i < s.size; ++i) {
+    const Op a = s.ops[i], b = s.ops[s.size - 1 - i];
+    const double scale = a.c < 0.0 ? -a.c : a.c;
+    const double diff = a.c - b.c < 0.0 ? b.c - a.c : a.c - b.c;
+    if (a.part != b.part || diff > kMirrorUlps * 2.220446049250313e-16 * (scale > 1.0 ? scale : 1.0)) return false;
+  }
+  return true;
+}
+template <class T>
+struct IsSymmetricDriftFirst : std::bool_constant<is_symmetric_drift_first<T>()> {};
+template <class T>
+struct IsDkdComposition : std::bool_constant<is_dkd_composition(T::table)> {};
+
+/// The name a drift-first family gives a table: DKD Strang is its "verlet".
+template <class T>
+using DriftFirstName = std::conditional_t<std::is_same_v<T, StrangDkd>, Use<StrangDkd, "verlet">, T>;
+
 /// The Kepler split (kepler_split.hpp) takes the DKD compositions (a stage is a Kepler solve, none
 /// shared between steps); being compositions, they also make its three-part methods for several centres.
-using KeplerSplitTables = List<Use<StrangDkd, "verlet">, Yoshida4, Yoshida6, KahanLi6, Yoshida8, KahanLi8>;
+using KeplerSplitTables = filtered_t<IsDkdComposition, AllTables, DriftFirstName>;
+
+/// The time-transformed families (logH, TTL: adaptive/) take the symmetric drift-first tables.
+using TimeTransformedTables = filtered_t<IsSymmetricDriftFirst, AllTables, DriftFirstName>;
 
 /// The thesis's five schemes (sec. 2.5) with the published code's index slip (code_slip.hpp) of
 /// each; the thesis calls Yoshida 4 "Forest-Ruth 4".
