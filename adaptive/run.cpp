@@ -353,13 +353,13 @@ MethodInfo transformed_row(std::string_view prefix, std::string_view family, Sce
 std::vector<MethodInfo> methods() {
   std::vector<MethodInfo> all;
   sp::for_each(sp::TimeTransformedTables{}, [&all]<class E>() {
-    all.push_back(transformed_row<LogHKernel, E>("logh-", "logH (repulsive scenes), ds = --h", &logh_check));
+    all.push_back(transformed_row<LogHKernel, E>("logh-", "logH (repulsive scenes), fictitious step ds", &logh_check));
   });
   sp::for_each(sp::TimeTransformedTables{}, [&all]<class E>() {
-    all.push_back(transformed_row<TtlKernel, E>("ttl-", "TTL (any sign of A), ds = --h", &ttl_check));
+    all.push_back(transformed_row<TtlKernel, E>("ttl-", "TTL (any sign of A), fictitious step ds", &ttl_check));
   });
   all.push_back({"ks", Family::Regularised, 0, 0, 0,
-                 "Kustaanheimo-Stiefel regularisation, exact in fictitious time (B = 0, one centre), ds = --h",
+                 "Kustaanheimo-Stiefel regularisation, exact in fictitious time (B = 0, one centre), fictitious step ds",
                  &run_ks, &ks_check});
   return all;
 }

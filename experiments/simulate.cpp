@@ -195,8 +195,7 @@ void add_simulate_options(po::options_description& desc, SimulateOptions& o) {
 void apply_output_options(const po::variables_map& vm, const SimulateOptions& o, const Scene& scene, RunPlan& plan) {
   if (plan.search && vm.count("omega-c")) throw Error("--tol uses the automatic time-step constant: drop --omega-c");
   if (vm.count("omega-c")) {
-    // Given, it is used: a constant c >= 0 for a time-transformed method (issue #24: -5, nan and a
-    // fixed-step method's --omega-c were ignored).
+    // Given, it is used: so it must be a constant c >= 0 of a method that takes one.
     require_non_negative(o.omega_c, "the time-step constant omega_c");
     if (plan.method && (!is_time_transformed(*plan.method) || plan.method->family == Family::Regularised))
       throw Error("--omega-c is the time-step constant of the time-transformed methods (logh-*, ttl-*); " +

@@ -1,4 +1,4 @@
-// `bodypoint study --name stress`: one method of each family on hostile scenes (issue #12). Every run
+// `bodypoint study --name stress`: one method of each family on hostile scenes. Every run
 // ends as ok (finite, energy error below 1), refused (with the reason: a method that does not accept
 // the scene, a budget, a validation), diverged or collision (flagged by assess()). Nothing is
 // reported as a number that does not mean one.
@@ -32,7 +32,7 @@ struct StressCase {
 
 Scene thesis(SceneParams p) { return thesis_scene(p); }
 
-/// The bound orbit of issue #12: A = +1, R = (1,0,0), K1 = (0,0.8,0), K2 = (0,0.3,0.2), E0 = -0.5745.
+/// A bound orbit: A = +1, R = (1,0,0), K1 = (0,0.8,0), K2 = (0,0.3,0.2), E0 = -0.5745.
 Scene bound_orbit() {
   Scene s;
   s.centres.push_back({Vec3::Zero(), 1.0});

@@ -110,7 +110,7 @@ void study_Kx(const StudyContext& c) {
   write_sweep(c, "Kx_sweep.csv", s, "fig. 4.10-4.11: d = 50, L = 200, h = 1e-4, n = 250000; Kx = -10..10 (our choice)");
 }
 
-// The (d, L) stability map (issue #14): the d and L sweeps' ranges at once, every fixed-step method.
+// The (d, L) stability map : the d and L sweeps' ranges at once, every fixed-step method.
 void study_dL_map(const StudyContext& c) {
   SweepSpec s = thesis_sweep("d");
   s.axes = {{"d", c.quick ? linear_range(5, 200, 65) : linear_range(5, 200, 5)},
@@ -327,7 +327,7 @@ void study_appendix(const StudyContext& c) {
   std::cerr << "wrote " << dir.string() << "/ (30 sets)\n";
 }
 
-/// Hostile scenes for one method of each family (issue #12): not part of "all" (the thesis's studies).
+/// Hostile scenes for one method of each family: not part of "all" (the thesis's studies).
 void study_stress(const StudyContext& c) {
   AtomicFile csv((c.dir / "stress.csv").string()), md((c.dir / "stress.md").string());
   const auto rows = run_stress(c.quick, [&](const StressRow& r) {
@@ -363,7 +363,7 @@ int cmd_study(int argc, char** argv) {
   po::options_description desc("bodypoint study");
   desc.add_options()
       ("name", po::value(&which)->default_value(which), "recipe: d, L, h, Kx, timing, evals, appendix, errata, orders, published (chapter 4 with the thesis code's force "
-       "law), all (these), stress (hostile scenes, issue #12), dL-map (the (d, L) stability map, issue #14) or scattering "
+       "law), all (these), stress (hostile scenes), dL-map (the (d, L) stability map) or scattering "
        "(the deflection function theta(b) against Rutherford's, spinning bodies, cross-sections)")
       ("results", po::value(&results)->default_value(results), "folder for the CSVs (created if missing)")
       ("quick", po::bool_switch(&quick), "coarser grids, same recipes (under two minutes on 2 cores)")

@@ -118,7 +118,7 @@ void settle(const po::variables_map& vm, WorkPrecisionArgs& a) {
   }
   if (a.o.repeats < 1) throw Error("--repeats must be >= 1");
   if (!(a.o.max_evals >= 1)) throw Error("--max-evals must be >= 1");
-  // Options that would be ignored or would write an empty table are refused (issue #24).
+  // Options that would be ignored or would write an empty table are refused.
   if (!vm["tols"].defaulted() && !a.by_tol) throw Error("--tols is for --by-tol");
   if (vm.count("summary") && a.summary.empty()) throw Error("--summary needs a file name");
   if (vm.count("out") && a.out.empty()) throw Error("--out needs a file name");

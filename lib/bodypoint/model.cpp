@@ -110,16 +110,17 @@ Scene thesis_scene(const SceneParams& sp) {
 }
 
 const std::vector<SceneParameter>& scene_parameters() {
+  using Of = SceneParameter::Of;
   static const std::vector<SceneParameter> list = {
-      {"A", "Coulomb constant of the centre at the origin (A < 0 repels)", [](SceneParams& p) -> double& { return p.A; }},
-      {"m", "mass", [](SceneParams& p) -> double& { return p.m; }},
-      {"B", "coupling inertia (B = 0: material point)", [](SceneParams& p) -> double& { return p.B; }},
-      {"J", "rotational inertia", [](SceneParams& p) -> double& { return p.J; }},
-      {"K1", "initial linear momentum K1(0) = K1 i", [](SceneParams& p) -> double& { return p.start.K1; }},
-      {"Kx", "K2(0) = Kx i - Kz k", [](SceneParams& p) -> double& { return p.start.Kx; }},
-      {"Kz", "K2(0) = Kx i - Kz k", [](SceneParams& p) -> double& { return p.start.Kz; }},
-      {"d", "angular-momentum impact parameter: K2Q_z = -d K1 (not the asymptote's b; see --b)", [](SceneParams& p) -> double& { return p.start.d; }},
-      {"L", "initial distance along -x", [](SceneParams& p) -> double& { return p.start.L; }},
+      {"A", "Coulomb constant of the centre at the origin (A < 0 repels)", [](SceneParams& p) -> double& { return p.A; }, Of::centre},
+      {"m", "mass", [](SceneParams& p) -> double& { return p.m; }, Of::body},
+      {"B", "coupling inertia (B = 0: material point)", [](SceneParams& p) -> double& { return p.B; }, Of::body},
+      {"J", "rotational inertia", [](SceneParams& p) -> double& { return p.J; }, Of::body},
+      {"K1", "initial linear momentum K1(0) = K1 i", [](SceneParams& p) -> double& { return p.start.K1; }, Of::start},
+      {"Kx", "K2(0) = Kx i - Kz k", [](SceneParams& p) -> double& { return p.start.Kx; }, Of::start},
+      {"Kz", "K2(0) = Kx i - Kz k", [](SceneParams& p) -> double& { return p.start.Kz; }, Of::start},
+      {"d", "angular-momentum impact parameter: K2Q_z = -d K1 (not the asymptote's b; see --b)", [](SceneParams& p) -> double& { return p.start.d; }, Of::start},
+      {"L", "initial distance along -x", [](SceneParams& p) -> double& { return p.start.L; }, Of::start},
   };
   return list;
 }

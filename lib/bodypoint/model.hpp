@@ -137,9 +137,13 @@ struct SceneParams {
 /// One number of SceneParams, by name: the CLI option, the sweep axis, the appendix recipes' key and
 /// the scene line of every output header read this list (one place for the names and the fields).
 struct SceneParameter {
+  /// What a parameter belongs to: the centre (A), the body-point's inertia (m, B, J), or its start in
+  /// the thesis's form (d, L, K1, Kx, Kz). Scene files take each under its name, in that table.
+  enum class Of { centre, body, start };
   std::string_view name;
   std::string_view help;
   double& (*field)(SceneParams& p);
+  Of of;
 };
 /// Every scene parameter, in the order options and headers list them.
 const std::vector<SceneParameter>& scene_parameters();

@@ -122,18 +122,18 @@ std::vector<MethodInfo> make_rows() {
        "Adams-Bashforth 4 started by RK4 (thesis 2.2; odeint adams_bashforth<4>)",
        &run_odeint_ab4},
       {"odeint-dopri5", Family::OdeintAdaptive, 5, 6, 6,
-       "Dormand-Prince 5(4) with step-size control (odeint runge_kutta_dopri5), --tol",
+       "Dormand-Prince 5(4) with step-size control (odeint runge_kutta_dopri5); a tolerance per step",
        &run_odeint_dopri5},
       {"odeint-rkf78", Family::OdeintAdaptive, 8, 13, 13,
-       "Fehlberg 7(8) with step-size control (odeint runge_kutta_fehlberg78), --tol",
+       "Fehlberg 7(8) with step-size control (odeint runge_kutta_fehlberg78); a tolerance per step",
        &run_odeint_rkf78},
       {"odeint-bs", Family::OdeintAdaptive, 0, 0, 0,
-       "Bulirsch-Stoer extrapolation with order and step control (odeint bulirsch_stoer), --tol",
+       "Bulirsch-Stoer extrapolation with order and step control (odeint bulirsch_stoer); a tolerance per step",
        &run_odeint_bs},
 #ifdef BODYPOINT_HAVE_GSL
-      {"gsl-rk8pd", Family::Gsl, 8, 13, 13, "GSL Prince-Dormand 8(7) with step-size control (gsl_odeiv2_step_rk8pd), --tol",
+      {"gsl-rk8pd", Family::Gsl, 8, 13, 13, "GSL Prince-Dormand 8(7) with step-size control (gsl_odeiv2_step_rk8pd); a tolerance per step",
        &run_gsl_rk8pd},
-      {"gsl-rkf45", Family::Gsl, 5, 6, 6, "GSL Runge-Kutta-Fehlberg 4(5) with step-size control (gsl_odeiv2_step_rkf45), --tol",
+      {"gsl-rkf45", Family::Gsl, 5, 6, 6, "GSL Runge-Kutta-Fehlberg 4(5) with step-size control (gsl_odeiv2_step_rkf45); a tolerance per step",
        &run_gsl_rkf45},
 #endif
   };

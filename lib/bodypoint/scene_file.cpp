@@ -4,6 +4,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <algorithm>
+#include <initializer_list>
 #include <set>
 #include <sstream>
 #include <toml++/toml.h>
@@ -59,27 +61,48 @@ constexpr std::uintmax_t kMaxSceneFileBytes = 16u << 20;
 
 namespace {
 
+/// The names of the scene parameters of one kind (model.hpp, scene_parameters()), and `extra`.
+std::set<std::string> keys_of(std::initializer_list<SceneParameter::Of> kinds, std::initializer_list<const char*> extra) {
+  std::set<std::string> keys(extra.begin(), extra.end());
+  for (const SceneParameter& q : scene_parameters())
+    if (std::find(kinds.begin(), kinds.end(), q.of) != kinds.end()) keys.emplace(q.name);
+  return keys;
+}
+
+/// Reads every parameter of kind `of` that the table has into p (each is required).
+void read_parameters(const toml::table& t, SceneParameter::Of of, SceneParams& p, const std::string& where,
+                     const std::string& origin) {
+  for (const SceneParameter& q : scene_parameters())
+    if (q.of == of) q.field(p) = number(t, std::string(q.name), where, origin);
+}
+
 Centre parse_centre(const toml::table& t, const std::string& where, const std::string& origin) {
-  only_keys(t, {"position", "A"}, where, origin);
+  only_keys(t, keys_of({SceneParameter::Of::centre}, {"position"}), where, origin);
+  SceneParams p;
+  read_parameters(t, SceneParameter::Of::centre, p, where, origin);
   Centre c;
-  c.A = number(t, "A", where, origin);
+  c.A = p.A;
   if (t.contains("position")) c.c = vector3(t, "position", where, origin);
   return c;
 }
 
-/// A body in either form: R, v, w, or the thesis's d, L, K1, Kx, Kz (eq. 1.11-1.13).
+/// A body in either form: R, v, w, or the thesis's start (d, L, K1, Kx, Kz; eq. 1.11-1.13).
 Body parse_body(const toml::table& t, std::size_t i, const std::string& origin) {
+  using Of = SceneParameter::Of;
   const std::string where = "body " + std::to_string(i + 1);
-  only_keys(t, {"name", "m", "B", "J", "R", "v", "w", "d", "L", "K1", "Kx", "Kz"}, where, origin);
+  only_keys(t, keys_of({Of::body, Of::start}, {"name", "R", "v", "w"}), where, origin);
   Body b;
   if (const toml::node* n = t.get("name")) {
     auto s = n->value<std::string>();
     if (!s) fail(origin, where + ": 'name' must be a string");
     b.name = *s;
   }
-  b.p = BodyPoint{number(t, "m", where, origin), number(t, "B", where, origin), number(t, "J", where, origin)};
+  SceneParams p;
+  read_parameters(t, Of::body, p, where, origin);
+  b.p = BodyPoint{p.m, p.B, p.J};
   const bool physical = t.contains("R") || t.contains("v") || t.contains("w");
-  const bool thesis = t.contains("d") || t.contains("L") || t.contains("K1") || t.contains("Kx") || t.contains("Kz");
+  const std::set<std::string> start = keys_of({Of::start}, {});
+  const bool thesis = std::any_of(start.begin(), start.end(), [&t](const std::string& k) { return t.contains(k); });
   if (physical == thesis)
     fail(origin, where + ": give either R, v, w or the thesis's d, L, K1, Kx, Kz (exactly one form)");
   try {
@@ -90,10 +113,9 @@ Body parse_body(const toml::table& t, std::size_t i, const std::string& origin) 
   if (physical) {
     b.s0 = State{vector3(t, "R", where, origin), vector3(t, "v", where, origin), vector3(t, "w", where, origin)};
   } else {
-    ThesisStart ts{number(t, "d", where, origin), number(t, "L", where, origin), number(t, "K1", where, origin),
-                   number(t, "Kx", where, origin), number(t, "Kz", where, origin)};
-    if (ts.K1 == 0.0) fail(origin, where + ": K1 must be non-zero");
-    b.s0 = to_state(b.p, thesis_momenta(ts));
+    read_parameters(t, Of::start, p, where, origin);
+    if (p.start.K1 == 0.0) fail(origin, where + ": K1 must be non-zero");
+    b.s0 = to_state(b.p, thesis_momenta(p.start));
   }
   if (b.name.empty()) b.name = "body" + std::to_string(i + 1);
   return b;

@@ -182,20 +182,6 @@ constexpr OpSequence<4 * N> flatten_three(const Table<N>& t) {
   return s;
 }
 
-/// Sums of the drift and kick coefficients (each must be 1 for a consistent method).
-template <std::size_t N>
-constexpr double drift_sum(const Table<N>& t) {
-  double s = 0.0;
-  for (double x : t.a) s += x;
-  return s;
-}
-template <std::size_t N>
-constexpr double kick_sum(const Table<N>& t) {
-  double s = 0.0;
-  for (double x : t.b) s += x;
-  return s;
-}
-
 /// An observer that observes nothing; the engine compiles it away.
 struct NullObserver {
   static constexpr bool active = false;
