@@ -197,6 +197,28 @@ std::string resolve_links(const std::string& path) {
   throw Error("output '" + path + "' is a loop of symbolic links");
 }
 
+/// True when `path`, or a link on the way to what it names, is an open descriptor of a process
+/// (/dev/stdout, /dev/fd/N, /proc/PID/fd/N): the stream a shell opened, for `--out /dev/stdout >> log`.
+bool through_descriptor(const std::string& path) {
+  namespace fs = std::filesystem;
+  auto descriptor = [](const std::string& p) {
+    if (p == "/dev/stdout" || p == "/dev/stderr" || p.rfind("/dev/fd/", 0) == 0) return true;
+    const std::size_t fd = p.find("/fd/");
+    return p.rfind("/proc/", 0) == 0 && fd != std::string::npos && p.find('/', fd + 4) == std::string::npos;
+  };
+  fs::path p(path);
+  for (int hop = 0; hop < 40; ++hop) {
+    if (descriptor(p.lexically_normal().string())) return true;
+    struct stat st {};
+    if (::lstat(p.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) return false;
+    std::error_code ec;
+    const fs::path to = fs::read_symlink(p, ec);
+    if (ec) return false;
+    p = to.is_absolute() ? to : p.parent_path() / to;
+  }
+  return false;
+}
+
 }  // namespace
 
 AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
@@ -211,7 +233,13 @@ AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
   if (::stat(path_.c_str(), &st) == 0) {
     if (S_ISDIR(st.st_mode)) throw Error("output '" + path_ + "' is a directory; give a file name");
     if (S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode)) {
-      open_direct(S_ISFIFO(st.st_mode));
+      open_direct(S_ISFIFO(st.st_mode), false);
+      return;
+    }
+    // A regular file reached through a process's descriptor (--out /dev/stdout >> log.txt) is the
+    // shell's stream: appended to in place, never replaced (its earlier contents stay).
+    if (S_ISREG(st.st_mode) && through_descriptor(path_)) {
+      open_direct(false, true);
       return;
     }
     if (!S_ISREG(st.st_mode)) throw Error("output '" + path_ + "' is neither a regular file, a FIFO nor a character device");
@@ -253,7 +281,7 @@ AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
   }
 }
 
-void AtomicFile::open_direct(bool fifo) {
+void AtomicFile::open_direct(bool fifo, bool append) {
   direct_ = true;
   int probe = -1;
   if (fifo) {
@@ -264,7 +292,7 @@ void AtomicFile::open_direct(bool fifo) {
       throw Error(errno == ENXIO ? "output '" + path_ + "' is a FIFO that nobody reads; start its reader first"
                                  : "cannot write output file '" + path_ + "' (" + std::strerror(errno) + ")");
   }
-  out_.open(path_, std::ios::out);
+  out_.open(path_, append ? std::ios::app : std::ios::out);
   if (probe >= 0) ::close(probe);
   if (!out_) throw Error("cannot write output file '" + path_ + "' (" + std::strerror(errno) + ")");
 }

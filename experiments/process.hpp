@@ -7,8 +7,9 @@
 // temporaries it left), an output that is another output or an input of the same run is refused, and
 // the terminating signals remove every temporary and lock file (install_signal_cleanup). Only a regular
 // file is ever replaced: a symbolic link's target is replaced and the link kept, a FIFO or character
-// device (/dev/null, /dev/stdout) is written directly, a directory or anything else is refused before
-// any work.
+// device (/dev/null, /dev/stdout) is written directly, a regular file reached through a process's
+// descriptor (/dev/stdout or /dev/fd/N redirected to a file) is appended to in place, a directory or
+// anything else is refused before any work.
 #pragma once
 
 #include "bodypoint/model.hpp"
@@ -32,12 +33,13 @@ class AtomicFile {
   std::ofstream& stream() { return out_; }
   /// Flushes, closes and renames onto the target path; throws Error on any failure.
   void commit();
-  /// True when the output is a FIFO or a device, written directly (nothing to resume from).
+  /// True when the output is a FIFO, a device or a process's open stream, written directly (nothing to
+  /// resume from).
   [[nodiscard]] bool direct() const { return direct_; }
 
  private:
   void release() noexcept;
-  void open_direct(bool fifo);
+  void open_direct(bool fifo, bool append);
 
   std::string path_, target_, tmp_, lock_, key_;
   std::ofstream out_;

@@ -230,6 +230,8 @@ int cmd_merge(int argc, char** argv) {
     std::size_t dropped = 0;
     RowsContent c = read_rows_file(path, &dropped);
     if (dropped > 0) throw Error("'" + path + "' has " + std::to_string(dropped) + " torn or corrupt record(s)");
+    // Every shard is written with the CSV's header lines: one without them was edited.
+    if (c.header.empty()) throw Error("'" + path + "' has no header lines (the CSV's column names): it was edited");
     if (all.key.empty()) {
       all.key = c.key;
       all.tasks = c.tasks;

@@ -157,6 +157,17 @@ TEST(Shards, MergedShardsEqualTheSingleProcessCsv) {
   std::ofstream(edited) << header;
   const auto headed = run_cli("merge --input " + files[0] + " " + edited.string());
   EXPECT_NE(headed.err.find("torn or corrupt"), std::string::npos) << headed.err;
+  // A shard whose header lines were removed (issue #40: merged into a CSV without its column names).
+  std::string headless;
+  {
+    std::istringstream lines(read(files[0]));
+    for (std::string l; std::getline(lines, l);)
+      if (l.rfind("H\t", 0) != 0) headless += l + "\n";
+  }
+  const fs::path no_header = dir.path / "headless.rows";
+  std::ofstream(no_header) << headless;
+  const auto unheaded = run_cli("merge --input " + no_header.string() + " " + files[1] + " " + files[2]);
+  EXPECT_NE(unheaded.err.find("has no header lines"), std::string::npos) << unheaded.err;
   // Two different rows under one task index: a file edited or mixed (the first was kept silently).
   std::string both = read(files[0]);
   const std::size_t rec = both.find("\nR\t") + 1;
@@ -176,7 +187,7 @@ TEST(Shards, MergedShardsEqualTheSingleProcessCsv) {
   ASSERT_EQ(::mkfifo((dir.path / "fifo").c_str(), 0644), 0);
   const auto fifo = run_cli("merge --input " + (dir.path / "fifo").string());
   EXPECT_NE(fifo.err.find("is not a regular file"), std::string::npos) << fifo.err;
-  for (const auto* r : {&missing, &twice, &foreign, &not_rows, &corrupt, &headed, &mixed, &fifo}) {
+  for (const auto* r : {&missing, &twice, &foreign, &not_rows, &corrupt, &headed, &unheaded, &mixed, &fifo}) {
     EXPECT_EQ(r->code, 2);
     EXPECT_TRUE(r->out.empty());
   }

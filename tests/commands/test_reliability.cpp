@@ -349,6 +349,18 @@ TEST(Reliability, OnlyARegularFileIsEverReplaced) {
   fs::create_symlink("loop2", dir / "loop1");
   fs::create_symlink("loop1", dir / "loop2");
   EXPECT_NE(run_cli(run + (dir / "loop1").string()).code, 0);
+  // The shell's stream redirected to a file (--out /dev/stdout >> log): appended to in place, so that
+  // what the file had stays (it was renamed over before).
+  const fs::path log = dir / "log.txt";
+  for (const std::string& redirect : {std::string("/dev/stdout >> LOG 2>/dev/null"), std::string("/dev/stderr 2>> LOG >/dev/null")}) {
+    std::ofstream(log) << "kept line\n";
+    std::string cmd = std::string(BODYPOINT_BIN) + " simulate --steps 100 --quiet --out " + redirect + " </dev/null";
+    cmd.replace(cmd.find("LOG"), 3, log.string());
+    EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    const std::string text = read(log);
+    EXPECT_EQ(text.rfind("kept line\n", 0), 0u) << cmd << ": the file's contents were lost";
+    EXPECT_NE(text.find("body,t,Rx"), std::string::npos) << cmd;
+  }
   // A FIFO: refused while nobody reads it, written directly (and left a FIFO) when someone does.
   ASSERT_EQ(::mkfifo((dir / "fifo").c_str(), 0644), 0);
   const auto unread = run_cli(run + (dir / "fifo").string());
