@@ -133,6 +133,8 @@ Event parse_event(const std::string& text) {
     e.normal = Vec3(n[0], n[1], n[2]);
     e.value = n[3];
     if (!(e.normal.norm() > 0.0)) throw Error("--event " + text + ": the plane's normal must not be zero");
+    if (!std::isfinite(e.normal.norm()))
+      throw Error("--event " + text + ": the plane's normal is too long (its length overflows); scale it down");
     return e;
   }
   throw Error("unknown --event '" + text + "': give closest, closest:K, r=RADIUS, r:K=RADIUS, x=X, y=Y, z=Z or "

@@ -363,11 +363,18 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
   if (help) return job;
   job.spec.axes = parse_axes(vm, grid);
   if (vm.count("scene")) throw Error("sweep varies the thesis's scene parameters; --scene is not supported");
-  if (!shard.empty()) parse_shard(shard, job);
+  if (vm.count("shard")) parse_shard(shard, job);
   if (job.resume && job.out.empty()) throw Error("--resume needs --out (the journal is <out>.journal)");
   if (job.sharded && job.out.empty()) throw Error("--shard needs --out (the shard's rows file)");
   job.spec.methods = parse_methods(methods_arg);
   job.spec.base = so.params;
+  // A value given is used, or refused: the tolerance per step whatever the methods, d or K1 beside
+  // the asymptotic data solved for them.
+  if (!vm["tol"].defaulted()) require_positive(job.spec.tol, "the tolerance per step tol");
+  for (const Axis& a : job.spec.axes) {
+    if (a.param == "b" && vm.count("d") && !vm["d"].defaulted()) throw Error("give --b or --d, not both (b solves d)");
+    if (a.param == "v_inf" && vm.count("K1") && !vm["K1"].defaulted()) throw Error("give --v-inf or --K1, not both (v_inf solves K1)");
+  }
   apply_fixed_data(vm, so, job.spec);
   apply_steps(vm, st, job.spec);
   job.command = science_command(argc, argv);

@@ -64,7 +64,8 @@ void validate_events(const std::vector<Event>& events, const std::vector<Centre>
       throw Error("event " + e.label() + ": the scene has " + std::to_string(centres.size()) + " centre(s)");
     if (e.kind == Event::Kind::radius && !(std::isfinite(e.value) && e.value > 0.0))
       throw Error("event " + e.label() + ": the radius must be a finite number > 0");
-    if (e.kind == Event::Kind::plane && !(std::isfinite(e.value) && e.normal.allFinite() && e.normal.norm() > 0.0))
+    if (e.kind == Event::Kind::plane &&
+        !(std::isfinite(e.value) && e.normal.allFinite() && e.normal.norm() > 0.0 && std::isfinite(e.normal.norm())))
       throw Error("event " + e.label() + ": a plane needs a finite non-zero normal and a finite offset");
   }
 }

@@ -123,8 +123,13 @@ void validate_sweep(const SweepSpec& spec) {
   if (spec.methods.empty()) throw Error("the method list is empty");
   check_energy_bound(spec.max_energy_error);
   if (spec.axes.empty()) throw Error("the sweep has no varied parameter");
-  for (const Axis& a : spec.axes)
+  for (const Axis& a : spec.axes) {
     if (a.values.empty()) throw Error("the sweep has no values of " + a.param);
+    // NaN stands for "not given" among the asymptotic data: a NaN value would compute another scene.
+    for (double v : a.values)
+      if (a.param == "b" || a.param == "v_inf" || a.param == "h") require_positive(v, "the sweep's values of " + a.param);
+      else if (!std::isfinite(v)) throw Error("the sweep's values of " + a.param + " must be finite numbers, got " + fmt(v));
+  }
   for (const Axis& a : spec.axes)
     for (const Axis& other : spec.axes)
       if ((a.param == "b" && other.param == "d") || (a.param == "v_inf" && other.param == "K1"))

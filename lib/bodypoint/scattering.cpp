@@ -1,6 +1,8 @@
 // bodypoint: the observables of a scattering encounter (scattering.hpp; docs/physics.md, "Scattering").
 #include "bodypoint/scattering.hpp"
 
+#include "bodypoint/io.hpp"
+
 #include "bodypoint/field.hpp"
 #include "bodypoint/invariants.hpp"
 
@@ -158,6 +160,7 @@ double solve_parameter(SceneParams params, double& (*field)(SceneParams&), doubl
   field(params) = x0;
   double f0 = f(params) - target;
   for (int i = 0; i < kImpactIterations; ++i) {
+    if (!std::isfinite(x1)) return x1;  // the secant left the numbers: the caller says which datum
     field(params) = x1;
     const double f1 = f(params) - target;
     if (f1 == 0.0 || std::abs(x1 - x0) <= kImpactRelTol * std::max(std::abs(x1), std::abs(target))) return x1;
@@ -183,7 +186,11 @@ double d_for_impact_parameter(SceneParams params, double b) {
   if (!(std::isfinite(b) && b > 0.0)) throw Error("the impact parameter b must be a finite number > 0");
   const double d0 = params.B == 0.0 ? params.start.Kz / params.start.K1 + b : b;
   params.start.d = d0;
-  return solve_parameter(params, d_of, b_of, b, d0, d0 - (b_of(params) - b));  // db/dd ~ 1
+  const double d = solve_parameter(params, d_of, b_of, b, d0, d0 - (b_of(params) - b));  // db/dd ~ 1
+  if (!std::isfinite(d))
+    throw Error("no start distance d gives the impact parameter b = " + fmt(b) +
+                " (the scene's numbers overflow on the way; give a smaller b)");
+  return d;
 }
 
 double k1_for_speed_at_infinity(SceneParams params, double v_inf) {

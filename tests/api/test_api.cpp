@@ -572,6 +572,13 @@ TEST(ApiSweep, AnInvalidPointIsNamed) {
   }
   s.axes = {{"h", {0.1, -1.0}}};
   EXPECT_THROW(run_sweep_rows(s), Error);
+  // NaN means "not given" among the asymptotic data: as a value it would run the scene at d = 10.
+  for (const char* datum : {"b", "v_inf"}) {
+    s.axes = {{datum, {1.0, std::nan("")}}};
+    EXPECT_THROW(run_sweep_rows(s), Error) << datum;
+  }
+  s.axes = {{"L", {100.0, std::numeric_limits<double>::infinity()}}};
+  EXPECT_THROW(run_sweep_rows(s), Error);
   s.axes.clear();
   EXPECT_THROW(run_sweep_rows(s), Error);
 }

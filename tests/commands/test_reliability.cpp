@@ -71,6 +71,16 @@ TEST(Reliability, EveryIssueExampleEndsWithItsReason) {
       {"work-precision --by-tol --tols 2 --scenes material", "--tols: tol must be below 1"},
       {"work-precision --by-tol --tols 1e-20 --scenes material", "--tols: tol below 1e-13"},
       {"sweep --param d --values 5 --methods odeint-rkf78 --steps 10 --tol nan", "the tolerance per step tol must be a finite number > 0"},
+      // Issue #40: accepted, or refused in another quantity's words.
+      {"sweep --param d --values 5 --methods lp-verlet --steps 10 --tol nan", "the tolerance per step tol must be a finite number > 0"},
+      {"sweep --param d --values 5 --methods lp-verlet --steps 10 --tol -1", "the tolerance per step tol must be a finite number > 0"},
+      {"sweep --param b --values nan --steps 10", "the sweep's values of b must be a finite number > 0"},
+      {"sweep --param v_inf --values 1,nan --steps 10", "the sweep's values of v_inf must be a finite number > 0"},
+      {"sweep --param L --values 100,inf --steps 10", "the sweep's values of L must be finite numbers"},
+      {"sweep --param b --values 1,2 --d 3 --steps 10", "give --b or --d, not both"},
+      {"sweep --param d --values 5 --steps 10 --shard ''", "--shard takes K/N"},
+      {"simulate --b 1e300 --steps 10", "no start distance d gives the impact parameter b = 1e+300"},
+      {"simulate --method lp-y4 --h 0.1 --t-end 20 --event plane=1e308,1e308,0,0", "the plane's normal is too long"},
       // Issue #24: options that were silently ignored.
       {"simulate --method logh-y4 --h 0.1 --t-end 1 --omega-c -5", "the time-step constant omega_c must be a finite number >= 0"},
       {"simulate --method logh-y4 --h 0.1 --t-end 1 --omega-c nan", "the time-step constant omega_c must be a finite number >= 0"},
