@@ -23,13 +23,14 @@ void print_markdown_table() {
 }
 
 /// One row per method for scripts (paper/ reads the families from it): method, family (family_key),
-/// order (0: variable), stages, force evaluations per step, and how it advances time.
+/// order (0: variable), stages, force evaluations per step, how it advances time, and the family's name.
 void print_csv() {
-  std::cout << "method,family,order,stages,evals_per_step,advance\n";
+  std::cout << "method,family,order,stages,evals_per_step,advance,family_name\n";
   for (const MethodInfo& m : methods()) {
     CsvLine row;
     row.text(m.name).text(std::string(family_key(m.family))).count(m.order).count(m.stages).count(m.evals_per_step);
     row.text(is_step_controlled(m) ? "controlled" : is_time_transformed(m) ? "fictitious" : "fixed");
+    row.quoted(std::string(family_name(m.family)));
     std::cout << row.str() << "\n";
   }
 }
@@ -50,7 +51,7 @@ int cmd_methods(int argc, char** argv) {
   po::options_description desc("bodypoint methods");
   bool markdown = false, csv = false;
   desc.add_options()("markdown", po::bool_switch(&markdown), "print the table as Markdown (README's Methods section)")(
-      "csv", po::bool_switch(&csv), "print one CSV row per method (method, family, order, stages, evals_per_step, advance)");
+      "csv", po::bool_switch(&csv), "print one CSV row per method (method, family, order, stages, evals_per_step, advance, family_name)");
   po::variables_map vm;
   if (!parse(argc, argv, desc, vm, "usage: bodypoint methods [--markdown | --csv]\nLists every integration method.")) return 0;
   if (markdown && csv) throw Error("give --markdown or --csv, not both");

@@ -5,8 +5,9 @@ without touching them."""
 import csv
 import os
 
-# The paper's grouping of the catalogue's families (bodypoint's family_key, run.hpp): the thesis's
-# seven are its five drift/kick schemes and Boost.Odeint's RK4 and AB4.
+# The paper's names of the catalogue's families (bodypoint's family_key, run.hpp), where they differ
+# from the catalogue's own (its family_name column): the thesis's seven are its five drift/kick schemes
+# and Boost.Odeint's RK4 and AB4. A family not named here is called by the catalogue's name.
 PAPER_FAMILY = {
     "thesis": "thesis's seven",
     "odeint": "thesis's seven",
@@ -26,15 +27,25 @@ def load(results):
     with open(os.path.join(results, "methods.csv"), newline="") as f:
         for row in csv.DictReader(f):
             _rows[row["method"]] = row
-    unknown = {r["family"] for r in _rows.values()} - PAPER_FAMILY.keys()
-    if unknown:
-        raise SystemExit(f"catalogue.py: give the paper's name of the families {sorted(unknown)} in PAPER_FAMILY")
+
+
+def _paper_name(row):
+    return PAPER_FAMILY.get(row["family"], row["family_name"])
 
 
 def family(method):
     """The paper's family of a method, or None for a method not in the catalogue."""
     row = _rows.get(method)
-    return PAPER_FAMILY[row["family"]] if row else None
+    return _paper_name(row) if row else None
+
+
+def families():
+    """The paper's families, in the catalogue's order of their first methods."""
+    out = []
+    for row in _rows.values():
+        if _paper_name(row) not in out:
+            out.append(_paper_name(row))
+    return out
 
 
 def has_fictitious_step(method):

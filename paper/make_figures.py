@@ -15,7 +15,7 @@ import math
 import os
 import sys
 
-from catalogue import family, load as load_catalogue
+from catalogue import families, family, load as load_catalogue
 
 import matplotlib
 
@@ -26,9 +26,18 @@ plt.rcParams.update({"font.size": 8, "axes.titlesize": 8, "legend.fontsize": 6, 
                      "pdf.fonttype": 42, "savefig.bbox": "tight"})
 
 THESIS_SEVEN = ["thesis-euler", "thesis-verlet", "thesis-ruth3", "thesis-fr4", "thesis-y6", "rk4", "ab4"]
-# Families of the work-precision figures, in drawing order, with a colour each.
+# Families of the work-precision figures, in drawing order, with a colour each; a family the catalogue
+# adds is drawn after them in the next free colour (family_colours).
 FAMILIES = [("thesis's seven", "tab:red"), ("Lie-Poisson", "tab:blue"), ("time-transformed", "tab:green"),
             ("KS", "tab:purple"), ("Kepler split", "tab:cyan"), ("Boost.Odeint", "tab:orange"), ("GSL", "tab:brown")]
+SPARE_COLOURS = ["tab:pink", "tab:olive", "tab:gray", "black", "gold", "navy"]
+
+
+def family_colours():
+    """FAMILIES, then every other family of the catalogue with a colour of its own."""
+    named = [f for f, _ in FAMILIES]
+    extra = [f for f in families() if f not in named]
+    return FAMILIES + list(zip(extra, SPARE_COLOURS))
 # Deviations above this mean the run diverged (the thesis's schemes reach 1e190 at coarse steps); they
 # are drawn at this ceiling so the other curves stay readable.
 DIVERGED = 1e2
@@ -236,7 +245,7 @@ def work_precision_figures(res, figs, listing):
     for scene in scenes:
         fig, ax = plt.subplots(figsize=(WIDE / 2, 2.8))
         labels = []  # (time, error, text, colour) of the methods named on the fronts
-        for fam, colour in FAMILIES:
+        for fam, colour in family_colours():
             pts = [(num(r["wall_s"]) * 1e3, num(r["err_rel"]), r["method"]) for r in rows
                    if r["scene"] == scene and family(r["method"]) == fam]
             pts = [p for p in pts if p[0] > 0 and 0 < p[1] < 1]
