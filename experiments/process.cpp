@@ -82,6 +82,27 @@ void remove_open_outputs() {
     }
 }
 
+/// How long a loop that stops at its own boundary (a sweep's row) may take after the first signal.
+constexpr unsigned kInterruptGraceSeconds = 1;
+
+/// From a signal handler: after kInterruptGraceSeconds the deadline path ends the process with a line
+/// saying why (only async-signal-safe calls: the message is composed by hand, alarm() arms the timer).
+void arm_interrupt_grace(int sig) {
+  static constexpr char kHead[] = "bodypoint: error: interrupted by signal ";
+  static constexpr char kTail[] = "; the rows finished so far are in the journal, finish with --resume\n";
+  std::size_t n = 0;
+  for (const char* c = kHead; *c && n + 1 < sizeof g_deadline_message; ++c) g_deadline_message[n++] = *c;
+  char digits[12];
+  int k = 0;
+  for (int x = sig; x > 0 && k < 11; x /= 10) digits[k++] = static_cast<char>('0' + x % 10);
+  while (k > 0 && n + 1 < sizeof g_deadline_message) g_deadline_message[n++] = digits[--k];
+  for (const char* c = kTail; *c && n + 1 < sizeof g_deadline_message; ++c) g_deadline_message[n++] = *c;
+  g_deadline_message[n] = '\0';
+  g_deadline_ns.store(monotonic_ns() + static_cast<long long>(kInterruptGraceSeconds) * 1'000'000'000LL - 1'000'000);
+  g_deadline.store(true);
+  ::alarm(kInterruptGraceSeconds);
+}
+
 extern "C" void on_signal(int sig) {
   if (sig == SIGALRM && g_deadline.load() && monotonic_ns() >= g_deadline_ns.load()) {  // the budget: stop now, wherever the process is
     remove_open_outputs();
@@ -89,10 +110,14 @@ extern "C" void on_signal(int sig) {
     (void)n;
     ::_exit(2);
   }
-  // A loop that stops at a boundary of its own (a sweep's row) gets one signal to do so; a second one
-  // (a row of minutes) stops the process at once.
+  // A loop that stops at a boundary of its own (a sweep's row) gets one signal and a grace of
+  // kInterruptGraceSeconds to do so; then, or at a second signal, the process stops at once, its
+  // finished rows kept in the journal.
   const int before = g_signal.exchange(sig);
-  if (g_cooperative.load() > 0 && before == 0) return;
+  if (g_cooperative.load() > 0 && before == 0) {
+    arm_interrupt_grace(sig);
+    return;
+  }
   remove_open_outputs();
   ::signal(sig, SIG_DFL);
   ::raise(sig);
@@ -360,7 +385,13 @@ void set_deadline(double seconds, const std::string& what) {
 CooperativeInterrupt::CooperativeInterrupt() { g_cooperative.fetch_add(1); }
 CooperativeInterrupt::~CooperativeInterrupt() { g_cooperative.fetch_sub(1); }
 void CooperativeInterrupt::check() {
-  if (const int sig = g_signal.load()) throw Error("interrupted by signal " + std::to_string(sig) + "; no output written");
+  if (const int sig = g_signal.load()) {
+    // Stopped at its boundary within the grace: the process unwinds and says so itself.
+    g_deadline.store(false);
+    const itimerval off{};
+    ::setitimer(ITIMER_REAL, &off, nullptr);
+    throw Error("interrupted by signal " + std::to_string(sig) + "; no output written");
+  }
 }
 
 }  // namespace bodypoint::cli

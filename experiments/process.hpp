@@ -53,8 +53,9 @@ void register_input(const std::string& path);
 /// Installs handlers for the terminating signals (SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1/2, SIGALRM,
 /// SIGVTALRM, SIGPROF, SIGPIPE; SIGXFSZ is ignored, so a write past the size limit fails) that remove the temporary and lock files of every
 /// open AtomicFile and then end the process with the signal (exit status 128 + signal). While a
-/// `CooperativeInterrupt` is alive the handler only records the signal, so that a loop can stop at a
-/// boundary of its own (a sweep's row) and unwind normally.
+/// `CooperativeInterrupt` is alive the handler records the first signal, so that a loop can stop at a
+/// boundary of its own (a sweep's row) and unwind normally; a loop that has not stopped a second later
+/// is ended there, with its one-line reason and exit status 2 (the journal keeps the finished rows).
 void install_signal_cleanup();
 
 /// The signal received since install_signal_cleanup(), or 0.

@@ -224,6 +224,33 @@ TEST(Reliability, ASweepStopsAtARowBoundaryOnSignal) {
   fs::remove_all(dir);
 }
 
+TEST(Reliability, AFirstSignalEndsASweepInTheMiddleOfALongRow) {
+  // Issue #40: the first SIGINT waited silently for the current row (32 s measured, unbounded for
+  // longer rows). Rows here take minutes; the sweep has a second's grace to reach a row boundary.
+  // Bound: the grace plus the process's teardown, far below one row.
+  constexpr auto kInterruptBound = std::chrono::seconds(10);
+  const fs::path dir = test::temp_path("bp_rel_sweep_long");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const pid_t pid = spawn({"sweep", "--param", "d", "--values", "5,10", "--methods", "lp-y4", "--steps", "2000000000",
+                           "--threads", "1", "--out", (dir / "d.csv").string()},
+                          dir / "err.txt");
+  ASSERT_GT(pid, 0);
+  std::this_thread::sleep_for(kSignalDelay);
+  const auto sent = std::chrono::steady_clock::now();
+  ::kill(pid, SIGINT);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  const auto took = std::chrono::steady_clock::now() - sent;
+  EXPECT_LT(took, kInterruptBound);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  EXPECT_NE(read(dir / "err.txt").find("interrupted by signal 2"), std::string::npos) << read(dir / "err.txt");
+  EXPECT_NE(read(dir / "err.txt").find("finish with --resume"), std::string::npos) << read(dir / "err.txt");
+  EXPECT_EQ(leftovers(dir, "d.csv"), std::vector<std::string>{"d.csv.journal"});
+  fs::remove_all(dir);
+}
+
 TEST(Reliability, OutputsCollideWithNothing) {
   const fs::path dir = test::temp_path("bp_rel_out");
   fs::remove_all(dir);
