@@ -73,6 +73,20 @@ std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body,
   return WorkEstimate{steps, r->wall_s * steps / kCalibrationSteps};
 }
 
+double estimated_seconds(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres, double step,
+                         double steps, double runs) {
+  if (!(steps > 0.0) || !(runs > 0.0) || is_step_controlled(m)) return 0.0;
+  // A calibration of kCalibrationSteps: asked for as a long run, so that estimate_work measures it.
+  constexpr long kAsLong = 2 * kCalibrateAbove;
+  const Advance how = is_time_transformed(m) ? Advance(FictitiousSteps{step, StepCount{kAsLong}})
+                                             : Advance(FixedSteps{step, kAsLong});
+  RunOptions quiet;
+  quiet.track_invariants = false;
+  const auto e = estimate_work(m, body, centres, how, quiet);
+  if (!e || !(e->steps > 0.0)) return 0.0;
+  return e->seconds / e->steps * steps * runs;
+}
+
 void check_budget(const WorkEstimate& e, double max_seconds, bool quiet) {
   char steps[32];
   std::snprintf(steps, sizeof steps, "%.3g", e.steps);

@@ -25,6 +25,15 @@ struct WorkEstimate {
 std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
                                           const Advance& how, const RunOptions& options);
 
+/// Every command's budget of wall-clock time unless --max-seconds says otherwise (0: none): a day, so
+/// that no command runs on without end by default (simulate's own default is an hour).
+inline constexpr double kDefaultMaxSeconds = 86400.0;
+
+/// The calibrated seconds of `runs` runs of `m` for `steps` steps (or fictitious steps) of `step`
+/// each: the time per step of a short calibration run times the steps. Never below zero.
+double estimated_seconds(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres, double step,
+                         double steps, double runs);
+
 /// Throws Error when the estimate exceeds max_seconds; prints it on stderr when it exceeds
 /// kAnnounceSeconds and `quiet` is false.
 void check_budget(const WorkEstimate& e, double max_seconds, bool quiet);

@@ -1,5 +1,6 @@
 #include "process.hpp"
 #include "cli.hpp"
+#include "budget.hpp"
 
 #include "bodypoint/io.hpp"
 #include "bodypoint/scattering.hpp"
@@ -171,8 +172,9 @@ bool parse(int argc, char** argv, const po::options_description& desc, po::varia
   all.add_options()("help", "show this help");
   // One budget for every command (simulate has its own default): past it, every loop stops alike.
   if (!desc.find_nothrow("max-seconds", false))
-    all.add_options()("max-seconds", po::value<double>()->default_value(0.0),
-                      "stop with an error after this many seconds of wall-clock time (0: no limit)");
+    all.add_options()("max-seconds", po::value<double>()->default_value(kDefaultMaxSeconds),
+                      "stop with an error after this many seconds of wall-clock time (0: no limit); runs "
+                      "whose calibrated estimate exceeds it are refused before they start");
   // Whole option names only: with boost's default prefix guessing, "--ou x" would mean "--out x".
   const int style = po::command_line_style::default_style & ~po::command_line_style::allow_guessing;
   try {

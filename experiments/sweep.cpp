@@ -4,6 +4,7 @@
 
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
+#include "budget.hpp"
 #include "cli.hpp"
 #include "mpi_sweep.hpp"
 #include "rows_file.hpp"
@@ -233,6 +234,7 @@ struct SweepJob {
   bool sharded = false;  ///< --shard given (1/1 too): the output is a rows file for merge
   bool no_simd = false;
   std::string command;  ///< the command without the options that do not change the rows
+  double max_seconds = 0.0;  ///< the budget (--max-seconds; 0: none)
 };
 
 /// --shard K/N with 1 <= K <= N.
@@ -378,6 +380,7 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
   apply_fixed_data(vm, so, job.spec);
   apply_steps(vm, st, job.spec);
   job.command = science_command(argc, argv);
+  job.max_seconds = vm["max-seconds"].as<double>();
   return job;
 }
 
@@ -435,11 +438,37 @@ void run_job_mpi(const SweepJob& job) {
 }
 
 /// Runs the job and writes its CSV (or, for a shard, its rows file), through a journal when it has a file.
+/// Refuses a sweep whose calibrated time (every row of this shard, on its threads) exceeds the budget:
+/// each method's time per step on the first grid point, times the steps of every row.
+void check_sweep_budget(const SweepJob& job) {
+  if (!(job.max_seconds > 0.0)) return;
+  const std::size_t tasks = task_count(job.spec), methods = job.spec.methods.size();
+  Scene scene;
+  try {
+    scene = thesis_scene(point_params(job.spec, grid_point(job.spec, 0)));
+  } catch (const Error&) {
+    return;  // validate_sweep names the point
+  }
+  double seconds = 0.0;
+  for (std::size_t k = 0; k < methods; ++k) {
+    const MethodInfo& m = *job.spec.methods[k];
+    if (!refusal(m, scene.bodies.front(), scene.centres).empty()) continue;
+    const FixedSteps f = sweep_steps(job.spec.h, job.spec.steps, job.spec.t_end, job.spec.base.law);
+    const double rows = static_cast<double>(tasks / methods) / static_cast<double>(job.shards);
+    seconds += estimated_seconds(m, scene.bodies.front(), scene.centres, f.h, static_cast<double>(f.steps), rows);
+  }
+  seconds /= static_cast<double>(thread_count(job.threads));
+  if (seconds > job.max_seconds)
+    throw Error("the sweep would take about " + fmt(std::round(seconds)) + " s (calibrated on its first point), above "
+                "--max-seconds " + fmt(job.max_seconds) + ": fewer points or steps, more threads or shards, or raise --max-seconds");
+}
+
 void run_job(const SweepJob& job) {
   if (launched_by_mpi()) return run_job_mpi(job);
+  check_sweep_budget(job);   // before validating every point, which a sweep of 1e9 points would spend long on
+  validate_sweep(job.spec);  // before a journal exists
   std::unique_ptr<AtomicFile> file;
   if (!job.out.empty()) file = std::make_unique<AtomicFile>(job.out);
-  validate_sweep(job.spec);  // before a journal exists
   const std::unique_ptr<RowJournal> journal = open_journal(job, file.get());
   SweepControl control{thread_count(job.threads), ::isatty(2) == 1, job.shard, job.shards, journal.get(), !job.no_simd};
   std::vector<std::string> rows;

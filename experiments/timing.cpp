@@ -5,16 +5,33 @@
 #include "timing.hpp"
 
 #include "bodypoint/io.hpp"
+#include "budget.hpp"
 #include "cli.hpp"
 #include "sweep.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <sstream>
 #include <unistd.h>
 
 namespace bodypoint::cli {
+
+/// Refuses a study whose calibrated time (every n, method, warm-up and repeat) exceeds the budget.
+void check_timing_budget(const TimingSpec& spec, double max_seconds) {
+  if (!(max_seconds > 0.0)) return;
+  const Scene scene = thesis_scene(spec.base);
+  double steps = 0.0;
+  for (long n : spec.ns) steps += static_cast<double>(n);
+  const double runs = static_cast<double>(spec.warmup) + static_cast<double>(spec.repeats);
+  double seconds = 0.0;
+  for (const MethodInfo* m : spec.methods)
+    seconds += estimated_seconds(*m, scene.bodies.front(), scene.centres, spec.h, steps, runs);
+  if (seconds > max_seconds)
+    throw Error("the timing study would take about " + fmt(std::round(seconds)) + " s (calibrated), above --max-seconds " +
+                fmt(max_seconds) + ": fewer or smaller n, fewer repeats or warm-up runs, or raise --max-seconds");
+}
 
 std::vector<TimingRow> run_timing(const TimingSpec& spec, bool progress) {
   if (spec.methods.empty()) throw Error("the method list is empty");
@@ -23,6 +40,9 @@ std::vector<TimingRow> run_timing(const TimingSpec& spec, bool progress) {
   // Each repeat keeps its time for the median: 1e15 of them ran (and allocated) without end.
   if (spec.repeats > 1'000'000) throw Error("--repeats must be at most 1e6");
   if (spec.warmup < 0) throw Error("--warmup must be >= 0");
+  for (long n : spec.ns)
+    if (n < 1) throw Error("n must be >= 1, got " + std::to_string(n));
+  check_timing_budget(spec, spec.max_seconds);
   const Scene scene = thesis_scene(spec.base);
   std::vector<TimingRow> rows;
   std::size_t done = 0;
@@ -102,6 +122,7 @@ int cmd_timing(int argc, char** argv) {
     ns = linear_range(from, to, step);
   }
   for (double n : ns) spec.ns.push_back(whole_number(n, "n (--values)", kMaxTimingSteps));
+  spec.max_seconds = vm["max-seconds"].as<double>();
   std::unique_ptr<AtomicFile> file;
   if (!out.empty()) file = std::make_unique<AtomicFile>(out);
   const auto rows = run_timing(spec, ::isatty(2) == 1);

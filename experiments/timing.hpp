@@ -19,6 +19,7 @@ struct TimingSpec {
   double tol = kDefaultStepTolerance;
   long repeats = 5;
   long warmup = 1;
+  double max_seconds = 0.0;  ///< refuse a study whose calibrated time exceeds this (0: no budget)
 };
 
 struct TimingRow {

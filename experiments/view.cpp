@@ -9,6 +9,7 @@
 #include "bodypoint/field.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/scattering.hpp"
+#include "budget.hpp"
 #include "cli.hpp"
 #include "view_bundle.hpp"
 
@@ -335,6 +336,11 @@ int cmd_view(int argc, char** argv) {
     throw Error("the page would hold about " + fmt(std::round(estimate / 1e5) / 10) + " MB (" + std::to_string(o.frames) +
                 " frames x " + std::to_string(scene.bodies.size()) + " bodies x " + std::to_string(plans.size()) +
                 " runs), above --max-mb " + fmt(o.max_mb) + ": lower --frames or raise --max-mb");
+  for (const RunPlan& p : plans)
+    if (!p.search)
+      for (const Body& body : scene.bodies)
+        if (const auto e = estimate_work(*p.method, body, scene.centres, p.how, p.options))
+          check_budget(*e, vm["max-seconds"].as<double>() > 0.0 ? vm["max-seconds"].as<double>() : HUGE_VAL, true);
   if (o.dry_run) {
     std::cout << "would write " << o.out << ": " << plans.size() << " run(s) of " << scene.bodies.size()
               << " body-point(s), about " << std::round(estimate / 1e3) << " kB\n";

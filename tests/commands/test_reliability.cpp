@@ -81,6 +81,11 @@ TEST(Reliability, EveryIssueExampleEndsWithItsReason) {
       {"sweep --param d --values 5 --steps 10 --shard ''", "--shard takes K/N"},
       {"simulate --b 1e300 --steps 10", "no start distance d gives the impact parameter b = 1e+300"},
       {"simulate --method lp-y4 --h 0.1 --t-end 20 --event plane=1e308,1e308,0,0", "the plane's normal is too long"},
+      // Issue #40: budgets only when asked; now every command has one, checked before it starts.
+      {"view --steps 1000000000000 --out /tmp/bp_rel_view.html", "the run would take 1e+12 steps"},
+      {"timing --values 1e10", "the timing study would take about"},
+      {"timing --values 1000 --warmup 9223372036854775807", "the timing study would take about"},
+      {"sweep --param d --values 5,6 --methods lp-y4 --steps 10000000000 --max-seconds 10", "the sweep would take about"},
       // Issue #24: options that were silently ignored.
       {"simulate --method logh-y4 --h 0.1 --t-end 1 --omega-c -5", "the time-step constant omega_c must be a finite number >= 0"},
       {"simulate --method logh-y4 --h 0.1 --t-end 1 --omega-c nan", "the time-step constant omega_c must be a finite number >= 0"},
