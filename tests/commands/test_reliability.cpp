@@ -133,16 +133,27 @@ constexpr double kBudgetSeconds = 1.0;
 constexpr double kBudgetLateness = 5.0;
 
 TEST(Reliability, MaxSecondsStopsEveryLoopAlike) {
-  // Loops that ran on past --max-seconds (issue #24): the accuracy search, a peer's stepper, timing's
-  // repeats, a sweep's row, the reference; each stops with the budget's reason and leaves no output.
+  // Loops that ran on past --max-seconds (issue #24): the accuracy search, a peer's stepper, the
+  // reference; each stops with the budget's reason and leaves no output.
   const fs::path dir = test::temp_path("bp_rel_budget");
   fs::remove_all(dir);
   fs::create_directories(dir);
   const std::string budget = " --max-seconds " + std::to_string(kBudgetSeconds) + " --out " + (dir / "o.csv").string();
-  for (const std::string args : {"simulate --tol 1e-12 --t-end 1e6", "simulate --method gsl-rk8pd --tol 1e-12 --t-end 1e7",
-                                 "simulate --h 0.3 --t-end 1000000 --reference --every 1000000",
-                                 "timing --repeats 1000000 --values 100000",
+  // timing and sweep calibrate their work first and refuse what would exceed the budget (issue #40):
+  // refused at once, with the estimate, and no output.
+  for (const std::string args : {"timing --repeats 1000000 --values 100000",
                                  "sweep --param d --values 1,2 --steps 100000000 --threads 1 --methods lp-y4"}) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto r = run_cli(args + budget);
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_NE(r.err.find("would take about"), std::string::npos) << args << " -> " << r.err;
+    EXPECT_LT(s, kBudgetSeconds + kBudgetLateness) << args;
+    EXPECT_FALSE(fs::exists(dir / "o.csv")) << args;
+    EXPECT_TRUE(leftovers(dir, "o.csv").empty()) << args;
+  }
+  for (const std::string args : {"simulate --tol 1e-12 --t-end 1e6", "simulate --method gsl-rk8pd --tol 1e-12 --t-end 1e7",
+                                 "simulate --h 0.3 --t-end 1000000 --reference --every 1000000"}) {
     const auto t0 = std::chrono::steady_clock::now();
     const auto r = run_cli(args + budget);
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
