@@ -161,7 +161,10 @@ std::string rows_file_text(const RowsContent& c) {
 RowJournal::RowJournal(std::string path, const std::string& key, std::size_t tasks,
                        const std::vector<std::string>& header, bool resume)
     : path_(std::move(path)) {
-  const bool exists = ::access(path_.c_str(), F_OK) == 0;
+  // An empty journal is one whose run was killed between creating it and writing its first line (one
+  // write): it holds no row, so it is started afresh.
+  struct stat st {};
+  const bool exists = ::stat(path_.c_str(), &st) == 0 && !(S_ISREG(st.st_mode) && st.st_size == 0);
   if (exists && !resume)
     throw Error("'" + path_ + "' holds the rows of an interrupted run of this output: add --resume to finish it, or delete it");
   if (exists) {

@@ -272,6 +272,17 @@ TEST(Resume, AJournalOfAnotherSweepIsRefused) {
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("belongs to another sweep"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
+  // An empty journal: its run was killed between creating it and writing its first line; it holds no
+  // row and is started afresh, with or without --resume.
+  for (const char* resume : {"", " --resume"}) {
+    std::ofstream(dir.path / "r.csv.journal").close();
+    const auto fresh = run_cli("sweep --grid d=10:50:10 --grid Kx=-2:2:1 --methods lp-y4,rk4 --h 1e-3 --steps 10 --out " +
+                               out.string() + resume);
+    EXPECT_EQ(fresh.code, 0) << resume << ": " << fresh.err;
+    EXPECT_TRUE(fs::exists(out));
+    EXPECT_FALSE(fs::exists(dir.path / "r.csv.journal"));
+    fs::remove(out);
+  }
 }
 
 }  // namespace

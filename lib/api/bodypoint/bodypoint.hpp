@@ -16,7 +16,10 @@
 //     cost; methods(), find_method(), and choose_method() for `auto`.
 //   - a way of advancing time, as a value (Advance): FixedSteps, FictitiousSteps (time-transformed
 //     and regularised methods), ControlledSteps (step-size-controlled peers) or Accuracy (a relative
-//     error of the final state to deliver; the step is searched).
+//     error of the final state to deliver; the step is searched); advance_for() makes the right one
+//     from a step, an end and a tolerance, as the command line and the Python module take them.
+//   - what a run observes (Options): invariants, samples to a sink (which may end the run by
+//     returning Flow::stop), events, the bound of the accuracy flag.
 //   - integrate(): every body of a scene with one method and one Advance; a Result per body with a
 //     typed Outcome (ok, diverged, collision, refused, failed) and its one-line reason.
 //   - events (Event): closest approaches, radii and planes crossed, located to round-off on the
