@@ -29,6 +29,11 @@ std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body,
 /// that no command runs on without end by default (simulate's own default is an hour).
 inline constexpr double kDefaultMaxSeconds = 86400.0;
 
+/// No step of any method takes this long (the slowest, a Kepler-split or Kahan-Li 8 step, takes a few
+/// microseconds; a sanitizer build some tens): below steps x this, a budget cannot be exceeded and the
+/// calibration is skipped.
+inline constexpr double kMaxSecondsPerStep = 1e-4;
+
 /// The calibrated seconds of `runs` runs of `m` for `steps` steps (or fictitious steps) of `step`
 /// each: the time per step of a short calibration run times the steps. Never below zero.
 double estimated_seconds(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres, double step,

@@ -443,6 +443,8 @@ void run_job_mpi(const SweepJob& job) {
 void check_sweep_budget(const SweepJob& job) {
   if (!(job.max_seconds > 0.0)) return;
   const std::size_t tasks = task_count(job.spec), methods = job.spec.methods.size();
+  const FixedSteps steps = sweep_steps(job.spec.h, job.spec.steps, job.spec.t_end, job.spec.base.law);
+  if (static_cast<double>(tasks) * static_cast<double>(steps.steps) * kMaxSecondsPerStep <= job.max_seconds) return;
   Scene scene;
   try {
     scene = thesis_scene(point_params(job.spec, grid_point(job.spec, 0)));

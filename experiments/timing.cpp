@@ -25,6 +25,7 @@ void check_timing_budget(const TimingSpec& spec, double max_seconds) {
   double steps = 0.0;
   for (long n : spec.ns) steps += static_cast<double>(n);
   const double runs = static_cast<double>(spec.warmup) + static_cast<double>(spec.repeats);
+  if (steps * runs * static_cast<double>(spec.methods.size()) * kMaxSecondsPerStep <= max_seconds) return;
   double seconds = 0.0;
   for (const MethodInfo* m : spec.methods)
     seconds += estimated_seconds(*m, scene.bodies.front(), scene.centres, spec.h, steps, runs);
