@@ -5,6 +5,7 @@
 //   build/bin/bench_steps --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include "bodypoint/field.hpp"
 #include "bodypoint/methods.hpp"
+#include "bodypoint/sweep.hpp"
 #include "bodypoint/rhs.hpp"
 #include "bodypoint/rk/odeint.hpp"
 #include "bodypoint/run.hpp"
@@ -58,10 +59,7 @@ void BM_MethodStep(benchmark::State& st, const std::string& method, const std::s
   const NamedScene ns = named_scene(scene);
   const MethodInfo& m = method_or_throw(method);
   // Every method to the same end time: kSteps steps of h, fictitious steps ds = h, or step-size control.
-  constexpr double h = 1e-3;
-  const Advance spec = is_step_controlled(m)  ? Advance(ControlledSteps{h, h * kSteps, 1e-10})
-                       : is_time_transformed(m) ? Advance(FictitiousSteps{h, EndTime{h * kSteps}})
-                                                : Advance(FixedSteps{h, kSteps});
+  const Advance spec = to_common_end(m, FixedSteps{1e-3, kSteps}, 1e-10);
   RunOptions quiet;
   quiet.track_invariants = false;
   long steps = 0, evals = 0;

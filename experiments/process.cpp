@@ -208,40 +208,37 @@ std::string stem_of(const std::string& target) {
 
 /// Where an output path leads: the regular file (or the place of a new one) that a symbolic link
 /// names, followed link by link, so that the link stays and its target is replaced.
-std::string resolve_links(const std::string& path) {
+/// The path and every symbolic link's target on the way to what it names, in order.
+std::vector<std::string> link_chain(const std::string& path) {
   namespace fs = std::filesystem;
   fs::path p(path);
+  std::vector<std::string> chain{p.string()};
   for (int hop = 0; hop < 40; ++hop) {
     struct stat st {};
-    if (::lstat(p.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) return p.string();
+    if (::lstat(p.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) return chain;
     std::error_code ec;
     const fs::path to = fs::read_symlink(p, ec);
     if (ec) throw Error("cannot read the symbolic link '" + p.string() + "': " + ec.message());
     p = to.is_absolute() ? to : p.parent_path() / to;
+    chain.push_back(p.string());
   }
   throw Error("output '" + path + "' is a loop of symbolic links");
 }
 
+/// What a path names in the end, its links followed.
+std::string resolve_links(const std::string& path) { return link_chain(path).back(); }
+
 /// True when `path`, or a link on the way to what it names, is an open descriptor of a process
 /// (/dev/stdout, /dev/fd/N, /proc/PID/fd/N): the stream a shell opened, for `--out /dev/stdout >> log`.
 bool through_descriptor(const std::string& path) {
-  namespace fs = std::filesystem;
-  auto descriptor = [](const std::string& p) {
+  auto descriptor = [](const std::string& link) {
+    const std::string p = std::filesystem::path(link).lexically_normal().string();
     if (p == "/dev/stdout" || p == "/dev/stderr" || p.rfind("/dev/fd/", 0) == 0) return true;
     const std::size_t fd = p.find("/fd/");
     return p.rfind("/proc/", 0) == 0 && fd != std::string::npos && p.find('/', fd + 4) == std::string::npos;
   };
-  fs::path p(path);
-  for (int hop = 0; hop < 40; ++hop) {
-    if (descriptor(p.lexically_normal().string())) return true;
-    struct stat st {};
-    if (::lstat(p.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) return false;
-    std::error_code ec;
-    const fs::path to = fs::read_symlink(p, ec);
-    if (ec) return false;
-    p = to.is_absolute() ? to : p.parent_path() / to;
-  }
-  return false;
+  const std::vector<std::string> chain = link_chain(path);
+  return std::any_of(chain.begin(), chain.end(), descriptor);
 }
 
 }  // namespace

@@ -455,9 +455,8 @@ void check_sweep_budget(const SweepJob& job) {
   for (std::size_t k = 0; k < methods; ++k) {
     const MethodInfo& m = *job.spec.methods[k];
     if (!refusal(m, scene.bodies.front(), scene.centres).empty()) continue;
-    const FixedSteps f = sweep_steps(job.spec.h, job.spec.steps, job.spec.t_end, job.spec.base.law);
     const double rows = static_cast<double>(tasks / methods) / static_cast<double>(job.shards);
-    seconds += estimated_seconds(m, scene.bodies.front(), scene.centres, f.h, static_cast<double>(f.steps), rows);
+    seconds += estimated_seconds(m, scene.bodies.front(), scene.centres, steps.h, static_cast<double>(steps.steps), rows);
   }
   seconds /= static_cast<double>(thread_count(job.threads));
   if (seconds > job.max_seconds)

@@ -21,11 +21,11 @@ namespace bodypoint::cli {
 /// Refuses a study whose calibrated time (every n, method, warm-up and repeat) exceeds the budget.
 void check_timing_budget(const TimingSpec& spec, double max_seconds) {
   if (!(max_seconds > 0.0)) return;
-  const Scene scene = thesis_scene(spec.base);
   double steps = 0.0;
   for (long n : spec.ns) steps += static_cast<double>(n);
   const double runs = static_cast<double>(spec.warmup) + static_cast<double>(spec.repeats);
   if (steps * runs * static_cast<double>(spec.methods.size()) * kMaxSecondsPerStep <= max_seconds) return;
+  const Scene scene = thesis_scene(spec.base);
   double seconds = 0.0;
   for (const MethodInfo* m : spec.methods)
     seconds += estimated_seconds(*m, scene.bodies.front(), scene.centres, spec.h, steps, runs);
@@ -49,13 +49,8 @@ std::vector<TimingRow> run_timing(const TimingSpec& spec, bool progress) {
   std::size_t done = 0;
   const std::size_t total = spec.ns.size() * spec.methods.size();
   for (long n : spec.ns) {
-    if (n < 1) throw Error("n must be >= 1, got " + std::to_string(n));
     for (const MethodInfo* m : spec.methods) {
-      // Every method to the same end time h n: n steps of h, fictitious steps ds = h, or step-size control.
-      const double t_end = spec.h * static_cast<double>(n);
-      const Advance how = is_step_controlled(*m)  ? Advance(ControlledSteps{spec.h, t_end, spec.tol})
-                          : is_time_transformed(*m) ? Advance(FictitiousSteps{spec.h, EndTime{t_end}})
-                                                    : Advance(FixedSteps{spec.h, n});
+      const Advance how = to_common_end(*m, FixedSteps{spec.h, n}, spec.tol);  // every method to t = h n
       const Options quiet = unobserved();
       for (long w = 0; w < spec.warmup; ++w) run_or_throw(*m, scene.bodies.front(), scene.centres, how, quiet);
       std::vector<double> t;

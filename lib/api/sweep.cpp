@@ -102,12 +102,15 @@ FixedSteps sweep_steps(double h, long steps, double t_end, ForceLaw law) {
   return {h, require_count(steps, "the number of steps")};
 }
 
-Advance point_advance(const SweepSpec& spec, const MethodInfo& method, const std::vector<double>& point) {
-  const FixedSteps f = sweep_steps(point_h(spec, point), spec.steps, spec.t_end, spec.base.law);
+Advance to_common_end(const MethodInfo& method, const FixedSteps& f, double tol) {
   const double t_end = f.h * static_cast<double>(f.steps);
   if (is_time_transformed(method)) return FictitiousSteps{f.h, EndTime{t_end}};
-  if (is_step_controlled(method)) return ControlledSteps{f.h, t_end, spec.tol};
+  if (is_step_controlled(method)) return ControlledSteps{f.h, t_end, tol};
   return f;
+}
+
+Advance point_advance(const SweepSpec& spec, const MethodInfo& method, const std::vector<double>& point) {
+  return to_common_end(method, sweep_steps(point_h(spec, point), spec.steps, spec.t_end, spec.base.law), spec.tol);
 }
 
 std::string point_label(const SweepSpec& spec, const std::vector<double>& point) {

@@ -71,6 +71,10 @@ SceneParams point_params(const SweepSpec& spec, const std::vector<double>& point
 /// on t_end (fixed_steps_to); under ForceLaw::thesis_code the code's count instead (thesis_code_steps:
 /// n - 1 steps of exactly h). Error for an h that is not a finite number > 0 or fewer than one step.
 FixedSteps sweep_steps(double h, long steps, double t_end, ForceLaw law = ForceLaw::coulomb);
+/// Every method to one end time T = f.h f.steps: fixed-step methods take f, time-transformed ones
+/// fictitious steps ds = f.h to T, step-size-controlled ones run to T from a first trial step f.h at
+/// tolerance tol per step (the rule of sweeps, the timing study and the step benchmarks).
+Advance to_common_end(const MethodInfo& method, const FixedSteps& f, double tol);
 /// How `method` advances at a grid point: every method of a sweep ends at the same time T = h n of the
 /// point's sweep_steps (h, n): fixed-step methods take those steps, time-transformed ones fictitious
 /// steps ds = h to T, step-size-controlled ones run to T from a first trial step h at tolerance tol.
