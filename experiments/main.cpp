@@ -84,6 +84,11 @@ int main(int argc, char** argv) {
   const std::string cmd = argv[1];
   bodypoint::cli::install_signal_cleanup();
   try {
+    // Every process of an MPI launch runs the same command line: only sweep shares its runs among them,
+    // any other command would run N times over, its outputs colliding.
+    if (bodypoint::cli::launched_by_mpi() && cmd != "sweep")
+      throw bodypoint::Error(cmd + " runs in one process: under an MPI launcher (more than one process) only sweep "
+                             "shares its runs among the processes; start it without mpirun, or with -np 1");
     if (cmd == "simulate") return bodypoint::cli::cmd_simulate(argc - 1, argv + 1);
     if (cmd == "methods") return bodypoint::cli::cmd_methods(argc - 1, argv + 1);
     if (cmd == "work-precision") return bodypoint::cli::cmd_work_precision(argc - 1, argv + 1);

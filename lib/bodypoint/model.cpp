@@ -73,9 +73,15 @@ void validate(const Scene& scene) {
     require_finite(b.s0.v, who + ": v");
     require_finite(b.s0.w, who + ": w");
     for (std::size_t k = 0; k < scene.centres.size(); ++k) {
-      // A body on a centre has infinite potential energy and an undefined force.
-      if ((b.s0.R - scene.centres[k].c).norm() == 0.0)
-        throw Error(who + " starts on centre " + std::to_string(k + 1) + " (R = c); move it off the centre");
+      // A body on a centre has infinite potential energy and an undefined force; one so close that A/r
+      // overflows (R = 1e-300: |R|^2 underflows to 0) has them too, in double precision.
+      const Vec3 d = b.s0.R - scene.centres[k].c;
+      const std::string centre = "centre " + std::to_string(k + 1);
+      if (d == Vec3::Zero()) throw Error(who + " starts on " + centre + " (R = c); move it off the centre");
+      const double r = d.stableNorm();
+      if (!(r > 0.0) || !std::isfinite(scene.centres[k].A / r) || !std::isfinite(scene.centres[k].A / (r * r)))
+        throw Error(who + " starts " + num(r) + " from " + centre + ": its potential or force there (A/r, A/r^2 with A = " +
+                    num(scene.centres[k].A) + ") overflows a double; start it farther or rescale the units");
     }
     // The integrals at the start must be representable: |R| |K1| and the energies of a scene of
     // scale 1e308 overflow, and every deviation after that is NaN.

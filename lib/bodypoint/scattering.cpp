@@ -154,7 +154,11 @@ std::pair<Asymptote, double> incoming(const SceneParams& p) {
   return {*a, k->mu};
 }
 
-/// Secant iterations on one scene parameter x (field) for f(x) = target, from x0 and x1.
+/// Secant iterations on one scene parameter x (field) for f(x) = target, from x0 (where f is defined)
+/// and x1. A trial where f is not defined (a scene without an incoming asymptote: K1 so small that the
+/// body does not drift along it) is pulled halfway back to the last point where it was, so that the
+/// secant approaches the edge of the admissible range instead of giving up (v_inf = 0.5 on table 3.1:
+/// the first guess K1 = 0.35 does not drift, the answer K1 = 1.65 does).
 double solve_parameter(SceneParams params, double& (*field)(SceneParams&), double (*f)(const SceneParams&),
                        double target, double x0, double x1) {
   field(params) = x0;
@@ -162,7 +166,14 @@ double solve_parameter(SceneParams params, double& (*field)(SceneParams&), doubl
   for (int i = 0; i < kImpactIterations; ++i) {
     if (!std::isfinite(x1)) return x1;  // the secant left the numbers: the caller says which datum
     field(params) = x1;
-    const double f1 = f(params) - target;
+    double f1 = 0.0;
+    try {
+      f1 = f(params) - target;
+    } catch (const Error&) {
+      if (i + 1 == kImpactIterations) throw;
+      x1 = 0.5 * (x0 + x1);
+      continue;
+    }
     if (f1 == 0.0 || std::abs(x1 - x0) <= kImpactRelTol * std::max(std::abs(x1), std::abs(target))) return x1;
     const double slope = (f1 - f0) / (x1 - x0);
     x0 = x1;

@@ -7,6 +7,11 @@
 #include <algorithm>
 #include <initializer_list>
 #include <set>
+#include <array>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <memory>
 #include <sstream>
 #include <toml++/toml.h>
 
@@ -154,11 +159,18 @@ Scene read_scene_file(const std::string& path) {
   if (!std::filesystem::is_regular_file(status)) throw Error(path + ": the scene file is not a regular file");
   if (std::filesystem::file_size(path, ec) > kMaxSceneFileBytes)
     throw Error(path + ": the scene file is larger than 16 MB");
-  std::ifstream in(path);
-  if (!in) throw Error(path + ": cannot open scene file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return parse_scene(ss.str(), path);
+  // Read with the C library, whose error indicator tells a read that failed (/proc/self/mem: EIO) from an
+  // empty file; a file that says it is small (/proc files say 0) is held to the limit while it is read.
+  const std::unique_ptr<std::FILE, int (*)(std::FILE*)> in(std::fopen(path.c_str(), "rb"), &std::fclose);
+  if (!in) throw Error(path + ": cannot open scene file (" + std::strerror(errno) + ")");
+  std::string text;
+  std::array<char, 65536> buf{};
+  for (std::size_t n; (n = std::fread(buf.data(), 1, buf.size(), in.get())) > 0;) {
+    text.append(buf.data(), n);
+    if (text.size() > kMaxSceneFileBytes) throw Error(path + ": the scene file is larger than 16 MB");
+  }
+  if (std::ferror(in.get())) throw Error(path + ": the scene file cannot be read (" + std::strerror(errno) + ")");
+  return parse_scene(text, path);
 }
 
 }  // namespace bodypoint
