@@ -60,6 +60,13 @@ constexpr double kMinRefinement = 1.25;
 /// by kStallFactor (scene long at tol 1e-12 spent 2e9 force evaluations, about 100 s, before).
 constexpr int kMaxStalls = 3;
 constexpr double kStallFactor = 2.0;
+/// Estimates that stop falling are a floor (round-off amplified by an encounter: 4e-12 on B = 0.9, b = 1)
+/// where the runs differ by less than kStallBelow: kMaxStalls refinements in a row end the search. Above
+/// it the step is still outside the asymptotic regime, where refinement lowers them (lp-kl8 at tol 1e-3
+/// on a two-centre pass stalled at runs 1.1e-3 apart; at 1e-4 it is delivered): kMaxFarStalls halvings
+/// are allowed.
+constexpr double kStallBelow = 1e-8;
+constexpr int kMaxFarStalls = 8;
 /// Budget of force evaluations (or KS steps) over all runs of one search.
 constexpr double kMaxEvals = 2e9;
 /// Below kProbeBelowTol (tolerance.hpp) a run about to be delivered is repeated kProbeRuns times with its
@@ -94,12 +101,6 @@ struct Level {
   RunResult run;
   std::vector<KeptSample> samples;  ///< kept until the run is known to be the delivered one
 };
-
-int effective_order(const MethodInfo& m, const Body& b) {
-  // The thesis's schemes freeze the gyroscopic term: first order for B != 0 (README, findings).
-  if (m.family == Family::Thesis && b.p.B != 0.0) return 1;
-  return m.order;
-}
 
 double speed_of(const Body& b) { return b.s0.v.norm(); }
 
@@ -143,9 +144,9 @@ double initial_step(const MethodInfo& m, const Body& b, const std::vector<Centre
 class Search {
  public:
   Search(const MethodInfo& m, const Body& b, const std::vector<Centre>& c, const Accuracy& a,
-         const RunOptions& delivery)
+         const RunOptions& delivery, bool verify)
       : m_(m), b_(b), c_(c), tol_(a.tol), t_end_(a.t_end), dt_out_(a.dt_out), p_(effective_order(m, b)),
-        delivery_(delivery) {}
+        delivery_(delivery), verify_(verify) {}
 
   ToleranceResult search() {
     Level best = p_ > 0 ? ladder() : exact_flow();
@@ -238,8 +239,10 @@ class Search {
     rungs.push_back(std::move(fine));
     double best_bound = std::numeric_limits<double>::infinity();
     int stalled = 0;
+    bool verified_finer = false;  // the newest rung is a verification's companion: estimate it first
     for (int k = 0; k < kMaxLevels; ++k) {
-      const double expected = refine(rungs, h_c);
+      const double expected = verified_finer ? estimate_ * std::pow(0.5, p_) : refine(rungs, h_c);
+      verified_finer = false;
       Level& a = rungs[rungs.size() - 2];
       const Level& b = rungs.back();
       a.samples = {};  // only the newest run can still be delivered: its predecessors' samples go
@@ -254,13 +257,27 @@ class Search {
       // carried over from the coarser runs predicted, within kAgree.
       bool smooth = estimate_ <= kAgree * expected && estimate_ >= expected / kAgree;
       if (rungs.size() >= 3) smooth = observed_order(rungs[rungs.size() - 3], a, b) >= p_ - kOrderSlack;
-      if (deliverable(rungs.back(), h_c, smooth || d <= kRoundOff)) return std::move(rungs.back());
+      if (deliverable(rungs.back(), h_c, smooth || d <= kRoundOff)) {
+        if (verified(rungs, h_c)) return std::move(rungs.back());
+        verified_finer = true;  // its companion joined the ladder
+        continue;
+      }
       // A search whose estimates stop falling (round-off, or resonances that refinement does not
-      // remove) says so instead of spending its whole budget.
+      // remove) says so instead of spending its whole budget; larger differences are not a floor but a
+      // step still outside the asymptotic regime (kStallBelow).
       if (estimate_ < best_bound / kStallFactor) {
         best_bound = estimate_;
         stalled = 0;
-      } else if (++stalled >= kMaxStalls) {
+      } else if (++stalled < (d > kStallBelow ? kMaxFarStalls : kMaxStalls)) {
+        continue;
+      } else if (d <= kAccept * tol_) {
+        // The finest runs differ by less than tol but their estimates are not trusted (not smooth in h):
+        // what they differ by bounds the finer one's error once its own companion agrees (kep-kl6 on a
+        // material close pass was refused at every tol with runs 4.98e-12 apart).
+        if (verified_at(rungs, h_c, d)) return std::move(rungs.back());
+        verified_finer = true;
+        stalled = 0;
+      } else {
         // The floor is what finer runs still disagree by, not the smallest estimate: an early pair
         // can agree by chance (B = 0.9, b = 1 at tol 1e-12: first estimate 9.9e-15, then three
         // refinements each 4e-12 apart, which one of them must be wrong by half of).
@@ -313,6 +330,26 @@ class Search {
     if (estimate_ + floor_ > kAccept * tol_) return false;
     estimate_ = last_estimate_ = estimate_ + floor_;
     return true;
+  }
+
+  /// Whether the ladder's newest run may be delivered as it is: without verification (auto: its choices'
+  /// estimates were measured honest), or when its companion at half its step, run now, agrees within TOL
+  /// (its difference over 1 - 2^-p: the error of the run at h). A companion that does not agree joins the
+  /// ladder as its newest run (false): the search goes on from there.
+  bool verified(std::vector<Level>& rungs, double h_c) {
+    return !verify_ || verified_at(rungs, h_c, estimate_);
+  }
+  /// The same with the delivered run's estimate `current`, which the companion's can only raise.
+  bool verified_at(std::vector<Level>& rungs, double h_c, double current) {
+    Level half = run_at(0.5 * rungs.back().h, h_c, true);
+    const double e = state_distance(rungs.back().run.final, half.run.final) / (1.0 - std::pow(0.5, p_));
+    if (e + std::max(floor_, 0.0) <= kAccept * tol_) {
+      estimate_ = last_estimate_ = std::max(current, e + std::max(floor_, 0.0));
+      return true;
+    }
+    rungs.back().samples = {};
+    rungs.push_back(std::move(half));
+    return false;
   }
 
   /// The most that the run `l` and its kProbeRuns repeats with other roundings differ by (kProbeBelowTol):
@@ -384,6 +421,7 @@ class Search {
   double tol_, t_end_, dt_out_;
   int p_;
   RunOptions delivery_;
+  bool verify_;  ///< a run about to be delivered is checked against a companion at half its step
   double estimate_ = 0.0, last_estimate_ = std::numeric_limits<double>::quiet_NaN();
   double floor_ = -1.0;  ///< the round-off floor last measured (below kProbeBelowTol), -1 before
   double spent_evals_ = 0.0, total_wall_ = 0.0;
@@ -392,6 +430,12 @@ class Search {
 };
 
 }  // namespace
+
+int effective_order(const MethodInfo& m, const Body& b) {
+  // The thesis's schemes freeze the gyroscopic term: first order for B != 0 (README, findings).
+  if (m.family == Family::Thesis && b.p.B != 0.0) return 1;
+  return m.order;
+}
 
 double state_distance(const State& a, const State& b) {
   auto rel = [](const Vec3& x, const Vec3& y) {
@@ -418,7 +462,7 @@ void check_searchable(const MethodInfo& method) {
 }
 
 ToleranceResult run_to_tolerance(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
-                                 const Accuracy& accuracy, const RunOptions& delivery) {
+                                 const Accuracy& accuracy, const RunOptions& delivery, bool verify) {
   check_tolerance(accuracy.tol);
   check(Advance(accuracy));
   check(delivery);
@@ -426,12 +470,12 @@ ToleranceResult run_to_tolerance(const MethodInfo& method, const Body& body, con
   validate(Scene{centres, {body}});
   if (non_coulomb(centres)) throw Error(std::string(kNeedsCoulomb));
   if (const std::string why = refusal(method, body, centres); !why.empty()) throw Error(why);
-  return search_step(method, body, centres, accuracy, delivery);
+  return search_step(method, body, centres, accuracy, delivery, verify);
 }
 
 ToleranceResult search_step(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
-                            const Accuracy& accuracy, const RunOptions& delivery) {
-  return Search(method, body, centres, accuracy, delivery).search();
+                            const Accuracy& accuracy, const RunOptions& delivery, bool verify) {
+  return Search(method, body, centres, accuracy, delivery, verify).search();
 }
 
 }  // namespace bodypoint::adaptive

@@ -52,6 +52,7 @@ std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body,
     cal.track_invariants = options.track_invariants;
     cal.omega_c = options.omega_c;
     cal.max_energy_error = std::numeric_limits<double>::infinity();
+    cal.estimate_error = false;
     const Advance a = fixed ? Advance(FixedSteps{fixed->h, steps}) : Advance(FictitiousSteps{fictitious->ds, StepCount{steps}});
     BodyResult r = integrate_body(body, centres, &m, a, cal);
     if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return std::nullopt;

@@ -64,7 +64,7 @@ TolRow measure_auto(const NamedScene& ns, const State& ref, double tol, long rep
   std::vector<double> times, delivered;
   adaptive::ToleranceResult r;
   for (long k = 0; k < repeats; ++k) {
-    r = adaptive::run_to_tolerance(m, body, ns.scene.centres, Accuracy{tol, ns.t_end}, unobserved());
+    r = adaptive::run_to_tolerance(m, body, ns.scene.centres, Accuracy{tol, ns.t_end}, unobserved(), false);  // as auto
     times.push_back(r.total_wall_s);
     delivered.push_back(r.result.wall_s);
   }

@@ -83,13 +83,24 @@ void add_step_options(po::options_description& desc, StepOptions& o) {
       ("t-end", po::value(&o.t_end), "end time T (steps = ceil(T/h), h adjusted to T/steps)")
       ("max-energy-error", po::value(&o.max_energy_error)->default_value(o.max_energy_error),
        "flag a run whose relative energy error exceeds this bound as inaccurate (inf: no bound; not applied "
-       "under --force-law thesis-code, whose flow does not conserve E)");
+       "under --force-law thesis-code, whose flow does not conserve E)")
+      ("max-error", po::value(&o.max_error)->default_value(o.max_error),
+       "flag a run whose estimated relative error of the final state exceeds this bound as inaccurate (inf: no "
+       "bound)")
+      ("no-error-estimate", po::bool_switch(&o.no_error_estimate),
+       "no companion run to estimate the error of a run by step (it costs about twice the run); the outputs "
+       "then say the run has no estimate");
 }
 
 double energy_bound(const StepOptions& o) {
   if (!(o.max_energy_error > 0.0))
     throw Error("--max-energy-error must be a number > 0 (inf: no bound), got " + fmt(o.max_energy_error));
   return o.max_energy_error;
+}
+
+double error_bound(const StepOptions& o) {
+  if (!(o.max_error > 0.0)) throw Error("--max-error must be a number > 0 (inf: no bound), got " + fmt(o.max_error));
+  return o.max_error;
 }
 
 StepRequest step_request(const po::variables_map& vm, const StepOptions& o, const MethodInfo* method, double tol) {

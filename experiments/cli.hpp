@@ -38,10 +38,14 @@ struct StepOptions {
   long steps = kDefaultSteps;
   double t_end = 0.0;
   double max_energy_error = kDefaultMaxEnergyError;  ///< the accuracy flag's bound (Options)
+  double max_error = kDefaultMaxError;               ///< the bound on the estimated error (Options)
+  bool no_error_estimate = false;                    ///< Options::estimate_error off
 };
 void add_step_options(po::options_description& desc, StepOptions& o);
 /// o.max_energy_error, checked: a number > 0 (inf: no bound); Error otherwise.
 double energy_bound(const StepOptions& o);
+/// o.max_error, checked the same way.
+double error_bound(const StepOptions& o);
 /// The library's step request from --h, --steps, --t-end and --tol as given (defaulted ones left out),
 /// with the command line's defaults: no end given, --steps 500000 (or with --tol, t_end = 50, the
 /// thesis's h n); --force-law thesis-code counts steps as the thesis's code did.
@@ -72,7 +76,10 @@ struct BodyRun {
   RunResult result;
   std::optional<double> err_R;
   std::optional<double> err_rel;  ///< max(|dR|/|R_ref|, |dv|/|v_ref|), the measure --tol bounds
+  std::optional<State> reference;  ///< --reference: the reference state at the run's end
   std::optional<AccuracyReport> search;
+  ErrorEstimate error;                ///< the run's estimated error, or why it has none
+  std::vector<std::string> warnings;  ///< what a heuristic saw but the estimate overruled
   std::string why;  ///< --method auto: what was chosen and why
   Outcome outcome = Outcome::ok;
   std::string reason;  ///< of an outcome other than ok
@@ -87,13 +94,16 @@ BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre
                  const SampleSink* sink, const std::vector<Event>& events = {});
 
 /// One run of a study through the public API (integrate_body): its RunResult, whatever its outcome's
-/// flag; a refused or failed run throws Error with the library's reason.
+/// flag; a refused or failed run throws Error with the library's reason. A study measures its errors
+/// against references: the run makes no error estimate of its own (Options::estimate_error off).
 RunResult run_or_throw(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres, const Advance& how,
                        const Options& options);
-/// Options that observe nothing (no invariants, no samples): the fastest run, for timings and errors.
+/// Options that observe nothing (no invariants, no samples, no error estimate): the fastest run, for
+/// timings and errors measured against references.
 inline Options unobserved() {
   Options o;
   o.track_invariants = false;
+  o.estimate_error = false;
   return o;
 }
 

@@ -25,6 +25,8 @@ RunPlan plan_run(const po::variables_map& vm, const StepOptions& st, const std::
   plan.how = advance_for(plan.method, step_request(vm, st, plan.method, tol));
   plan.search = std::holds_alternative<Accuracy>(plan.how);
   plan.options.max_energy_error = energy_bound(st);
+  plan.options.max_error = error_bound(st);
+  plan.options.estimate_error = !st.no_error_estimate;
   return plan;
 }
 
@@ -57,6 +59,8 @@ BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre
   b.method = r.method;
   b.result = std::move(r.run);
   b.search = r.accuracy;
+  b.error = std::move(r.error);
+  b.warnings = std::move(r.warnings);
   b.why = std::move(r.chosen);
   b.outcome = r.outcome;
   b.reason = std::move(r.reason);
@@ -68,7 +72,9 @@ BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre
 
 RunResult run_or_throw(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres, const Advance& how,
                        const Options& options) {
-  BodyResult r = integrate_body(body, centres, &m, how, options);
+  Options o = options;
+  o.estimate_error = false;
+  BodyResult r = integrate_body(body, centres, &m, how, o);
   if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) throw Error(r.reason);
   return std::move(r.run);
 }

@@ -28,7 +28,7 @@ std::string scene_header(const po::variables_map& vm, const SceneOptions& o) {
 }
 
 std::string json_body(const RunResult& r, const std::optional<double>& err_R,
-                      const std::optional<double>& err_rel = std::nullopt) {
+                      const std::optional<double>& err_rel = std::nullopt, const std::optional<State>& ref = std::nullopt) {
   std::ostringstream os;
   os << "\"R\": " << json_vec(r.final.R) << ", \"v\": " << json_vec(r.final.v)
      << ", \"w\": " << json_vec(r.final.w);
@@ -39,6 +39,7 @@ std::string json_body(const RunResult& r, const std::optional<double>& err_R,
   }
   if (err_R) os << ", \"err_R\": " << json_number(*err_R);
   if (err_rel) os << ", \"err_rel\": " << json_number(*err_rel);
+  if (ref) os << ", \"R_ref\": " << json_vec(ref->R) << ", \"v_ref\": " << json_vec(ref->v);
   if (r.max_step > 0.0)
     os << ", \"accepted_steps\": " << r.steps << ", \"min_step\": " << json_number(r.min_step)
        << ", \"max_step\": " << json_number(r.max_step);
@@ -49,8 +50,7 @@ std::string json_body(const RunResult& r, const std::optional<double>& err_R,
 std::string search_json(const BodyRun& b, double tol) {
   if (!b.search) return "";
   std::ostringstream os;
-  os << ", \"tol\": " << json_number(tol) << ", \"err_estimate\": " << json_number(b.search->err_estimate)
-     << ", \"h_chosen\": " << json_number(b.search->step) << ", \"search_runs\": " << b.search->runs
+  os << ", \"tol\": " << json_number(tol) << ", \"h_chosen\": " << json_number(b.search->step) << ", \"search_runs\": " << b.search->runs
      << ", \"search_force_evals\": " << b.search->force_evals
      << ", \"search_wall_s\": " << json_number(b.search->wall_s);
   if (!b.why.empty()) os << ", \"chosen\": " << json_string(b.why);
@@ -61,9 +61,29 @@ std::string search_line(const BodyRun& b) {
   std::ostringstream os;
   os << "method=" << b.method->name;
   if (b.search)
-    os << (is_time_transformed(*b.method) ? " ds=" : " h=") << fmt(b.search->step)
-       << " err_estimate=" << fmt(b.search->err_estimate) << " search: " << b.search->runs << " runs (the delivered one included), "
-       << b.search->force_evals << " force evaluations";
+    os << (is_time_transformed(*b.method) ? " ds=" : " h=") << fmt(b.search->step) << " search: " << b.search->runs
+       << " runs (the delivered one included), " << b.search->force_evals << " force evaluations";
+  return os.str();
+}
+
+/// The run's error estimate, or that it has none, with how it was obtained (ErrorEstimate).
+std::string error_line(const ErrorEstimate& e) {
+  if (!e.known()) return "estimated relative error: none (" + e.basis + ")";
+  std::ostringstream value;
+  value.precision(3);
+  value << e.value;
+  std::string line = "estimated relative error = " + value.str() + " (" + e.basis;
+  if (e.force_evals > 0) line += ", " + std::to_string(e.force_evals) + " force evaluations";
+  return line + ")";
+}
+
+std::string error_json(const BodyRun& b) {
+  std::ostringstream os;
+  os << ", \"err_estimate\": " << (b.error.known() ? json_number(b.error.value) : "null")
+     << ", \"err_basis\": " << json_string(b.error.basis) << ", \"estimate_force_evals\": " << b.error.force_evals
+     << ", \"warnings\": [";
+  for (std::size_t i = 0; i < b.warnings.size(); ++i) os << (i ? ", " : "") << json_string(b.warnings[i]);
+  os << "]";
   return os.str();
 }
 
@@ -296,6 +316,8 @@ BodyRun simulate_body(const SimulateOptions& o, const RunPlan& plan, const Body&
   std::optional<WorkEstimate> estimate;
   if (!plan.search) {
     estimate = estimate_work(*plan.method, body, scene.centres, plan.how, plan.options);
+    // The error estimate's companion costs kStepRatio runs more.
+    if (estimate && plan.options.estimate_error) estimate->seconds *= 1.0 + ErrorEstimate::kStepRatio;
     if (estimate) check_budget(*estimate, o.max_seconds, o.quiet || o.json);
   }
   BodyRun br;
@@ -306,16 +328,21 @@ BodyRun simulate_body(const SimulateOptions& o, const RunPlan& plan, const Body&
   if (br.outcome != Outcome::ok) {
     const std::string smaller = is_step_controlled(*br.method) ? "the tolerance is too loose for this scene (reduce --tol"
                                                                : "the step is too large for this scene (reduce --h";
+    const bool energy = br.result.invariants && br.result.invariants->max_rel_dE > plan.options.max_energy_error;
     throw Error("body '" + body.name + "' (" + std::string(br.method->name) + "): " + br.reason + "; " +
                 (br.outcome == Outcome::collision ? "a time-transformed method (ttl-*) or a smaller --h can follow it"
-                 : br.outcome == Outcome::inaccurate ? smaller + ", or raise --max-energy-error if that error will do)"
-                                                     : smaller + ")") +
+                 : br.outcome == Outcome::inaccurate
+                     ? smaller + ", or raise " + (energy ? "--max-energy-error" : "--max-error") + " if that error will do)"
+                     : smaller + ")") +
                 "; no output written");
   }
+  for (const std::string& w : br.warnings)
+    std::cerr << "bodypoint: warning: body '" << body.name << "' (" << br.method->name << "): " << w << "\n";
   if (o.with_reference) {
     const State ref = reference_state(body, scene.centres, br.result.t_end);
     br.err_R = (br.result.final.R - ref.R).norm();
     br.err_rel = adaptive::state_distance(br.result.final, ref);
+    br.reference = ref;
   }
   return br;
 }
@@ -326,8 +353,8 @@ void report_json(const std::vector<BodyRun>& runs, const Scene& scene, const Run
   const double h0 = r0.search ? r0.search->step : planned_step(plan);
   std::cout << "{\"method\": " << json_string(r0.method->name) << ", \"h\": " << json_number(h0)
             << (is_step_controlled(*r0.method) ? ", \"tol\": " + json_number(plan.tol) : std::string())
-            << search_json(r0, plan.tol) << ", \"steps\": " << r0.result.steps
-            << ", \"t_end\": " << json_number(r0.result.t_end) << ", " << json_body(r0.result, r0.err_R, r0.err_rel)
+            << search_json(r0, plan.tol) << error_json(r0) << ", \"steps\": " << r0.result.steps
+            << ", \"t_end\": " << json_number(r0.result.t_end) << ", " << json_body(r0.result, r0.err_R, r0.err_rel, r0.reference)
             << events_json(o.events, r0) << scattering_json(enc.front());
   if (runs.size() > 1) {
     // The run's totals (the top-level fields above are the first body's): every body's force
@@ -336,15 +363,15 @@ void report_json(const std::vector<BodyRun>& runs, const Scene& scene, const Run
     double wall = 0.0;
     for (const BodyRun& r : runs) {
       evals += r.total_force_evals;
-      wall += r.search ? r.search->wall_s : r.result.wall_s;
+      wall += (r.search ? r.search->wall_s : r.result.wall_s) + r.error.wall_s;
     }
     std::cout << ", \"run\": {\"bodies\": " << runs.size() << ", \"force_evals\": " << evals
               << ", \"wall_s\": " << json_number(wall) << "}";
     std::cout << ", \"bodies\": [";
     for (std::size_t b = 0; b < runs.size(); ++b)
       std::cout << (b ? ", " : "") << "{\"name\": " << json_string(scene.bodies[b].name) << ", \"method\": "
-                << json_string(runs[b].method->name) << search_json(runs[b], plan.tol) << ", "
-                << json_body(runs[b].result, runs[b].err_R, runs[b].err_rel) << events_json(o.events, runs[b])
+                << json_string(runs[b].method->name) << search_json(runs[b], plan.tol) << error_json(runs[b]) << ", "
+                << json_body(runs[b].result, runs[b].err_R, runs[b].err_rel, runs[b].reference) << events_json(o.events, runs[b])
                 << scattering_json(enc[b]) << "}";
     std::cout << "]";
   }
@@ -366,9 +393,10 @@ void report_body(const BodyRun& run, const std::string& name) {
     if (r.invariants->has_K2Q) std::cout << "  max |K2Q - K2Q_0|          = " << r.invariants->max_abs_dK2Q << "\n";
     std::cout << std::defaultfloat;
   }
+  std::cout << "  " << error_line(run.error) << "\n";
   if (run.err_R)
     std::cout << std::setprecision(3) << std::scientific << "  |R - R_ref| (odeint rkf78, long double) = "
-              << *run.err_R << "\n" << std::defaultfloat;
+              << *run.err_R << ", relative error (as estimated) = " << *run.err_rel << "\n" << std::defaultfloat;
   std::cout << "  force evaluations = " << r.force_evals << ", wall time = " << std::setprecision(3) << r.wall_s
             << " s\n";
 }
@@ -427,7 +455,7 @@ int cmd_simulate(int argc, char** argv) {
     const Body& body = scene.bodies[b];
     const SampleSink sink = file ? file->sink(static_cast<long>(b), body.p) : SampleSink();
     runs.push_back(simulate_body(o, plan, body, scene, file ? &sink : nullptr));
-    if (plan.search && file) file->stream() << "# body " << b << ": " << search_line(runs.back()) << "\n";
+    if (file) file->stream() << "# body " << b << ": " << search_line(runs.back()) << "; " << error_line(runs.back().error) << "\n";
   }
   if (file) file->commit();
   std::vector<std::optional<Encounter>> enc(runs.size());

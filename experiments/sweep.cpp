@@ -78,6 +78,8 @@ std::string format_row(const SweepSpec& spec, const SweepRow& r) {
   row.text(r.method->name).num(s.max_rel_dE).num(s.max_rel_dK2sq).num(s.max_abs_dK2Q);
   row.num(r.result.final.R.x()).num(r.result.final.R.y()).num(r.result.final.R.z());
   row.count(r.result.force_evals).num(r.result.wall_s).text(std::string(status)).quoted(r.reason);
+  row.num(r.error.known() ? r.error.value : nan).count(r.error.force_evals).quoted(r.error.basis);
+  row.quoted(join(r.warnings, "; "));
   if (spec.scattering) {  // NaN where there is no value (no minimum, no asymptotes, a run that did not finish)
     const Scattering sc = r.scattering ? *r.scattering : Scattering{};
     row.num(r.r_min).num(r.t_min).num(sc.deflection).num(sc.out_of_plane).num(sc.b).num(sc.v_inf).num(sc.time_delay);
@@ -144,7 +146,8 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
   // genfromtxt(names=True, comments="#") takes the first line for the names; pandas' read_csv(comment="#")
   // the first line that is not a comment).
   std::string columns =
-      names + ",method,max_rel_dE,max_rel_dK2sq,max_abs_dK2Q,Rx,Ry,Rz,force_evals,wall_s,status,reason" +
+      names + ",method,max_rel_dE,max_rel_dK2sq,max_abs_dK2Q,Rx,Ry,Rz,force_evals,wall_s,status,reason,err_estimate,"
+              "estimate_force_evals,err_basis,warning" +
       (spec.scattering ? ",r_min,t_min,deflection,out_of_plane,b_in,v_inf_in,time_delay,K1_turn,spin_turn,K1x,K1y,K1z,"
                          "asymptotes"
                        : "");
@@ -160,8 +163,12 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
               " trajectories run in vector lanes shares its time equally);"
               " status = ok | diverged (non-finite, or energy error above 1) | unresolved (a step turned the spin by"
               " more than pi or the direction to a centre by more than pi/2) | inaccurate (energy error above"
-              " max_energy_error = " + fmt(spec.max_energy_error) + ") | collision (diverged after a fall onto an"
-              " attracting centre) | refused (not run); reason = why, when not ok" +
+              " max_energy_error = " + fmt(spec.max_energy_error) + ", or estimated error above max_error = " +
+              fmt(spec.max_error) + ") | collision (diverged after a fall onto an"
+              " attracting centre) | refused (not run); reason = why, when not ok;"
+              " err_estimate = estimated relative error of the final state, max(|dR|/|R|, |dv|/|v|) (NaN: none),"
+              " estimate_force_evals = its companion run's cost, err_basis = how it was estimated or why there is"
+              " none; warning = a flag the estimate overruled" +
               std::string(spec.scattering
                               ? "; r_min,t_min = the closest approach to any centre (located on the method's steps);"
                                 " deflection, out_of_plane = angles between the incoming and outgoing asymptotes (rad);"
@@ -182,6 +189,7 @@ std::string sweep_key(const SweepSpec& spec) {
   }
   for (const MethodInfo* m : spec.methods) s.append("|").append(m->name);
   if (spec.scattering) s.append("|scattering");
+  s.append("|").append(spec.estimate_error ? fmt(spec.max_error) : "no-estimate").append("|").append(fmt(spec.max_energy_error));
   return hex64(fnv1a(s));
 }
 
@@ -317,6 +325,8 @@ void apply_fixed_data(const po::variables_map& vm, const SceneOptions& so, Sweep
 void apply_steps(const po::variables_map& vm, const StepOptions& st, SweepSpec& spec) {
   spec.h = st.h;
   spec.max_energy_error = energy_bound(st);
+  spec.max_error = error_bound(st);
+  spec.estimate_error = !st.no_error_estimate;
   bool sweeps_h = false;
   for (const Axis& a : spec.axes) sweeps_h = sweeps_h || a.param == "h";
   if (vm.count("t-end")) {
@@ -417,7 +427,7 @@ std::unique_ptr<RowJournal> open_journal(const SweepJob& job, const AtomicFile* 
 void run_job_mpi(const SweepJob& job) {
   if (job.sharded) throw Error("give --shard or run under mpirun, not both");
   MpiSession mpi;
-  const unsigned threads = job.threads > 0 ? thread_count(job.threads) : 1;  // one per rank unless asked
+  const unsigned threads = job.threads == 0 ? 1 : thread_count(job.threads);  // one per rank unless asked; checked
   if (mpi.rank() != 0) {
     if (mpi.agree(false)) run_sweep_mpi(mpi, job.spec, SweepControl{});
     return;

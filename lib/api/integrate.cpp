@@ -6,6 +6,7 @@
 #include "bodypoint/field.hpp"
 #include "bodypoint/invariants.hpp"
 #include "choice.hpp"
+#include "estimate.hpp"
 #include "events.hpp"
 
 #include <algorithm>
@@ -19,7 +20,7 @@
 namespace bodypoint {
 
 long BodyResult::total_force_evals() const {
-  return (accuracy ? accuracy->force_evals : run.force_evals) + event_force_evals;
+  return (accuracy ? accuracy->force_evals : run.force_evals) + error.force_evals + event_force_evals;
 }
 
 namespace {
@@ -34,7 +35,8 @@ void judge(BodyResult& r, const std::vector<Centre>& centres, const Options& opt
 /// The accuracy mode: the step search, whose delivered run carries the observers.
 void run_accurately(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Accuracy& a,
                     const Options& options) {
-  adaptive::ToleranceResult t = adaptive::search_step(*r.method, body, centres, a, options);
+  // A method the user named is verified against a companion at half the delivered step; auto's are not.
+  adaptive::ToleranceResult t = adaptive::search_step(*r.method, body, centres, a, options, r.chosen.empty());
   r.accuracy = AccuracyReport{a.tol, t.err_estimate, t.h, t.omega_c, t.runs, t.total_force_evals, t.total_wall_s};
   r.run = std::move(t.result);
 }
@@ -316,7 +318,20 @@ void check_request(const Scene& scene, const MethodInfo* method, const Advance& 
   }
   check(options);
   check_energy_bound(options.max_energy_error);
+  check_error_bound(options.max_error);
   detail::validate_events(options.events, scene.centres);
+}
+
+/// A checked request's run, with its error estimate (estimate.hpp) and its outcome in the light of it.
+BodyResult integrate_estimated(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
+                               const Advance& how, const Options& options) {
+  BodyResult r = integrate_valid_body(body, centres, method, how, options);
+  detail::estimate_error(r, body, centres, how, options, [&](const Advance& a, const Options& o) {
+    return integrate_valid_body(body, centres, r.method, a, o);
+  });
+  detail::settle(r.outcome, r.reason, r.warnings, r.error, options.max_error, options.max_energy_error,
+                 detail::final_energy_error(body, centres, r.run.final));
+  return r;
 }
 
 }  // namespace
@@ -324,16 +339,16 @@ void check_request(const Scene& scene, const MethodInfo* method, const Advance& 
 BodyResult integrate_body(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
                           const Advance& how, const Options& options) {
   check_request(Scene{centres, {body}}, method, how, options);
-  return integrate_valid_body(body, centres, method, how, options);
+  return integrate_estimated(body, centres, method, how, options);
 }
 
 Result integrate(const Scene& scene, const MethodInfo* method, const Advance& how, const Options& options) {
   check_request(scene, method, how, options);
   Result all;
   for (const Body& body : scene.bodies) {
-    BodyResult b = integrate_valid_body(body, scene.centres, method, how, options);
+    BodyResult b = integrate_estimated(body, scene.centres, method, how, options);
     all.force_evals += b.total_force_evals();
-    all.wall_s += (b.accuracy ? b.accuracy->wall_s : b.run.wall_s);
+    all.wall_s += (b.accuracy ? b.accuracy->wall_s : b.run.wall_s) + b.error.wall_s;
     if (all.outcome == Outcome::ok && b.outcome != Outcome::ok) {
       all.outcome = b.outcome;
       all.reason = (body.name.empty() ? std::string("body") : body.name) + ": " + b.reason;
@@ -391,6 +406,9 @@ Stepper::Stepper(const MethodInfo& method, Body body, std::vector<Centre> centre
   // that every segment integrates the same transformed system.
   if (is_time_transformed(method) && options_.omega_c < 0.0)
     options_.omega_c = adaptive::automatic_omega_c(body_, centres_, step_);
+  // A segment has no error estimate of its own (a companion per segment would compare segments that
+  // start from one state, not the runs).
+  options_.estimate_error = false;
 }
 
 Stepper::Stepper(std::string_view method, Body body, std::vector<Centre> centres, double step, Options options)

@@ -4,6 +4,7 @@
 #include "bodypoint/batch.hpp"
 #include "bodypoint/threads.hpp"
 #include "bodypoint/io.hpp"
+#include "estimate.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -34,34 +35,74 @@ SweepRow unrun_row(SweepRow row, Outcome outcome, std::string why) {
   return row;
 }
 
-/// The row of a finished run, judged by assess().
-SweepRow run_row(SweepRow row, RunResult result, const SweepSpec& spec, const std::vector<Centre>& centres) {
-  Health h = assess(result, checks_for(*row.method, centres, spec.max_energy_error));
-  row.result = std::move(result);
-  row.outcome = h.outcome;
-  row.reason = std::move(h.why);
+/// Options of every run of the sweep: its bounds and whether its error is estimated.
+Options sweep_options(const SweepSpec& spec) {
+  Options options;
+  options.max_energy_error = spec.max_energy_error;
+  options.estimate_error = spec.estimate_error;
+  options.max_error = spec.max_error;
+  return options;
+}
+
+/// The row of a finished run of the public API.
+SweepRow result_row(SweepRow row, BodyResult r) {
+  if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return unrun_row(std::move(row), r.outcome, r.reason);
+  row.result = std::move(r.run);
+  row.outcome = r.outcome;
+  row.reason = std::move(r.reason);
+  row.error = std::move(r.error);
+  row.warnings = std::move(r.warnings);
   return row;
+}
+
+/// The rows of a batch: its lanes, judged by assess() and, with SweepSpec::estimate_error, by the
+/// estimate from a companion batch at h/2 (the same kernel, as integrate() would run them alone).
+void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const MethodInfo& method,
+                const std::vector<batch::Member>& members, const std::vector<Scene>& scenes) {
+  const FixedSteps how = std::get<FixedSteps>(point_advance(spec, method, rows.front().point));
+  auto results = batch::run(method, members, how);
+  std::vector<RunResult> companions, second;
+  if (spec.estimate_error) companions = batch::run(method, members, detail::fixed_companion(how));
+  for (std::size_t k = 0; k < rows.size() && spec.estimate_error && second.empty(); ++k)
+    if (assess(results[k], checks_for(method, scenes[k].centres, spec.max_energy_error)).outcome == Outcome::unresolved)
+      second = batch::run(method, members, detail::fixed_companion(how, 2));  // to confirm the flagged lanes' estimates
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    SweepRow& row = rows[k];
+    Health h = assess(results[k], checks_for(method, scenes[k].centres, spec.max_energy_error));
+    row.result = std::move(results[k]);
+    row.outcome = h.outcome;
+    row.reason = std::move(h.why);
+    if (!spec.estimate_error) {
+      row.error.basis = "not asked for (estimate_error off)";
+    } else if (row.outcome == Outcome::ok || row.outcome == Outcome::unresolved || row.outcome == Outcome::inaccurate) {
+      row.error = detail::fixed_step_estimate(method, scenes[k].bodies.front(), row.result.final, companions[k].final);
+      row.error.force_evals = companions[k].force_evals;
+      row.error.wall_s = companions[k].wall_s;
+      if (row.outcome == Outcome::unresolved)
+        row.error.confirmed = detail::confirms(method, scenes[k].bodies.front(), row.result.final, companions[k].final,
+                                               second[k].final);
+    } else {
+      row.error.basis = "the run ended " + std::string(outcome_name(row.outcome));
+    }
+    detail::settle(row.outcome, row.reason, row.warnings, row.error, spec.max_error, spec.max_energy_error,
+                   detail::final_energy_error(scenes[k].bodies.front(), scenes[k].centres, row.result.final));
+  }
 }
 
 /// The row of a run with its encounter (SweepSpec::scattering): integrate_body with every centre's
 /// closest approach as events, then scattering() of the run.
 SweepRow encounter_row(SweepRow row, const MethodInfo& method, const Scene& scene, const Advance& how,
-                       double max_energy_error) {
+                       const SweepSpec& spec) {
   const Body& body = scene.bodies.front();
-  Options options;
-  options.max_energy_error = max_energy_error;
+  Options options = sweep_options(spec);
   options.events = closest_approaches(scene.centres.size());
   BodyResult r = integrate_body(body, scene.centres, &method, how, options);
-  if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return unrun_row(std::move(row), r.outcome, r.reason);
   if (const EventHit* nearest = nearest_approach(r.events, options.events)) {
     row.r_min = nearest->distance;
     row.t_min = nearest->t;
   }
   if (r.outcome == Outcome::ok) row.scattering = scattering(body.p, scene.centres, body.s0, r.run.final, r.run.t_end);
-  row.result = std::move(r.run);
-  row.outcome = r.outcome;
-  row.reason = std::move(r.reason);
-  return row;
+  return result_row(std::move(row), std::move(r));
 }
 
 }  // namespace
@@ -125,6 +166,7 @@ std::string point_label(const SweepSpec& spec, const std::vector<double>& point)
 void validate_sweep(const SweepSpec& spec) {
   if (spec.methods.empty()) throw Error("the method list is empty");
   check_energy_bound(spec.max_energy_error);
+  check_error_bound(spec.max_error);
   if (spec.axes.empty()) throw Error("the sweep has no varied parameter");
   for (const Axis& a : spec.axes) {
     if (a.values.empty()) throw Error("the sweep has no values of " + a.param);
@@ -155,39 +197,25 @@ std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vect
   const MethodInfo& method = *spec.methods[unit.front() % M];
   std::vector<SweepRow> rows;
   std::vector<batch::Member> members;
-  std::vector<std::vector<Centre>> centres;
+  std::vector<Scene> scenes;
   for (std::size_t i : unit) {
     SweepRow row;
     row.task = i;
     row.point = grid_point(spec, i / M);
     row.method = &method;
     rows.push_back(std::move(row));
-    const Scene scene = thesis_scene(point_params(spec, rows.back().point));
-    members.push_back({scene.bodies.front().p, scene.bodies.front().s0, scene.centres.front().A});
-    centres.push_back(scene.centres);
+    scenes.push_back(thesis_scene(point_params(spec, rows.back().point)));
+    members.push_back({scenes.back().bodies.front().p, scenes.back().bodies.front().s0, scenes.back().centres.front().A});
   }
   if (unit.size() > 1) {  // a batch: one method, one step (plan_units), lanes that accept it
-    auto results = batch::run(method, members, std::get<FixedSteps>(point_advance(spec, method, rows.front().point)));
-    for (std::size_t k = 0; k < unit.size(); ++k)
-      rows[k] = run_row(std::move(rows[k]), std::move(results[k]), spec, centres[k]);
+    batch_rows(rows, spec, method, members, scenes);
     return rows;
   }
   SweepRow& row = rows.front();
-  const Scene scene = thesis_scene(point_params(spec, row.point));
-  if (spec.scattering) {
-    row = encounter_row(std::move(row), method, scene, point_advance(spec, method, row.point), spec.max_energy_error);
-    return rows;
-  }
-  Options options;
-  options.max_energy_error = spec.max_energy_error;
-  BodyResult r = integrate_body(scene.bodies.front(), scene.centres, &method, point_advance(spec, method, row.point), options);
-  if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) {
-    row = unrun_row(std::move(row), r.outcome, std::move(r.reason));
-    return rows;
-  }
-  row.result = std::move(r.run);
-  row.outcome = r.outcome;
-  row.reason = std::move(r.reason);
+  const Scene& scene = scenes.front();
+  const Advance how = point_advance(spec, method, row.point);
+  if (spec.scattering) row = encounter_row(std::move(row), method, scene, how, spec);
+  else row = result_row(std::move(row), integrate_body(scene.bodies.front(), scene.centres, &method, how, sweep_options(spec)));
   return rows;
 }
 

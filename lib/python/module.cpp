@@ -125,6 +125,10 @@ py::dict body_result(const Body& body, const BodyResult& r, const std::vector<Ev
   d["w"] = vec(r.run.final.w);
   d["invariants"] = invariants_dict(r.run.invariants);
   if (!r.chosen.empty()) d["chosen"] = r.chosen;
+  d["err_estimate"] = r.error.known() ? py::object(py::float_(r.error.value)) : py::object(py::none());
+  d["err_basis"] = r.error.basis;
+  d["estimate_force_evals"] = r.error.force_evals;
+  d["warnings"] = r.warnings;
   if (r.accuracy) {
     py::dict a;
     a["tol"] = r.accuracy->tol;
@@ -179,7 +183,7 @@ Event event_from(const std::string& text) {
 py::dict integrate_py(const Scene& scene, const std::string& method, std::optional<double> h,
                       std::optional<long> steps, std::optional<double> t_end, std::optional<double> tol,
                       bool invariants, double omega_c, const std::vector<std::string>& event_names,
-                      double max_energy_error) {
+                      double max_energy_error, bool estimate_error, double max_error) {
   const MethodInfo* m = method == "auto" ? nullptr : &method_or_throw(method);
   const bool code_loop = std::any_of(scene.centres.begin(), scene.centres.end(),
                                      [](const Centre& c) { return c.law == ForceLaw::thesis_code; });
@@ -188,6 +192,8 @@ py::dict integrate_py(const Scene& scene, const std::string& method, std::option
   o.track_invariants = invariants;
   o.omega_c = omega_c;
   o.max_energy_error = max_energy_error;
+  o.estimate_error = estimate_error;
+  o.max_error = max_error;
   for (const std::string& e : event_names) o.events.push_back(event_from(e));
   Result r;
   {
@@ -257,9 +263,11 @@ py::list trajectory_py(const Scene& scene, const std::string& method, double ste
 /// A sweep or grid of the thesis's scene as columns (sweep.hpp).
 py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>& axes,
                   const std::vector<std::string>& methods, const py::dict& base, double h, long steps, double t_end,
-                  double tol, unsigned threads, double max_energy_error) {
+                  double tol, unsigned threads, double max_energy_error, bool estimate_error, double max_error) {
   SweepSpec s;
   s.max_energy_error = max_energy_error;
+  s.estimate_error = estimate_error;
+  s.max_error = max_error;
   for (const auto& [param, values] : axes) s.axes.push_back({param, values});
   for (const std::string& m : methods) s.methods.push_back(&method_or_throw(m));
   for (const auto& [k, v] : base) scene_field(s.base, k.cast<std::string>()) = v.cast<double>();
@@ -277,7 +285,9 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
   std::vector<py::array_t<double>> point(s.axes.size(), py::array_t<double>(n));
   for (auto& p : point) p = py::array_t<double>(n);
   py::list method, outcome, reason;
-  const char* names[] = {"t_end", "Rx", "Ry", "Rz", "vx", "vy", "vz", "wx", "wy", "wz", "max_rel_dE", "max_rel_dK2sq", "max_abs_dK2Q"};
+  const char* names[] = {"t_end", "Rx", "Ry", "Rz", "vx", "vy", "vz", "wx", "wy", "wz", "max_rel_dE", "max_rel_dK2sq", "max_abs_dK2Q",
+                         "err_estimate"};
+  py::list err_basis;
   std::vector<py::array_t<double>> num;
   for (std::size_t c = 0; c < std::size(names); ++c) num.emplace_back(n);
   py::array_t<long> force_evals(n), nsteps(n);
@@ -291,7 +301,8 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
     const auto& inv = r.result.invariants;
     const double v[] = {r.result.t_end, f.R.x(), f.R.y(), f.R.z(), f.v.x(), f.v.y(), f.v.z(), f.w.x(), f.w.y(), f.w.z(),
                         inv ? inv->max_rel_dE : kNaN, inv ? inv->max_rel_dK2sq : kNaN,
-                        inv && inv->has_K2Q ? inv->max_abs_dK2Q : kNaN};
+                        inv && inv->has_K2Q ? inv->max_abs_dK2Q : kNaN, r.error.known() ? r.error.value : kNaN};
+    err_basis.append(r.error.basis);
     for (std::size_t c = 0; c < std::size(names); ++c) num[c].mutable_at(i) = v[c];
     force_evals.mutable_at(i) = r.result.force_evals;
     nsteps.mutable_at(i) = r.result.steps;
@@ -302,6 +313,7 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
   cols["reason"] = reason;
   cols["steps"] = nsteps;
   cols["force_evals"] = force_evals;
+  cols["err_basis"] = err_basis;
   for (std::size_t c = 0; c < std::size(names); ++c) cols[names[c]] = num[c];
   return cols;
 }
@@ -345,7 +357,6 @@ py::dict encounter_py(const Scene& scene, const std::string& method, double tol,
 PYBIND11_MODULE(_bodypoint, mod) {
   mod.doc() = "bodypoint: integrator of a body-point (translation and rotation) in Coulomb fields";
   py::register_exception<Error>(mod, "Error", PyExc_ValueError);
-
   py::class_<Scene>(mod, "Scene", "Fixed Coulomb centres and independent body-points (docs/physics.md).")
       .def(py::init([](const std::vector<py::dict>& centres, const std::vector<py::dict>& bodies) {
              Scene s;
@@ -392,13 +403,14 @@ PYBIND11_MODULE(_bodypoint, mod) {
     }
     return l;
   });
-  mod.attr("DEFAULT_MAX_ENERGY_ERROR") = kDefaultMaxEnergyError;
+  mod.attr("DEFAULT_MAX_ENERGY_ERROR") = kDefaultMaxEnergyError;  // the bounds of a run called ok
+  mod.attr("DEFAULT_MAX_ERROR") = kDefaultMaxError;
   mod.def("_integrate", &integrate_py, py::arg("scene"), py::arg("method"), py::arg("h"), py::arg("steps"),
           py::arg("t_end"), py::arg("tol"), py::arg("invariants"), py::arg("omega_c"), py::arg("events"),
-          py::arg("max_energy_error"));
+          py::arg("max_energy_error"), py::arg("estimate_error"), py::arg("max_error"));
   mod.def("_trajectory", &trajectory_py, py::arg("scene"), py::arg("method"), py::arg("step"), py::arg("times"),
           py::arg("omega_c"));
   mod.def("_sweep", &sweep_py, py::arg("axes"), py::arg("methods"), py::arg("base"), py::arg("h"), py::arg("steps"),
-          py::arg("t_end"), py::arg("tol"), py::arg("threads"), py::arg("max_energy_error"));
+          py::arg("t_end"), py::arg("tol"), py::arg("threads"), py::arg("max_energy_error"), py::arg("estimate_error"), py::arg("max_error"));
   mod.def("_encounter", &encounter_py, py::arg("scene"), py::arg("method"), py::arg("tol"), py::arg("t_end"));
 }

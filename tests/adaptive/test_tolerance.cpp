@@ -137,7 +137,7 @@ TEST(Tolerance, AutoDeliversTolWithAnHonestEstimate) {
       const MethodInfo& m = choose_method(b, c.scene.centres, tol, &why);
       adaptive::ToleranceResult r;
       try {
-        r = adaptive::run_to_tolerance(m, b, c.scene.centres, Accuracy{tol, c.t_end}, kUnobserved);
+        r = adaptive::run_to_tolerance(m, b, c.scene.centres, Accuracy{tol, c.t_end}, kUnobserved, false);  // as auto
       } catch (const Error& e) {
         // Below the probe's threshold the scene's round-off may be above tol: a refusal that says so is
         // the right answer when it is true.

@@ -56,7 +56,7 @@ TEST(Sweep, RowsEqualSingleSimulateRunsBitForBit) {
   ASSERT_EQ(rows.size(), 8u);
   for (const auto& row : rows) {
     // A row flagged inaccurate keeps its numbers; simulate writes them only without the bound.
-    const Result sim = run_cli("simulate --json --max-energy-error inf --d " + row[0] + " --method " + row[1] + common);
+    const Result sim = run_cli("simulate --json --max-energy-error inf --max-error inf --d " + row[0] + " --method " + row[1] + common);
     ASSERT_EQ(sim.code, 0) << sim.err;
     EXPECT_EQ(row[2], json_field(sim.out, "max_rel_dE")) << row[1];
     EXPECT_EQ(row[3], json_field(sim.out, "max_rel_dK2sq")) << row[1];

@@ -56,14 +56,23 @@ struct ToleranceResult {
 /// `delivery`'s observers: its invariants, and its samples (every k-th step, or with dt_out the states
 /// at t = k dt_out), handed to the sink after the search. Throws Error with a one-line reason when tol
 /// cannot be met (round-off floor, a budget of force evaluations exceeded).
+/// `verify`: as search_step's (false for a method auto chose).
 ToleranceResult run_to_tolerance(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
-                                 const Accuracy& accuracy, const RunOptions& delivery = {});
+                                 const Accuracy& accuracy, const RunOptions& delivery = {}, bool verify = true);
 /// The search alone, for a request whose every part was checked already (integrate() checks each once).
+/// With `verify` (a method the user named) the run about to be delivered is checked against a companion
+/// at half its step, and the search goes on from that companion when they disagree by more than tol:
+/// the ladder's own estimate can be fooled where the error is not smooth in h (lp-kl8 at tol 1e-4 on a
+/// two-centre pass delivered 46x tol). `auto`'s choices were measured honest without it.
 ToleranceResult search_step(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
-                            const Accuracy& accuracy, const RunOptions& delivery);
+                            const Accuracy& accuracy, const RunOptions& delivery, bool verify = true);
 /// Throws Error unless the accuracy mode can search `method`'s step: a fixed-step or time-transformed
 /// method with a known order, or ks.
 void check_searchable(const MethodInfo& method);
+
+/// The order p of `m`'s error on `body`: the method's, but 1 for the thesis's schemes with B != 0 (they
+/// freeze the gyroscopic term); 0 for a method without a fixed order.
+int effective_order(const MethodInfo& m, const Body& body);
 
 /// Relative distance of two final states: max(|dR|/|R_b|, |dv|/|v_b|).
 double state_distance(const State& a, const State& b);

@@ -38,7 +38,9 @@
 #include "bodypoint/scattering.hpp"
 #include "bodypoint/scene_file.hpp"
 
+#include <cmath>
 #include <cstddef>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -85,6 +87,13 @@ std::vector<Event> closest_approaches(std::size_t centres);
 /// a hit with a finite distance before one without. nullptr when there is none.
 const EventHit* nearest_approach(const std::vector<EventHit>& hits, const std::vector<Event>& events);
 
+/// The default bound on the estimated relative error of a run called ok (Options::max_error): 1 %, as
+/// the energy's (kDefaultMaxEnergyError).
+inline constexpr double kDefaultMaxError = 1e-2;
+
+/// Throws Error unless max_error is a number > 0 (infinity: no bound).
+void check_error_bound(double max_error);
+
 /// What a run asks for besides the way of advancing time and what it observes (RunOptions: invariants,
 /// samples, the time-step constant c): events to locate and the bound of the accuracy flag.
 struct Options : RunOptions {
@@ -93,6 +102,34 @@ struct Options : RunOptions {
   /// A run whose relative energy error exceeds this bound ends Outcome::inaccurate (> 0; infinity: no
   /// bound). Not applied where E is not conserved (the thesis code's force law).
   double max_energy_error = kDefaultMaxEnergyError;
+  /// Estimate the error of a run asked for by step with a companion run (ErrorEstimate; it costs about
+  /// twice the run). Off: BodyResult::error says the run has none. The accuracy mode always has one.
+  bool estimate_error = true;
+  /// A run whose estimated relative error (BodyResult::error) exceeds this bound ends Outcome::inaccurate
+  /// (> 0; infinity: no bound).
+  double max_error = kDefaultMaxError;
+};
+
+/// How good a run's final state is: an a-posteriori estimate of its relative error,
+///   err = max(|R - R_exact|/|R_exact|, |v - v_exact|/|v_exact|)   (the accuracy mode's measure, tol),
+/// or, when the run has none, why. A run by step is compared with a companion run of the same method
+/// to the same end (the same stop event, the same time-step constant c) at half the step (fixed and
+/// fictitious steps) or a tenth of the tolerance per step (step-size-controlled methods): the
+/// companion's error is 2^-p of the run's in the asymptotic regime, so the run's error is their
+/// difference over 1 - 2^-p (Richardson's principle, Hairer, Norsett, Wanner, Solving ODEs I, sec. II.4);
+/// where round-off or a step outside the asymptotic regime dominates, the difference is still of the
+/// run's error's size. The accuracy mode's estimate is its search's (adaptive/tolerance.hpp).
+struct ErrorEstimate {
+  /// The companion of a run by step runs at the step over this ratio: it costs that many runs.
+  static constexpr double kStepRatio = 2.0;
+  double value = std::numeric_limits<double>::quiet_NaN();  ///< the estimate; NaN when the run has none
+  std::string basis;       ///< how it was obtained ("companion at h/2, order 4"), or why there is none
+  long force_evals = 0;    ///< what the companion cost (the accuracy mode: counted in its search)
+  double wall_s = 0.0;
+  /// Where the run was flagged unresolved: a second companion one level finer showed the error falling
+  /// as the step's order says, so the estimate may overrule the flag (the accuracy mode: always).
+  bool confirmed = false;
+  [[nodiscard]] bool known() const { return !std::isnan(value); }
 };
 
 /// What the accuracy mode did to deliver its tolerance (Accuracy).
@@ -116,9 +153,14 @@ struct BodyResult {
   std::string reason;                  ///< one line; empty when ok
   RunResult run;                       ///< final state, steps, cost, invariants (unless refused or failed)
   std::optional<AccuracyReport> accuracy;
+  ErrorEstimate error;                 ///< the run's estimated error, or why it has none
+  /// What a heuristic saw but could not judge (a step that turned the spin by more than pi, while the
+  /// error estimate says the state is right): reported, not refused.
+  std::vector<std::string> warnings;
   std::vector<EventHit> events;  ///< Options::events located, in time order
   long event_force_evals = 0;    ///< spent locating them
-  /// The force evaluations this body cost in all: the run, the search of the accuracy mode, the events.
+  /// The force evaluations this body cost in all: the run, the search of the accuracy mode or the error
+  /// estimate's companion, the events.
   [[nodiscard]] long total_force_evals() const;
 };
 
@@ -177,6 +219,7 @@ Result integrate(const Scene& scene, std::string_view method, const Advance& how
 ///   step: fixed-step methods: the largest step <= step that lands on t; time-transformed methods: the
 ///         fictitious step ds; step-size-controlled methods: the tolerance per step, and the first
 ///         trial step is min(1e-3, t - time()).
+/// A segment has no error estimate (Options::estimate_error is off for it).
 class Stepper {
  public:
   Stepper(const MethodInfo& method, Body body, std::vector<Centre> centres, double step, Options options = {});

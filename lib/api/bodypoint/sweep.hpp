@@ -5,7 +5,8 @@
 // list of methods. Task i is grid point i / M with method i % M (M methods). Every task is one run of
 // the thesis's scene (thesis_scene) at that point, with fixed steps h (or fictitious steps ds = h, or
 // a first trial step h for step-size-controlled methods, with tol) to the end time, invariants
-// tracked; its result is a typed SweepRow. Tasks of one method and step that a batch kernel accepts
+// tracked, its error estimated by a companion run (SweepSpec::estimate_error); its result is a typed
+// SweepRow. Tasks of one method and step that a batch kernel accepts
 // run in the lanes of one vector register, bit for bit as they would alone (batch.hpp).
 //
 //   bodypoint::SweepSpec s;
@@ -59,6 +60,8 @@ struct SweepSpec {
   /// task then runs alone through integrate_body (no vector lanes), the same run with an observer.
   bool scattering = false;
   double max_energy_error = kDefaultMaxEnergyError;  ///< Options::max_energy_error of every run
+  bool estimate_error = true;                        ///< Options::estimate_error of every run
+  double max_error = kDefaultMaxError;               ///< Options::max_error of every run
 };
 
 /// Number of (grid point, method) tasks; Error above 1e9.
@@ -95,6 +98,8 @@ struct SweepRow {
   Outcome outcome = Outcome::ok;
   std::string reason;  ///< one line; empty when ok
   RunResult result;    ///< final state NaN when refused or failed
+  ErrorEstimate error;                ///< the run's estimated error, or why it has none (ErrorEstimate)
+  std::vector<std::string> warnings;  ///< what a heuristic saw but the estimate overruled
   /// With SweepSpec::scattering, a run that finished: its encounter (time delay included) and the
   /// closest of its closest approaches to any centre (NaN when the distance had no minimum).
   std::optional<Scattering> scattering;

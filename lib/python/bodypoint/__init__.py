@@ -52,7 +52,8 @@ def parse_scene(text):
 
 
 def integrate(scene, method="auto", *, h=None, steps=None, t_end=None, tol=None, invariants=True,
-              omega_c=-1.0, events=(), max_energy_error=_core.DEFAULT_MAX_ENERGY_ERROR):
+              omega_c=-1.0, events=(), max_energy_error=_core.DEFAULT_MAX_ENERGY_ERROR, estimate_error=True,
+              max_error=_core.DEFAULT_MAX_ERROR):
     """Integrates every body of the scene; returns a dict (outcome, reason, force_evals, wall_s, bodies).
 
     How time advances follows the method's kind, as on the command line:
@@ -66,13 +67,18 @@ def integrate(scene, method="auto", *, h=None, steps=None, t_end=None, tol=None,
     Each body's dict holds the final R, v, w (numpy arrays), t_end, steps, force_evals, the
     invariants' largest deviations, the accuracy mode's report, and the events asked for
     ("closest", "closest:K", "r=V", "r:K=V"), located on the method's own steps.
+    Each body's ``err_estimate`` is the estimated relative error of its final state, max(|dR|/|R|,
+    |dv|/|v|): from a companion run at half the step (a tenth of a peer's tolerance; it costs about twice
+    the run), or the accuracy mode's; None when there is none, ``err_basis`` saying how it was obtained
+    or why there is none (``estimate_error=False``: not asked for). ``warnings``: flags the estimate
+    overruled.
     The outcome is "ok", or the flag of a run whose numbers bodypoint does not vouch for: "diverged",
     "unresolved" (a step too large for the spin or the encounter), "inaccurate" (an energy error above
-    ``max_energy_error``; float("inf") lifts the bound), "collision"; or "refused"/"failed" without a
-    run (docs/physics.md, "Resolution and accuracy flags").
+    ``max_energy_error``, or an estimated error above ``max_error``; float("inf") lifts a bound),
+    "collision"; or "refused"/"failed" without a run (docs/physics.md, "Resolution and accuracy flags").
     """
     return _core._integrate(scene, method, h, steps, t_end, tol, invariants, omega_c, list(events),
-                            float(max_energy_error))
+                            float(max_energy_error), bool(estimate_error), float(max_error))
 
 
 def trajectory(scene, method, step, times, *, omega_c=-1.0):
@@ -84,22 +90,23 @@ def trajectory(scene, method, step, times, *, omega_c=-1.0):
 
 
 def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, threads=1, max_energy_error=_core.DEFAULT_MAX_ENERGY_ERROR,
-          **base):
+          estimate_error=True, max_error=_core.DEFAULT_MAX_ERROR, **base):
     """Runs the thesis's scene over a grid of parameters and methods; returns columns.
 
     ``axes``: {parameter: values} in order (one axis, or a grid of every combination, the last axis
     fastest); a parameter is h, one of scene_parameters(), b or v_inf. ``methods``: names.
     ``base``: fixed scene parameters. Steps of h: ``steps`` of them, or to ``t_end``. The result has a
     column per axis, method, outcome, reason, steps, force_evals, t_end, Rx..wz and the invariants'
-    deviations, one row per (grid point, method), grid point major; outcome as integrate()'s, with
-    the bound ``max_energy_error``.
+    deviations, err_estimate and err_basis (integrate()'s), one row per (grid point, method), grid point
+    major; outcome as integrate()'s, with the bounds ``max_energy_error`` and ``max_error``.
     """
     if isinstance(methods, str):
         methods = [methods]
     if not steps and not t_end:
         raise Error("give steps or t_end")
     return _core._sweep([(k, [float(v) for v in vals]) for k, vals in dict(axes).items()], list(methods), base,
-                        float(h), int(steps), float(t_end), float(tol), int(threads), float(max_energy_error))
+                        float(h), int(steps), float(t_end), float(tol), int(threads), float(max_energy_error),
+                        bool(estimate_error), float(max_error))
 
 
 def encounter(scene, *, t_end, method="auto", tol=1e-10):

@@ -1,0 +1,119 @@
+// Every answer says how good it is (issue #40): a run by step carries an error estimate from a
+// companion run, or says it has none; a run the estimate shows far off is flagged, and a run a
+// heuristic flagged but the estimate shows right is kept with a warning.
+#include "cli_helpers.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <regex>
+#include <string>
+#include <vector>
+
+namespace bodypoint {
+namespace {
+
+using test::run_cli;
+
+/// An estimate is honest when it is within this factor of the error measured against the reference
+/// (Boost.Odeint rkf78 in long double): the companion at h/2 has 2^-p of the run's error in the
+/// asymptotic regime, so the estimate is off by a few tens of per cent there; outside it (round-off,
+/// a step that does not resolve the scene) the two runs' errors are of one size, not of one sign.
+constexpr double kHonestFactor = 3.0;
+
+double json_num(const std::string& json, const std::string& key) {
+  const std::regex re("\"" + key + "\": ([^,}]+)");
+  std::smatch m;
+  EXPECT_TRUE(std::regex_search(json, m, re)) << key << " in " << json;
+  return m.empty() ? std::nan("") : std::stod(m[1]);
+}
+
+/// The issue's bound orbit: A = 1, R = (1, 0, 0), v = (0, 1.2, 0), a material point.
+std::string bound_orbit() {
+  const auto path = test::temp_path("bound-orbit.toml");
+  std::ofstream(path) << "[[centre]]\nposition = [0.0, 0.0, 0.0]\nA = 1.0\n[[body]]\nname = \"bound\"\nm = 1.0\n"
+                         "B = 0.0\nJ = 1.0\nR = [1.0, 0.0, 0.0]\nv = [0.0, 1.2, 0.0]\nw = [0.0, 0.0, 1.0]\n";
+  return "--scene " + path.string();
+}
+
+TEST(Estimates, RunsFarOffAreFlaggedByTheirEstimate) {
+  // Each exited 0 before, 26 % to 303 % off with energy errors down to 1.6e-14 (phase, not energy).
+  const std::vector<std::string> cases = {
+      bound_orbit() + " --t-end 300 --method ttl-y4 --h 1",
+      bound_orbit() + " --t-end 300 --method odeint-dopri5 --tol 1e-5",
+      bound_orbit() + " --t-end 300 --method lp-verlet --h 0.05",
+      bound_orbit() + " --t-end 300 --method rk4 --h 0.2",
+      "--A 2 --d 3 --method lp-y4 --h 0.45 --t-end 80",
+  };
+  for (const std::string& c : cases) {
+    const auto refused = run_cli("simulate " + c);
+    EXPECT_NE(refused.code, 0) << c;
+    EXPECT_NE(refused.err.find("the estimated relative error of the final state is"), std::string::npos) << refused.err;
+    EXPECT_NE(refused.err.find("--max-error"), std::string::npos) << refused.err;
+    // Without the bound the numbers come out, with an estimate that says what the reference does.
+    const auto r = run_cli("simulate --json --reference --max-error inf " + c);
+    ASSERT_EQ(r.code, 0) << c << ": " << r.err;
+    const double est = json_num(r.out, "err_estimate"), err = json_num(r.out, "err_rel");
+    EXPECT_GT(err, 0.1) << c;
+    EXPECT_LT(est, kHonestFactor * err) << c;
+    EXPECT_GT(est, err / kHonestFactor) << c;
+  }
+}
+
+TEST(Estimates, ARightRunAHeuristicFlagsIsKeptWithAWarning) {
+  // 4.73 rad of spin per step, "unresolved" before; its error is 5.3e-10.
+  const auto r = run_cli("simulate --json --reference --method lp-kl8 --h 0.7 --t-end 20");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("warning"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("turned the spin by 4.73 rad"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("turned the spin by 4.73 rad"), std::string::npos) << "the JSON's warnings: " << r.out;
+  const double est = json_num(r.out, "err_estimate"), err = json_num(r.out, "err_rel");
+  EXPECT_LT(err, 1e-8);
+  EXPECT_LT(est, kHonestFactor * err);
+  EXPECT_GT(est, err / kHonestFactor);
+  // Without an estimate nothing can overrule the heuristic: the run is refused as before.
+  const auto alone = run_cli("simulate --no-error-estimate --method lp-kl8 --h 0.7 --t-end 20");
+  EXPECT_NE(alone.code, 0);
+  EXPECT_NE(alone.err.find("turned the spin by 4.73 rad"), std::string::npos) << alone.err;
+}
+
+TEST(Estimates, EveryOutputSaysTheEstimateOrThatThereIsNone) {
+  // The README's run: an estimate, and its companion's cost.
+  const auto readme = run_cli("simulate --steps 20000");
+  ASSERT_EQ(readme.code, 0) << readme.err;
+  EXPECT_NE(readme.out.find("estimated relative error = "), std::string::npos) << readme.out;
+  EXPECT_NE(readme.out.find("companion run at h/2, order 4"), std::string::npos) << readme.out;
+  const auto none = run_cli("simulate --steps 20000 --no-error-estimate");
+  ASSERT_EQ(none.code, 0) << none.err;
+  EXPECT_NE(none.out.find("estimated relative error: none (not asked for"), std::string::npos) << none.out;
+  const auto json = run_cli("simulate --steps 20000 --no-error-estimate --json");
+  EXPECT_NE(json.out.find("\"err_estimate\": null"), std::string::npos) << json.out;
+  // A number of fictitious steps ends at a time no companion reaches: none, and why.
+  const auto counted = run_cli("simulate --method ttl-y4 --h 0.1 --steps 100");
+  ASSERT_EQ(counted.code, 0) << counted.err;
+  EXPECT_NE(counted.out.find("estimated relative error: none (a run of a number of fictitious steps"),
+            std::string::npos) << counted.out;
+  // The trajectory file says it too, and a sweep's rows carry it.
+  const auto csv = test::temp_path("estimated.csv");
+  ASSERT_EQ(run_cli("simulate --steps 2000 --out " + csv.string()).code, 0);
+  std::ifstream in(csv);
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  EXPECT_NE(text.find("# body 0: method=lp-y4; estimated relative error = "), std::string::npos) << text;
+  const auto sweep = run_cli("sweep --param d --values 3,10 --methods rk4,ttl-y4 --h 0.01 --t-end 20");
+  ASSERT_EQ(sweep.code, 0) << sweep.err;
+  EXPECT_NE(sweep.out.find(",err_estimate,estimate_force_evals,err_basis,warning"), std::string::npos) << sweep.out;
+  EXPECT_NE(sweep.out.find("\"companion run at ds/2 and the same time-step constant, order 4\""), std::string::npos);
+}
+
+TEST(Estimates, ARunCutAtAnEventIsComparedAtThatEvent) {
+  const auto r = run_cli("simulate --json --reference --method lp-y4 --h 0.01 --t-end 200 --stop-at r=100");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_LT(json_num(r.out, "t_end"), 200.0) << "the event stopped it";
+  const double est = json_num(r.out, "err_estimate");
+  EXPECT_GT(est, 0.0) << r.out;
+  EXPECT_LT(est, 1e-6) << r.out;
+}
+
+}  // namespace
+}  // namespace bodypoint
