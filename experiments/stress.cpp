@@ -132,6 +132,7 @@ StressRow run_case(const StressCase& c, const MethodInfo& m, double max_seconds)
     row.reason = std::move(r.reason);
     if (r.outcome != Outcome::refused && r.outcome != Outcome::failed) {
       row.max_rel_dE = r.run.invariants ? r.run.invariants->max_rel_dE : std::nan("");
+      row.err_estimate = r.error.value;
       row.steps = r.run.steps;
       row.wall_s = r.run.wall_s;
     }
@@ -155,13 +156,14 @@ std::vector<StressRow> run_stress(bool quick, const std::function<void(const Str
 }
 
 void write_stress(std::ostream& csv, std::ostream& md, const std::vector<StressRow>& rows) {
-  csv << "case,method,status,max_rel_dE,steps,wall_s,reason\n"
+  csv << "case,method,status,max_rel_dE,steps,wall_s,reason,err_estimate\n"
       << "# bodypoint study stress, revision " << git_revision() << "\n"
       << "# status: ok | refused (not run, reason) | failed (started and stopped, reason) | diverged | unresolved | inaccurate | collision (flagged, reason; "
-         "docs/physics.md, Resolution and accuracy flags); max_rel_dE only for runs\n";
+         "docs/physics.md, Resolution and accuracy flags); max_rel_dE only for runs; err_estimate = the run's estimated "
+         "relative error (a companion at half the step; docs/physics.md, Error estimate of a run by step; NaN: none)\n";
   for (const StressRow& r : rows) {
     csv << CsvLine().quoted(r.case_name).text(r.method).text(std::string(outcome_name(r.outcome))).num(r.max_rel_dE).count(r.steps)
-               .num(r.wall_s).quoted(r.reason).str()
+               .num(r.wall_s).quoted(r.reason).num(r.err_estimate).str()
         << '\n';
   }
   md << "| case | method | outcome | max rel dE | steps | wall [s] |\n|---|---|---|---|---|---|\n";

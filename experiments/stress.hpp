@@ -17,6 +17,7 @@ struct StressRow {
   Outcome outcome = Outcome::refused;
   std::string reason;
   double max_rel_dE = std::nan("");
+  double err_estimate = std::nan("");  ///< the run's estimated relative error (ErrorEstimate; NaN: none)
   long steps = 0;
   double wall_s = 0.0;
 };

@@ -653,8 +653,10 @@ def stress(res, out, M):
         M.add("StressFarWorst", sci(max(far)))
     bound = {r["method"]: r for r in rows if r["case"].startswith("bound orbit")}
     for m, r in bound.items():
-        if r["status"] == "ok":
+        if r["status"] not in ("refused", "failed"):  # a run, ok or flagged: its energy and estimated error
             M.add(f"StressBound{camel(m)}", sci(num(r["max_rel_dE"])))
+            M.add(f"StressBoundErr{camel(m)}", sci(num(r["err_estimate"])))
+            M.add(f"StressBoundStatus{camel(m)}", r["status"], math_mode=False)
 
 
 def appendix(res, M):
