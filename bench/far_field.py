@@ -89,8 +89,10 @@ def far_share(binary):
         out = os.path.join(tmp, "traj.csv")
         for tol in TOLS:
             for method in ["auto"] + PEERS:
+                # Where the delivered run's steps go: no companion run for an error estimate, and a peer
+                # at a loose tolerance reports its steps whatever its error.
                 args = [binary, "simulate", "--tol", tol, "--Kz", "0.1", "--d", "0.05", "--t-end", str(T_END),
-                        "--out", out]
+                        "--out", out, "--no-error-estimate"]
                 if method != "auto":
                     args += ["--method", method]
                 run = subprocess.run(args, check=True, capture_output=True, text=True)

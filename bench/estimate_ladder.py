@@ -1,0 +1,193 @@
+#!/usr/bin/env python3
+"""Do a run's flags and its error estimate tell right answers from wrong ones? (issue #40)
+
+A step ladder of every method over nine scenes: each run is made as a user makes it (`bodypoint
+simulate --json`, the default bounds: energy error and estimated error 1e-2) and its final state is
+compared with a reference (Boost.Odeint rkf78 in long double at tolerance 1e-16, `--reference`, one per
+scene). A run refused by a flag is made again with the bounds lifted, to know its error. Prints:
+  - exit 0 with a true error above 10 % and no estimate showing it (the estimate below 10 %);
+  - right answers refused: a flag refused a run whose true error is below the flag's bound (1e-2);
+  - the estimate's ratio to the true error (runs whose error is above the round-off level);
+  - runs with no estimate, and the methods' refusals of scenes they do not take (not flags).
+
+Usage (from the repository, after the build; a few minutes on 2 cores):
+    /usr/bin/python3 bench/estimate_ladder.py [build/bin/bodypoint] [--threads 2] [--csv out.csv]
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+from concurrent.futures import ThreadPoolExecutor
+
+# The flags' bound (bodypoint's kDefaultMaxError and kDefaultMaxEnergyError).
+BOUND = 1e-2
+# The issue's threshold of a wrong answer.
+WRONG = 0.1
+# Below this the reference's own error is of the size of the error itself: on the bound orbit (t = 300)
+# kep-y8d at h = 0.05 and 0.025 and kep-kl8 at h = 0.02 agree to 1e-13 and are all 3.5e-12 from it.
+COMPARABLE = 1e-10
+# Above this a state is lost whatever its estimate says (diverged runs reach 1e120): no ratio is taken.
+LOST = 1.0
+# Estimates within this factor of the true error count as honest.
+FACTOR = 3.0
+STEPS = ["1", "0.5", "0.2", "0.1", "0.05", "0.02", "0.01"]
+TOLS = ["1e-3", "1e-5", "1e-7", "1e-9"]
+
+TWO_CENTRES = """[[centre]]
+position = [0.0, 0.0, 0.0]
+A = -2.0
+[[centre]]
+position = [40.0, 6.0, 0.0]
+A = -1.0
+[[body]]
+name = "material"
+m = 1.0
+B = 0.0
+J = 1.0
+R = [-150.0, 3.0, 0.0]
+v = [5.0, 0.0, 0.0]
+w = [0.0, 0.0, 0.0]
+"""
+
+
+def bound_orbit(B):
+    return f"""[[centre]]
+position = [0.0, 0.0, 0.0]
+A = 1.0
+[[body]]
+name = "bound"
+m = 1.0
+B = {B}
+J = 1.0
+R = [1.0, 0.0, 0.0]
+v = [0.0, 1.2, 0.0]
+w = [0.0, 0.0, 1.0]
+"""
+
+
+def scenes(folder):
+    files = {}
+    for name, text in [("two-centres", TWO_CENTRES), ("bound", bound_orbit(0.0)), ("bound-spin", bound_orbit(0.7))]:
+        path = os.path.join(folder, name + ".toml")
+        with open(path, "w") as f:
+            f.write(text)
+        files[name] = path
+    return [
+        ("table-3.1", [], "20"),
+        ("material", ["--B", "0"], "20"),
+        ("close-pass", ["--d", "1"], "40"),
+        ("attracting", ["--A", "2", "--d", "3"], "80"),
+        ("head-on", ["--d", "0.05", "--Kz", "0.1"], "80"),
+        ("strong-spin", ["--B", "0.9", "--d", "3"], "40"),
+        ("two-centres", ["--scene", files["two-centres"]], "60"),
+        ("bound-orbit", ["--scene", files["bound"]], "300"),
+        ("bound-spin", ["--scene", files["bound-spin"]], "300"),
+    ]
+
+
+def simulate(binary, args):
+    r = subprocess.run([binary, "simulate", "--json", "--quiet", *args], capture_output=True, text=True)
+    return r.returncode, (json.loads(r.stdout) if r.returncode == 0 else None), r.stderr.strip()
+
+
+def distance(a, b):
+    def rel(x, y):
+        n = math.sqrt(sum(c * c for c in y))
+        d = math.hypot(*(p - q for p, q in zip(x, y)))
+        return d / n if n > 0 else d
+    return max(rel(a["R"], b["R_ref"]), rel(a["v"], b["v_ref"]))
+
+
+def one(binary, job):
+    scene, args, t_end, method, step = job
+    base = [*args, "--t-end", t_end, "--method", method["method"]]
+    base += ["--tol", step] if method["advance"] == "controlled" else ["--h", step]
+    code, out, err = simulate(binary, base)
+    row = {"scene": scene, "method": method["method"], "step": step, "exit": code, "reason": err}
+    # Without invariants no flag is raised: the state and its estimate come out whatever the flags said.
+    lifted = out if code == 0 else simulate(binary, base + ["--no-invariants", "--max-error", "inf",
+                                                           "--max-energy-error", "inf"])[1]
+    if lifted is not None:
+        row["R"], row["v"] = lifted["R"], lifted["v"]
+        row["estimate"] = lifted["err_estimate"]
+    return row
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("binary", nargs="?", default="build/bin/bodypoint")
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--csv")
+    a = ap.parse_args()
+    listing = subprocess.run([a.binary, "methods", "--csv"], capture_output=True, text=True, check=True).stdout
+    methods = list(csv.DictReader(listing.splitlines()))
+    with tempfile.TemporaryDirectory() as folder:
+        scene_list = scenes(folder)
+        refs = {}
+        for scene, args, t_end in scene_list:
+            code, out, err = simulate(a.binary, [*args, "--t-end", t_end, "--method", "lp-y4", "--h", "0.01",
+                                                 "--reference", "--max-error", "inf", "--max-energy-error", "inf"])
+            if code != 0:
+                sys.exit(f"reference of {scene}: {err}")
+            refs[scene] = out
+        jobs = [(s, args, t, m, step) for s, args, t in scene_list for m in methods
+                for step in (TOLS if m["advance"] == "controlled" else STEPS)]
+        with ThreadPoolExecutor(a.threads) as pool:
+            rows = list(pool.map(lambda j: one(a.binary, j), jobs))
+    wrong_ok, right_refused, no_estimate, not_run, between = [], [], 0, 0, 0
+    ratios = {"delivered (exit 0)": [], "refused (made again without flags)": []}
+    for r in rows:
+        if "R" not in r:
+            not_run += 1  # the method refuses the scene, or its state is not finite
+            continue
+        r["error"] = distance(r, refs[r["scene"]])
+        est = r["estimate"]
+        if est is None:
+            no_estimate += 1
+        if r["exit"] == 0:
+            if r["error"] > WRONG and (est is None or est < WRONG):
+                wrong_ok.append(r)
+            elif r["error"] > BOUND:
+                between += 1
+        elif r["error"] < BOUND:
+            right_refused.append(r)
+        if est is not None and COMPARABLE < r["error"] <= LOST:
+            ratios["delivered (exit 0)" if r["exit"] == 0 else "refused (made again without flags)"].append(
+                (est / r["error"], r))
+    print(f"{len(rows)} runs ({len(methods)} methods, {len(scene_list)} scenes); {not_run} not run (the method "
+          f"refuses the scene) or not finite; {no_estimate} without an estimate")
+    print(f"exit 0 with error > {WRONG:g} and no estimate showing it: {len(wrong_ok)}")
+    for r in wrong_ok[:10]:
+        print(f"   {r['scene']} {r['method']} {r['step']}: error {r['error']:.3g}, estimate {r['estimate']}")
+    print(f"exit 0 with error between {BOUND:g} and {WRONG:g}: {between}")
+    print(f"refused with error below the bound {BOUND:g}: {len(right_refused)}")
+    for r in right_refused[:10]:
+        print(f"   {r['scene']} {r['method']} {r['step']}: error {r['error']:.3g}, estimate {r['estimate']}: {r['reason'][:150]}")
+    for label, pairs in ratios.items():
+        x = [p[0] for p in pairs]
+        if len(x) < 2:
+            continue
+        q = statistics.quantiles(x, n=20)
+        within = sum(1 for v in x if 1 / FACTOR <= v <= FACTOR)
+        low = sorted((p for p in pairs if p[0] < 1 / FACTOR), key=lambda p: p[0])
+        print(f"estimate / error, {label}, {len(x)} runs with error in ({COMPARABLE:g}, {LOST:g}]: median {statistics.median(x):.3g}, "
+              f"5 % {q[0]:.3g}, 95 % {q[-1]:.3g}, min {min(x):.3g}, max {max(x):.3g}; within {FACTOR:g}x: "
+              f"{within} ({100 * within / len(x):.1f} %), more than {FACTOR:g}x low: {len(low)}")
+        for v, r in low[:8]:
+            print(f"   {r['scene']} {r['method']} {r['step']}: error {r['error']:.3g}, estimate {r['estimate']:.3g}")
+    if a.csv:
+        with open(a.csv, "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(["scene", "method", "step", "exit", "error", "estimate", "reason"])
+            for r in rows:
+                w.writerow([r["scene"], r["method"], r["step"], r["exit"], r.get("error", ""), r.get("estimate", ""),
+                            r["reason"]])
+
+
+if __name__ == "__main__":
+    main()
