@@ -2,6 +2,7 @@
 // never a hang or a number that means nothing; outputs are complete or absent.
 #include "cli_helpers.hpp"
 
+#include "bodypoint/bodypoint.hpp"
 #include "bodypoint/io.hpp"
 #include "process.hpp"
 #include "bodypoint/run.hpp"
@@ -549,7 +550,7 @@ TEST(Reliability, StressStudyEndsEveryRunWithAMeaningfulOutcome) {
   while (std::getline(in, line)) {
     if (line.empty() || line[0] == '#' || line.rfind("case,", 0) == 0) continue;
     const auto f = csv_fields(line);
-    ASSERT_EQ(f.size(), 7u) << line;
+    ASSERT_EQ(f.size(), 8u) << line;
     ++rows;
     const std::string& status = f[2];
     ++outcomes[status];
@@ -557,6 +558,10 @@ TEST(Reliability, StressStudyEndsEveryRunWithAMeaningfulOutcome) {
       const double dE = std::stod(f[3]);
       EXPECT_TRUE(std::isfinite(dE) && dE <= kOkEnergyBound) << line;
       EXPECT_EQ(f[6], "") << line;
+      // An estimate, within the bound, or none (NaN: a time-transformed run that lands on t_end in one
+      // step whatever its ds, as at |K1| = 1e-8, has no companion that refines it).
+      const double est = std::stod(f[7]);
+      EXPECT_TRUE(std::isnan(est) || est <= kDefaultMaxError) << line;
     } else {
       // refused: not run; failed: started and stopped (a step that no longer advances time, a budget).
       EXPECT_TRUE(status == "refused" || status == "failed" || status == "diverged" || status == "collision" ||

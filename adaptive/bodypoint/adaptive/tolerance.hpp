@@ -27,12 +27,13 @@ namespace bodypoint::adaptive {
 /// delivered, nor estimated, in double precision.
 inline constexpr double kMinTolerance = 1e-13;
 
-/// Below this tolerance a run about to be delivered is repeated kProbeRuns times with its roundings
-/// changed, and what they differ by is added to the estimate (tolerance.cpp): an encounter amplifies
-/// round-off, which Richardson's estimate cannot tell from truncation. The search then costs that many
-/// delivered runs more.
-inline constexpr double kProbeBelowTol = 1e-11;
-inline constexpr int kProbeRuns = 2;
+/// Below this tolerance a run about to be delivered is repeated kProbeRuns times: with its roundings
+/// changed (all but one), and once from its start moved by a rounding; what they differ by is added to the estimate
+/// (tolerance.cpp): an encounter amplifies round-off, which Richardson's estimate cannot tell from
+/// truncation. The search then costs that many delivered runs more. (At 1e-11, unprobed, lp-rkn6
+/// delivered 2.6e-11 on a close pass with an estimate of 8.9e-13: bench/accuracy_grid.py.)
+inline constexpr double kProbeBelowTol = 1e-10;
+inline constexpr int kProbeRuns = 3;
 
 /// Why the accuracy mode refuses a scene with a centre that does not follow Coulomb's law.
 inline constexpr std::string_view kNeedsCoulomb =
