@@ -231,7 +231,9 @@ ErrorEstimate fixed_step_estimate(const MethodInfo& m, const Body& body, const S
 double final_energy_error(const Body& body, const std::vector<Centre>& centres, const State& end) {
   if (non_coulomb(centres)) return std::numeric_limits<double>::quiet_NaN();  // E is not an integral there
   const CentreList field{centres};
-  return relative_deviation(energy(body.p, field, end), energy(body.p, field, body.s0));
+  const double scale = energy_scale(body.p, field, body.s0);
+  const double dE = std::abs(energy(body.p, field, end) - energy(body.p, field, body.s0));
+  return scale > 0.0 ? dE / scale : dE;
 }
 
 void settle(Outcome& outcome, std::string& reason, std::vector<std::string>& warnings, const ErrorEstimate& e,
