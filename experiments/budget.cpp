@@ -41,7 +41,7 @@ std::string duration(double s) {
 }  // namespace
 
 std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
-                                          const Advance& how, const RunOptions& options) {
+                                          const Advance& how, const Options& options) {
   const auto* fixed = std::get_if<FixedSteps>(&how);
   const auto* fictitious = std::get_if<FictitiousSteps>(&how);
   if (!fixed && !fictitious) return std::nullopt;
@@ -71,7 +71,8 @@ std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body,
   const auto r = calibrate(kCalibrationSteps);
   if (!r) return std::nullopt;
   if (t_end > 0.0) steps = r->t_end > 0.0 ? kCalibrationSteps * t_end / r->t_end : HUGE_VAL;
-  return WorkEstimate{steps, r->wall_s * steps / kCalibrationSteps};
+  const double companion = options.estimate_error ? ErrorEstimate::kStepRatio : 0.0;  // its steps, at the same pace
+  return WorkEstimate{steps, (1.0 + companion) * r->wall_s * steps / kCalibrationSteps};
 }
 
 double estimated_seconds(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres, double step,
@@ -81,8 +82,9 @@ double estimated_seconds(const MethodInfo& m, const Body& body, const std::vecto
   constexpr long kAsLong = 2 * kCalibrateAbove;
   const Advance how = is_time_transformed(m) ? Advance(FictitiousSteps{step, StepCount{kAsLong}})
                                              : Advance(FixedSteps{step, kAsLong});
-  RunOptions quiet;
+  Options quiet;
   quiet.track_invariants = false;
+  quiet.estimate_error = false;  // the caller counts the runs
   const auto e = estimate_work(m, body, centres, how, quiet);
   if (!e || !(e->steps > 0.0)) return 0.0;
   return e->seconds / e->steps * steps * runs;

@@ -6,6 +6,7 @@
 // terminal (never under CI, with --quiet, or when standard error is not a terminal).
 #pragma once
 
+#include "bodypoint/bodypoint.hpp"
 #include "bodypoint/run.hpp"
 
 #include <atomic>
@@ -21,9 +22,10 @@ struct WorkEstimate {
 
 /// The estimate for a run that may be long, or nothing when the run is short (or adaptive: those are
 /// bounded by their own step cap).
-/// `options` are the run's (the calibration observes as it will).
+/// `options` are the run's (the calibration observes as it will; an error estimate's companion costs
+/// ErrorEstimate::kStepRatio runs more).
 std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
-                                          const Advance& how, const RunOptions& options);
+                                          const Advance& how, const Options& options);
 
 /// Every command's budget of wall-clock time unless --max-seconds says otherwise (0: none): a day, so
 /// that no command runs on without end by default (simulate's own default is an hour).

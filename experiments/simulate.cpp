@@ -316,8 +316,6 @@ BodyRun simulate_body(const SimulateOptions& o, const RunPlan& plan, const Body&
   std::optional<WorkEstimate> estimate;
   if (!plan.search) {
     estimate = estimate_work(*plan.method, body, scene.centres, plan.how, plan.options);
-    // The error estimate's companion costs kStepRatio runs more.
-    if (estimate && plan.options.estimate_error) estimate->seconds *= 1.0 + ErrorEstimate::kStepRatio;
     if (estimate) check_budget(*estimate, o.max_seconds, o.quiet || o.json);
   }
   BodyRun br;

@@ -454,7 +454,9 @@ void check_sweep_budget(const SweepJob& job) {
   if (!(job.max_seconds > 0.0)) return;
   const std::size_t tasks = task_count(job.spec), methods = job.spec.methods.size();
   const FixedSteps steps = sweep_steps(job.spec.h, job.spec.steps, job.spec.t_end, job.spec.base.law);
-  if (static_cast<double>(tasks) * static_cast<double>(steps.steps) * kMaxSecondsPerStep <= job.max_seconds) return;
+  const double runs_per_task = job.spec.estimate_error ? 1.0 + ErrorEstimate::kStepRatio : 1.0;  // and the companion
+  if (static_cast<double>(tasks) * static_cast<double>(steps.steps) * runs_per_task * kMaxSecondsPerStep <= job.max_seconds)
+    return;
   Scene scene;
   try {
     scene = thesis_scene(point_params(job.spec, grid_point(job.spec, 0)));
@@ -465,7 +467,7 @@ void check_sweep_budget(const SweepJob& job) {
   for (std::size_t k = 0; k < methods; ++k) {
     const MethodInfo& m = *job.spec.methods[k];
     if (!refusal(m, scene.bodies.front(), scene.centres).empty()) continue;
-    const double rows = static_cast<double>(tasks / methods) / static_cast<double>(job.shards);
+    const double rows = static_cast<double>(tasks / methods) / static_cast<double>(job.shards) * runs_per_task;
     seconds += estimated_seconds(m, scene.bodies.front(), scene.centres, steps.h, static_cast<double>(steps.steps), rows);
   }
   seconds /= static_cast<double>(thread_count(job.threads));
