@@ -21,7 +21,7 @@ import tempfile
 from concurrent.futures import ThreadPoolExecutor
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from estimate_ladder import distance, scenes, simulate  # noqa: E402
+from estimate_ladder import distance, references, scenes, simulate  # noqa: E402
 
 # The seven scenes: the ladder's without its two longest (the bound orbits to t = 300, whose reference
 # is 3.5e-12 off).
@@ -53,13 +53,7 @@ def main():
     methods = [m["method"] for m in csv.DictReader(listing.splitlines()) if m["advance"] != "controlled"]
     with tempfile.TemporaryDirectory() as folder:
         chosen = [s for s in scenes(folder) if s[0] in SCENES]
-        refs = {}
-        for scene, args, t_end in chosen:
-            code, out, err = simulate(a.binary, [*args, "--t-end", t_end, "--method", "lp-y4", "--h", "0.01",
-                                                 "--reference", "--max-error", "inf", "--max-energy-error", "inf"])
-            if code != 0:
-                sys.exit(f"reference of {scene}: {err}")
-            refs[scene] = out
+        refs = references(a.binary, chosen)
         jobs = [(s, args, t, m, tol) for s, args, t in chosen for m in methods for tol in a.tols.split(",")]
         with ThreadPoolExecutor(a.threads) as pool:
             rows = list(pool.map(lambda j: one(a.binary, a.max_seconds, j), jobs))

@@ -103,6 +103,18 @@ def distance(a, b):
     return max(rel(a["R"], b["R_ref"]), rel(a["v"], b["v_ref"]))
 
 
+def references(binary, scene_list):
+    """Each scene's reference final state (R_ref, v_ref: `--reference`), by scene name."""
+    refs = {}
+    for scene, args, t_end in scene_list:
+        code, out, err = simulate(binary, [*args, "--t-end", t_end, "--method", "lp-y4", "--h", "0.01", "--reference",
+                                           "--max-error", "inf", "--max-energy-error", "inf"])
+        if code != 0:
+            sys.exit(f"reference of {scene}: {err}")
+        refs[scene] = out
+    return refs
+
+
 def one(binary, job):
     scene, args, t_end, method, step = job
     base = [*args, "--t-end", t_end, "--method", method["method"]]
@@ -128,13 +140,7 @@ def main():
     methods = list(csv.DictReader(listing.splitlines()))
     with tempfile.TemporaryDirectory() as folder:
         scene_list = scenes(folder)
-        refs = {}
-        for scene, args, t_end in scene_list:
-            code, out, err = simulate(a.binary, [*args, "--t-end", t_end, "--method", "lp-y4", "--h", "0.01",
-                                                 "--reference", "--max-error", "inf", "--max-energy-error", "inf"])
-            if code != 0:
-                sys.exit(f"reference of {scene}: {err}")
-            refs[scene] = out
+        refs = references(a.binary, scene_list)
         jobs = [(s, args, t, m, step) for s, args, t in scene_list for m in methods
                 for step in (TOLS if m["advance"] == "controlled" else STEPS)]
         with ThreadPoolExecutor(a.threads) as pool:
