@@ -61,14 +61,16 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
                 const std::vector<batch::Member>& members, const std::vector<Scene>& scenes) {
   const FixedSteps how = std::get<FixedSteps>(point_advance(spec, method, rows.front().point));
   auto results = batch::run(method, members, how);
+  std::vector<Health> health;
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    health.push_back(assess(results[k], checks_for(method, scenes[k].centres, spec.max_energy_error)));
   std::vector<RunResult> companions, second;
   if (spec.estimate_error) companions = batch::run(method, members, detail::fixed_companion(how));
-  for (std::size_t k = 0; k < rows.size() && spec.estimate_error && second.empty(); ++k)
-    if (assess(results[k], checks_for(method, scenes[k].centres, spec.max_energy_error)).outcome == Outcome::unresolved)
-      second = batch::run(method, members, detail::fixed_companion(how, 2));  // to confirm the flagged lanes' estimates
+  if (spec.estimate_error && std::any_of(health.begin(), health.end(), [](const Health& h) { return h.outcome == Outcome::unresolved; }))
+    second = batch::run(method, members, detail::fixed_companion(how, 2));  // to confirm the flagged lanes' estimates
   for (std::size_t k = 0; k < rows.size(); ++k) {
     SweepRow& row = rows[k];
-    Health h = assess(results[k], checks_for(method, scenes[k].centres, spec.max_energy_error));
+    Health& h = health[k];
     row.result = std::move(results[k]);
     row.outcome = h.outcome;
     row.reason = std::move(h.why);
