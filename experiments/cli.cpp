@@ -103,7 +103,8 @@ double error_bound(const StepOptions& o) {
   return o.max_error;
 }
 
-StepRequest step_request(const po::variables_map& vm, const StepOptions& o, const MethodInfo* method, double tol) {
+StepRequest step_request(const po::variables_map& vm, const StepOptions& o, const MethodInfo* method, double tol,
+                         std::optional<double> end_if_none) {
   StepRequest r;
   if ((vm.count("tol") && !vm["tol"].defaulted()) || (method && is_step_controlled(*method))) r.tol = tol;
   // A step given is passed on (the accuracy mode refuses it); a default one only where a step is used.
@@ -112,6 +113,7 @@ StepRequest step_request(const po::variables_map& vm, const StepOptions& o, cons
   if (vm.count("t-end")) r.t_end = o.t_end;
   // --force-law thesis-code counts steps as the thesis's code did (n - 1 of n asked; run.hpp).
   r.code_loop = vm.count("force-law") && parse_force_law(vm["force-law"].as<std::string>()) == ForceLaw::thesis_code;
+  if (!r.t_end && !r.steps && end_if_none) r.t_end = end_if_none;
   if (!r.t_end && !r.steps) {
     if (searches(method, r)) r.t_end = kDefaultStep * static_cast<double>(kDefaultSteps);
     else r.steps = kDefaultSteps;

@@ -49,7 +49,9 @@ double error_bound(const StepOptions& o);
 /// The library's step request from --h, --steps, --t-end and --tol as given (defaulted ones left out),
 /// with the command line's defaults: no end given, --steps 500000 (or with --tol, t_end = 50, the
 /// thesis's h n); --force-law thesis-code counts steps as the thesis's code did.
-StepRequest step_request(const po::variables_map& vm, const StepOptions& o, const MethodInfo* method, double tol);
+/// end_if_none: the end time when neither --t-end nor --steps is given (else table 3.1's).
+StepRequest step_request(const po::variables_map& vm, const StepOptions& o, const MethodInfo* method, double tol,
+                         std::optional<double> end_if_none = std::nullopt);
 
 /// What --method, --tol and the step options ask for: a method (nullptr: auto) and the way it
 /// advances (Accuracy when --tol chooses the step), with the run's options.
@@ -64,7 +66,7 @@ struct RunPlan {
 /// The method, the way of advancing time and the energy bound from the options; throws Error with
 /// the reason (plan.cpp).
 RunPlan plan_run(const po::variables_map& vm, const StepOptions& st, const std::string& method_name,
-                 bool method_defaulted, double tol);
+                 bool method_defaulted, double tol, std::optional<double> end_if_none = std::nullopt);
 /// plan.how's step: h, the fictitious step ds, or a controlled method's first trial step (0: search).
 double planned_step(const RunPlan& plan);
 /// plan.how's end time: t_end, or the end of its steps (fictitious steps: 0, not known in advance).
@@ -106,10 +108,6 @@ inline Options unobserved() {
   o.estimate_error = false;
   return o;
 }
-
-/// An event from its command-line form: closest, closest:K (centre K), r=V, r:K=V, x=V, y=V, z=V or
-/// plane=nx,ny,nz,V (normal.R = V); Error naming the forms otherwise.
-Event parse_event(const std::string& text);
 
 /// Parses argv into vm, rejecting unknown options and positional words; returns false after
 /// printing help when --help is given.

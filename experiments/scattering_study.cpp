@@ -55,7 +55,7 @@ std::vector<Series> series() {
 struct Point {
   double b_target = 0.0, d = 0.0;
   Scattering sc;
-  double r_min = kNaN, t_min = kNaN, t_end = 0.0, r_end = kNaN, tol = kStudyTolerance;
+  double r_min = kNaN, t_min = kNaN, t_end = 0.0, r_end = kNaN, tol = kStudyTolerance, asymptote_error = kNaN;
   long force_evals = 0;
   std::string method, failure;
   static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -73,29 +73,27 @@ Point run_point(const Series& s, double b) {
     params.start.d = p.d;
     const Scene scene = thesis_scene(params);
     const Body& body = scene.bodies.front();
-    const auto k = kepler_particle(body.p, body.s0, scene.centres.front().c);
-    p.t_end = 2.0 * params.start.L / (k->P.norm() / k->mu);
     Options o;
     o.track_invariants = false;
-    o.events = {Event{}};
-    Result r = integrate(scene, s.method, Accuracy{p.tol, p.t_end}, o);
-    if (r.outcome == Outcome::failed && r.reason.find("out of reach") != std::string::npos) {
+    const MethodInfo* method = std::string_view(s.method) == "auto" ? nullptr : &method_or_throw(s.method);
+    EncounterResult r = encounter(body, scene.centres, method, p.tol, Scattering::kNaN, o);
+    if (r.run.outcome == Outcome::failed && r.run.reason.find("out of reach") != std::string::npos) {
       p.tol *= kRetryLooser;
-      r = integrate(scene, s.method, Accuracy{p.tol, p.t_end}, o);
+      r = encounter(body, scene.centres, method, p.tol, Scattering::kNaN, o);
     }
-    const BodyResult& br = r.bodies.front();
+    const BodyResult& br = r.run;
     p.force_evals = br.total_force_evals();
+    p.t_end = br.run.t_end;
     if (br.method) p.method = br.method->name;
-    if (r.outcome != Outcome::ok) {
-      p.failure = r.reason;
+    if (r.encounter.outcome != Outcome::ok) {
+      p.failure = r.encounter.reason;
       return p;
     }
-    p.sc = scattering(body.p, scene.centres, body.s0, br.run.final, br.run.t_end);
+    p.sc = r.encounter.scattering;
+    p.asymptote_error = r.encounter.asymptote_error;
     p.r_end = (br.run.final.R - scene.centres.front().c).norm();
-    if (const EventHit* nearest = nearest_approach(br.events, o.events)) {
-      p.r_min = nearest->distance;
-      p.t_min = nearest->t;
-    }
+    p.r_min = r.encounter.r_min;
+    p.t_min = r.encounter.t_min;
   } catch (const Error& e) {
     p.failure = e.what();
   }

@@ -87,20 +87,6 @@ std::string error_json(const BodyRun& b) {
   return os.str();
 }
 
-/// The encounter's observables of one body (--scattering): scattering.hpp, and the closest approach
-/// among the located closest-approach events.
-struct Encounter {
-  Scattering sc;
-  std::optional<EventHit> closest;
-};
-
-Encounter encounter(const Body& body, const std::vector<Centre>& centres, const std::vector<Event>& events,
-                    const BodyRun& run) {
-  Encounter e{scattering(body.p, centres, body.s0, run.result.final, run.result.t_end), std::nullopt};
-  if (const EventHit* nearest = nearest_approach(run.events, events)) e.closest = *nearest;
-  return e;
-}
-
 std::string events_json(const std::vector<Event>& events, const BodyRun& run) {
   if (events.empty()) return "";
   std::ostringstream os;
@@ -121,15 +107,15 @@ std::string json_or_null(double x) { return std::isfinite(x) ? json_number(x) : 
 
 std::string scattering_json(const std::optional<Encounter>& e) {
   if (!e) return "";
-  const Scattering& sc = e->sc;
+  const Scattering& sc = e->scattering;
   std::ostringstream os;
   os << ", \"scattering\": {\"asymptotes\": " << json_string(sc.asymptotes)
      << ", \"deflection\": " << json_or_null(sc.deflection) << ", \"out_of_plane\": " << json_or_null(sc.out_of_plane)
      << ", \"b\": " << json_or_null(sc.b) << ", \"v_inf\": " << json_or_null(sc.v_inf)
-     << ", \"time_delay\": " << json_or_null(sc.time_delay);
+     << ", \"time_delay\": " << json_or_null(sc.time_delay) << ", \"asymptote_error\": " << json_or_null(e->asymptote_error)
+     << ", \"asymptote_basis\": " << json_string(e->asymptote_basis);
   if (sc.in) os << ", \"direction_in\": " << json_vec(sc.in->direction) << ", \"direction_out\": " << json_vec(sc.out->direction);
-  os << ", \"r_min\": " << (e->closest ? json_number(e->closest->distance) : "null")
-     << ", \"t_min\": " << (e->closest ? json_number(e->closest->t) : "null")
+  os << ", \"r_min\": " << json_or_null(e->r_min) << ", \"t_min\": " << json_or_null(e->t_min)
      << ", \"K1_turn\": " << json_number(sc.K1_turn) << ", \"spin_turn\": " << json_number(sc.spin_turn)
      << ", \"K1_start\": " << json_vec(sc.K1_start) << ", \"K1_end\": " << json_vec(sc.K1_end)
      << ", \"K2_start\": " << json_vec(sc.K2_start) << ", \"K2_end\": " << json_vec(sc.K2_end)
@@ -145,13 +131,16 @@ void print_encounter(const std::vector<Event>& events, const BodyRun& run, const
               << ", R = " << json_vec(h.s.R) << "\n";
   if (run.result.stopped) std::cout << "  the run stopped at event " << events[run.events.back().event].label() << "\n";
   if (!e) return;
-  const Scattering& sc = e->sc;
+  const Scattering& sc = e->scattering;
   std::cout << "  scattering (asymptotes: " << sc.asymptotes << ")\n";
   if (sc.in)
     std::cout << "    deflection = " << fmt(sc.deflection) << " rad (out of the incoming plane: " << fmt(sc.out_of_plane)
               << "), impact parameter b = " << fmt(sc.b) << ", v_inf = " << fmt(sc.v_inf)
-              << ", time delay = " << fmt(sc.time_delay) << "\n";
-  if (e->closest) std::cout << "    closest approach r_min = " << fmt(e->closest->distance) << " at t_min = " << fmt(e->closest->t) << "\n";
+              << ", time delay = " << fmt(sc.time_delay) << "\n"
+              << "    the asymptotes' model error in the deflection: "
+              << (std::isfinite(e->asymptote_error) ? fmt(e->asymptote_error) + " (" : "") << e->asymptote_basis
+              << (std::isfinite(e->asymptote_error) ? ")" : "") << "\n";
+  if (std::isfinite(e->r_min)) std::cout << "    closest approach r_min = " << fmt(e->r_min) << " at t_min = " << fmt(e->t_min) << "\n";
   else std::cout << "    no closest approach within the run (the distance has no minimum between its ends)\n";
   std::cout << "    K1 turned " << fmt(sc.K1_turn) << " rad, the spin K2 " << fmt(sc.spin_turn) << " rad; K1: "
             << json_vec(sc.K1_start) << " -> " << json_vec(sc.K1_end) << "\n";
@@ -170,7 +159,9 @@ struct SimulateOptions {
   double tol = kDefaultStepTolerance, dt_out = 0.0, omega_c = -1.0;
   bool json = false, no_invariants = false, with_reference = false, dry_run = false, quiet = false, scattering = false;
   std::vector<std::string> event_text, stop_text;
-  std::vector<Event> events;  ///< parsed from event_text, and the closest approaches --scattering adds
+  std::vector<Event> events;  ///< parsed from event_text and stop_text
+  /// Each body's events: `events`, and with --scattering those of its encounter (encounter_options).
+  std::vector<std::vector<Event>> body_events;
   double max_seconds = 3600.0, max_rows = 1e7;
   std::vector<std::string> observe;
 };
@@ -312,7 +303,7 @@ class TrajectoryFile {
 
 /// One body: budget, run (with the progress bar), health, and the reference error when asked for.
 BodyRun simulate_body(const SimulateOptions& o, const RunPlan& plan, const Body& body, const Scene& scene,
-                      const SampleSink* sink) {
+                      const std::vector<Event>& events, const SampleSink* sink) {
   std::optional<WorkEstimate> estimate;
   if (!plan.search) {
     estimate = estimate_work(*plan.method, body, scene.centres, plan.how, plan.options);
@@ -321,7 +312,7 @@ BodyRun simulate_body(const SimulateOptions& o, const RunPlan& plan, const Body&
   BodyRun br;
   {
     const ProgressBar bar(estimate, progress_wanted(o.quiet));
-    br = run_body(plan, body, scene.centres, plan.how, sink, o.events);
+    br = run_body(plan, body, scene.centres, plan.how, sink, events);
   }
   if (br.outcome != Outcome::ok) {
     const std::string smaller = is_step_controlled(*br.method) ? "the tolerance is too loose for this scene (reduce --tol"
@@ -353,7 +344,7 @@ void report_json(const std::vector<BodyRun>& runs, const Scene& scene, const Run
             << (is_step_controlled(*r0.method) ? ", \"tol\": " + json_number(plan.tol) : std::string())
             << search_json(r0, plan.tol) << error_json(r0) << ", \"steps\": " << r0.result.steps
             << ", \"t_end\": " << json_number(r0.result.t_end) << ", " << json_body(r0.result, r0.err_R, r0.err_rel, r0.reference)
-            << events_json(o.events, r0) << scattering_json(enc.front());
+            << events_json(o.body_events.front(), r0) << scattering_json(enc.front());
   if (runs.size() > 1) {
     // The run's totals (the top-level fields above are the first body's): every body's force
     // evaluations, its accuracy search and its events included, and its step-loop time.
@@ -369,7 +360,7 @@ void report_json(const std::vector<BodyRun>& runs, const Scene& scene, const Run
     for (std::size_t b = 0; b < runs.size(); ++b)
       std::cout << (b ? ", " : "") << "{\"name\": " << json_string(scene.bodies[b].name) << ", \"method\": "
                 << json_string(runs[b].method->name) << search_json(runs[b], plan.tol) << error_json(runs[b]) << ", "
-                << json_body(runs[b].result, runs[b].err_R, runs[b].err_rel, runs[b].reference) << events_json(o.events, runs[b])
+                << json_body(runs[b].result, runs[b].err_R, runs[b].err_rel, runs[b].reference) << events_json(o.body_events[b], runs[b])
                 << scattering_json(enc[b]) << "}";
     std::cout << "]";
   }
@@ -411,7 +402,7 @@ void report_text(const std::vector<BodyRun>& runs, const Scene& scene, const Run
             << " body-point(s))\n";
   for (std::size_t b = 0; b < runs.size(); ++b) {
     report_body(runs[b], scene.bodies[b].name);
-    print_encounter(o.events, runs[b], enc[b]);
+    print_encounter(o.body_events[b], runs[b], enc[b]);
   }
 }
 
@@ -427,21 +418,26 @@ int cmd_simulate(int argc, char** argv) {
              "Integrates the scene (default: thesis table 3.1, h = 1e-4, n = 500000) with one method.\n"
              "With --tol and no --method (or --method auto) the method and its step are chosen to deliver tol."))
     return 0;
-  RunPlan plan = plan_run(vm, o.st, o.method_name, vm["method"].defaulted(), o.tol);
-  if (plan.automatic) o.method_name = "auto";
   const Scene scene = make_scene(vm, o.so);
+  // An encounter with no end given runs until every body has left (the departure event), at most
+  // kEncounterSpans free passes.
+  const bool to_departure = o.scattering && !vm.count("t-end") && vm["steps"].defaulted();
+  std::optional<double> span;
+  if (to_departure)
+    for (const Body& body : scene.bodies) span = std::max(span.value_or(0.0), encounter_span(body, scene.centres));
+  RunPlan plan = plan_run(vm, o.st, o.method_name, vm["method"].defaulted(), o.tol, span);
+  if (plan.automatic) o.method_name = "auto";
   apply_output_options(vm, o, scene, plan);
   for (const std::string& text : o.event_text) o.events.push_back(parse_event(text));
   for (const std::string& text : o.stop_text) {
     o.events.push_back(parse_event(text));
     o.events.back().stop = true;
   }
-  if (o.scattering)  // every centre's closest approach, unless --event asked for it already
-    for (const Event& closest : closest_approaches(scene.centres.size()))
-      if (std::none_of(o.events.begin(), o.events.end(), [&closest](const Event& e) {
-            return e.kind == Event::Kind::closest_approach && e.centre == closest.centre && !e.stop;
-          }))
-        o.events.push_back(closest);
+  for (const Body& body : scene.bodies) {
+    Options with{};
+    with.events = o.events;
+    o.body_events.push_back(o.scattering ? encounter_options(body, scene.centres, with, to_departure).events : o.events);
+  }
   if (o.dry_run) {
     print_dry_run(plan, o.method_name, scene);
     return 0;
@@ -452,13 +448,17 @@ int cmd_simulate(int argc, char** argv) {
   for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
     const Body& body = scene.bodies[b];
     const SampleSink sink = file ? file->sink(static_cast<long>(b), body.p) : SampleSink();
-    runs.push_back(simulate_body(o, plan, body, scene, file ? &sink : nullptr));
+    runs.push_back(simulate_body(o, plan, body, scene, o.body_events[b], file ? &sink : nullptr));
     if (file) file->stream() << "# body " << b << ": " << search_line(runs.back()) << "; " << error_line(runs.back().error) << "\n";
   }
-  if (file) file->commit();
   std::vector<std::optional<Encounter>> enc(runs.size());
   if (o.scattering)
-    for (std::size_t b = 0; b < runs.size(); ++b) enc[b] = encounter(scene.bodies[b], scene.centres, o.events, runs[b]);
+    for (std::size_t b = 0; b < runs.size(); ++b) {
+      enc[b] = measure_encounter(scene.bodies[b], scene.centres, runs[b].result, runs[b].events, o.body_events[b]);
+      if (enc[b]->outcome != Outcome::ok)
+        throw Error("body '" + scene.bodies[b].name + "': " + enc[b]->reason + "; no output written");
+    }
+  if (file) file->commit();
   if (o.json) {
     report_json(runs, scene, plan, o, enc);
     return 0;

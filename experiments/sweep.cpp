@@ -83,6 +83,7 @@ std::string format_row(const SweepSpec& spec, const SweepRow& r) {
   if (spec.scattering) {  // NaN where there is no value (no minimum, no asymptotes, a run that did not finish)
     const Scattering sc = r.scattering ? *r.scattering : Scattering{};
     row.num(r.r_min).num(r.t_min).num(sc.deflection).num(sc.out_of_plane).num(sc.b).num(sc.v_inf).num(sc.time_delay);
+    row.num(r.asymptote_error);
     row.num(r.scattering ? sc.K1_turn : nan).num(r.scattering ? sc.spin_turn : nan);
     row.num(sc.K1_end.x()).num(sc.K1_end.y()).num(sc.K1_end.z());
     row.quoted(r.scattering ? sc.asymptotes : std::string("none: the run did not finish"));
@@ -148,7 +149,7 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
   std::string columns =
       names + ",method,max_rel_dE,max_rel_dK2sq,max_abs_dK2Q,Rx,Ry,Rz,force_evals,wall_s,status,reason,err_estimate,"
               "estimate_force_evals,err_basis,warning" +
-      (spec.scattering ? ",r_min,t_min,deflection,out_of_plane,b_in,v_inf_in,time_delay,K1_turn,spin_turn,K1x,K1y,K1z,"
+      (spec.scattering ? ",r_min,t_min,deflection,out_of_plane,b_in,v_inf_in,time_delay,asymptote_error,K1_turn,spin_turn,K1x,K1y,K1z,"
                          "asymptotes"
                        : "");
   return {std::move(columns),
@@ -162,7 +163,8 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
               " Rx,Ry,Rz = final position; force_evals; wall_s = step-loop time (runs share the cores; a batch of"
               " trajectories run in vector lanes shares its time equally);"
               " status = ok | diverged (non-finite, or energy error above 1) | unresolved (a step turned the spin by"
-              " more than pi or the direction to a centre by more than pi/2) | inaccurate (energy error above"
+              " more than pi or the direction to a centre by more than pi/2) | incomplete (--scattering: the encounter had"
+              " not finished) | inaccurate (energy error above"
               " max_energy_error = " + fmt(spec.max_energy_error) + ", or estimated error above max_error = " +
               fmt(spec.max_error) + ") | collision (diverged after a fall onto an"
               " attracting centre) | refused (not run); reason = why, when not ok;"
@@ -174,7 +176,10 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
                                 " deflection, out_of_plane = angles between the incoming and outgoing asymptotes (rad);"
                                 " b_in = impact parameter of the incoming asymptote, v_inf_in = speed at infinity on it (of the guiding centre"
                                 " for B != 0);"
-                                " time_delay = against free motion, Coulomb logarithm removed; K1_turn, spin_turn ="
+                                " time_delay = against free motion, Coulomb logarithm removed; asymptote_error = the"
+                                " asymptotes' model error in the deflection (estimated from half the start distance);"
+                                " a run that ended before the body left is status incomplete, without them;"
+                                " K1_turn, spin_turn ="
                                 " angles K1 and K2 turned over the run (rad); K1x,K1y,K1z = final K1;"
                                 " asymptotes = kepler | guiding-centre | none: why (docs/physics.md, Scattering)"
                               : "")};

@@ -13,15 +13,18 @@ namespace bodypoint {
 
 std::string Event::label() const {
   std::ostringstream os;
+  const auto at_centre = [&] {
+    if (centre) os << "(" << centre << ")";
+  };
   switch (kind) {
-    case Kind::closest_approach:
-      os << "closest";
-      if (centre) os << "(" << centre << ")";
-      break;
-    case Kind::radius:
-      os << "r";
-      if (centre) os << "(" << centre << ")";
-      os << "=" << fmt(value);
+    case Kind::closest_approach: os << "closest"; at_centre(); break;
+    case Kind::local_minimum: os << "local-min"; at_centre(); break;
+    case Kind::radius: os << "r"; at_centre(); os << "=" << fmt(value); break;
+    case Kind::departure:
+    case Kind::arrival:
+      os << (kind == Kind::departure ? "departure" : "arrival");
+      at_centre();
+      if (value != 0.0) os << "=" << fmt(value);
       break;
     case Kind::plane:
       if (normal == Vec3::UnitX()) os << "x";
@@ -34,6 +37,73 @@ std::string Event::label() const {
   return os.str();
 }
 
+namespace {
+
+/// The grammar's forms, for the message that refuses a text.
+constexpr const char* kEventForms = "closest, closest:K, local-min, local-min:K, r=RADIUS, r:K=RADIUS, x=X, y=Y, z=Z, "
+                                    "plane=nx,ny,nz,offset, departure, departure=R, arrival=R (K: a centre's index)";
+
+double event_number(std::string_view text, const std::string& value) {
+  std::size_t used = 0;
+  double x = 0.0;
+  try {
+    x = std::stod(value, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != value.size() || !std::isfinite(x))
+    throw Error("event '" + std::string(text) + "': '" + value + "' is not a finite number");
+  return x;
+}
+
+std::size_t event_centre(std::string_view text, const std::string& index) {
+  if (index.empty() || index.find_first_not_of("0123456789") != std::string::npos || index.size() > 6)
+    throw Error("event '" + std::string(text) + "': the centre must be an index 0, 1, ...");
+  return static_cast<std::size_t>(std::stoul(index));
+}
+
+Event parse_plane(std::string_view text, const std::string& value) {
+  double n[4];
+  std::size_t from = 0;
+  for (int i = 0; i < 4; ++i) {
+    const std::size_t comma = i < 3 ? value.find(',', from) : value.size();
+    if (comma == std::string::npos) throw Error("event '" + std::string(text) + "': give plane=nx,ny,nz,offset");
+    n[i] = event_number(text, value.substr(from, comma - from));
+    from = comma + 1;
+  }
+  Event e{Event::Kind::plane, 0, n[3], Vec3(n[0], n[1], n[2])};
+  if (!(e.normal.norm() > 0.0)) throw Error("event '" + std::string(text) + "': the plane's normal must not be zero");
+  if (!std::isfinite(e.normal.norm()))
+    throw Error("event '" + std::string(text) + "': the plane's normal is too long (its length overflows); scale it down");
+  return e;
+}
+
+}  // namespace
+
+Event parse_event(std::string_view text_view) {
+  const std::string text(text_view);
+  const std::size_t eq = text.find('=');
+  const bool valued = eq != std::string::npos;
+  const std::string key = text.substr(0, eq), value = valued ? text.substr(eq + 1) : "";
+  const std::string name = key.substr(0, key.find(':'));
+  const bool indexed = key.find(':') != std::string::npos;
+  const std::size_t centre = event_centre(text_view, indexed ? key.substr(key.find(':') + 1) : "0");
+  if ((name == "closest" || name == "local-min") && !valued)
+    return Event{name == "closest" ? Event::Kind::closest_approach : Event::Kind::local_minimum, centre};
+  if (name == "departure" && !valued) return Event{Event::Kind::departure, centre};
+  if ((name == "r" || name == "departure" || name == "arrival") && valued) {
+    const Event::Kind kind = name == "r" ? Event::Kind::radius : name == "departure" ? Event::Kind::departure : Event::Kind::arrival;
+    Event e{kind, centre, event_number(text_view, value)};
+    if (!(e.value > 0.0)) throw Error("event '" + text + "': the distance must be > 0");
+    return e;
+  }
+  if (!indexed && valued && (key == "x" || key == "y" || key == "z"))
+    return Event{Event::Kind::plane, 0, event_number(text_view, value),
+                 key == "x" ? Vec3::UnitX() : key == "y" ? Vec3::UnitY() : Vec3::UnitZ()};
+  if (!indexed && valued && key == "plane") return parse_plane(text_view, value);
+  throw Error("unknown event '" + text + "': give " + kEventForms);
+}
+
 std::vector<Event> closest_approaches(std::size_t centres) {
   std::vector<Event> out;
   for (std::size_t c = 0; c < centres; ++c) out.push_back(Event{Event::Kind::closest_approach, c, 0.0, Vec3::UnitX(), false});
@@ -43,7 +113,7 @@ std::vector<Event> closest_approaches(std::size_t centres) {
 const EventHit* nearest_approach(const std::vector<EventHit>& hits, const std::vector<Event>& events) {
   const EventHit* nearest = nullptr;
   for (const EventHit& h : hits)
-    if (events[h.event].kind == Event::Kind::closest_approach &&
+    if ((events[h.event].kind == Event::Kind::closest_approach || events[h.event].kind == Event::Kind::local_minimum) &&
         (!nearest || h.distance < nearest->distance || (std::isnan(nearest->distance) && !std::isnan(h.distance))))
       nearest = &h;
   return nearest;
@@ -59,21 +129,58 @@ constexpr double kBracketUlps = 4.0;
 constexpr int kMaxIterations = 200;
 
 void validate_events(const std::vector<Event>& events, const std::vector<Centre>& centres) {
+  using K = Event::Kind;
   for (const Event& e : events) {
-    if (e.kind != Event::Kind::plane && e.centre >= centres.size())
+    if (e.kind != K::plane && e.centre >= centres.size())
       throw Error("event " + e.label() + ": the scene has " + std::to_string(centres.size()) + " centre(s)");
-    if (e.kind == Event::Kind::radius && !(std::isfinite(e.value) && e.value > 0.0))
-      throw Error("event " + e.label() + ": the radius must be a finite number > 0");
-    if (e.kind == Event::Kind::plane &&
+    if ((e.kind == K::radius || e.kind == K::arrival) && !(std::isfinite(e.value) && e.value > 0.0))
+      throw Error("event " + e.label() + ": the distance must be a finite number > 0");
+    if (e.kind == K::departure && !(std::isfinite(e.value) && e.value >= 0.0))
+      throw Error("event " + e.label() + ": the distance must be a finite number > 0 (0: the start's)");
+    if (e.kind == K::plane &&
         !(std::isfinite(e.value) && e.normal.allFinite() && e.normal.norm() > 0.0 && std::isfinite(e.normal.norm())))
       throw Error("event " + e.label() + ": a plane needs a finite non-zero normal and a finite offset");
+    if (e.kind == K::closest_approach && e.stop)
+      throw Error("event " + e.label() + ": a run cannot stop at its closest approach, which is known only at its end; "
+                  "stop at local-min (the first local minimum of the distance; for a spinning body it may be a "
+                  "wiggle of its helix) or at departure (the encounter has ended)");
   }
 }
 
-double event_function(const Event& e, const std::vector<Centre>& centres, const State& s) {
+Vec3 guiding_centre(const BodyPoint& p, const State& s) {
+  if (p.B == 0.0) return s.R;
+  const Momenta q = to_momenta(p, s);
+  const double K1sq = q.K1.squaredNorm();
+  return K1sq > 0.0 ? Vec3(s.R + q.K1.cross(q.K2) / K1sq) : s.R;
+}
+
+std::vector<Event> resolved(std::vector<Event> events, const BodyPoint& p, const std::vector<Centre>& centres,
+                            const State& start) {
+  for (Event& e : events)
+    if (e.kind == Event::Kind::departure && e.value == 0.0)
+      e.value = (guiding_centre(p, start) - centres[e.centre].c).norm();
+  return events;
+}
+
+void keep_closest(std::vector<EventHit>& hits, const std::vector<Event>& events) {
+  std::vector<const EventHit*> nearest(events.size(), nullptr);
+  for (const EventHit& h : hits)
+    if (events[h.event].kind == Event::Kind::closest_approach &&
+        (!nearest[h.event] || h.distance < nearest[h.event]->distance))
+      nearest[h.event] = &h;
+  std::vector<EventHit> kept;
+  for (const EventHit& h : hits)
+    if (events[h.event].kind != Event::Kind::closest_approach || nearest[h.event] == &h) kept.push_back(h);
+  hits = std::move(kept);
+}
+
+double event_function(const Event& e, const BodyPoint& p, const std::vector<Centre>& centres, const State& s) {
   switch (e.kind) {
-    case Event::Kind::closest_approach: return (s.R - centres[e.centre].c).dot(s.v);
+    case Event::Kind::closest_approach:
+    case Event::Kind::local_minimum: return (s.R - centres[e.centre].c).dot(s.v);
     case Event::Kind::radius: return (s.R - centres[e.centre].c).norm() - e.value;
+    case Event::Kind::departure:
+    case Event::Kind::arrival: return (guiding_centre(p, s) - centres[e.centre].c).norm() - e.value;
     case Event::Kind::plane: return e.normal.dot(s.R) - e.value;
   }
   return 0.0;
@@ -82,7 +189,9 @@ double event_function(const Event& e, const std::vector<Centre>& centres, const 
 namespace {
 
 bool crosses(const Event& e, double g_a, double g_b) {
-  if (e.kind == Event::Kind::closest_approach) return g_a < 0.0 && g_b >= 0.0;
+  using K = Event::Kind;
+  if (e.kind == K::closest_approach || e.kind == K::local_minimum || e.kind == K::departure) return g_a < 0.0 && g_b >= 0.0;
+  if (e.kind == K::arrival) return g_a > 0.0 && g_b <= 0.0;
   return (g_a < 0.0 && g_b >= 0.0) || (g_a > 0.0 && g_b <= 0.0);
 }
 
@@ -100,9 +209,12 @@ namespace {
 /// change starts from.
 constexpr double kStartUlps = 64.0;
 
-double event_scale(const Event& e, const std::vector<Centre>& centres, const State& s) {
+double event_scale(const Event& e, const BodyPoint& p, const std::vector<Centre>& centres, const State& s) {
   switch (e.kind) {
-    case Event::Kind::closest_approach: return (s.R - centres[e.centre].c).norm() * s.v.norm();
+    case Event::Kind::closest_approach:
+    case Event::Kind::local_minimum: return (s.R - centres[e.centre].c).norm() * s.v.norm();
+    case Event::Kind::departure:
+    case Event::Kind::arrival: return std::max((guiding_centre(p, s) - centres[e.centre].c).norm(), e.value);
     case Event::Kind::radius: return std::max((s.R - centres[e.centre].c).norm(), e.value);
     case Event::Kind::plane: return e.normal.norm() * s.R.norm() + std::abs(e.value);
   }
@@ -113,8 +225,8 @@ double event_scale(const Event& e, const std::vector<Centre>& centres, const Sta
 
 void EventWatch::observe(double t, const State& s) {
   for (std::size_t k = 0; k < events_.size(); ++k) {
-    double g = event_function(events_[k], centres_, s);
-    if (!started_ && std::abs(g) <= kStartUlps * std::numeric_limits<double>::epsilon() * event_scale(events_[k], centres_, s))
+    double g = event_function(events_[k], p_, centres_, s);
+    if (!started_ && std::abs(g) <= kStartUlps * std::numeric_limits<double>::epsilon() * event_scale(events_[k], p_, centres_, s))
       g = 0.0;
     if (started_ && t > t_ && crosses(events_[k], g_[k], g)) brackets_.push_back({k, t_, t, g_[k], g, s_, s});
     g_[k] = g;
@@ -124,7 +236,7 @@ void EventWatch::observe(double t, const State& s) {
   s_ = s;
 }
 
-std::vector<EventHit> locate(const EventWatch& watch, const std::vector<Event>& events,
+std::vector<EventHit> locate(const EventWatch& watch, const std::vector<Event>& events, const BodyPoint& p,
                              const std::vector<Centre>& centres, const Advancer& advance, long& evals) {
   std::vector<EventHit> hits;
   for (const EventWatch::Bracket& b : watch.brackets()) {
@@ -143,7 +255,7 @@ std::vector<EventHit> locate(const EventWatch& watch, const std::vector<Event>& 
       double tau = (it % 3 == 2) ? 0.5 * (lo + hi) : lo - g_lo * (hi - lo) / (g_hi - g_lo);
       if (!(tau > lo && tau < hi)) tau = 0.5 * (lo + hi);
       const State s = tau > 0.0 ? advance(b.s_a, tau, evals) : b.s_a;
-      const double g = sign * event_function(e, centres, s);
+      const double g = sign * event_function(e, p, centres, s);
       if (std::abs(g) <= best_g) {
         best = s;
         best_tau = tau;

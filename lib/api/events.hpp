@@ -18,8 +18,18 @@ namespace bodypoint::detail {
 /// is not a finite number > 0, a plane normal that is zero or not finite, an offset not finite).
 void validate_events(const std::vector<Event>& events, const std::vector<Centre>& centres);
 
+/// The guiding centre G = R + K1 x K2/|K1|^2 of a state (B = 0: R).
+Vec3 guiding_centre(const BodyPoint& p, const State& s);
+
+/// The events with their values fixed by the run's start (a departure through the start's distance).
+std::vector<Event> resolved(std::vector<Event> events, const BodyPoint& p, const std::vector<Centre>& centres,
+                            const State& start);
+
+/// Of the hits of each closest_approach event only the nearest is kept (the run's closest approach).
+void keep_closest(std::vector<EventHit>& hits, const std::vector<Event>& events);
+
 /// The function whose sign change is the event.
-double event_function(const Event& e, const std::vector<Centre>& centres, const State& s);
+double event_function(const Event& e, const BodyPoint& p, const std::vector<Centre>& centres, const State& s);
 
 class EventWatch {
  public:
@@ -28,13 +38,14 @@ class EventWatch {
     double t_a, t_b, g_a, g_b;
     State s_a, s_b;
   };
-  EventWatch(const std::vector<Event>& events, const std::vector<Centre>& centres)
-      : events_(events), centres_(centres), g_(events.size()) {}
+  EventWatch(const std::vector<Event>& events, const BodyPoint& p, const std::vector<Centre>& centres)
+      : events_(events), p_(p), centres_(centres), g_(events.size()) {}
   void observe(double t, const State& s);
   [[nodiscard]] const std::vector<Bracket>& brackets() const { return brackets_; }
 
  private:
   const std::vector<Event>& events_;
+  const BodyPoint& p_;
   const std::vector<Centre>& centres_;
   std::vector<double> g_;
   bool started_ = false;
@@ -48,7 +59,7 @@ class EventWatch {
 using Advancer = std::function<State(const State& s, double tau, long& evals)>;
 
 /// The events of the brackets, located, in time order.
-std::vector<EventHit> locate(const EventWatch& watch, const std::vector<Event>& events,
+std::vector<EventHit> locate(const EventWatch& watch, const std::vector<Event>& events, const BodyPoint& p,
                              const std::vector<Centre>& centres, const Advancer& advance, long& evals);
 
 }  // namespace bodypoint::detail

@@ -204,7 +204,8 @@ class OutputTimesSink {
 BodyResult run_with_events(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
                            const Advance& how, const Options& options) {
   const bool accuracy = std::holds_alternative<Accuracy>(how);
-  detail::EventWatch watch(options.events, centres);
+  const std::vector<Event> events = detail::resolved(options.events, body.p, centres, body.s0);
+  detail::EventWatch watch(events, body.p, centres);
   WatchingSink watching(watch, options, output_interval(how) > 0.0, !accuracy);
   const SampleSink sink = [&watching](const Sample& s) { return watching(s); };
   Options inner = options;
@@ -213,8 +214,8 @@ BodyResult run_with_events(const Body& body, const std::vector<Centre>& centres,
   inner.every = 1;
   BodyResult r = integrate_valid_body(body, centres, method, how, inner);
   if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return r;
-  r.events = detail::locate(watch, options.events, centres, advancer(r, body, centres, how, options),
-                            r.event_force_evals);
+  r.events = detail::locate(watch, events, body.p, centres, advancer(r, body, centres, how, options), r.event_force_evals);
+  detail::keep_closest(r.events, events);
   const auto stop = std::find_if(r.events.begin(), r.events.end(),
                                  [&](const EventHit& h) { return options.events[h.event].stop; });
   if (stop == r.events.end()) {
@@ -409,6 +410,9 @@ Stepper::Stepper(const MethodInfo& method, Body body, std::vector<Centre> centre
   // A segment has no error estimate of its own (a companion per segment would compare segments that
   // start from one state, not the runs).
   options_.estimate_error = false;
+  // A departure through the start's distance is the stepper's start, not each segment's.
+  detail::validate_events(options_.events, centres_);
+  options_.events = detail::resolved(options_.events, body_.p, centres_, body_.s0);
 }
 
 Stepper::Stepper(std::string_view method, Body body, std::vector<Centre> centres, double step, Options options)
@@ -444,6 +448,7 @@ Outcome Stepper::advance_to(double t) {
     h.t += t0;
     events_.push_back(h);
   }
+  detail::keep_closest(events_, options_.events);  // the closest approach so far
   body_.s0 = r.run.final;
   stopped_ = r.run.stopped;
   t_ = r.run.stopped ? t0 + r.run.t_end : t;

@@ -91,20 +91,27 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
   }
 }
 
-/// The row of a run with its encounter (SweepSpec::scattering): integrate_body with every centre's
-/// closest approach as events, then scattering() of the run.
+/// The row of a run with its encounter (SweepSpec::scattering): integrate_body with the encounter's
+/// events (encounter_options: it stops at the departure, the sweep's end the latest), measured by
+/// measure_encounter; an encounter that did not finish by the end is the row's outcome (incomplete).
 SweepRow encounter_row(SweepRow row, const MethodInfo& method, const Scene& scene, const Advance& how,
                        const SweepSpec& spec) {
   const Body& body = scene.bodies.front();
-  Options options = sweep_options(spec);
-  options.events = closest_approaches(scene.centres.size());
+  const Options options = encounter_options(body, scene.centres, sweep_options(spec), true);
   BodyResult r = integrate_body(body, scene.centres, &method, how, options);
-  if (const EventHit* nearest = nearest_approach(r.events, options.events)) {
-    row.r_min = nearest->distance;
-    row.t_min = nearest->t;
+  if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return result_row(std::move(row), std::move(r));
+  const Encounter e = measure_encounter(body, scene.centres, r.run, r.events, options.events);
+  row.r_min = e.r_min;
+  row.t_min = e.t_min;
+  row.asymptote_error = e.asymptote_error;
+  row = result_row(std::move(row), std::move(r));
+  if (row.outcome != Outcome::ok) return row;
+  row.scattering = e.scattering;
+  if (e.outcome != Outcome::ok) {
+    row.outcome = e.outcome;
+    row.reason = e.reason;
   }
-  if (r.outcome == Outcome::ok) row.scattering = scattering(body.p, scene.centres, body.s0, r.run.final, r.run.t_end);
-  return result_row(std::move(row), std::move(r));
+  return row;
 }
 
 }  // namespace

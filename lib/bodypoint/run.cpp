@@ -296,6 +296,7 @@ std::string_view outcome_name(Outcome o) {
     case Outcome::failed: return "failed";
     case Outcome::unresolved: return "unresolved";
     case Outcome::inaccurate: return "inaccurate";
+    case Outcome::incomplete: return "incomplete";
   }
   return "?";
 }

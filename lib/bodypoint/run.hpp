@@ -244,8 +244,10 @@ enum class Outcome {
   failed,      ///< started but stopped: a budget, a time transformation that broke down, an accuracy out of reach
   unresolved,  ///< a step turned the spin by more than pi or the direction to a centre by more than pi/2
   inaccurate,  ///< the energy error exceeded the bound asked for (but not 1)
+  incomplete,  ///< an encounter whose run ended before the body left: it has no scattering observables
 };
-/// The outcome as one word, for outputs (ok, diverged, collision, refused, failed, unresolved, inaccurate).
+/// The outcome as one word, for outputs (ok, diverged, collision, refused, failed, unresolved, inaccurate,
+/// incomplete).
 std::string_view outcome_name(Outcome o);
 
 struct Health {

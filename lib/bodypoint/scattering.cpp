@@ -67,18 +67,32 @@ std::optional<KeplerParticle> kepler_particle(const BodyPoint& p, const State& s
   }
   const double K1sq = q.K1.squaredNorm();
   const double drift = p.J * K1sq - p.B * q.K2.dot(q.K1);  // u |K1| D
-  if (!(K1sq > 0.0) || !(drift > 0.0)) return std::nullopt;
-  k.mu = p.D() * K1sq / drift;
+  if (!(K1sq > 0.0) || drift == 0.0 || !std::isfinite(drift)) return std::nullopt;
+  // G moves at u K1/|K1|. Drifting against K1 (u < 0, a spin along K1 that outweighs it) it is a
+  // particle of momentum -K1, which the field pushes the other way: kappa's sign turns.
+  k.mu = p.D() * K1sq / std::abs(drift);
   k.X = s.R + q.K1.cross(q.K2) / K1sq - c;
+  if (drift < 0.0) {
+    k.P = -q.K1;
+    k.kappa_sign = -1.0;
+  }
   return k;
 }
 
 namespace {
 
-/// One leg's Coulomb time delay, -kappa/(mu v_inf^3) (1 + ln e) (scattering.hpp, time_delay).
-double leg_delay(double mu, double kappa, const Periapsis& q, double p_inf) {
-  const double v = p_inf / mu;
-  return kappa == 0.0 ? 0.0 : -kappa / (mu * v * v * v) * (1.0 + std::log(q.e));
+/// One leg's Coulomb time delay, -kappa/(mu v_inf^3) (1 + ln e) (scattering.hpp, time_delay), and for
+/// a spinning body the term that makes the delay converge: the guiding centre's kinetic energy
+/// (J P^2 - 2 B K2.K1/|K1| P)/(2D) is not P^2/(2 mu), so its time along a leg grows as
+/// r/v + kappa J/(D v^3) ln r, not kappa/(mu v^3) ln r as the Kepler hyperbola's; the difference,
+/// -kappa/v^3 (J/D - 1/mu) ln(2 r/a) at the leg's distance r (a = |kappa|/(mu v^2)), is added (0 for B = 0).
+/// A guiding centre drifting against K1 (kappa_sign -1, kappa the leg's) slows as |K1| grows: s J/D.
+double leg_delay(const BodyPoint& b, const KeplerParticle& k, double kappa, const Periapsis& q, double p_inf) {
+  if (kappa == 0.0) return 0.0;
+  const double v = p_inf / k.mu, v3 = v * v * v;
+  const double a = std::abs(kappa) / (k.mu * v * v);
+  const double spin = b.B == 0.0 ? 0.0 : -kappa / v3 * (k.kappa_sign * b.J / b.D() - 1.0 / k.mu) * std::log(2.0 * k.X.norm() / a);
+  return -kappa / (k.mu * v3) * (1.0 + std::log(q.e)) + spin;
 }
 
 }  // namespace
@@ -110,12 +124,12 @@ Scattering scattering(const BodyPoint& p, const std::vector<Centre>& centres, co
   }
   const auto in = kepler_particle(p, start, k.c), fin = kepler_particle(p, end, k.c);
   if (!in || !fin) {
-    out.asymptotes = "none: the body does not drift along K1";
+    out.asymptotes = "none: the guiding centre does not drift (u = 0)";
     return out;
   }
-  const double kappa = -k.A;
-  out.in = kepler_asymptote(in->mu, kappa, in->X, in->P, false);
-  out.out = kepler_asymptote(fin->mu, kappa, fin->X, fin->P, true);
+  const double kappa_in = -k.A * in->kappa_sign, kappa_out = -k.A * fin->kappa_sign;
+  out.in = kepler_asymptote(in->mu, kappa_in, in->X, in->P, false);
+  out.out = kepler_asymptote(fin->mu, kappa_out, fin->X, fin->P, true);
   if (!out.in || !out.out) {
     out.asymptotes = "none: the orbit is bound (energy at infinity <= 0)";
     out.in.reset();
@@ -129,10 +143,11 @@ Scattering scattering(const BodyPoint& p, const std::vector<Centre>& centres, co
   const Vec3 normal = out.in->direction.cross(out.in->impact);
   out.out_of_plane = normal.squaredNorm() > 0.0 ? std::asin(std::clamp(out.out->direction.dot(normal.normalized()), -1.0, 1.0))
                                                 : 0.0;
-  const auto q_in = kepler_periapsis(in->mu, kappa, in->X, in->P), q_out = kepler_periapsis(fin->mu, kappa, fin->X, fin->P);
+  const auto q_in = kepler_periapsis(in->mu, kappa_in, in->X, in->P);
+  const auto q_out = kepler_periapsis(fin->mu, kappa_out, fin->X, fin->P);
   if (std::isfinite(elapsed) && q_in && q_out)
-    out.time_delay = elapsed - q_in->dt + q_out->dt + leg_delay(in->mu, kappa, *q_in, out.in->p_inf) +
-                     leg_delay(fin->mu, kappa, *q_out, out.out->p_inf);
+    out.time_delay = elapsed - q_in->dt + q_out->dt + leg_delay(p, *in, kappa_in, *q_in, out.in->p_inf) +
+                     leg_delay(p, *fin, kappa_out, *q_out, out.out->p_inf);
   return out;
 }
 
@@ -149,7 +164,7 @@ std::pair<Asymptote, double> incoming(const SceneParams& p) {
   const Body& body = s.bodies.front();
   const auto k = kepler_particle(body.p, body.s0, s.centres.front().c);
   if (!k) throw Error("the scene's body does not drift along K1: it has no incoming asymptote");
-  const auto a = kepler_asymptote(k->mu, -s.centres.front().A, k->X, k->P, false);
+  const auto a = kepler_asymptote(k->mu, -s.centres.front().A * k->kappa_sign, k->X, k->P, false);
   if (!a) throw Error("the scene's orbit is bound (energy at infinity <= 0): it has no incoming asymptote");
   return {*a, k->mu};
 }

@@ -58,10 +58,13 @@ struct Periapsis {
 std::optional<Periapsis> kepler_periapsis(double mu, double kappa, const Vec3& X, const Vec3& P);
 
 /// The Kepler particle a body-point's state is far from a centre at c: (mu, X, P) as above (B = 0:
-/// the body itself; B != 0: its guiding centre). Nothing when it does not drift along K1 (u <= 0).
+/// the body itself; B != 0: its guiding centre). Nothing when the guiding centre does not drift (u = 0).
 struct KeplerParticle {
   double mu = 0.0;
   Vec3 X = Vec3::Zero(), P = Vec3::Zero();
+  /// +1; -1 when the guiding centre drifts against K1 (u < 0): then P = -K1, and the centre's force
+  /// acts on the particle as kappa_sign * kappa (a repelling centre attracts it).
+  double kappa_sign = 1.0;
 };
 std::optional<KeplerParticle> kepler_particle(const BodyPoint& p, const State& s, const Vec3& c);
 

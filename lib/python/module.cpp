@@ -161,25 +161,6 @@ Advance advance_of_keywords(const MethodInfo* m, std::optional<double> h, std::o
   return advance_for(m, request);
 }
 
-Event event_from(const std::string& text) {
-  // The library's events by the command line's names: closest, closest:K, r=V, r:K=V.
-  Event e;
-  const auto eq = text.find('=');
-  const std::string key = text.substr(0, eq);
-  const std::string name = key.substr(0, key.find(':'));
-  const std::size_t centre = key.find(':') == std::string::npos ? 0 : std::stoul(key.substr(key.find(':') + 1));
-  if (name == "closest" && eq == std::string::npos) {
-    e.kind = Event::Kind::closest_approach;
-  } else if (name == "r" && eq != std::string::npos) {
-    e.kind = Event::Kind::radius;
-    e.value = std::stod(text.substr(eq + 1));
-  } else {
-    throw Error("event '" + text + "': use closest, closest:K, r=V or r:K=V");
-  }
-  e.centre = centre;
-  return e;
-}
-
 py::dict integrate_py(const Scene& scene, const std::string& method, std::optional<double> h,
                       std::optional<long> steps, std::optional<double> t_end, std::optional<double> tol,
                       bool invariants, double omega_c, const std::vector<std::string>& event_names,
@@ -194,7 +175,7 @@ py::dict integrate_py(const Scene& scene, const std::string& method, std::option
   o.max_energy_error = max_energy_error;
   o.estimate_error = estimate_error;
   o.max_error = max_error;
-  for (const std::string& e : event_names) o.events.push_back(event_from(e));
+  for (const std::string& e : event_names) o.events.push_back(parse_event(e));
   Result r;
   {
     py::gil_scoped_release free;
@@ -318,35 +299,41 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
   return cols;
 }
 
+py::object number_or_none(double x) { return std::isfinite(x) ? py::object(py::float_(x)) : py::object(py::none()); }
+
 py::dict encounter_py(const Scene& scene, const std::string& method, double tol, double t_end) {
   const MethodInfo* m = method == "auto" ? nullptr : &method_or_throw(method);
+  validate(scene);
   Options o;
   o.track_invariants = false;
-  o.events = closest_approaches(scene.centres.size());
-  Result r;
+  EncounterResult r;
   {
     py::gil_scoped_release free;
-    r = integrate(scene, m, Accuracy{tol, t_end}, o);
+    r = encounter(scene.bodies.front(), scene.centres, m, tol, t_end, o);
   }
-  if (r.outcome != Outcome::ok) throw Error(r.reason);
-  const Body& body = scene.bodies.front();
-  const BodyResult& br = r.bodies.front();
-  const Scattering sc = scattering(body.p, scene.centres, body.s0, br.run.final, br.run.t_end);
+  if (r.run.outcome != Outcome::ok) throw Error(r.run.reason);
+  const BodyResult& br = r.run;
+  const Encounter& e = r.encounter;
+  const Scattering& sc = e.scattering;
   py::dict d;
   d["method"] = br.method ? br.method->name : std::string();
-  d["deflection"] = sc.deflection;
-  d["out_of_plane"] = sc.out_of_plane;
-  d["b"] = sc.b;
-  d["v_inf"] = sc.v_inf;
-  d["time_delay"] = sc.time_delay;
+  d["outcome"] = std::string(outcome_name(e.outcome));
+  d["reason"] = e.reason;
+  d["deflection"] = number_or_none(sc.deflection);
+  d["out_of_plane"] = number_or_none(sc.out_of_plane);
+  d["b"] = number_or_none(sc.b);
+  d["v_inf"] = number_or_none(sc.v_inf);
+  d["time_delay"] = number_or_none(sc.time_delay);
+  d["asymptote_error"] = number_or_none(e.asymptote_error);
+  d["asymptote_basis"] = e.asymptote_basis;
   d["K1_turn"] = sc.K1_turn;
   d["spin_turn"] = sc.spin_turn;
   d["asymptotes"] = sc.asymptotes;
   d["K1_start"] = vec(sc.K1_start);
   d["K1_end"] = vec(sc.K1_end);
-  const EventHit* nearest = nearest_approach(br.events, o.events);
-  d["r_min"] = nearest ? nearest->distance : kNaN;
-  d["t_min"] = nearest ? nearest->t : kNaN;
+  d["r_min"] = e.r_min;
+  d["t_min"] = e.t_min;
+  d["t_end"] = br.run.t_end;
   d["err_estimate"] = br.accuracy ? br.accuracy->err_estimate : kNaN;
   d["force_evals"] = br.total_force_evals();
   return d;

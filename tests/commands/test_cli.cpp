@@ -301,7 +301,8 @@ TEST(Cli, ObserveAddsTheSpinAngleColumn) {
 }
 
 TEST(Cli, ScatteringAndEventsAreTheLibrarysToTheLastBit) {
-  const Result r = run_cli("simulate --method lp-y8 --h 2e-3 --steps 4000 --B 0 --d 2 --L 20 --scattering --event r=5 --json");
+  // 5000 steps (t = 10): the body, at speed ~5 from L = 20, is back beyond its start distance, receding.
+  const Result r = run_cli("simulate --method lp-y8 --h 2e-3 --steps 5000 --B 0 --d 2 --L 20 --scattering --event r=5 --json");
   ASSERT_EQ(r.code, 0) << r.err;
   SceneParams p;
   p.B = 0.0;
@@ -311,7 +312,7 @@ TEST(Cli, ScatteringAndEventsAreTheLibrarysToTheLastBit) {
   const Body& b = s.bodies.front();
   Options o;
   o.events = {Event{Event::Kind::radius, 0, 5.0, Vec3::UnitX()}, Event{}};
-  const bodypoint::Result lib = integrate(s, "lp-y8", FixedSteps{2e-3, 4000}, o);
+  const bodypoint::Result lib = integrate(s, "lp-y8", FixedSteps{2e-3, 5000}, o);
   ASSERT_EQ(lib.outcome, Outcome::ok);
   const Scattering sc = scattering(b.p, s.centres, b.s0, lib.bodies.front().run.final);
   EXPECT_EQ(json_num(r.out, "deflection"), sc.deflection);
@@ -320,7 +321,7 @@ TEST(Cli, ScatteringAndEventsAreTheLibrarysToTheLastBit) {
   EXPECT_EQ(json_num(r.out, "t_min"), lib.bodies.front().events[1].t);
   EXPECT_NE(r.out.find("\"asymptotes\": \"kepler\""), std::string::npos);
   EXPECT_NE(r.out.find("\"event\": \"r=5\""), std::string::npos);
-  test::expect_refused("simulate --steps 10 ", {{"--event nearest", "unknown --event 'nearest'"},
+  test::expect_refused("simulate --steps 10 ", {{"--event nearest", "unknown event 'nearest'"},
                                                 {"--event r=abc", "is not a finite number"},
                                                 {"--event r:4=5", "the scene has 1 centre(s)"},
                                                 {"--event plane=0,0,0,1", "normal must not be zero"}});
@@ -328,7 +329,7 @@ TEST(Cli, ScatteringAndEventsAreTheLibrarysToTheLastBit) {
 
 TEST(Cli, SweepScatteringColumnsAreThoseOfSingleRuns) {
   // A sweep over the impact parameter with two families; each row's encounter columns equal, to the
-  // last bit, simulate's --scattering --json for the same scene given by --b.
+  // last bit, simulate's --scattering --json for the same scene given by --b (both stop at the departure).
   const fs::path csv = test::temp_path("bp_sweep_scattering.csv");
   const std::string common = " --B 0 --L 50 --h 0.01 --t-end 25";
   const Result sweep = run_cli("sweep --param b --values 0.5,2 --methods lp-kl8,ks --scattering --threads 2 --out " +
@@ -348,7 +349,7 @@ TEST(Cli, SweepScatteringColumnsAreThoseOfSingleRuns) {
     std::map<std::string, std::string> row;
     for (std::size_t i = 0; i < f.size(); ++i) row.emplace(names[i], f[i]);  // the first "b" is the varied one
     const Result one = run_cli("simulate --method " + row.at("method") + " --b " + row.at("b") + common +
-                               " --scattering --json --quiet");
+                               " --stop-at departure --scattering --json --quiet");
     ASSERT_EQ(one.code, 0) << one.err;
     for (const char* key : {"deflection", "r_min", "t_min", "time_delay", "spin_turn"})
       EXPECT_EQ(std::stod(row.at(key)), json_num(one.out, key)) << row.at("method") << " b = " << row.at("b") << ": " << key;
@@ -373,7 +374,8 @@ TEST(Cli, StopAtEndsTheRunAtTheEvent) {
   ASSERT_EQ(never.code, 0) << never.err;
   EXPECT_NE(never.out.find("\"stopped_by\": null"), std::string::npos);
   EXPECT_EQ(json_num(never.out, "t_end"), 4.0);
-  test::expect_refused("simulate --steps 10 ", {{"--stop-at nowhere", "unknown --event 'nowhere'"},
+  test::expect_refused("simulate --steps 10 ", {{"--stop-at nowhere", "unknown event 'nowhere'"},
+                                                {"--stop-at closest", "cannot stop at its closest approach"},
                                                 {"--b 1 --d 2", "give --b or --d, not both"},
                                                 {"--v-inf 0", "--v-inf must be a finite number > 0"}});
 }

@@ -128,10 +128,37 @@ def test_rutherford_deflection_for_a_material_point():
     A, m = -2.0, 1.0
     for b in (0.1, 1.0, 10.0):
         scene = bp.thesis_scene(B=0, b=b)
-        e = bp.encounter(scene, t_end=2 * 200 / 5.0, tol=1e-12)
+        e = bp.encounter(scene, tol=1e-12)  # to its departure: back at the start distance
+        assert e["outcome"] == "ok" and e["asymptote_error"] == 0.0
         rutherford = 2 * math.atan(abs(A) / (m * e["v_inf"] ** 2 * e["b"]))
         assert abs(e["deflection"] / rutherford - 1) < RUTHERFORD_TOL, b
         assert abs(e["b"] / b - 1) < 1e-12
+
+
+def test_an_unfinished_encounter_has_no_deflection():
+    # Issue #42's example: t_end = 20 ends the pass near the centre (K1 has turned by 8e-6 rad).
+    scene = bp.thesis_scene(B=0.7, b=1.0)
+    cut = bp.encounter(scene, t_end=20)
+    assert cut["outcome"] == "incomplete" and "did not finish" in cut["reason"]
+    assert cut["deflection"] is None and cut["b"] is None and cut["time_delay"] is None
+    done = bp.encounter(scene)
+    assert done["outcome"] == "ok" and done["reason"] == ""
+    assert abs(done["deflection"] - 0.2876) < 1e-4  # the finished encounter's, as the issue measured it
+    # the closest approach is the encounter's global minimum, not the helix's first wiggle
+    hits = bp.integrate(scene, "lp-kl8", h=0.01, t_end=60, events=["local-min"])["bodies"][0]["events"]
+    assert done["r_min"] <= min(h["distance"] for h in hits) * (1 + 1e-9)
+    assert done["asymptote_error"] < 1e-6
+
+
+def test_events_are_the_librarys_grammar():
+    scene = bp.thesis_scene(B=0.7, b=1.0)
+    r = bp.integrate(scene, "lp-kl8", h=0.01, t_end=60, events=["x=0", "plane=1,0,0,0", "departure", "closest"])
+    names = [h["event"] for h in r["bodies"][0]["events"]]
+    assert names.count("x=0") == 2 and names.count("closest") == 1 and "departure" in names
+    for bad, why in (("r=abc", "not a finite number"), ("closest:99999999999999999999", "centre must be an index"),
+                     ("r=5garbage", "not a finite number"), ("r=1e400", "not a finite number"), ("nearest", "unknown event")):
+        with pytest.raises(bp.Error, match=why):
+            bp.integrate(scene, "lp-kl8", h=0.01, t_end=1, events=[bad])
 
 
 def test_scene_from_dicts_and_from_a_file_are_one_scene():

@@ -56,22 +56,40 @@ namespace bodypoint {
 /// time-transformed, regularised and step-size-controlled, serves as its own dense output.
 struct Event {
   enum class Kind {
-    closest_approach,  ///< a local minimum of |R - c| (g = (R - c).v turns from < 0 to >= 0)
-    radius,            ///< |R - c| crosses `value`, either way
-    plane,             ///< normal.R crosses `value`, either way
+    /// The run's closest approach to a centre: the smallest of the local minima of |R - c| (a spinning
+    /// body's helix makes several). Only that one is reported; it cannot stop a run (it is known only
+    /// at the run's end).
+    closest_approach,
+    local_minimum,  ///< every local minimum of |R - c| (g = (R - c).v turns from < 0 to >= 0)
+    radius,         ///< |R - c| crosses `value`, either way
+    plane,          ///< normal.R crosses `value`, either way
+    /// The guiding centre G = R + K1 x K2/|K1|^2 (B = 0: the body) crosses the distance `value` from
+    /// the centre outward; value 0: its distance at the start of the run (the encounter has ended).
+    departure,
+    arrival,  ///< G crosses the distance `value` > 0 from the centre inward
   };
   Kind kind = Kind::closest_approach;
-  std::size_t centre = 0;  ///< closest_approach, radius: which of the scene's centres
-  double value = 0.0;      ///< radius: the distance; plane: the offset
+  std::size_t centre = 0;  ///< every kind but plane: which of the scene's centres
+  double value = 0.0;      ///< radius, departure, arrival: the distance; plane: the offset
   Vec3 normal = Vec3::UnitX();
   /// The run ends at this event's first hit: the state there is the run's final state (RunResult::
   /// stopped, t_end its time) and the last of BodyResult::events. A fixed-step, time-transformed or
   /// step-size-controlled run stops stepping on the step that crosses it; the accuracy mode searches
   /// its step over the whole span t_end and delivers the run cut at the event.
   bool stop = false;
-  /// "closest", "r=5", "plane(1,0,0)=0": for outputs and messages.
+  /// "closest", "local-min(1)", "r=5", "plane(1,0,0)=0", "departure": for outputs and messages.
   [[nodiscard]] std::string label() const;
 };
+
+/// An event from its text, the one grammar of the command line, scene tools and Python:
+///   closest, closest:K        the closest approach (to centre K)
+///   local-min, local-min:K    every local minimum of the distance
+///   r=V, r:K=V                the distance crosses V
+///   x=X, y=Y, z=Z, plane=nx,ny,nz,offset
+///   departure, departure=V, departure:K=V   the guiding centre leaves through V (the start distance)
+///   arrival=V, arrival:K=V    the guiding centre comes in through V
+/// Throws Error with the text and what is wrong with it.
+Event parse_event(std::string_view text);
 
 /// One located event.
 struct EventHit {
@@ -211,6 +229,58 @@ BodyResult integrate_body(const Body& body, const std::vector<Centre>& centres, 
 Result integrate(const Scene& scene, const MethodInfo* method, const Advance& how, const Options& options = {});
 /// The same with the method by name; "auto" with Accuracy chooses per body.
 Result integrate(const Scene& scene, std::string_view method, const Advance& how, const Options& options = {});
+
+// --- Encounters ---
+
+/// A body's encounter with a single centre, measured on a run: the observables of scattering.hpp
+/// when the encounter finished, and whether it did. An encounter has finished when the guiding
+/// centre G (B = 0: the body) recedes from every centre and is at least as far from each as at the
+/// start: back at its start distance on the way out (the departure event stops a run there).
+struct Encounter {
+  Outcome outcome = Outcome::ok;  ///< ok; incomplete when the run ended before the body left
+  std::string reason;             ///< of incomplete: where the run ended
+  /// The two ends' observables (K1, K2, E, turns: always); asymptotes, deflection, b, v_inf and time
+  /// delay only when ok.
+  Scattering scattering;
+  double r_min = Scattering::kNaN, t_min = Scattering::kNaN;  ///< the closest approach (to any centre)
+  /// Estimated error of the deflection that the asymptotes' model leaves at the run's distances (the
+  /// guiding centre is a Kepler particle only far away): the change of the deflection between the
+  /// asymptotes taken at the run's ends and at half the start distance, over 2^p - 1 with p =
+  /// kAsymptoteFall. 0 for B = 0 (Kepler's asymptotes are exact); NaN when not known (no
+  /// asymptotes, or the body never came within half its start distance).
+  double asymptote_error = Scattering::kNaN;
+  std::string asymptote_basis;  ///< how asymptote_error was obtained, or why it is not known
+};
+
+/// The slowest fall of the asymptotes' model error with the distance L measured (L^-2.7; study
+/// --name scattering, docs/physics.md "Scattering"): halving the distance raises it at least 2^2.7x.
+inline constexpr double kAsymptoteFall = 2.7;
+/// A run with no end time given ends at the departure, or after this many free passes (twice the
+/// start distance over the speed at infinity), then incomplete.
+inline constexpr double kEncounterSpans = 2.0;
+
+/// The events an encounter's run needs, added to `options`: every centre's closest approach; with a
+/// single centre, the guiding centre's arrival at and departure from half its start distance (the
+/// asymptotes' error estimate) and, with `stop_at_departure`, its departure through the start distance
+/// as a stop event. The caller's events stay first, with their indices.
+Options encounter_options(const Body& body, const std::vector<Centre>& centres, Options options, bool stop_at_departure);
+
+/// The encounter of `body` on its run (`run` and the hits of `events`, as encounter_options made them).
+Encounter measure_encounter(const Body& body, const std::vector<Centre>& centres, const RunResult& run,
+                            const std::vector<EventHit>& hits, const std::vector<Event>& events);
+
+/// The end time an encounter of `body` runs to when none is given: kEncounterSpans free passes. Error
+/// when the body has no speed at infinity (a bound orbit, several centres).
+double encounter_span(const Body& body, const std::vector<Centre>& centres);
+
+/// One body's encounter with the accuracy mode (tol; method nullptr: auto): the run stops at the
+/// departure, by t_end (NaN: encounter_span). A run that is not ok keeps its outcome and reason.
+struct EncounterResult {
+  BodyResult run;
+  Encounter encounter;
+};
+EncounterResult encounter(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method, double tol,
+                          double t_end = Scattering::kNaN, Options options = {});
 
 /// One body advanced in segments: advance_to(t) integrates from the current time to t and may be
 /// called again to continue. Each segment starts from the state the previous one ended in, as a run

@@ -56,8 +56,9 @@ struct SweepSpec {
   long steps = 0;           ///< fixed number of steps, or 0 when t_end is fixed
   double t_end = 0;         ///< fixed end time (steps = ceil(t_end/h), h = t_end/steps), or 0
   double tol = kDefaultStepTolerance;  ///< step-size-controlled methods: tolerance per step
-  /// Also locate each run's closest approaches and report the encounter (SweepRow::scattering): each
-  /// task then runs alone through integrate_body (no vector lanes), the same run with an observer.
+  /// Also report each run's encounter (SweepRow::scattering): each task then runs alone through
+  /// integrate_body (no vector lanes) with the encounter's events; it stops when the body has left
+  /// (the departure event) or at the sweep's end, and is incomplete if it had not left by then.
   bool scattering = false;
   double max_energy_error = kDefaultMaxEnergyError;  ///< Options::max_energy_error of every run
   bool estimate_error = true;                        ///< Options::estimate_error of every run
@@ -100,10 +101,12 @@ struct SweepRow {
   RunResult result;    ///< final state NaN when refused or failed
   ErrorEstimate error;                ///< the run's estimated error, or why it has none (ErrorEstimate)
   std::vector<std::string> warnings;  ///< what a heuristic saw but the estimate overruled
-  /// With SweepSpec::scattering, a run that finished: its encounter (time delay included) and the
-  /// closest of its closest approaches to any centre (NaN when the distance had no minimum).
+  /// With SweepSpec::scattering, a run that reached its end (outcome ok, or incomplete: an encounter
+  /// that had not finished, whose asymptotes and deflection are then NaN): its encounter (time delay
+  /// included), the closest approach to any centre (NaN when the distance had no minimum) and the
+  /// asymptotes' model error in the deflection (Encounter::asymptote_error).
   std::optional<Scattering> scattering;
-  double r_min = Scattering::kNaN, t_min = Scattering::kNaN;
+  double r_min = Scattering::kNaN, t_min = Scattering::kNaN, asymptote_error = Scattering::kNaN;
 };
 
 /// The tasks of `todo` in units: batches of up to batch::width() tasks of one method and step whose

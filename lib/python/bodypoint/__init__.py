@@ -109,8 +109,14 @@ def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, threads=1, ma
                         bool(estimate_error), float(max_error))
 
 
-def encounter(scene, *, t_end, method="auto", tol=1e-10):
-    """The first body's encounter in the accuracy mode: deflection, out_of_plane, b, v_inf, time_delay,
-    K1_turn, spin_turn, r_min, t_min (closest approach to any centre), asymptotes, err_estimate
-    (docs/physics.md, Scattering)."""
-    return _core._encounter(scene, method, tol, t_end)
+def encounter(scene, *, t_end=None, method="auto", tol=1e-10):
+    """The first body's encounter in the accuracy mode (docs/physics.md, Scattering).
+
+    Without t_end the run stops when the body has left (its guiding centre back at its start distance),
+    at the latest after two free passes; with t_end it runs to t_end. Returns outcome ("ok", or
+    "incomplete" when the run ended before the body left: then deflection, out_of_plane, b, v_inf and
+    time_delay are None), reason, deflection, out_of_plane, b, v_inf, time_delay, asymptote_error (the
+    asymptotes' model error in the deflection; 0 for B = 0) and asymptote_basis, K1_turn, spin_turn,
+    r_min, t_min (the closest approach to any centre), asymptotes, err_estimate (the run's), force_evals.
+    A run that is not ok (refused, diverged, ...) raises bodypoint.Error."""
+    return _core._encounter(scene, method, tol, float("nan") if t_end is None else t_end)

@@ -1,0 +1,141 @@
+// bodypoint: an encounter measured on a run (bodypoint.hpp, Encounter; scattering.hpp).
+#include "bodypoint/bodypoint.hpp"
+#include "bodypoint/io.hpp"
+#include "events.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace bodypoint {
+namespace {
+
+/// A finished encounter's guiding centre is back at its start distance; the departure event locates
+/// that distance to round-off in time (~1e-15 relative), and this much slack covers the located
+/// state's own error without calling a body that is still inside "finished".
+constexpr double kLeftSlack = 1e-9;
+
+double start_distance(const Body& body, const Centre& c) { return (detail::guiding_centre(body.p, body.s0) - c.c).norm(); }
+
+bool has_event(const std::vector<Event>& events, Event::Kind kind, std::size_t centre, bool stop) {
+  return std::any_of(events.begin(), events.end(),
+                     [&](const Event& e) { return e.kind == kind && e.centre == centre && e.stop == stop; });
+}
+
+/// Why the run ended before the body left, or empty when it had left.
+std::string unfinished(const Body& body, const std::vector<Centre>& centres, const RunResult& run) {
+  for (std::size_t k = 0; k < centres.size(); ++k) {
+    const double r0 = start_distance(body, centres[k]);
+    const Vec3 G = detail::guiding_centre(body.p, run.final) - centres[k].c;
+    const auto particle = kepler_particle(body.p, run.final, centres[k].c);
+    const bool receding = particle && particle->X.dot(particle->P) > 0.0;
+    if (receding && G.norm() >= r0 * (1.0 - kLeftSlack)) continue;
+    const std::string where = centres.size() > 1 ? " from centre " + std::to_string(k) : "";
+    return "the run ended at t = " + fmt(run.t_end) + " with the " + (body.p.B == 0.0 ? "body" : "guiding centre") +
+           " at distance " + fmt(G.norm()) + where + ", " + (receding ? "receding" : "not receding") +
+           ", against " + fmt(r0) + " at the start: the encounter did not finish (run longer, or to its departure)";
+  }
+  return "";
+}
+
+/// The first hit of an event of `kind` through `value` (not a stop), or nullptr.
+const EventHit* marker(const std::vector<EventHit>& hits, const std::vector<Event>& events, Event::Kind kind, double value,
+                       bool last) {
+  const EventHit* found = nullptr;
+  for (const EventHit& h : hits) {
+    const Event& e = events[h.event];
+    if (e.kind == kind && !e.stop && e.value == value && (!found || last)) found = &h;
+  }
+  return found;
+}
+
+void estimate_asymptote_error(Encounter& e, const Body& body, const std::vector<Centre>& centres,
+                              const std::vector<EventHit>& hits, const std::vector<Event>& events) {
+  if (!std::isfinite(e.scattering.deflection)) {
+    e.asymptote_basis = "not known: no asymptotes";
+    return;
+  }
+  if (body.p.B == 0.0) {
+    e.asymptote_error = 0.0;
+    e.asymptote_basis = "exact: a material point's asymptotes are its Kepler orbit's";
+    return;
+  }
+  const double half = 0.5 * start_distance(body, centres.front());
+  const EventHit* in = marker(hits, events, Event::Kind::arrival, half, false);
+  const EventHit* out = marker(hits, events, Event::Kind::departure, half, true);
+  if (!in || !out || out->t <= in->t) {
+    e.asymptote_basis = "not known: the guiding centre did not pass half its start distance (" + fmt(half) + ") both ways";
+    return;
+  }
+  const double theta_half = scattering(body.p, centres, in->s, out->s).deflection;
+  e.asymptote_error = std::abs(e.scattering.deflection - theta_half) / (std::pow(2.0, kAsymptoteFall) - 1.0);
+  e.asymptote_basis = "deflection at the run's ends against at half the start distance (" + fmt(half) + "), over 2^" +
+                      fmt(kAsymptoteFall) + " - 1";
+}
+
+}  // namespace
+
+Options encounter_options(const Body& body, const std::vector<Centre>& centres, Options options, bool stop_at_departure) {
+  using K = Event::Kind;
+  for (std::size_t k = 0; k < centres.size(); ++k)
+    if (!has_event(options.events, K::closest_approach, k, false)) options.events.push_back(Event{K::closest_approach, k});
+  if (centres.size() != 1) return options;
+  const double half = 0.5 * start_distance(body, centres.front());
+  options.events.push_back(Event{K::arrival, 0, half});
+  options.events.push_back(Event{K::departure, 0, half});
+  if (stop_at_departure && !has_event(options.events, K::departure, 0, true)) {
+    Event leave{K::departure, 0, 0.0};
+    leave.stop = true;
+    options.events.push_back(leave);
+  }
+  return options;
+}
+
+Encounter measure_encounter(const Body& body, const std::vector<Centre>& centres, const RunResult& run,
+                            const std::vector<EventHit>& hits, const std::vector<Event>& events) {
+  Encounter e;
+  e.scattering = scattering(body.p, centres, body.s0, run.final, run.t_end);
+  if (const EventHit* nearest = nearest_approach(hits, events)) {
+    e.r_min = nearest->distance;
+    e.t_min = nearest->t;
+  }
+  e.reason = unfinished(body, centres, run);
+  if (!e.reason.empty()) {
+    e.outcome = Outcome::incomplete;
+    Scattering& sc = e.scattering;
+    if (sc.in) sc.asymptotes = "none: the encounter did not finish";
+    sc.in.reset();
+    sc.out.reset();
+    sc.deflection = sc.out_of_plane = sc.b = sc.v_inf = sc.time_delay = Scattering::kNaN;
+    e.asymptote_basis = "not known: the encounter did not finish";
+    return e;
+  }
+  estimate_asymptote_error(e, body, centres, hits, events);
+  return e;
+}
+
+double encounter_span(const Body& body, const std::vector<Centre>& centres) {
+  if (centres.size() != 1) throw Error("an encounter without an end time t_end needs a single centre (give t_end)");
+  const auto k = kepler_particle(body.p, body.s0, centres.front().c);
+  const auto a = k ? kepler_asymptote(k->mu, -centres.front().A * k->kappa_sign, k->X, k->P, false) : std::nullopt;
+  if (!a) throw Error("the body has no speed at infinity (a bound orbit, or a guiding centre at rest): give t_end");
+  return kEncounterSpans * 2.0 * k->X.norm() / (a->p_inf / k->mu);
+}
+
+EncounterResult encounter(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method, double tol,
+                          double t_end, Options options) {
+  const bool to_departure = std::isnan(t_end);
+  const double end = to_departure ? encounter_span(body, centres) : t_end;
+  const Options o = encounter_options(body, centres, std::move(options), to_departure);
+  EncounterResult r{integrate_body(body, centres, method, Accuracy{tol, end}, o), {}};
+  if (r.run.outcome != Outcome::ok) {
+    r.encounter.outcome = r.run.outcome;
+    r.encounter.reason = r.run.reason;
+    return r;
+  }
+  r.encounter = measure_encounter(body, centres, r.run.run, r.run.events, o.events);
+  return r;
+}
+
+}  // namespace bodypoint
