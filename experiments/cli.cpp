@@ -48,6 +48,8 @@ void add_scene_options(po::options_description& desc, SceneOptions& o) {
       ("b", po::value(&o.b), "the scene by its impact parameter b (of the incoming asymptote): d is solved for it "
        "(docs/physics.md, Scattering)")
       ("v-inf", po::value(&o.v_inf), "the scene by its speed at infinity (B != 0: the guiding centre's): K1 is solved for it")
+      ("arrival-phase", po::value(&o.arrival_phase), "the scene by the helix's phase when its guiding centre reaches "
+       "the periapsis (rad): --phase is solved for it (docs/physics.md, Scattering)")
       ("scene", po::value(&o.scene_file), "TOML scene file with several centres and bodies (see scenes/)");
 }
 
@@ -57,14 +59,17 @@ SceneParams scene_params(const po::variables_map& vm, const SceneOptions& o) {
     throw Error("give --v-inf or --K1, not both (--v-inf solves K1)");
   if (vm.count("b") && !(std::isfinite(o.b) && o.b > 0.0)) throw Error("--b must be a finite number > 0");
   if (vm.count("v-inf") && !(std::isfinite(o.v_inf) && o.v_inf > 0.0)) throw Error("--v-inf must be a finite number > 0");
-  if (!vm.count("b") && !vm.count("v-inf")) return o.params;
+  if (vm.count("arrival-phase") && vm.count("phase") && !vm["phase"].defaulted())
+    throw Error("give --arrival-phase or --phase, not both (--arrival-phase solves phase)");
+  if (vm.count("arrival-phase") && !std::isfinite(o.arrival_phase)) throw Error("--arrival-phase must be a finite number");
+  if (!vm.count("b") && !vm.count("v-inf") && !vm.count("arrival-phase")) return o.params;
   validate(thesis_scene(o.params));  // the scene's own errors first, in their words
-  return with_asymptotic_data(o.params, o.b, o.v_inf);
+  return with_asymptotic_data(o.params, o.b, o.v_inf, o.arrival_phase);
 }
 
 Scene make_scene(const po::variables_map& vm, const SceneOptions& o) {
   if (vm.count("scene")) {
-    std::vector<std::string> keys{"force-law", "b", "v-inf"};
+    std::vector<std::string> keys{"force-law", "b", "v-inf", "arrival-phase"};
     for (const SceneParameter& q : scene_parameters()) keys.emplace_back(q.name);
     for (const std::string& k : keys)
       if (vm.count(k) && !vm[k].defaulted())

@@ -22,6 +22,7 @@ struct SceneOptions {
   std::string scene_file;
   /// --b, --v-inf: the scene by its asymptotic data (NaN: not given); d and K1 solved for them.
   double b = std::numeric_limits<double>::quiet_NaN(), v_inf = std::numeric_limits<double>::quiet_NaN();
+  double arrival_phase = std::numeric_limits<double>::quiet_NaN();  ///< --arrival-phase: the start phase solved for it
 };
 void add_scene_options(po::options_description& desc, SceneOptions& o);
 /// --force-law NAME: coulomb, thesis-code or thesis-code-force (model.hpp, ForceLaw).

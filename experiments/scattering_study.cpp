@@ -1,29 +1,35 @@
 // `bodypoint study --name scattering` (scattering_study.hpp).
 //
 // Every run is the thesis's scene (table 3.1: A = -2, m = J = 1, K1 = 5, L = 200) with the coupling B
-// and the spin (Kx, Kz) of its series, d solved so that the incoming asymptote has impact parameter b
-// (scattering.hpp, d_for_impact_parameter), integrated by the accuracy mode (--method auto) to twice
-// the time the body needs to cross L, so that it ends as far from the centre as it started. Per run:
-// the deflection between the asymptotes and its part out of the incoming plane, the closest approach
-// (located on the method's own steps) and the angle the spin turned. Per series: the differential
-// cross-section dsigma/dOmega = b/sin(theta) |db/dtheta| from neighbouring b (centred differences),
-// rainbows (where dtheta/db changes sign), and for B = 0 the largest relative difference from
-// Rutherford's tan(theta/2) = |A|/(m v_inf^2 b) and its cross-section (|A|/(2 m v_inf^2))^2/sin^4(theta/2).
+// and the spin (Kx, Kz) of its series, given by its asymptotic data: d solved so that the incoming
+// asymptote has impact parameter b, the start phase so that the helix has the arrival phase psi when
+// the guiding centre reaches its periapsis (scattering.hpp, with_asymptotic_data). A spinning body's
+// deflection depends on psi as much as on b, so each b is run at kPhases phases; a material point's
+// does not (one phase). Each encounter runs in the accuracy mode until the body has left (encounter()).
+// Written:
+//   scattering.csv              one row per (series, b, psi): theta, its asymptotes' model error, r_min, ...
+//   scattering_rainbows.csv     per (series, psi): every extremum of theta(b), located by golden-section
+//                               search on b between the grid points that bracket it (not read off the grid)
+//   scattering_cross_section.csv  per (series, theta bin): dsigma/dOmega of a beam uniform in b (over the
+//                               grid's range) and in psi, summed over every branch of b(theta), with its
+//                               quadrature error, beside Rutherford's for the guiding centre's mass |K1|/u
+//   scattering_summary.csv      one row per series
 #include "process.hpp"
 #include "scattering_study.hpp"
 
 #include "bodypoint/bodypoint.hpp"
-#include "bodypoint/threads.hpp"
 #include "bodypoint/io.hpp"
+#include "bodypoint/threads.hpp"
 #include "sweep.hpp"
 
 #include <algorithm>
 #include <atomic>
-#include <limits>
 #include <cmath>
+#include <functional>
 #include <iostream>
+#include <limits>
+#include <numbers>
 #include <string>
-#include <thread>
 #include <vector>
 
 namespace bodypoint::cli {
@@ -32,11 +38,15 @@ namespace {
 /// The accuracy asked of every run: the final state to 1e-12 relative, so that the deflection, a
 /// function of the conserved quantities at the two ends, is known to ~1e-12 as well.
 constexpr double kStudyTolerance = 1e-12;
-
-/// A run whose tolerance is out of reach (finer runs stop agreeing better than the round-off floor the
-/// encounter amplifies: B = 0.9, b = 1..2 differ by ~4e-12)
-/// is repeated this much looser; the row records the tolerance delivered.
+/// A run whose tolerance is out of reach is repeated this much looser, up to kRetries times (to 1e-9:
+/// round-off amplified by a close pass reaches 5e-10 at B = 0.5); the row records the tolerance.
 constexpr double kRetryLooser = 10.0;
+constexpr int kRetries = 3;
+/// Golden-section steps that locate a rainbow: the bracket (two grid intervals) shrinks 0.618^30 ~ 5e-7,
+/// about where theta's own 1e-12 accuracy stops telling b apart (theta - theta_max ~ (db)^2).
+constexpr int kGoldenSteps = 30;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kPi = std::numbers::pi;
 
 struct Series {
   std::string name;
@@ -44,54 +54,61 @@ struct Series {
   const char* method = "auto";
 };
 
-/// B = 0 (Rutherford; auto chooses ks there, exact in its fictitious time, so lp-kl8 too), then the thesis's spin (Kx, Kz) = (2, 5) at B = 0.2 .. 0.9, and at B = 0.7 a
-/// spin along K1 (Kz = 0) and one perpendicular to it (Kx = 0).
+/// B = 0 (Rutherford; auto chooses ks there, exact in its fictitious time, so lp-kl8 too), then the
+/// thesis's spin (Kx, Kz) = (2, 5) at B = 0.2 .. 0.9, and at B = 0.7 a spin along K1 (Kz = 0: the
+/// guiding centre drifts back along -K1 after a close pass) and one perpendicular to it (Kx = 0).
 std::vector<Series> series() {
   return {{"B=0", 0.0, 2, 5},         {"B=0 lp-kl8", 0.0, 2, 5, "lp-kl8"}, {"B=0.2", 0.2, 2, 5},          {"B=0.5", 0.5, 2, 5},
           {"B=0.7", 0.7, 2, 5},       {"B=0.9", 0.9, 2, 5},          {"B=0.7 spin along K1", 0.7, 5, 0},
           {"B=0.7 spin across K1", 0.7, 0, 5}};
 }
 
+/// The helix's phase matters only where it moves the body about its guiding centre (B != 0, Kz != 0).
+bool phased(const Series& s) { return s.B != 0.0 && s.Kz != 0.0; }
+
 struct Point {
-  double b_target = 0.0, d = 0.0;
+  double b_target = 0.0, psi = 0.0, d = 0.0;
   Scattering sc;
-  double r_min = kNaN, t_min = kNaN, t_end = 0.0, r_end = kNaN, tol = kStudyTolerance, asymptote_error = kNaN;
+  double r_min = kNaN, t_min = kNaN, t_end = 0.0, tol = kStudyTolerance, asymptote_error = kNaN;
   long force_evals = 0;
   std::string method, failure;
-  static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  [[nodiscard]] bool ok() const { return failure.empty() && std::isfinite(sc.deflection); }
 };
 
-Point run_point(const Series& s, double b) {
-  Point p;
-  p.b_target = b;
+SceneParams series_params(const Series& s) {
   SceneParams params;
   params.B = s.B;
   params.start.Kx = s.Kx;
   params.start.Kz = s.Kz;
+  return params;
+}
+
+Point run_point(const Series& s, double b, double psi) {
+  Point p;
+  p.b_target = b;
+  p.psi = psi;
   try {
-    p.d = d_for_impact_parameter(params, b);
-    params.start.d = p.d;
+    const SceneParams params = with_asymptotic_data(series_params(s), b, kNaN, phased(s) ? psi : kNaN);
+    p.d = params.start.d;
     const Scene scene = thesis_scene(params);
     const Body& body = scene.bodies.front();
     Options o;
     o.track_invariants = false;
     const MethodInfo* method = std::string_view(s.method) == "auto" ? nullptr : &method_or_throw(s.method);
-    EncounterResult r = encounter(body, scene.centres, method, p.tol, Scattering::kNaN, o);
-    if (r.run.outcome == Outcome::failed && r.run.reason.find("out of reach") != std::string::npos) {
+    EncounterResult r = encounter(body, scene.centres, method, p.tol, kNaN, o);
+    for (int k = 0; k < kRetries && r.run.outcome == Outcome::failed && r.run.reason.find("out of reach") != std::string::npos; ++k) {
       p.tol *= kRetryLooser;
-      r = encounter(body, scene.centres, method, p.tol, Scattering::kNaN, o);
+      r = encounter(body, scene.centres, method, p.tol, kNaN, o);
     }
-    const BodyResult& br = r.run;
-    p.force_evals = br.total_force_evals();
-    p.t_end = br.run.t_end;
-    if (br.method) p.method = br.method->name;
+    p.force_evals = r.run.total_force_evals();
+    p.t_end = r.run.run.t_end;
+    if (r.run.method) p.method = r.run.method->name;
     if (r.encounter.outcome != Outcome::ok) {
       p.failure = r.encounter.reason;
       return p;
     }
     p.sc = r.encounter.scattering;
     p.asymptote_error = r.encounter.asymptote_error;
-    p.r_end = (br.run.final.R - scene.centres.front().c).norm();
     p.r_min = r.encounter.r_min;
     p.t_min = r.encounter.t_min;
   } catch (const Error& e) {
@@ -102,114 +119,314 @@ Point run_point(const Series& s, double b) {
 
 double rutherford(double A, double mu, double v_inf, double b) { return 2.0 * std::atan(std::abs(A) / (mu * v_inf * v_inf * b)); }
 
-}  // namespace
-
-namespace {
-
-/// Every (series, b) point, on `threads` threads.
-std::vector<Point> run_points(const std::vector<Series>& all, const std::vector<double>& bs, unsigned threads) {
-  std::vector<Point> points(all.size() * bs.size());
+/// Runs f(i) for i < n on `threads` threads.
+void parallel_for(std::size_t n, unsigned threads, const std::function<void(std::size_t)>& f) {
   std::atomic<std::size_t> next{0};
   auto worker = [&] {
-    for (std::size_t i; (i = next++) < points.size();) points[i] = run_point(all[i / bs.size()], bs[i % bs.size()]);
+    for (std::size_t i; (i = next++) < n;) f(i);
   };
-  {
-    const WorkerThreads pool(std::max(1u, threads) - 1, worker);  // joined before points is read
-    worker();
-  }
-  return points;
+  const WorkerThreads pool(std::max(1u, threads) - 1, worker);  // joined before the caller reads
+  worker();
 }
 
-/// What a series' summary row gathers from its points.
-struct SeriesTotals {
-  double max_rel = 0.0, max_oop = 0.0, min_r = Point::kNaN, first_rainbow = Point::kNaN;
-  long evals = 0, rainbows = 0, failed = 0;
+/// The study's grid: per series its phases, per phase every b.
+struct Grid {
+  std::vector<Series> all;
+  std::vector<double> bs, phases;
+  std::vector<Point> points;  ///< series-major, then phase, then b
+  [[nodiscard]] std::size_t phases_of(const Series& s) const { return phased(s) ? phases.size() : 1; }
+  [[nodiscard]] std::size_t first(std::size_t series) const {
+    std::size_t at = 0;
+    for (std::size_t k = 0; k < series; ++k) at += phases_of(all[k]) * bs.size();
+    return at;
+  }
+  [[nodiscard]] const Point* row(std::size_t series, std::size_t phase) const { return &points[first(series) + phase * bs.size()]; }
 };
 
-/// One series' n points as rows of scattering.csv; returns what its summary row needs.
-SeriesTotals write_series_rows(std::ostream& os, const Series& s, const Point* row, std::size_t n) {
-  const double A = SceneParams{}.A, m = SceneParams{}.m;
-  SeriesTotals t;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Point& p = row[i];
-    t.evals += p.force_evals;
-    const bool ok = p.failure.empty() && std::isfinite(p.sc.deflection);
-    t.failed += ok ? 0 : 1;
-    const double th_r = ok && s.B == 0.0 ? rutherford(A, m, p.sc.v_inf, p.sc.b) : Point::kNaN;
-    const double rel = ok && s.B == 0.0 ? std::abs(p.sc.deflection / th_r - 1.0) : Point::kNaN;
-    if (rel > t.max_rel) t.max_rel = rel;
-    if (ok) t.max_oop = std::max(t.max_oop, std::abs(p.sc.out_of_plane));
-    if (ok && !(p.r_min >= t.min_r)) t.min_r = p.r_min;
-    // dsigma/dOmega = b/sin(theta) |db/dtheta| from the neighbours (centred differences)
-    double dsigma = Point::kNaN, dsigma_r = Point::kNaN;
-    bool rainbow = false;
-    if (ok && i > 0 && i + 1 < n && row[i - 1].failure.empty() && row[i + 1].failure.empty()) {
-      const double dtheta_db = (row[i + 1].sc.deflection - row[i - 1].sc.deflection) / (row[i + 1].sc.b - row[i - 1].sc.b);
-      dsigma = p.sc.b / std::sin(p.sc.deflection) / std::abs(dtheta_db);
-      if (s.B == 0.0) {
-        const double a = std::abs(A) / (2.0 * m * p.sc.v_inf * p.sc.v_inf);
-        dsigma_r = a * a / std::pow(std::sin(0.5 * th_r), 4);
-      }
-      // a rainbow between i-1 and i+1: theta(b) has an extremum at i
-      const double left = p.sc.deflection - row[i - 1].sc.deflection, right = row[i + 1].sc.deflection - p.sc.deflection;
-      if (left * right < 0.0) {
-        rainbow = true;
-        ++t.rainbows;
-        if (!std::isfinite(t.first_rainbow)) t.first_rainbow = p.sc.b;
-      }
-    }
-    CsvLine line;
-    line.quoted(s.name).num(s.B).num(s.Kx).num(s.Kz).num(ok ? p.sc.b : p.b_target).num(p.d).num(p.sc.v_inf).num(p.sc.deflection);
-    line.num_if(s.B == 0.0 && ok, th_r).num_if(s.B == 0.0 && ok, rel).num(p.sc.out_of_plane).num_if(std::isfinite(dsigma), dsigma);
-    line.num_if(std::isfinite(dsigma_r), dsigma_r).count(rainbow ? 1 : 0).num(p.r_min).num(p.t_min).num(p.r_end).num(p.sc.spin_turn).num(p.sc.K1_turn);
-    line.num(p.sc.time_delay).quoted(p.sc.asymptotes).text(p.method).num(p.tol).count(p.force_evals).quoted(p.failure);
-    os << line.str() << "\n";
-  }
-  return t;
+Grid run_grid(bool quick, unsigned threads) {
+  Grid g{series(), log_range(1e-3, 1e3, quick ? 13 : 61), {}, {}};
+  const std::size_t n_phases = quick ? 4 : 8;
+  for (std::size_t j = 0; j < n_phases; ++j) g.phases.push_back(2.0 * kPi * static_cast<double>(j) / static_cast<double>(n_phases));
+  struct Task {
+    std::size_t series;
+    double b, psi;
+  };
+  std::vector<Task> tasks;
+  for (std::size_t k = 0; k < g.all.size(); ++k)
+    for (std::size_t j = 0; j < g.phases_of(g.all[k]); ++j)
+      for (double b : g.bs) tasks.push_back({k, b, g.phases[j]});
+  g.points.resize(tasks.size());
+  parallel_for(tasks.size(), threads, [&](std::size_t i) { g.points[i] = run_point(g.all[tasks[i].series], tasks[i].b, tasks[i].psi); });
+  return g;
 }
 
-/// One series' row of scattering_summary.csv.
-void write_series_summary(std::ostream& ss, const Series& s, const Point& first, std::size_t n, const SeriesTotals& t) {
+// --- rainbows ---
+
+struct Rainbow {
+  std::size_t series = 0;
+  double psi = 0.0, b = kNaN, theta = kNaN;
+  bool maximum = true;
+  long runs = 0;
+};
+
+/// The extremum of theta(b) at phase psi inside [lo, hi] (log b), by golden-section search.
+Rainbow locate_rainbow(const Series& s, std::size_t series, double psi, double lo, double hi, bool maximum) {
+  Rainbow r{series, psi, kNaN, kNaN, maximum, 0};
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  auto f = [&](double x) {
+    ++r.runs;
+    const Point p = run_point(s, std::exp(x), psi);
+    if (!p.ok()) throw Error(p.failure);
+    return maximum ? p.sc.deflection : -p.sc.deflection;
+  };
+  double a = std::log(lo), c = std::log(hi);
+  double x1 = c - g * (c - a), x2 = a + g * (c - a), f1 = f(x1), f2 = f(x2);
+  for (int i = 0; i < kGoldenSteps; ++i) {
+    if (f1 > f2) {
+      c = x2;
+      x2 = x1;
+      f2 = f1;
+      x1 = c - g * (c - a);
+      f1 = f(x1);
+    } else {
+      a = x1;
+      x1 = x2;
+      f1 = f2;
+      x2 = a + g * (c - a);
+      f2 = f(x2);
+    }
+  }
+  r.b = std::exp(f1 > f2 ? x1 : x2);
+  r.theta = maximum ? std::max(f1, f2) : -std::max(f1, f2);
+  return r;
+}
+
+std::vector<Rainbow> find_rainbows(const Grid& g, unsigned threads) {
+  struct Bracket {
+    std::size_t series, phase, i;
+    bool maximum;
+  };
+  std::vector<Bracket> brackets;
+  for (std::size_t k = 0; k < g.all.size(); ++k)
+    for (std::size_t j = 0; j < g.phases_of(g.all[k]); ++j) {
+      const Point* row = g.row(k, j);
+      for (std::size_t i = 1; i + 1 < g.bs.size(); ++i) {
+        if (!row[i - 1].ok() || !row[i].ok() || !row[i + 1].ok()) continue;
+        const double left = row[i].sc.deflection - row[i - 1].sc.deflection, right = row[i + 1].sc.deflection - row[i].sc.deflection;
+        if (left * right < 0.0) brackets.push_back({k, j, i, left > 0.0});
+      }
+    }
+  std::vector<Rainbow> out(brackets.size());
+  parallel_for(brackets.size(), threads, [&](std::size_t n) {
+    const Bracket& br = brackets[n];
+    try {
+      out[n] = locate_rainbow(g.all[br.series], br.series, g.phases_of(g.all[br.series]) > 1 ? g.phases[br.phase] : 0.0,
+                              g.bs[br.i - 1], g.bs[br.i + 1], br.maximum);
+    } catch (const Error&) {
+      out[n] = Rainbow{br.series, g.phases[br.phase], kNaN, kNaN, br.maximum, 0};
+    }
+  });
+  return out;
+}
+
+// --- the beam's cross-section ---
+
+/// Bins of theta (log-spaced from kThetaMin to pi).
+constexpr double kThetaMin = 1e-4;
+
+struct Bins {
+  std::vector<double> edges;
+  explicit Bins(std::size_t n) {
+    for (std::size_t i = 0; i <= n; ++i)
+      edges.push_back(kThetaMin * std::pow(kPi / kThetaMin, static_cast<double>(i) / static_cast<double>(n)));
+  }
+  [[nodiscard]] std::size_t size() const { return edges.size() - 1; }
+  [[nodiscard]] double solid_angle(std::size_t k) const { return 2.0 * kPi * (std::cos(edges[k]) - std::cos(edges[k + 1])); }
+};
+
+/// dsigma/dOmega per bin of a beam uniform in b over the grid's range and in the phases: each interval
+/// [b_i, b_i+step] of each phase carries its annulus' area pi (b_{i+step}^2 - b_i^2) / phases, spread
+/// over the angles it sweeps with theta a power of b, so every branch of b(theta) adds where it lands and
+/// a rainbow's narrow sweep gives its peak. `step` 2 and every other phase: the coarser quadrature whose
+/// difference is the error estimate.
+std::vector<double> cross_section(const Grid& g, std::size_t k, const Bins& bins, std::size_t step) {
+  std::vector<double> sigma(bins.size(), 0.0);
+  const std::size_t phases = g.phases_of(g.all[k]);
+  const std::size_t phase_step = phases > 1 ? step : 1;
+  const double weight = static_cast<double>(phase_step) / static_cast<double>(phases);
+  for (std::size_t j = 0; j < phases; j += phase_step) {
+    const Point* row = g.row(k, j);
+    for (std::size_t i = 0; i + step < g.bs.size(); i += step) {
+      const Point &p = row[i], &q = row[i + step];
+      if (!p.ok() || !q.ok()) continue;
+      // theta is a power of b inside the interval (exact for Rutherford's small angles): b(theta) =
+      // b_p (theta/theta_p)^(1/s), and the angles [x, y] of a bin get the area pi |b(y)^2 - b(x)^2|.
+      const double tp = p.sc.deflection, tq = q.sc.deflection, bp = p.sc.b, bq = q.sc.b;
+      const double lo = std::min(tp, tq), hi = std::max(tp, tq);
+      const auto b_at = [&](double t) { return bp * std::pow(t / tp, std::log(bq / bp) / std::log(tq / tp)); };
+      for (std::size_t n = 0; n < bins.size(); ++n) {
+        if (hi == lo) {
+          if (lo >= bins.edges[n] && lo < bins.edges[n + 1]) sigma[n] += kPi * (bq * bq - bp * bp) * weight;
+          continue;
+        }
+        const double x = std::max(lo, bins.edges[n]), y = std::min(hi, bins.edges[n + 1]);
+        if (y > x) sigma[n] += kPi * std::abs(std::pow(b_at(y), 2) - std::pow(b_at(x), 2)) * weight;
+      }
+    }
+  }
+  for (std::size_t n = 0; n < bins.size(); ++n) sigma[n] /= bins.solid_angle(n);
+  return sigma;
+}
+
+/// The smallest angle the beam covers at every phase: below it, b beyond the grid's range would add.
+double covered_from(const Grid& g, std::size_t k) {
+  double theta = 0.0;
+  for (std::size_t j = 0; j < g.phases_of(g.all[k]); ++j) {
+    const Point& last = g.row(k, j)[g.bs.size() - 1];
+    if (last.ok()) theta = std::max(theta, last.sc.deflection);
+  }
+  return theta;
+}
+
+void write_cross_sections(std::ostream& os, const Grid& g, bool quick) {
+  const Bins bins(quick ? 24 : 48);
+  const double A = SceneParams{}.A;
+  for (std::size_t k = 0; k < g.all.size(); ++k) {
+    const std::vector<double> fine = cross_section(g, k, bins, 1), coarse = cross_section(g, k, bins, 2);
+    const double from = covered_from(g, k);
+    // The guiding centre's Kepler particle: mass mu = p_inf / v_inf, the same for every b of the series.
+    const Point* first = nullptr;
+    for (const Point* p = g.row(k, 0); p != g.row(k, 0) + g.bs.size() && !first; ++p)
+      if (p->ok() && p->sc.in) first = p;
+    const double mu = first ? first->sc.in->p_inf / first->sc.v_inf : kNaN, v = first ? first->sc.v_inf : kNaN;
+    const double a = std::abs(A) / (2.0 * mu * v * v);
+    for (std::size_t n = 0; n < bins.size(); ++n) {
+      const double mid = std::sqrt(bins.edges[n] * bins.edges[n + 1]);
+      // Rutherford's a^2/sin^4(theta/2) averaged over the bin: its integral over the bin's solid angle,
+      // 4 pi a^2 (1/sin^2(theta_lo/2) - 1/sin^2(theta_hi/2)), per steradian.
+      const auto inv_sin2 = [](double t) { return 1.0 / std::pow(std::sin(0.5 * t), 2); };
+      const double ruth = 4.0 * kPi * a * a * (inv_sin2(bins.edges[n]) - inv_sin2(bins.edges[n + 1])) / bins.solid_angle(n);
+      CsvLine line;
+      line.quoted(g.all[k].name).num(g.all[k].B).num(bins.edges[n]).num(bins.edges[n + 1]).num(mid).num(fine[n]);
+      line.num(std::abs(fine[n] - coarse[n])).count(bins.edges[n] >= from ? 1 : 0).num(ruth);
+      os << line.str() << "\n";
+    }
+  }
+}
+
+// --- outputs ---
+
+void write_points(std::ostream& os, const Grid& g) {
   const double A = SceneParams{}.A, m = SceneParams{}.m;
-  CsvLine line;
-  line.quoted(s.name).num(s.B).num(s.Kx).num(s.Kz).count(static_cast<long>(n)).count(t.failed);
-  line.num_if(s.B == 0.0, t.max_rel).num(first.sc.deflection);
-  // a material point of mass m with the same momentum at infinity and impact parameter
-  const double p_inf = first.sc.in ? first.sc.in->p_inf : Point::kNaN;
-  line.num(rutherford(A, m, p_inf / m, first.sc.b)).num(t.max_oop).count(t.rainbows);
-  line.num_if(std::isfinite(t.first_rainbow), t.first_rainbow).num(t.min_r).count(t.evals);
-  ss << line.str() << "\n";
+  for (std::size_t k = 0; k < g.all.size(); ++k) {
+    const Series& s = g.all[k];
+    for (std::size_t j = 0; j < g.phases_of(s); ++j)
+      for (std::size_t i = 0; i < g.bs.size(); ++i) {
+        const Point& p = g.row(k, j)[i];
+        const bool ok = p.ok();
+        const double th_r = ok && s.B == 0.0 ? rutherford(A, m, p.sc.v_inf, p.sc.b) : kNaN;
+        CsvLine line;
+        line.quoted(s.name).num(s.B).num(s.Kx).num(s.Kz).num(ok ? p.sc.b : p.b_target).num_if(phased(s), p.psi).num(p.d);
+        line.num(p.sc.v_inf).num(p.sc.deflection).num(p.asymptote_error).num_if(s.B == 0.0 && ok, th_r);
+        line.num_if(s.B == 0.0 && ok, std::abs(p.sc.deflection / th_r - 1.0)).num(p.sc.out_of_plane).num(p.r_min).num(p.t_min);
+        line.num(p.t_end).num(p.sc.spin_turn).num(p.sc.K1_turn).num(p.sc.time_delay).quoted(p.sc.asymptotes).text(p.method);
+        line.num(p.tol).count(p.force_evals).quoted(p.failure);
+        os << line.str() << "\n";
+      }
+  }
+}
+
+void write_rainbows(std::ostream& os, const Grid& g, const std::vector<Rainbow>& rainbows) {
+  for (const Rainbow& r : rainbows) {
+    CsvLine line;
+    line.quoted(g.all[r.series].name).num(g.all[r.series].B).num_if(phased(g.all[r.series]), r.psi).num(r.b).num(r.theta);
+    line.text(r.maximum ? "max" : "min").count(r.runs);
+    os << line.str() << "\n";
+  }
+}
+
+void write_summary(std::ostream& ss, const Grid& g, const std::vector<Rainbow>& rainbows) {
+  const double A = SceneParams{}.A, m = SceneParams{}.m;
+  for (std::size_t k = 0; k < g.all.size(); ++k) {
+    const Series& s = g.all[k];
+    long points = 0, failed = 0, evals = 0;
+    double max_rel = 0.0, max_oop = 0.0, min_r = kNaN, max_asym = 0.0, th_lo = kNaN, th_hi = kNaN;
+    for (std::size_t j = 0; j < g.phases_of(s); ++j)
+      for (std::size_t i = 0; i < g.bs.size(); ++i) {
+        const Point& p = g.row(k, j)[i];
+        ++points;
+        evals += p.force_evals;
+        if (!p.ok()) {
+          ++failed;
+          continue;
+        }
+        if (s.B == 0.0) max_rel = std::max(max_rel, std::abs(p.sc.deflection / rutherford(A, m, p.sc.v_inf, p.sc.b) - 1.0));
+        max_oop = std::max(max_oop, std::abs(p.sc.out_of_plane));
+        if (!(p.r_min >= min_r)) min_r = p.r_min;
+        if (std::isfinite(p.asymptote_error)) max_asym = std::max(max_asym, p.asymptote_error);
+        if (i == 0) {
+          th_lo = std::isnan(th_lo) ? p.sc.deflection : std::min(th_lo, p.sc.deflection);
+          th_hi = std::isnan(th_hi) ? p.sc.deflection : std::max(th_hi, p.sc.deflection);
+        }
+      }
+    long n_rainbows = 0;
+    double rb_lo = kNaN, rb_hi = kNaN;
+    for (const Rainbow& r : rainbows)
+      if (r.series == k && r.maximum && std::isfinite(r.theta)) {
+        ++n_rainbows;
+        rb_lo = std::isnan(rb_lo) ? r.theta : std::min(rb_lo, r.theta);
+        rb_hi = std::isnan(rb_hi) ? r.theta : std::max(rb_hi, r.theta);
+      }
+    const Point& first = g.row(k, 0)[0];
+    const double p_inf = first.sc.in ? first.sc.in->p_inf : kNaN;
+    CsvLine line;
+    line.quoted(s.name).num(s.B).num(s.Kx).num(s.Kz).count(static_cast<long>(g.phases_of(s))).count(points).count(failed);
+    line.num_if(s.B == 0.0, max_rel).num(th_lo).num(th_hi).num(rutherford(A, m, p_inf / m, first.sc.b)).num(max_oop);
+    line.count(n_rainbows).num(rb_lo).num(rb_hi).num(min_r).num(max_asym).count(evals);
+    ss << line.str() << "\n";
+  }
+}
+
+std::string header_line(bool quick, const Grid& g) {
+  return "# bodypoint study --name scattering" + std::string(quick ? " --quick" : "") + ", revision " + git_revision() +
+         ": thesis table 3.1 with B and spin (Kx, Kz) per series, d solved for the incoming impact parameter b, the "
+         "start phase for the arrival phase psi (" + std::to_string(g.phases.size()) +
+         " phases per spinning series), the accuracy mode at tol " + fmt(kStudyTolerance) + " (" + fmt(kRetryLooser) +
+         "x looser where out of reach; column tol) until the body has left\n";
 }
 
 }  // namespace
 
 void write_scattering_study(const std::filesystem::path& dir, bool quick, unsigned threads) {
-  const std::vector<double> bs = log_range(1e-3, 1e3, quick ? 13 : 61);
-  const std::vector<Series> all = series();
-  const std::vector<Point> points = run_points(all, bs, threads);
-  AtomicFile csv((dir / "scattering.csv").string()), summary((dir / "scattering_summary.csv").string());
-  std::ostream& os = csv.stream();
-  os << "series,B,Kx,Kz,b,d,v_inf,theta,theta_rutherford,rel_diff_rutherford,out_of_plane,dsigma_domega,"
-        "dsigma_rutherford,rainbow,r_min,t_min,r_end,spin_turn,K1_turn,time_delay,asymptotes,method,tol,force_evals,failure\n"
-     << "# bodypoint study --name scattering" << (quick ? " --quick" : "") << ", revision " << git_revision()
-     << ": thesis table 3.1 with B and spin (Kx, Kz) per series, d solved for the incoming impact parameter b, "
-        "the accuracy mode at tol " << fmt(kStudyTolerance) << " (" << fmt(kRetryLooser)
-     << "x looser where out of reach; column tol) to t_end = 2 L / v_inf; no asymptotes where the body does not "
-        "drift away along K1\n";
-  std::ostream& ss = summary.stream();
-  ss << "series,B,Kx,Kz,points,failed,max_rel_diff_rutherford,theta_at_smallest_b,theta_material_point_at_smallest_b,"
-        "max_abs_out_of_plane,rainbows,first_rainbow_b,min_r_min,force_evals\n"
-     << "# bodypoint study --name scattering" << (quick ? " --quick" : "") << ", revision " << git_revision()
-     << ": one row per series; rainbows where dtheta/db changes sign (b of the extremum between grid points)\n";
-  for (std::size_t si = 0; si < all.size(); ++si) {
-    const Point* row = &points[si * bs.size()];
-    const SeriesTotals t = write_series_rows(os, all[si], row, bs.size());
-    write_series_summary(ss, all[si], row[0], bs.size(), t);
-  }
+  const Grid g = run_grid(quick, threads);
+  const std::vector<Rainbow> rainbows = find_rainbows(g, threads);
+  AtomicFile csv((dir / "scattering.csv").string()), summary((dir / "scattering_summary.csv").string()),
+      rb((dir / "scattering_rainbows.csv").string()), xs((dir / "scattering_cross_section.csv").string());
+  const std::string header = header_line(quick, g);
+  csv.stream() << "series,B,Kx,Kz,b,arrival_phase,d,v_inf,theta,asymptote_error,theta_rutherford,rel_diff_rutherford,"
+                  "out_of_plane,r_min,t_min,t_end,spin_turn,K1_turn,time_delay,asymptotes,method,tol,force_evals,failure\n"
+               << header;
+  write_points(csv.stream(), g);
+  rb.stream() << "series,B,arrival_phase,b,theta,kind,runs\n" << header
+              << "# every extremum of theta(b) at fixed arrival phase, located by golden-section search on ln b\n";
+  write_rainbows(rb.stream(), g, rainbows);
+  xs.stream() << "series,B,theta_lo,theta_hi,theta,dsigma_domega,quadrature_error,covered,dsigma_rutherford_gc\n" << header
+              << "# a beam uniform in b over [" << fmt(g.bs.front()) << ", " << fmt(g.bs.back())
+              << "] and in the arrival phase, every branch summed; quadrature_error = |this - the same on every other b and "
+                 "phase|; covered = 0 below the largest deflection at the largest b (larger b would add there); "
+                 "dsigma_rutherford_gc = Rutherford's for the guiding centre's mass |K1|/u, averaged over the bin\n";
+  write_cross_sections(xs.stream(), g, quick);
+  summary.stream() << "series,B,Kx,Kz,phases,points,failed,max_rel_diff_rutherford,theta_min_at_smallest_b,"
+                      "theta_max_at_smallest_b,theta_material_point_at_smallest_b,max_abs_out_of_plane,rainbows,"
+                      "rainbow_theta_min,rainbow_theta_max,min_r_min,max_asymptote_error,force_evals\n"
+                   << header << "# one row per series; rainbows: maxima of theta(b) over every phase\n";
+  write_summary(summary.stream(), g, rainbows);
   csv.commit();
   summary.commit();
-  std::cerr << "wrote " << (dir / "scattering.csv").string() << " and scattering_summary.csv (" << points.size()
-            << " runs)\n";
+  rb.commit();
+  xs.commit();
+  std::cerr << "wrote " << (dir / "scattering.csv").string() << ", scattering_summary.csv, scattering_rainbows.csv and "
+            << "scattering_cross_section.csv (" << g.points.size() << " runs on the grid)\n";
 }
 
 }  // namespace bodypoint::cli

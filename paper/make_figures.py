@@ -351,53 +351,59 @@ def map_figure(res, figs, listing):
 
 
 def scattering_figure(res, figs, listing):
-    """bodypoint study --name scattering: the deflection function theta(b), the differential cross-section
-    against theta, and the closest approach r_min(b), one line per series, the material point's and the
-    spinning bodies' in two rows; Rutherford's in grey, rainbows (theta(b) extremal) as open circles."""
+    """bodypoint study --name scattering: per series the band of the deflection theta(b) over the helix's
+    arrival phase (a material point's has none), the beam's differential cross-section summed over every
+    branch with its quadrature error beside Rutherford's for the guiding centre's mass (grey), and the
+    band of the closest approach r_min(b); rainbows located per phase as open circles."""
     path = os.path.join(res, "scattering.csv")
     if not os.path.exists(path):
         return
     rows = read_csv(path)
+    xs = read_csv(os.path.join(res, "scattering_cross_section.csv"))
+    rainbows = read_csv(os.path.join(res, "scattering_rainbows.csv"))
     series = list(dict.fromkeys(r["series"] for r in rows))
-    # Two rows of at most six lines: the material point (B = 0, by two methods) against Rutherford, then
-    # the spinning bodies (couplings and spin orientations) with Rutherford's curve as the reference.
     material = [n for n in series if n == "B=0" or n.startswith("B=0 ")]
     groups = [("material point", material), ("spinning body", [n for n in series if n not in material])]
     fig, grid = plt.subplots(2, 3, figsize=(WIDE, 4.8))
     cmap = plt.get_cmap("tab10")
-    reference = [r for r in rows if r["series"] == "B=0" and r["failure"] == "" and num(r["theta"]) > 0]
     for axes, (title, names) in zip(grid, groups):
         for ax in axes:
             ax.set_title(title)
-        rb_ = [num(r["b"]) for r in reference]
-        axes[0].plot(rb_, [num(r["theta_rutherford"]) for r in reference], color="grey", linewidth=2.5, alpha=0.35,
-                     label="Rutherford", zorder=0)
-        rr = [r for r in reference if num(r["dsigma_rutherford"]) > 0]
-        axes[1].plot([num(r["theta"]) for r in rr], [num(r["dsigma_rutherford"]) for r in rr], color="grey",
-                     linewidth=2.5, alpha=0.35, zorder=0)
         for i, name in enumerate(names):
             rs = [r for r in rows if r["series"] == name and r["failure"] == "" and num(r["theta"]) > 0]
             if not rs:
                 continue
+            colour = cmap(i % 10)
             dashed = i > 0 and title == "material point"  # the second method on the same curve
-            style = dict(color=cmap(i % 10), linewidth=0.9, label=name, linestyle="--" if dashed else "-")
-            b = [num(r["b"]) for r in rs]
-            axes[0].plot(b, [num(r["theta"]) for r in rs], **style)
-            rb = [r for r in rs if r["rainbow"] == "1"]
-            axes[0].plot([num(r["b"]) for r in rb], [num(r["theta"]) for r in rb], "o", markersize=4,
-                         markerfacecolor="none", color=cmap(i % 10))
-            ds = [r for r in rs if num(r["dsigma_domega"]) > 0]
-            axes[1].plot([num(r["theta"]) for r in ds], [num(r["dsigma_domega"]) for r in ds], **style)
-            axes[2].plot(b, [num(r["r_min"]) for r in rs], **style)
+            style = dict(color=colour, linewidth=0.9, label=name, linestyle="--" if dashed else "-")
+            bs = sorted({num(r["b"]) for r in rs})
+            for col, ax in (("theta", axes[0]), ("r_min", axes[2])):
+                at = {b: [num(r[col]) for r in rs if num(r["b"]) == b] for b in bs}
+                lo, hi = [min(at[b]) for b in bs], [max(at[b]) for b in bs]
+                ax.plot(bs, hi, **style)
+                if lo != hi:
+                    ax.plot(bs, lo, color=colour, linewidth=0.6)
+                    ax.fill_between(bs, lo, hi, color=colour, alpha=0.2, linewidth=0)
+            rb = [r for r in rainbows if r["series"] == name and r["kind"] == "max" and num(r["theta"]) > 0]
+            axes[0].plot([num(r["b"]) for r in rb], [num(r["theta"]) for r in rb], "o", markersize=3,
+                         markerfacecolor="none", color=colour)
+            bins = [r for r in xs if r["series"] == name and r["covered"] == "1" and num(r["dsigma_domega"]) > 0]
+            axes[1].errorbar([num(r["theta"]) for r in bins], [num(r["dsigma_domega"]) for r in bins],
+                             yerr=[min(num(r["quadrature_error"]), 0.9 * num(r["dsigma_domega"])) for r in bins],
+                             fmt="o-", markersize=2, capsize=1.5, **style)
+            if i == 0:
+                axes[1].plot([num(r["theta"]) for r in bins], [num(r["dsigma_rutherford_gc"]) for r in bins],
+                             color="grey", linewidth=2.5, alpha=0.35, zorder=0, label="Rutherford (guiding centre)")
         for ax, (xl, yl) in zip(axes, [("impact parameter b", "deflection theta (rad)"),
-                                       ("deflection theta (rad)", "dsigma/dOmega"),
+                                       ("deflection theta (rad)", "dsigma/dOmega (beam)"),
                                        ("impact parameter b", "closest approach r_min")]):
             ax.set_xscale("log")
             ax.set_yscale("log")
             ax.set_xlabel(xl)
             ax.set_ylabel(yl)
-        handles, labels = axes[0].get_legend_handles_labels()  # Rutherford with the series
+        handles, labels = axes[0].get_legend_handles_labels()
         axes[2].legend(handles, labels, loc="upper left", frameon=False)
+        axes[1].legend(loc="lower left", frameon=False)
     fig.tight_layout()
     save(fig, os.path.join(figs, "fig_scattering.pdf"), listing,
          "scattering: deflection function, differential cross-section and closest approach per series")

@@ -740,15 +740,17 @@ def ensembles(res, M):
 
 
 def scattering(res, M):
-    """bodypoint study --name scattering: Rutherford's agreement, the spinning body's head-on deflection
-    against a material point's, rainbows, and the series without asymptotes."""
+    """bodypoint study --name scattering: Rutherford's agreement, the band of the spinning body's deflection
+    over the helix's arrival phase, the rainbows located per phase, the beam's cross-section errors."""
     path = os.path.join(res, "scattering_summary.csv")
     if not os.path.exists(path):
         return
     summary, _ = read_csv(path)
     rows, _ = read_csv(os.path.join(res, "scattering.csv"))
+    xs, _ = read_csv(os.path.join(res, "scattering_cross_section.csv"))
     by = {r["series"]: r for r in summary}
     M.add("ScatPoints", count(int(by["B=0"]["points"])))
+    M.add("ScatPhases", count(int(by["B=0.7"]["phases"])))
     M.add("ScatRuns", count(len(rows)))
     M.add("ScatSeries", count(len(summary)))
     bs = [num(r["b"]) for r in rows if r["series"] == "B=0"]
@@ -758,17 +760,28 @@ def scattering(res, M):
     M.add("ScatRutherfordLpKlEight", sci(num(by["B=0 lp-kl8"]["max_rel_diff_rutherford"])))
     M.add("ScatAutoMethods", ", ".join(tt(m) for m in sorted({r["method"] for r in rows if r["series"] == "B=0"})),
           math_mode=False)
-    M.add("ScatThetaMaterial", sci(num(by["B=0"]["theta_at_smallest_b"]), 3))
+    M.add("ScatThetaMaterial", sci(num(by["B=0"]["theta_min_at_smallest_b"]), 3))
     for B in ("0.2", "0.5", "0.7", "0.9"):
         r = by["B=" + B]
         word = camel("B" + B.replace("0.", ""))
-        M.add(f"ScatTheta{word}", sci(num(r["theta_at_smallest_b"]), 2))
-        M.add(f"ScatRainbow{word}", sci(num(r["first_rainbow_b"]), 2))
+        M.add(f"ScatThetaLo{word}", sci(num(r["theta_min_at_smallest_b"]), 3))
+        M.add(f"ScatThetaHi{word}", sci(num(r["theta_max_at_smallest_b"]), 3))
+        M.add(f"ScatRainbows{word}", count(int(r["rainbows"])))
+        M.add(f"ScatRainbowLo{word}", sci(num(r["rainbow_theta_min"]), 3))
+        M.add(f"ScatRainbowHi{word}", sci(num(r["rainbow_theta_max"]), 3))
         M.add(f"ScatOutOfPlane{word}", sci(num(r["max_abs_out_of_plane"]), 2))
         M.add(f"ScatRMin{word}", sci(num(r["min_r_min"]), 2))
+        M.add(f"ScatAsymptote{word}", sci(num(r["max_asymptote_error"]), 1))
     along, across = by["B=0.7 spin along K1"], by["B=0.7 spin across K1"]
     M.add("ScatAlongFailed", count(int(along["failed"])))
-    M.add("ScatThetaAcross", sci(num(across["theta_at_smallest_b"]), 2))
+    M.add("ScatThetaAlong", sci(num(along["theta_min_at_smallest_b"]), 4))
+    M.add("ScatThetaAcross", sci(num(across["theta_max_at_smallest_b"]), 2))
+    covered = [r for r in xs if r["covered"] == "1" and num(r["dsigma_domega"]) > 0]
+    rel = [num(r["quadrature_error"]) / num(r["dsigma_domega"]) for r in covered]
+    M.add("ScatXsBins", count(len(covered)))
+    M.add("ScatXsErrMedian", sci(sorted(rel)[len(rel) // 2], 2))
+    zero = [r for r in covered if r["series"] == "B=0"]
+    M.add("ScatXsRutherfordMax", sci(max(abs(num(r["dsigma_domega"]) / num(r["dsigma_rutherford_gc"]) - 1) for r in zero), 2))
     delays = [num(r["time_delay"]) for r in rows if r["series"] == "B=0.7" and r["failure"] == ""]
     delays0 = [num(r["time_delay"]) for r in rows if r["series"] == "B=0" and r["failure"] == ""]
     M.add("ScatDelaySevenMin", sci(min(delays), 2))

@@ -135,14 +135,16 @@ std::vector<double> grid_point(const SweepSpec& spec, std::size_t p) {
 
 SceneParams point_params(const SweepSpec& spec, const std::vector<double>& point) {
   SceneParams p = spec.base;
-  double b = Scattering::kNaN, v_inf = Scattering::kNaN;  // asymptotic data: solved for once the rest is set
+  // asymptotic data: solved for once the rest is set
+  double b = Scattering::kNaN, v_inf = Scattering::kNaN, arrival = Scattering::kNaN;
   for (std::size_t a = 0; a < spec.axes.size(); ++a) {
     const std::string& name = spec.axes[a].param;
     if (name == "b") b = point[a];
     else if (name == "v_inf") v_inf = point[a];
+    else if (name == "arrival_phase") arrival = point[a];
     else if (name != "h") scene_field(p, name) = point[a];
   }
-  return std::isnan(b) && std::isnan(v_inf) ? p : with_asymptotic_data(p, b, v_inf);
+  return std::isnan(b) && std::isnan(v_inf) && std::isnan(arrival) ? p : with_asymptotic_data(p, b, v_inf, arrival);
 }
 
 FixedSteps sweep_steps(double h, long steps, double t_end, ForceLaw law) {
@@ -186,7 +188,8 @@ void validate_sweep(const SweepSpec& spec) {
   }
   for (const Axis& a : spec.axes)
     for (const Axis& other : spec.axes)
-      if ((a.param == "b" && other.param == "d") || (a.param == "v_inf" && other.param == "K1"))
+      if ((a.param == "b" && other.param == "d") || (a.param == "v_inf" && other.param == "K1") ||
+          (a.param == "arrival_phase" && other.param == "phase"))
         throw Error("the sweep varies " + a.param + " and " + other.param + ", which it solves for " + a.param);
   // Every point's scene and every method's way of advancing there, checked once for the sweep.
   const std::size_t points = task_count(spec) / spec.methods.size();

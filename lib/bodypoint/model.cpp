@@ -104,6 +104,7 @@ Scene thesis_scene(const SceneParams& sp) {
   require_finite(sp.start.K1, "K1");
   require_finite(sp.start.Kx, "Kx");
   require_finite(sp.start.Kz, "Kz");
+  require_finite(sp.start.phase, "phase");
   if (sp.start.K1 == 0.0) throw Error("K1 must be non-zero (R(0) contains Kz/K1)");
   BodyPoint p{sp.m, sp.B, sp.J};
   validate(p, "body");
@@ -127,6 +128,9 @@ const std::vector<SceneParameter>& scene_parameters() {
       {"Kz", "K2(0) = Kx i - Kz k", [](SceneParams& p) -> double& { return p.start.Kz; }, Of::start},
       {"d", "angular-momentum impact parameter: K2Q_z = -d K1 (not the asymptote's b; see --b)", [](SceneParams& p) -> double& { return p.start.d; }, Of::start},
       {"L", "initial distance along -x", [](SceneParams& p) -> double& { return p.start.L; }, Of::start},
+      {"phase", "the helix's phase at the start: K2 turned about K1 by this angle (rad), the body with it about its "
+                "guiding centre (0: the thesis's start; see arrival_phase)",
+       [](SceneParams& p) -> double& { return p.start.phase; }, Of::start, true},
   };
   return list;
 }

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cmath>
 
 #include <stdexcept>
 #include <string>
@@ -99,15 +100,20 @@ struct ThesisStart {
   double K1 = 5.0;   ///< |K1(0)|, K1(0) = K1 i
   double Kx = 2.0;   ///< K2(0) = Kx i - Kz k
   double Kz = 5.0;
+  /// The helix's phase at the start (rad): K2's part across K1 turned about K1 by this angle, and the
+  /// body with it about its guiding centre G = (-L, d, 0), which stays. 0: the thesis's start.
+  double phase = 0.0;
 };
 
 /// K1(0) = K1 i, K2(0) = Kx i - Kz k, R(0) = -L i + (d - Kz/K1) j (eq. 1.11-1.13), so that the
-/// z-component of K2Q = R x K1 + K2 is -d K1.
+/// z-component of K2Q = R x K1 + K2 is -d K1; with a phase psi, K2(0) = Kx i + Kz (sin psi j - cos psi k)
+/// and R(0) = -L i + (d - Kz/K1 cos psi) j - (Kz/K1) sin psi k (G and K2Q_z kept).
 inline Momenta thesis_momenta(const ThesisStart& t) {
   Momenta q;
+  const double c = t.phase == 0.0 ? 1.0 : std::cos(t.phase), s = t.phase == 0.0 ? 0.0 : std::sin(t.phase);
   q.K1 = Vec3(t.K1, 0.0, 0.0);
-  q.K2 = Vec3(t.Kx, 0.0, -t.Kz);
-  q.R = Vec3(-t.L, t.d - t.Kz / t.K1, 0.0);
+  q.K2 = Vec3(t.Kx, t.Kz * s, -t.Kz * c);
+  q.R = Vec3(-t.L, t.d - t.Kz / t.K1 * c, -t.Kz / t.K1 * s);
   return q;
 }
 
@@ -144,6 +150,7 @@ struct SceneParameter {
   std::string_view help;
   double& (*field)(SceneParams& p);
   Of of;
+  bool optional = false;  ///< a scene file may leave it out (its default then)
 };
 /// Every scene parameter, in the order options and headers list them.
 const std::vector<SceneParameter>& scene_parameters();

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <string>
 #include <utility>
 
@@ -208,6 +209,85 @@ double v_of(const SceneParams& p) {
 
 }  // namespace
 
+namespace {
+
+/// The guiding centre's far-field model from the thesis's start (centre at the origin): G moves at
+/// u K1/|K1| with u = (J |K1| - B k)/D (k = K2.K1/|K1|, constant far away) and K1 feels the force at G,
+/// while the helix turns about K1 at -(B/D)|K1|. Integrated by RK4 in the transformed time
+/// dt/ds = |G|/|u| (steps of ds move G by a fixed fraction of its distance) until G's periapsis (or
+/// the turn where u changes sign): returns the helix's turn on the way, -(B/D) int |K1| dt.
+constexpr double kPhaseStep = 2e-3;     ///< ds: RK4's error per unit ln r is ~ds^4, far below 1e-10 rad
+constexpr long kPhaseMaxSteps = 5000000;  ///< ~ln(r0/r_min)/ds steps; beyond: no periapsis (error)
+
+struct GuidingModel {
+  double A, B, J, D, k;
+  struct Y {
+    Vec3 G, K;
+    double phase;
+  };
+  [[nodiscard]] double u(const Y& y) const { return (J * y.K.norm() - B * k) / D; }
+  [[nodiscard]] double dt_ds(const Y& y, double u_floor) const { return y.G.norm() / std::max(std::abs(u(y)), u_floor); }
+  /// dy/ds.
+  [[nodiscard]] Y rate(const Y& y, double u_floor) const {
+    const double P = y.K.norm(), r = y.G.norm(), ts = dt_ds(y, u_floor);
+    return {u(y) / P * y.K * ts, -A / (r * r * r) * y.G * ts, -B / D * P * ts};
+  }
+  [[nodiscard]] Y step(const Y& y, double ds, double u_floor) const {
+    const auto add = [](const Y& a, const Y& d, double f) { return Y{a.G + f * d.G, a.K + f * d.K, a.phase + f * d.phase}; };
+    const Y k1 = rate(y, u_floor), k2 = rate(add(y, k1, ds / 2), u_floor), k3 = rate(add(y, k2, ds / 2), u_floor),
+            k4 = rate(add(y, k3, ds), u_floor);
+    return Y{y.G + ds / 6 * (k1.G + 2 * k2.G + 2 * k3.G + k4.G), y.K + ds / 6 * (k1.K + 2 * k2.K + 2 * k3.K + k4.K),
+             y.phase + ds / 6 * (k1.phase + 2 * k2.phase + 2 * k3.phase + k4.phase)};
+  }
+  /// G.dG/dt: < 0 on the way in.
+  [[nodiscard]] double radial(const Y& y) const { return u(y) * y.G.dot(y.K); }
+};
+
+/// Number of halvings that locate the periapsis inside its last step (ds 2e-3 / 2^40: to round-off).
+constexpr int kPhaseBisections = 40;
+
+double helix_turn_to_periapsis(const SceneParams& p) {
+  const Momenta q = thesis_momenta(p.start);
+  const double D = p.m * p.J - p.B * p.B;
+  GuidingModel model{p.A, p.B, p.J, D, q.K2.dot(q.K1) / q.K1.norm()};
+  GuidingModel::Y y{q.R + q.K1.cross(q.K2) / q.K1.squaredNorm(), q.K1, 0.0};
+  const double u_floor = 1e-3 * std::abs(model.u(y));
+  if (!(u_floor > 0.0)) throw Error("the guiding centre does not drift (u = 0): it has no arrival phase");
+  if (!(model.radial(y) < 0.0)) return 0.0;  // not approaching: the start is its arrival
+  for (long i = 0; i < kPhaseMaxSteps; ++i) {
+    const GuidingModel::Y next = model.step(y, kPhaseStep, u_floor);
+    if (model.radial(next) >= 0.0) {
+      double lo = 0.0, hi = kPhaseStep;
+      for (int it = 0; it < kPhaseBisections; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (model.radial(model.step(y, mid, u_floor)) < 0.0 ? lo : hi) = mid;
+      }
+      return model.step(y, hi, u_floor).phase;
+    }
+    y = next;
+  }
+  throw Error("the guiding centre reaches no periapsis: the scene has no arrival phase");
+}
+
+double wrapped(double angle) {
+  const double two_pi = 2.0 * std::numbers::pi;
+  const double w = std::fmod(angle, two_pi);
+  return w < 0.0 ? w + two_pi : w;
+}
+
+}  // namespace
+
+double arrival_phase(const SceneParams& params) {
+  return wrapped(params.start.phase + helix_turn_to_periapsis(params));
+}
+
+double start_phase_for_arrival(const SceneParams& params, double arrival) {
+  if (!std::isfinite(arrival)) throw Error("the arrival phase must be a finite number (rad)");
+  SceneParams at_zero = params;
+  at_zero.start.phase = 0.0;
+  return wrapped(arrival - helix_turn_to_periapsis(at_zero));
+}
+
 double d_for_impact_parameter(SceneParams params, double b) {
   if (!(std::isfinite(b) && b > 0.0)) throw Error("the impact parameter b must be a finite number > 0");
   const double d0 = params.B == 0.0 ? params.start.Kz / params.start.K1 + b : b;
@@ -226,6 +306,12 @@ double k1_for_speed_at_infinity(SceneParams params, double v_inf) {
   const double k = solve_parameter(params, k1_of, v_of, v_inf, k0, k1);
   if (!(std::isfinite(k) && k > 0.0)) throw Error("no momentum K1 > 0 gives the speed at infinity v_inf = " + std::to_string(v_inf));
   return k;
+}
+
+SceneParams with_asymptotic_data(SceneParams params, double b, double v_inf, double arrival) {
+  params = with_asymptotic_data(params, b, v_inf);
+  if (!std::isnan(arrival)) params.start.phase = start_phase_for_arrival(params, arrival);
+  return params;
 }
 
 SceneParams with_asymptotic_data(SceneParams params, double b, double v_inf) {

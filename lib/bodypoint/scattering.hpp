@@ -24,7 +24,7 @@
 // "Exact Lie-Poisson splitting"): far from the centre G is a Kepler particle of momentum K1 and mass
 // mu = |K1|/u. Its asymptotes are those of that hyperbola ("guiding-centre"); the model neglects
 // the helix's radius against the distance and the slow change of K2.K1, an error that falls as
-// 1/L^2 with the starting distance L (`bodypoint study --name scattering` measures it).
+// L^-2.7 .. L^-3.9 with the distance L it is applied at (Encounter::asymptote_error estimates it).
 #pragma once
 
 #include "bodypoint/model.hpp"
@@ -117,6 +117,19 @@ double k1_for_speed_at_infinity(SceneParams params, double v_inf);
 /// not given, the scene's own d or K1 kept). Both are solved together (each depends a little on the
 /// other through the start at finite distance L) until neither d nor K1 changes.
 SceneParams with_asymptotic_data(SceneParams params, double b, double v_inf);
+/// The same with the helix's phase at arrival (NaN: the scene's own start phase kept), set after b and
+/// v_inf (which do not depend on it): start_phase_for_arrival.
+SceneParams with_asymptotic_data(SceneParams params, double b, double v_inf, double arrival);
+
+/// The helix's phase at arrival of the thesis's scene (rad, in [0, 2 pi)): its start phase (ThesisStart::
+/// phase) advanced by the turn of the spin about K1, -(B/D) int |K1| dt, along the guiding centre's
+/// far-field motion (G drifting at u along K1, K1 pushed by the force at G) from the start to G's
+/// periapsis. Starting further away at the same arrival phase gives the same encounter, up to the
+/// asymptotes' model error (docs/physics.md, "Scattering": the phase is a parameter of the encounter).
+double arrival_phase(const SceneParams& params);
+/// The start phase that gives the arrival phase `arrival`. Error when it is not finite or the guiding
+/// centre does not drift.
+double start_phase_for_arrival(const SceneParams& params, double arrival);
 
 /// The angle between two vectors, accurate for small and for near-opposite angles: atan2(|a x b|, a.b).
 double angle_between(const Vec3& a, const Vec3& b);

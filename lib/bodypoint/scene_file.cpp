@@ -78,7 +78,7 @@ std::set<std::string> keys_of(std::initializer_list<SceneParameter::Of> kinds, s
 void read_parameters(const toml::table& t, SceneParameter::Of of, SceneParams& p, const std::string& where,
                      const std::string& origin) {
   for (const SceneParameter& q : scene_parameters())
-    if (q.of == of) q.field(p) = number(t, std::string(q.name), where, origin);
+    if (q.of == of && !(q.optional && !t.contains(q.name))) q.field(p) = number(t, std::string(q.name), where, origin);
 }
 
 Centre parse_centre(const toml::table& t, const std::string& where, const std::string& origin) {

@@ -90,14 +90,15 @@ Body body_from(const py::dict& d) {
 /// The thesis's scene from keyword parameters (model.hpp scene_parameters(); b and v_inf: asymptotic data).
 Scene thesis_from(const py::dict& kw) {
   SceneParams sp;
-  double b = kNaN, v_inf = kNaN;
+  double b = kNaN, v_inf = kNaN, arrival = kNaN;
   for (const auto& [k, v] : kw) {
     const auto key = k.cast<std::string>();
     if (key == "b") b = v.cast<double>();
     else if (key == "v_inf") v_inf = v.cast<double>();
+    else if (key == "arrival_phase") arrival = v.cast<double>();
     else scene_field(sp, key) = v.cast<double>();
   }
-  if (!std::isnan(b) || !std::isnan(v_inf)) sp = with_asymptotic_data(sp, b, v_inf);
+  if (!std::isnan(b) || !std::isnan(v_inf) || !std::isnan(arrival)) sp = with_asymptotic_data(sp, b, v_inf, arrival);
   return thesis_scene(sp);
 }
 
@@ -371,6 +372,11 @@ PYBIND11_MODULE(_bodypoint, mod) {
   mod.def("_thesis_scene", &thesis_from, py::arg("params"));
   mod.def("_read_scene", &read_scene_file, py::arg("path"));
   mod.def("_parse_scene", [](const std::string& text) { return parse_scene(text, "<string>"); }, py::arg("text"));
+  mod.def("_arrival_phase", [](const py::dict& kw) {
+    SceneParams sp;
+    for (const auto& [k, v] : kw) scene_field(sp, k.cast<std::string>()) = v.cast<double>();
+    return arrival_phase(sp);
+  });
   mod.def("_scene_parameters", [] {
     std::vector<std::string> names;
     for (const SceneParameter& p : scene_parameters()) names.emplace_back(p.name);

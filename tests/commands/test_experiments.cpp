@@ -238,20 +238,24 @@ TEST(Study, ScatteringAgreesWithRutherfordAndReportsEverySeries) {
   ASSERT_EQ(rows.size(), 8u);  // B = 0 twice (auto, lp-kl8), B = 0.2 .. 0.9, two other spins
   int material = 0;
   for (const auto& row : rows) {
-    // series, B, Kx, Kz, points, failed, max_rel_diff_rutherford, theta_at_smallest_b, ...
+    // series, B, Kx, Kz, phases, points, failed, max_rel_diff_rutherford, theta_min_at_smallest_b,
+    // theta_max_at_smallest_b, theta_material_point_at_smallest_b, ...
+    EXPECT_EQ(row[6], "0") << row[0] << ": every encounter finished";
     if (std::stod(row[1]) != 0.0) {
-      // a spinning body with the thesis's spin is deflected less than a material point head-on
+      // a spinning body with the thesis's spin is deflected less than a material point head-on, at
+      // every phase; its phases were sampled
       if (row[3] == "5" && row[2] == "2") {
-        EXPECT_LT(std::stod(row[7]), std::stod(row[8])) << row[0];
+        EXPECT_LT(std::stod(row[9]), std::stod(row[10])) << row[0];
+        EXPECT_GT(std::stoi(row[4]), 1) << row[0];
       }
       continue;
     }
     ++material;
-    EXPECT_EQ(row[5], "0") << row[0];
-    EXPECT_LT(std::stod(row[6]), kRutherfordRel) << row[0];
+    EXPECT_LT(std::stod(row[7]), kRutherfordRel) << row[0];
   }
   EXPECT_EQ(material, 2);
-  EXPECT_TRUE(fs::exists(dir / "scattering.csv"));
+  for (const char* name : {"scattering.csv", "scattering_rainbows.csv", "scattering_cross_section.csv"})
+    EXPECT_TRUE(fs::exists(dir / name)) << name;
 }
 
 }  // namespace

@@ -28,13 +28,15 @@ namespace bodypoint {
 
 /// The parameters a sweep can vary: the step h, every scene parameter (model.hpp), and the scene's
 /// asymptotic data, b (the incoming asymptote's impact parameter: d is solved for it) and v_inf (the
-/// speed at infinity: K1 is solved for it; scattering.hpp, with_asymptotic_data).
+/// speed at infinity: K1 is solved for it) and arrival_phase (the helix's phase at the periapsis: the
+/// start phase is solved for it; scattering.hpp, with_asymptotic_data).
 inline const std::vector<std::string>& sweep_parameters() {
   static const std::vector<std::string> p = [] {
     std::vector<std::string> names{"h"};
     for (const SceneParameter& q : scene_parameters()) names.emplace_back(q.name);
     names.emplace_back("b");
     names.emplace_back("v_inf");
+    names.emplace_back("arrival_phase");
     return names;
   }();
   return p;

@@ -33,10 +33,11 @@ def scene_parameters():
 def thesis_scene(**params):
     """The thesis's scene: one centre at the origin and one body-point, table 3.1 unless changed.
 
-    Keywords: any of scene_parameters() (A, m, B, J, d, L, K1, Kx, Kz), and the asymptotic data
-    b (the incoming asymptote's impact parameter; d is solved for it) and v_inf (the speed at
-    infinity; K1 is solved for it). docs/physics.md says what each means: d is *not* the geometric
-    impact parameter.
+    Keywords: any of scene_parameters() (A, m, B, J, K1, Kx, Kz, d, L, phase), and the asymptotic
+    data b (the incoming asymptote's impact parameter; d is solved for it), v_inf (the speed at
+    infinity; K1 is solved for it) and arrival_phase (the helix's phase when the guiding centre
+    reaches its periapsis; phase is solved for it). docs/physics.md says what each means: d is *not*
+    the geometric impact parameter.
     """
     return _core._thesis_scene(params)
 
