@@ -118,7 +118,7 @@ Encounter measure_encounter(const Body& body, const std::vector<Centre>& centres
 double encounter_span(const Body& body, const std::vector<Centre>& centres) {
   if (centres.size() != 1) throw Error("an encounter without an end time t_end needs a single centre (give t_end)");
   const auto k = kepler_particle(body.p, body.s0, centres.front().c);
-  const auto a = k ? kepler_asymptote(k->mu, -centres.front().A * k->kappa_sign, k->X, k->P, false) : std::nullopt;
+  const auto a = k ? kepler_asymptote(k->mu, k->kappa(centres.front().A), k->X, k->P, false) : std::nullopt;
   if (!a) throw Error("the body has no speed at infinity (a bound orbit, or a guiding centre at rest): give t_end");
   return kEncounterSpans * 2.0 * k->X.norm() / (a->p_inf / k->mu);
 }

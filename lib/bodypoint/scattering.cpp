@@ -128,7 +128,7 @@ Scattering scattering(const BodyPoint& p, const std::vector<Centre>& centres, co
     out.asymptotes = "none: the guiding centre does not drift (u = 0)";
     return out;
   }
-  const double kappa_in = -k.A * in->kappa_sign, kappa_out = -k.A * fin->kappa_sign;
+  const double kappa_in = in->kappa(k.A), kappa_out = fin->kappa(k.A);
   out.in = kepler_asymptote(in->mu, kappa_in, in->X, in->P, false);
   out.out = kepler_asymptote(fin->mu, kappa_out, fin->X, fin->P, true);
   if (!out.in || !out.out) {
@@ -165,7 +165,7 @@ std::pair<Asymptote, double> incoming(const SceneParams& p) {
   const Body& body = s.bodies.front();
   const auto k = kepler_particle(body.p, body.s0, s.centres.front().c);
   if (!k) throw Error("the scene's body does not drift along K1: it has no incoming asymptote");
-  const auto a = kepler_asymptote(k->mu, -s.centres.front().A * k->kappa_sign, k->X, k->P, false);
+  const auto a = kepler_asymptote(k->mu, k->kappa(s.centres.front().A), k->X, k->P, false);
   if (!a) throw Error("the scene's orbit is bound (energy at infinity <= 0): it has no incoming asymptote");
   return {*a, k->mu};
 }

@@ -65,6 +65,8 @@ struct KeplerParticle {
   /// +1; -1 when the guiding centre drifts against K1 (u < 0): then P = -K1, and the centre's force
   /// acts on the particle as kappa_sign * kappa (a repelling centre attracts it).
   double kappa_sign = 1.0;
+  /// The force constant the particle feels from a centre of constant A: -A kappa_sign.
+  [[nodiscard]] double kappa(double A) const { return -A * kappa_sign; }
 };
 std::optional<KeplerParticle> kepler_particle(const BodyPoint& p, const State& s, const Vec3& c);
 
