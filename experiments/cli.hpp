@@ -73,27 +73,10 @@ double planned_step(const RunPlan& plan);
 /// plan.how's end time: t_end, or the end of its steps (fictitious steps: 0, not known in advance).
 double planned_end(const RunPlan& plan);
 
-/// What one body's run used: the method (auto may choose per body) and, with --tol, the search.
-struct BodyRun {
-  const MethodInfo* method = nullptr;
-  RunResult result;
-  std::optional<double> err_R;
-  std::optional<double> err_rel;  ///< max(|dR|/|R_ref|, |dv|/|v_ref|), the measure --tol bounds
-  std::optional<State> reference;  ///< --reference: the reference state at the run's end
-  std::optional<AccuracyReport> search;
-  ErrorEstimate error;                ///< the run's estimated error, or why it has none
-  std::vector<std::string> warnings;  ///< what a heuristic saw but the estimate overruled
-  std::string why;  ///< --method auto: what was chosen and why
-  Outcome outcome = Outcome::ok;
-  std::string reason;  ///< of an outcome other than ok
-  std::vector<EventHit> events;  ///< the events asked for, located
-  long event_force_evals = 0;
-  long total_force_evals = 0;  ///< the run, the accuracy search and the events (BodyResult::total_force_evals)
-};
 /// Runs one body as planned through the library (integrate_body with `how`, plan.options, the sink
 /// and the events). A method that refuses the scene or a run that fails throws Error with the
 /// library's reason; diverged and collision are left to the caller (outcome, reason).
-BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre>& centres, const Advance& how,
+BodyResult run_body(const RunPlan& plan, const Body& body, const std::vector<Centre>& centres, const Advance& how,
                  const SampleSink* sink, const std::vector<Event>& events = {});
 
 /// One run of a study through the public API (integrate_body): its RunResult, whatever its outcome's

@@ -48,26 +48,14 @@ double planned_end(const RunPlan& plan) {
       plan.how);
 }
 
-BodyRun run_body(const RunPlan& plan, const Body& body, const std::vector<Centre>& centres, const Advance& how,
-                 const SampleSink* sink, const std::vector<Event>& events) {
+BodyResult run_body(const RunPlan& plan, const Body& body, const std::vector<Centre>& centres, const Advance& how,
+                    const SampleSink* sink, const std::vector<Event>& events) {
   Options options = plan.options;
   options.events = events;
   options.sink = sink;
   BodyResult r = integrate_body(body, centres, plan.method, how, options);
   if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) throw Error(r.reason);
-  BodyRun b;
-  b.method = r.method;
-  b.result = std::move(r.run);
-  b.search = r.accuracy;
-  b.error = std::move(r.error);
-  b.warnings = std::move(r.warnings);
-  b.why = std::move(r.chosen);
-  b.outcome = r.outcome;
-  b.reason = std::move(r.reason);
-  b.events = std::move(r.events);
-  b.event_force_evals = r.event_force_evals;
-  b.total_force_evals = r.total_force_evals();
-  return b;
+  return r;
 }
 
 RunResult run_or_throw(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres, const Advance& how,

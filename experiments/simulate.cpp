@@ -4,6 +4,7 @@
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
 #include "bodypoint/observables.hpp"
+#include "bodypoint/record.hpp"
 #include "bodypoint/reference.hpp"
 #include "bodypoint/run.hpp"
 #include "budget.hpp"
@@ -27,42 +28,12 @@ std::string scene_header(const po::variables_map& vm, const SceneOptions& o) {
   return describe(o.params);
 }
 
-std::string json_body(const RunResult& r, const std::optional<double>& err_R,
-                      const std::optional<double>& err_rel = std::nullopt, const std::optional<State>& ref = std::nullopt) {
-  std::ostringstream os;
-  os << "\"R\": " << json_vec(r.final.R) << ", \"v\": " << json_vec(r.final.v)
-     << ", \"w\": " << json_vec(r.final.w);
-  if (r.invariants) {
-    os << ", \"max_rel_dE\": " << json_number(r.invariants->max_rel_dE)
-       << ", \"max_rel_dK2sq\": " << json_number(r.invariants->max_rel_dK2sq);
-    if (r.invariants->has_K2Q) os << ", \"max_abs_dK2Q\": " << json_number(r.invariants->max_abs_dK2Q);
-  }
-  if (err_R) os << ", \"err_R\": " << json_number(*err_R);
-  if (err_rel) os << ", \"err_rel\": " << json_number(*err_rel);
-  if (ref) os << ", \"R_ref\": " << json_vec(ref->R) << ", \"v_ref\": " << json_vec(ref->v);
-  if (r.max_step > 0.0)
-    os << ", \"accepted_steps\": " << r.steps << ", \"min_step\": " << json_number(r.min_step)
-       << ", \"max_step\": " << json_number(r.max_step);
-  os << ", \"force_evals\": " << r.force_evals << ", \"wall_s\": " << json_number(r.wall_s);
-  return os.str();
-}
-
-std::string search_json(const BodyRun& b, double tol) {
-  if (!b.search) return "";
-  std::ostringstream os;
-  os << ", \"tol\": " << json_number(tol) << ", \"h_chosen\": " << json_number(b.search->step) << ", \"search_runs\": " << b.search->runs
-     << ", \"search_force_evals\": " << b.search->force_evals
-     << ", \"search_wall_s\": " << json_number(b.search->wall_s);
-  if (!b.why.empty()) os << ", \"chosen\": " << json_string(b.why);
-  return os.str();
-}
-
-std::string search_line(const BodyRun& b) {
+std::string search_line(const BodyResult& b) {
   std::ostringstream os;
   os << "method=" << b.method->name;
-  if (b.search)
-    os << (is_time_transformed(*b.method) ? " ds=" : " h=") << fmt(b.search->step) << " search: " << b.search->runs
-       << " runs (the delivered one included), " << b.search->force_evals << " force evaluations";
+  if (b.accuracy)
+    os << (is_time_transformed(*b.method) ? " ds=" : " h=") << fmt(b.accuracy->step) << " search: " << b.accuracy->runs
+       << " runs (the delivered one included), " << b.accuracy->force_evals << " force evaluations";
   return os.str();
 }
 
@@ -77,59 +48,11 @@ std::string error_line(const ErrorEstimate& e) {
   return line + ")";
 }
 
-std::string error_json(const BodyRun& b) {
-  std::ostringstream os;
-  os << ", \"err_estimate\": " << (b.error.known() ? json_number(b.error.value) : "null")
-     << ", \"err_basis\": " << json_string(b.error.basis) << ", \"estimate_force_evals\": " << b.error.force_evals
-     << ", \"warnings\": [";
-  for (std::size_t i = 0; i < b.warnings.size(); ++i) os << (i ? ", " : "") << json_string(b.warnings[i]);
-  os << "]";
-  return os.str();
-}
-
-std::string events_json(const std::vector<Event>& events, const BodyRun& run) {
-  if (events.empty()) return "";
-  std::ostringstream os;
-  os << ", \"events\": [";
-  for (std::size_t i = 0; i < run.events.size(); ++i) {
-    const EventHit& h = run.events[i];
-    os << (i ? ", " : "") << "{\"event\": " << json_string(events[h.event].label()) << ", \"t\": " << json_number(h.t)
-       << ", \"r\": " << json_number(h.distance) << ", \"R\": " << json_vec(h.s.R) << ", \"v\": " << json_vec(h.s.v)
-       << ", \"w\": " << json_vec(h.s.w) << "}";
-  }
-  os << "], \"event_force_evals\": " << run.event_force_evals;
-  if (std::any_of(events.begin(), events.end(), [](const Event& e) { return e.stop; }))
-    os << ", \"stopped_by\": " << (run.result.stopped ? json_string(events[run.events.back().event].label()) : "null");
-  return os.str();
-}
-
-std::string json_or_null(double x) { return std::isfinite(x) ? json_number(x) : "null"; }
-
-std::string scattering_json(const std::optional<Encounter>& e) {
-  if (!e) return "";
-  const Scattering& sc = e->scattering;
-  std::ostringstream os;
-  os << ", \"scattering\": {\"asymptotes\": " << json_string(sc.asymptotes)
-     << ", \"deflection\": " << json_or_null(sc.deflection) << ", \"out_of_plane\": " << json_or_null(sc.out_of_plane)
-     << ", \"b\": " << json_or_null(sc.b) << ", \"v_inf\": " << json_or_null(sc.v_inf)
-     << ", \"time_delay\": " << json_or_null(sc.time_delay) << ", \"asymptote_error\": " << json_or_null(e->asymptote_error)
-     << ", \"asymptote_basis\": " << json_string(e->asymptote_basis);
-  if (sc.in) os << ", \"direction_in\": " << json_vec(sc.in->direction) << ", \"direction_out\": " << json_vec(sc.out->direction);
-  os << ", \"r_min\": " << json_or_null(e->r_min) << ", \"t_min\": " << json_or_null(e->t_min)
-     << ", \"K1_turn\": " << json_number(sc.K1_turn) << ", \"spin_turn\": " << json_number(sc.spin_turn)
-     << ", \"K1_start\": " << json_vec(sc.K1_start) << ", \"K1_end\": " << json_vec(sc.K1_end)
-     << ", \"K2_start\": " << json_vec(sc.K2_start) << ", \"K2_end\": " << json_vec(sc.K2_end)
-     << ", \"E_start\": " << json_number(sc.E_start) << ", \"E_end\": " << json_number(sc.E_end);
-  if (sc.has_K2Q) os << ", \"K2Q_start\": " << json_vec(sc.K2Q_start) << ", \"K2Q_end\": " << json_vec(sc.K2Q_end);
-  os << "}";
-  return os.str();
-}
-
-void print_encounter(const std::vector<Event>& events, const BodyRun& run, const std::optional<Encounter>& e) {
+void print_encounter(const std::vector<Event>& events, const BodyResult& run, const std::optional<Encounter>& e) {
   for (const EventHit& h : run.events)
     std::cout << "  event " << events[h.event].label() << ": t = " << fmt(h.t) << ", r = " << fmt(h.distance)
               << ", R = " << json_vec(h.s.R) << "\n";
-  if (run.result.stopped) std::cout << "  the run stopped at event " << events[run.events.back().event].label() << "\n";
+  if (run.run.stopped) std::cout << "  the run stopped at event " << events[run.events.back().event].label() << "\n";
   if (!e) return;
   const Scattering& sc = e->scattering;
   std::cout << "  scattering (asymptotes: " << sc.asymptotes << ")\n";
@@ -301,23 +224,30 @@ class TrajectoryFile {
   long rows_ = 0;
 };
 
-/// One body: budget, run (with the progress bar), health, and the reference error when asked for.
-BodyRun simulate_body(const SimulateOptions& o, const RunPlan& plan, const Body& body, const Scene& scene,
-                      const std::vector<Event>& events, const SampleSink* sink) {
+/// One body's run and, with --reference, the reference state at its end.
+struct SimulatedBody {
+  BodyResult run;
+  std::optional<State> reference;
+};
+
+/// One body: budget, run (with the progress bar), health, and the reference state when asked for.
+SimulatedBody simulate_body(const SimulateOptions& o, const RunPlan& plan, const Body& body, const Scene& scene,
+                            const std::vector<Event>& events, const SampleSink* sink) {
   std::optional<WorkEstimate> estimate;
   if (!plan.search) {
     estimate = estimate_work(*plan.method, body, scene.centres, plan.how, plan.options);
     if (estimate) check_budget(*estimate, o.max_seconds, o.quiet || o.json);
   }
-  BodyRun br;
+  SimulatedBody sb;
   {
     const ProgressBar bar(estimate, progress_wanted(o.quiet));
-    br = run_body(plan, body, scene.centres, plan.how, sink, events);
+    sb.run = run_body(plan, body, scene.centres, plan.how, sink, events);
   }
+  const BodyResult& br = sb.run;
   if (br.outcome != Outcome::ok) {
     const std::string smaller = is_step_controlled(*br.method) ? "the tolerance is too loose for this scene (reduce --tol"
                                                                : "the step is too large for this scene (reduce --h";
-    const bool energy = br.result.invariants && br.result.invariants->max_rel_dE > plan.options.max_energy_error;
+    const bool energy = br.run.invariants && br.run.invariants->max_rel_dE > plan.options.max_energy_error;
     throw Error("body '" + body.name + "' (" + std::string(br.method->name) + "): " + br.reason + "; " +
                 (br.outcome == Outcome::collision ? "a time-transformed method (ttl-*) or a smaller --h can follow it"
                  : br.outcome == Outcome::inaccurate
@@ -327,51 +257,55 @@ BodyRun simulate_body(const SimulateOptions& o, const RunPlan& plan, const Body&
   }
   for (const std::string& w : br.warnings)
     std::cerr << "bodypoint: warning: body '" << body.name << "' (" << br.method->name << "): " << w << "\n";
-  if (o.with_reference) {
-    const State ref = reference_state(body, scene.centres, br.result.t_end);
-    br.err_R = (br.result.final.R - ref.R).norm();
-    br.err_rel = adaptive::state_distance(br.result.final, ref);
-    br.reference = ref;
-  }
-  return br;
+  if (o.with_reference) sb.reference = reference_state(body, scene.centres, br.run.t_end);
+  return sb;
 }
 
-void report_json(const std::vector<BodyRun>& runs, const Scene& scene, const RunPlan& plan, const SimulateOptions& o,
+/// A body's JSON fields: the library's record of the run (record.hpp), the reference's (err_R, err_rel,
+/// R_ref, v_ref) before the step range and cost, and the encounter's.
+Record simulated_record(const SimulatedBody& b, const Advance& how, const std::vector<Event>& events,
+                        const std::optional<Encounter>& e) {
+  Record r = body_record(b.run, how, events);
+  if (b.reference) {
+    const State& final = b.run.run.final;
+    Record ref;
+    ref.number("err_R", (final.R - b.reference->R).norm()).number("err_rel", adaptive::state_distance(final, *b.reference));
+    ref.vector("R_ref", b.reference->R).vector("v_ref", b.reference->v);
+    r.insert_before(r.find("accepted_steps") ? "accepted_steps" : "force_evals", ref);
+  }
+  if (e) r.record("scattering", encounter_record(*e));
+  return r;
+}
+
+/// The first body's fields at the top level and, with several bodies, the run's totals and every body.
+void report_json(const std::vector<SimulatedBody>& runs, const Scene& scene, const RunPlan& plan, const SimulateOptions& o,
                  const std::vector<std::optional<Encounter>>& enc) {
-  const BodyRun& r0 = runs.front();
-  const double h0 = r0.search ? r0.search->step : planned_step(plan);
-  std::cout << "{\"method\": " << json_string(r0.method->name) << ", \"h\": " << json_number(h0)
-            << (is_step_controlled(*r0.method) ? ", \"tol\": " + json_number(plan.tol) : std::string())
-            << search_json(r0, plan.tol) << error_json(r0) << ", \"steps\": " << r0.result.steps
-            << ", \"t_end\": " << json_number(r0.result.t_end) << ", " << json_body(r0.result, r0.err_R, r0.err_rel, r0.reference)
-            << events_json(o.body_events.front(), r0) << scattering_json(enc.front());
+  Record top = simulated_record(runs.front(), plan.how, o.body_events.front(), enc.front());
   if (runs.size() > 1) {
     // The run's totals (the top-level fields above are the first body's): every body's force
     // evaluations, its accuracy search and its events included, and its step-loop time.
     long evals = 0;
     double wall = 0.0;
-    for (const BodyRun& r : runs) {
-      evals += r.total_force_evals;
-      wall += (r.search ? r.search->wall_s : r.result.wall_s) + r.error.wall_s;
+    std::vector<Record> bodies;
+    for (std::size_t b = 0; b < runs.size(); ++b) {
+      const BodyResult& r = runs[b].run;
+      evals += r.total_force_evals();
+      wall += (r.accuracy ? r.accuracy->wall_s : r.run.wall_s) + r.error.wall_s;
+      bodies.push_back(Record().text("name", scene.bodies[b].name).append(simulated_record(runs[b], plan.how, o.body_events[b], enc[b])));
     }
-    std::cout << ", \"run\": {\"bodies\": " << runs.size() << ", \"force_evals\": " << evals
-              << ", \"wall_s\": " << json_number(wall) << "}";
-    std::cout << ", \"bodies\": [";
-    for (std::size_t b = 0; b < runs.size(); ++b)
-      std::cout << (b ? ", " : "") << "{\"name\": " << json_string(scene.bodies[b].name) << ", \"method\": "
-                << json_string(runs[b].method->name) << search_json(runs[b], plan.tol) << error_json(runs[b]) << ", "
-                << json_body(runs[b].result, runs[b].err_R, runs[b].err_rel, runs[b].reference) << events_json(o.body_events[b], runs[b])
-                << scattering_json(enc[b]) << "}";
-    std::cout << "]";
+    top.record("run", Record().count("bodies", static_cast<long>(runs.size())).count("force_evals", evals).number("wall_s", wall));
+    top.records("bodies", std::move(bodies));
   }
-  std::cout << "}\n";
+  write_json(std::cout, top);
+  std::cout << "\n";
 }
 
-void report_body(const BodyRun& run, const std::string& name) {
-  const RunResult& r = run.result;
+void report_body(const SimulatedBody& body, const std::string& name) {
+  const BodyResult& run = body.run;
+  const RunResult& r = run.run;
   std::cout << "\n[" << name << "]\n";
-  if (!run.why.empty()) std::cout << "  chosen: " << run.why << "\n";
-  if (run.search) std::cout << "  " << search_line(run) << "\n";
+  if (!run.chosen.empty()) std::cout << "  chosen: " << run.chosen << "\n";
+  if (run.accuracy) std::cout << "  " << search_line(run) << "\n";
   std::cout << std::setprecision(12) << "  R(t_end) = " << r.final.R.transpose() << "\n"
             << "  v(t_end) = " << r.final.v.transpose() << "\n"
             << "  w(t_end) = " << r.final.w.transpose() << "\n";
@@ -383,26 +317,27 @@ void report_body(const BodyRun& run, const std::string& name) {
     std::cout << std::defaultfloat;
   }
   std::cout << "  " << error_line(run.error) << "\n";
-  if (run.err_R)
+  if (body.reference)
     std::cout << std::setprecision(3) << std::scientific << "  |R - R_ref| (odeint rkf78, long double) = "
-              << *run.err_R << ", relative error (as estimated) = " << *run.err_rel << "\n" << std::defaultfloat;
+              << (r.final.R - body.reference->R).norm() << ", relative error (as estimated) = "
+              << adaptive::state_distance(r.final, *body.reference) << "\n" << std::defaultfloat;
   std::cout << "  force evaluations = " << r.force_evals << ", wall time = " << std::setprecision(3) << r.wall_s
             << " s\n";
 }
 
-void report_text(const std::vector<BodyRun>& runs, const Scene& scene, const RunPlan& plan, const SimulateOptions& o,
+void report_text(const std::vector<SimulatedBody>& runs, const Scene& scene, const RunPlan& plan, const SimulateOptions& o,
                  const std::vector<std::optional<Encounter>>& enc, const std::string& header) {
   const std::string& method_name = o.method_name;
-  const BodyRun& r0 = runs.front();
+  const BodyResult& r0 = runs.front().run;
   std::cout << "bodypoint simulate  method=" << (plan.search ? method_name : std::string(r0.method->name));
   if (plan.search) std::cout << "  tol=" << fmt(plan.tol);
   else std::cout << (is_time_transformed(*r0.method) ? "  ds=" : "  h=") << fmt(planned_step(plan));
-  std::cout << "  steps=" << r0.result.steps << "  t_end=" << fmt(r0.result.t_end) << "\n"
+  std::cout << "  steps=" << r0.run.steps << "  t_end=" << fmt(r0.run.t_end) << "\n"
             << "scene: " << header << "  (" << scene.centres.size() << " centre(s), " << scene.bodies.size()
             << " body-point(s))\n";
   for (std::size_t b = 0; b < runs.size(); ++b) {
     report_body(runs[b], scene.bodies[b].name);
-    print_encounter(o.body_events[b], runs[b], enc[b]);
+    print_encounter(o.body_events[b], runs[b].run, enc[b]);
   }
 }
 
@@ -444,17 +379,17 @@ int cmd_simulate(int argc, char** argv) {
   }
   std::unique_ptr<TrajectoryFile> file;
   if (vm.count("out")) file = std::make_unique<TrajectoryFile>(o.out, o, vm, plan, scene);
-  std::vector<BodyRun> runs;
+  std::vector<SimulatedBody> runs;
   for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
     const Body& body = scene.bodies[b];
     const SampleSink sink = file ? file->sink(static_cast<long>(b), body.p) : SampleSink();
     runs.push_back(simulate_body(o, plan, body, scene, o.body_events[b], file ? &sink : nullptr));
-    if (file) file->stream() << "# body " << b << ": " << search_line(runs.back()) << "; " << error_line(runs.back().error) << "\n";
+    if (file) file->stream() << "# body " << b << ": " << search_line(runs.back().run) << "; " << error_line(runs.back().run.error) << "\n";
   }
   std::vector<std::optional<Encounter>> enc(runs.size());
   if (o.scattering)
     for (std::size_t b = 0; b < runs.size(); ++b) {
-      enc[b] = measure_encounter(scene.bodies[b], scene.centres, runs[b].result, runs[b].events, o.body_events[b]);
+      enc[b] = measure_encounter(scene.bodies[b], scene.centres, runs[b].run.run, runs[b].run.events, o.body_events[b]);
       if (enc[b]->outcome != Outcome::ok)
         throw Error("body '" + scene.bodies[b].name + "': " + enc[b]->reason + "; no output written");
     }

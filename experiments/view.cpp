@@ -152,10 +152,10 @@ struct TrackJson {
 /// The marks of the encounter: the located closest approach (nearest of every centre's) and, for a
 /// single Coulomb centre, the incoming and outgoing asymptotes (scattering.hpp) as a point on each line
 /// and its direction.
-std::string encounter_json(const Body& body, const std::vector<Centre>& centres, const BodyRun& br,
+std::string encounter_json(const Body& body, const std::vector<Centre>& centres, const BodyResult& br,
                            const std::vector<Event>& closest) {
   const EventHit* nearest = nearest_approach(br.events, closest);
-  const Scattering sc = scattering(body.p, centres, body.s0, br.result.final, br.result.t_end);
+  const Scattering sc = scattering(body.p, centres, body.s0, br.run.final, br.run.t_end);
   std::string out = ", \"encounter\": {\"R_min\": " + (nearest ? json_vec(nearest->s.R) : std::string("null"));
   if (nearest) out += ", \"r_min\": " + json_number(nearest->distance) + ", \"t_min\": " + json_number(nearest->t);
   out += ", \"asymptotes\": [";
@@ -175,7 +175,7 @@ TrackJson body_json(const Body& body, const std::vector<Centre>& centres, RunPla
   Decimator d(centres, std::max<std::size_t>(8 * frames, 1 << 16));
   const SampleSink sink = [&d](const Sample& s) { d.add(s); };
   const std::vector<Event> closest = closest_approaches(centres.size());  // located for the marks
-  const BodyRun br = run_body(plan, body, centres, how, &sink, closest);
+  const BodyResult br = run_body(plan, body, centres, how, &sink, closest);
   const std::string who = "body '" + body.name + "' with " + method_label;
   if (d.non_finite_at())
     throw Error(who + ": the state became non-finite at t = " + fmt(*d.non_finite_at()) + "; no page written");
@@ -190,10 +190,10 @@ TrackJson body_json(const Body& body, const std::vector<Centre>& centres, RunPla
   const std::vector<Frame> f = d.frames(frames);
   std::string out = "{\"name\": " + json_string(body.name, true) + ", \"status\": " +
                     json_string(std::string(outcome_name(br.outcome)), true) + ", \"reason\": " +
-                    json_string(br.reason, true) + ", \"steps\": " + std::to_string(br.result.steps) +
-                    ", \"force_evals\": " + std::to_string(br.result.force_evals) + ", \"invariants\": {";
-  if (br.result.invariants) {
-    const InvariantStats& inv = *br.result.invariants;
+                    json_string(br.reason, true) + ", \"steps\": " + std::to_string(br.run.steps) +
+                    ", \"force_evals\": " + std::to_string(br.run.force_evals) + ", \"invariants\": {";
+  if (br.run.invariants) {
+    const InvariantStats& inv = *br.run.invariants;
     out += "\"max_rel_dE\": " + json_number(inv.max_rel_dE) + ", \"max_rel_dK2sq\": " + json_number(inv.max_rel_dK2sq);
     if (inv.has_K2Q) out += ", \"max_abs_dK2Q\": " + json_number(inv.max_abs_dK2Q);
   }
@@ -213,7 +213,7 @@ TrackJson body_json(const Body& body, const std::vector<Centre>& centres, RunPla
   out += ", ";
   put_array(out, "dt", f, kOtherDigits, [](std::string& o, const Frame& x, int g) { put(o, x.dt, g); });
   out += "}" + encounter_json(body, centres, br, closest) + "}";
-  return {out, br.result.t_end};
+  return {out, br.run.t_end};
 }
 
 /// The step the run used, as the header shows it.

@@ -128,7 +128,7 @@ EncounterResult encounter(const Body& body, const std::vector<Centre>& centres, 
   const bool to_departure = std::isnan(t_end);
   const double end = to_departure ? encounter_span(body, centres) : t_end;
   const Options o = encounter_options(body, centres, std::move(options), to_departure);
-  EncounterResult r{integrate_body(body, centres, method, Accuracy{tol, end}, o), {}};
+  EncounterResult r{integrate_body(body, centres, method, Accuracy{tol, end}, o), {}, o.events};
   if (r.run.outcome != Outcome::ok) {
     r.encounter.outcome = r.run.outcome;
     r.encounter.reason = r.run.reason;

@@ -14,6 +14,7 @@ install(TARGETS bodypoint_core bodypoint_adaptive bodypoint
 install(FILES
           ${PROJECT_SOURCE_DIR}/lib/api/bodypoint/bodypoint.hpp
           ${PROJECT_SOURCE_DIR}/lib/api/bodypoint/methods.hpp
+          ${PROJECT_SOURCE_DIR}/lib/api/bodypoint/record.hpp
           ${PROJECT_SOURCE_DIR}/lib/api/bodypoint/sweep.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/field.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/invariant_stats.hpp

@@ -4,6 +4,7 @@
 // library's one-line reason; the GIL is released while integrating. The Python-side docs and the
 // keyword interface are in bodypoint/__init__.py; this file holds only the conversions.
 #include "bodypoint/bodypoint.hpp"
+#include "bodypoint/record.hpp"
 #include "bodypoint/sweep.hpp"
 
 #include <pybind11/numpy.h>
@@ -102,57 +103,34 @@ Scene thesis_from(const py::dict& kw) {
   return thesis_scene(sp);
 }
 
-py::dict invariants_dict(const std::optional<InvariantStats>& inv) {
+/// A record of the library's (record.hpp) as a dict: the keys of `simulate --json`, numbers that are
+/// not finite as None, vectors as numpy arrays.
+py::object to_py(const Value& v);
+py::dict to_py(const Record& r) {
   py::dict d;
-  if (!inv) return d;
-  d["max_rel_dE"] = inv->max_rel_dE;
-  d["max_rel_dK2sq"] = inv->max_rel_dK2sq;
-  if (inv->has_K2Q) d["max_abs_dK2Q"] = inv->max_abs_dK2Q;
+  for (const Field& f : r.fields) d[py::str(f.key)] = to_py(f.value);
   return d;
 }
+py::object to_py(const Value& v) {
+  switch (v.kind) {
+    case Value::Kind::null: return py::none();
+    case Value::Kind::number: return std::isfinite(v.number) ? py::object(py::float_(v.number)) : py::object(py::none());
+    case Value::Kind::count: return py::int_(v.count);
+    case Value::Kind::text: return py::str(v.text);
+    case Value::Kind::vector: return vec(v.vector);
+    case Value::Kind::texts: return py::cast(v.texts);
+    case Value::Kind::record: return to_py(v.records.front());
+    case Value::Kind::records: {
+      py::list l;
+      for (const Record& r : v.records) l.append(to_py(r));
+      return l;
+    }
+  }
+  return py::none();
+}
 
-py::dict body_result(const Body& body, const BodyResult& r, const std::vector<Event>& events) {
-  py::dict d;
-  d["name"] = body.name;
-  d["method"] = r.method ? py::cast(r.method->name) : py::none();
-  d["outcome"] = std::string(outcome_name(r.outcome));
-  d["reason"] = r.reason;
-  d["t_end"] = r.run.t_end;
-  d["steps"] = r.run.steps;
-  d["force_evals"] = r.total_force_evals();
-  d["wall_s"] = r.run.wall_s;
-  d["R"] = vec(r.run.final.R);
-  d["v"] = vec(r.run.final.v);
-  d["w"] = vec(r.run.final.w);
-  d["invariants"] = invariants_dict(r.run.invariants);
-  if (!r.chosen.empty()) d["chosen"] = r.chosen;
-  d["err_estimate"] = r.error.known() ? py::object(py::float_(r.error.value)) : py::object(py::none());
-  d["err_basis"] = r.error.basis;
-  d["estimate_force_evals"] = r.error.force_evals;
-  d["warnings"] = r.warnings;
-  if (r.accuracy) {
-    py::dict a;
-    a["tol"] = r.accuracy->tol;
-    a["err_estimate"] = r.accuracy->err_estimate;
-    a["step"] = r.accuracy->step;
-    a["omega_c"] = r.accuracy->omega_c;
-    a["runs"] = r.accuracy->runs;
-    a["force_evals"] = r.accuracy->force_evals;
-    d["accuracy"] = a;
-  }
-  py::list hits;
-  for (const EventHit& h : r.events) {
-    py::dict e;
-    e["event"] = events[h.event].label();
-    e["t"] = h.t;
-    e["distance"] = h.distance;
-    e["R"] = vec(h.s.R);
-    e["v"] = vec(h.s.v);
-    e["w"] = vec(h.s.w);
-    hits.append(e);
-  }
-  d["events"] = hits;
-  return d;
+py::dict body_result(const Body& body, const BodyResult& r, const Advance& how, const std::vector<Event>& events) {
+  return to_py(Record().text("name", body.name).append(body_record(r, how, events)));
 }
 
 /// The Advance the keywords ask for: the library's one mapping (advance_for, bodypoint.hpp).
@@ -188,7 +166,7 @@ py::dict integrate_py(const Scene& scene, const std::string& method, std::option
   d["force_evals"] = r.force_evals;
   d["wall_s"] = r.wall_s;
   py::list bodies;
-  for (std::size_t i = 0; i < r.bodies.size(); ++i) bodies.append(body_result(scene.bodies[i], r.bodies[i], o.events));
+  for (std::size_t i = 0; i < r.bodies.size(); ++i) bodies.append(body_result(scene.bodies[i], r.bodies[i], how, o.events));
   d["bodies"] = bodies;
   return d;
 }
@@ -300,11 +278,9 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
   return cols;
 }
 
-py::object number_or_none(double x) { return std::isfinite(x) ? py::object(py::float_(x)) : py::object(py::none()); }
-
+/// The encounter's record with its run's (`run`: method, steps, t_end, err_estimate, force_evals, ...).
 py::dict encounter_py(const Scene& scene, const std::string& method, double tol, double t_end) {
   const MethodInfo* m = method == "auto" ? nullptr : &method_or_throw(method);
-  validate(scene);
   Options o;
   o.track_invariants = false;
   EncounterResult r;
@@ -313,31 +289,8 @@ py::dict encounter_py(const Scene& scene, const std::string& method, double tol,
     r = encounter(scene.bodies.front(), scene.centres, m, tol, t_end, o);
   }
   if (r.run.outcome != Outcome::ok) throw Error(r.run.reason);
-  const BodyResult& br = r.run;
-  const Encounter& e = r.encounter;
-  const Scattering& sc = e.scattering;
-  py::dict d;
-  d["method"] = br.method ? br.method->name : std::string();
-  d["outcome"] = std::string(outcome_name(e.outcome));
-  d["reason"] = e.reason;
-  d["deflection"] = number_or_none(sc.deflection);
-  d["out_of_plane"] = number_or_none(sc.out_of_plane);
-  d["b"] = number_or_none(sc.b);
-  d["v_inf"] = number_or_none(sc.v_inf);
-  d["time_delay"] = number_or_none(sc.time_delay);
-  d["asymptote_error"] = number_or_none(e.asymptote_error);
-  d["asymptote_basis"] = e.asymptote_basis;
-  d["K1_turn"] = sc.K1_turn;
-  d["spin_turn"] = sc.spin_turn;
-  d["asymptotes"] = sc.asymptotes;
-  d["K1_start"] = vec(sc.K1_start);
-  d["K1_end"] = vec(sc.K1_end);
-  d["r_min"] = e.r_min;
-  d["t_min"] = e.t_min;
-  d["t_end"] = br.run.t_end;
-  d["err_estimate"] = br.accuracy ? br.accuracy->err_estimate : kNaN;
-  d["force_evals"] = br.total_force_evals();
-  return d;
+  const Advance how = Accuracy{tol, r.run.run.t_end};
+  return to_py(encounter_record(r.encounter).record("run", body_record(r.run, how, r.events)));
 }
 
 }  // namespace

@@ -278,6 +278,7 @@ double encounter_span(const Body& body, const std::vector<Centre>& centres);
 struct EncounterResult {
   BodyResult run;
   Encounter encounter;
+  std::vector<Event> events;  ///< the events of the run (encounter_options), which run.events index
 };
 EncounterResult encounter(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method, double tol,
                           double t_end = Scattering::kNaN, Options options = {});

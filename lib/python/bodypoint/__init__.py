@@ -65,9 +65,13 @@ def integrate(scene, method="auto", *, h=None, steps=None, t_end=None, tol=None,
       step-size-controlled peers (odeint-*, gsl-*): ``tol`` per step to t_end, first trial step h;
       ``tol`` with any other method, or method "auto": the accuracy mode, the final state's relative
           error at most tol at t_end (the step, and for "auto" the method, are chosen).
-    Each body's dict holds the final R, v, w (numpy arrays), t_end, steps, force_evals, the
-    invariants' largest deviations, the accuracy mode's report, and the events asked for
-    ("closest", "closest:K", "r=V", "r:K=V"), located on the method's own steps.
+    Each body's dict has its name and the keys of ``bodypoint simulate --json`` (docs/guide.md, "Output
+    fields"): method, outcome, reason, h, the final R, v, w (numpy arrays), t_end, steps, the invariants'
+    largest deviations (max_rel_dE, max_rel_dK2sq, max_abs_dK2Q), force_evals (the delivered run's),
+    total_force_evals (with the accuracy mode's search, the error estimate and the events), the
+    accuracy mode's search (tol, h_chosen, search_runs, search_force_evals) and its choice (chosen),
+    and the events asked for (the forms of the command line's --event), located on the method's own
+    steps: events (event, t, r, R, v, w), event_force_evals.
     Each body's ``err_estimate`` is the estimated relative error of its final state, max(|dR|/|R|,
     |dv|/|v|): from a companion run at half the step (a tenth of a peer's tolerance; it costs about twice
     the run), or the accuracy mode's; None when there is none, ``err_basis`` saying how it was obtained
@@ -118,6 +122,9 @@ def encounter(scene, *, t_end=None, method="auto", tol=1e-10):
     "incomplete" when the run ended before the body left: then deflection, out_of_plane, b, v_inf and
     time_delay are None), reason, deflection, out_of_plane, b, v_inf, time_delay, asymptote_error (the
     asymptotes' model error in the deflection; 0 for B = 0) and asymptote_basis, K1_turn, spin_turn,
-    r_min, t_min (the closest approach to any centre), asymptotes, err_estimate (the run's), force_evals.
+    r_min, t_min (the closest approach to any centre), asymptotes, direction_in and direction_out, K1,
+    K2 (and K2Q) and E at both ends: the keys of ``simulate --scattering --json``'s "scattering" object.
+    ``run`` holds the run's own fields, as integrate() gives a body's (method, steps, t_end,
+    err_estimate, force_evals, total_force_evals, events, ...).
     A run that is not ok (refused, diverged, ...) raises bodypoint.Error."""
     return _core._encounter(scene, method, tol, float("nan") if t_end is None else t_end)

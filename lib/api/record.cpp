@@ -1,0 +1,180 @@
+// A run's results as named fields (record.hpp): built once here, written as JSON by the command line
+// and turned into dicts by the Python module.
+#include "bodypoint/record.hpp"
+
+#include "bodypoint/io.hpp"
+
+#include <algorithm>
+#include <ostream>
+#include <utility>
+
+namespace bodypoint {
+
+namespace {
+
+Record& add(Record& r, std::string key, Value v) {
+  r.fields.push_back({std::move(key), std::move(v)});
+  return r;
+}
+
+/// The step a run was asked for or chosen: h, ds, the first trial step, the accuracy mode's choice.
+double step_of(const BodyResult& r, const Advance& how) {
+  if (const auto* f = std::get_if<FixedSteps>(&how)) return f->h;
+  if (const auto* f = std::get_if<FictitiousSteps>(&how)) return f->ds;
+  if (const auto* c = std::get_if<ControlledSteps>(&how)) return c->h0;
+  return r.accuracy ? r.accuracy->step : Scattering::kNaN;
+}
+
+Record event_hits(const BodyResult& r, const std::vector<Event>& events) {
+  std::vector<Record> hits;
+  for (const EventHit& h : r.events) {
+    Record e;
+    e.text("event", events[h.event].label()).number("t", h.t).number("r", h.distance);
+    e.vector("R", h.s.R).vector("v", h.s.v).vector("w", h.s.w);
+    hits.push_back(std::move(e));
+  }
+  Record out;
+  out.records("events", std::move(hits)).count("event_force_evals", r.event_force_evals);
+  if (std::any_of(events.begin(), events.end(), [](const Event& e) { return e.stop; })) {
+    if (r.run.stopped && !r.events.empty()) out.text("stopped_by", events[r.events.back().event].label());
+    else out.null("stopped_by");
+  }
+  return out;
+}
+
+void write_value(std::ostream& os, const Value& v) {
+  switch (v.kind) {
+    case Value::Kind::null: os << "null"; return;
+    case Value::Kind::number: os << json_number(v.number); return;
+    case Value::Kind::count: os << v.count; return;
+    case Value::Kind::text: os << json_string(v.text); return;
+    case Value::Kind::vector: os << json_vec(v.vector); return;
+    case Value::Kind::texts:
+      os << "[";
+      for (std::size_t i = 0; i < v.texts.size(); ++i) os << (i ? ", " : "") << json_string(v.texts[i]);
+      os << "]";
+      return;
+    case Value::Kind::record: write_json(os, v.records.front()); return;
+    case Value::Kind::records:
+      os << "[";
+      for (std::size_t i = 0; i < v.records.size(); ++i) {
+        if (i) os << ", ";
+        write_json(os, v.records[i]);
+      }
+      os << "]";
+      return;
+  }
+}
+
+}  // namespace
+
+Record& Record::number(std::string key, double x) {
+  Value v;
+  v.kind = Value::Kind::number;
+  v.number = x;
+  return add(*this, std::move(key), std::move(v));
+}
+Record& Record::count(std::string key, long n) {
+  Value v;
+  v.kind = Value::Kind::count;
+  v.count = n;
+  return add(*this, std::move(key), std::move(v));
+}
+Record& Record::text(std::string key, std::string s) {
+  Value v;
+  v.kind = Value::Kind::text;
+  v.text = std::move(s);
+  return add(*this, std::move(key), std::move(v));
+}
+Record& Record::vector(std::string key, const Vec3& x) {
+  Value v;
+  v.kind = Value::Kind::vector;
+  v.vector = x;
+  return add(*this, std::move(key), std::move(v));
+}
+Record& Record::texts(std::string key, std::vector<std::string> list) {
+  Value v;
+  v.kind = Value::Kind::texts;
+  v.texts = std::move(list);
+  return add(*this, std::move(key), std::move(v));
+}
+Record& Record::record(std::string key, Record r) {
+  Value v;
+  v.kind = Value::Kind::record;
+  v.records.push_back(std::move(r));
+  return add(*this, std::move(key), std::move(v));
+}
+Record& Record::records(std::string key, std::vector<Record> list) {
+  Value v;
+  v.kind = Value::Kind::records;
+  v.records = std::move(list);
+  return add(*this, std::move(key), std::move(v));
+}
+Record& Record::null(std::string key) { return add(*this, std::move(key), Value{}); }
+
+Record& Record::append(const Record& more) {
+  fields.insert(fields.end(), more.fields.begin(), more.fields.end());
+  return *this;
+}
+
+Record& Record::insert_before(std::string_view key, const Record& more) {
+  const auto at = std::find_if(fields.begin(), fields.end(), [key](const Field& f) { return f.key == key; });
+  fields.insert(at, more.fields.begin(), more.fields.end());
+  return *this;
+}
+
+const Value* Record::find(std::string_view key) const {
+  for (const Field& f : fields)
+    if (f.key == key) return &f.value;
+  return nullptr;
+}
+
+Record body_record(const BodyResult& r, const Advance& how, const std::vector<Event>& events) {
+  Record out;
+  if (r.method) out.text("method", std::string(r.method->name));
+  else out.null("method");
+  out.text("outcome", std::string(outcome_name(r.outcome))).text("reason", r.reason).number("h", step_of(r, how));
+  if (const auto* c = std::get_if<ControlledSteps>(&how)) out.number("tol", c->tol);
+  if (const auto* a = r.accuracy ? &*r.accuracy : nullptr) {
+    out.number("tol", a->tol).number("h_chosen", a->step).count("search_runs", a->runs);
+    out.count("search_force_evals", a->force_evals).number("search_wall_s", a->wall_s);
+  }
+  if (!r.chosen.empty()) out.text("chosen", r.chosen);
+  out.number("err_estimate", r.error.value).text("err_basis", r.error.basis).count("estimate_force_evals", r.error.force_evals);
+  out.texts("warnings", r.warnings).count("steps", r.run.steps).number("t_end", r.run.t_end);
+  out.vector("R", r.run.final.R).vector("v", r.run.final.v).vector("w", r.run.final.w);
+  if (const auto& inv = r.run.invariants) {
+    out.number("max_rel_dE", inv->max_rel_dE).number("max_rel_dK2sq", inv->max_rel_dK2sq);
+    if (inv->has_K2Q) out.number("max_abs_dK2Q", inv->max_abs_dK2Q);
+  }
+  if (r.run.max_step > 0.0)
+    out.count("accepted_steps", r.run.steps).number("min_step", r.run.min_step).number("max_step", r.run.max_step);
+  out.count("force_evals", r.run.force_evals).number("wall_s", r.run.wall_s).count("total_force_evals", r.total_force_evals());
+  return out.append(event_hits(r, events));
+}
+
+Record encounter_record(const Encounter& e) {
+  const Scattering& sc = e.scattering;
+  Record out;
+  out.text("outcome", std::string(outcome_name(e.outcome))).text("reason", e.reason).text("asymptotes", sc.asymptotes);
+  out.number("deflection", sc.deflection).number("out_of_plane", sc.out_of_plane).number("b", sc.b);
+  out.number("v_inf", sc.v_inf).number("time_delay", sc.time_delay).number("asymptote_error", e.asymptote_error);
+  out.text("asymptote_basis", e.asymptote_basis);
+  if (sc.in) out.vector("direction_in", sc.in->direction).vector("direction_out", sc.out->direction);
+  out.number("r_min", e.r_min).number("t_min", e.t_min).number("K1_turn", sc.K1_turn).number("spin_turn", sc.spin_turn);
+  out.vector("K1_start", sc.K1_start).vector("K1_end", sc.K1_end).vector("K2_start", sc.K2_start).vector("K2_end", sc.K2_end);
+  out.number("E_start", sc.E_start).number("E_end", sc.E_end);
+  if (sc.has_K2Q) out.vector("K2Q_start", sc.K2Q_start).vector("K2Q_end", sc.K2Q_end);
+  return out;
+}
+
+void write_json(std::ostream& os, const Record& r) {
+  os << "{";
+  for (std::size_t i = 0; i < r.fields.size(); ++i) {
+    os << (i ? ", " : "") << json_string(r.fields[i].key) << ": ";
+    write_value(os, r.fields[i].value);
+  }
+  os << "}";
+}
+
+}  // namespace bodypoint
