@@ -119,13 +119,12 @@ double spin_orbit_period(const Body& b) {
 }
 
 /// The way of advancing time at step h: fictitious steps ds = h to t_end for time-transformed methods,
-/// otherwise n = ceil(t_end/h) fixed steps of t_end/n.
+/// otherwise the fixed steps of at most h that land on t_end (fixed_steps_to's rule).
 Advance step_advance(const MethodInfo& m, double h, double t_end, double dt_out) {
   if (is_time_transformed(m)) return FictitiousSteps{h, EndTime{t_end}, dt_out};
-  const double n = std::ceil(t_end / h * (1.0 - 1e-12));
+  const double n = steps_landing_on(t_end, h);
   if (!(n <= 1e12)) throw SearchLimit("tol: the step the search needs (" + std::to_string(h) + ") is too small");
-  const long steps = std::max(1L, static_cast<long>(n));
-  return FixedSteps{t_end / static_cast<double>(steps), steps, dt_out};
+  return FixedSteps{t_end / n, static_cast<long>(n), dt_out};
 }
 
 /// The first, coarse step of the ladder.

@@ -62,7 +62,7 @@ RunResult run_splitting(const Body& body, const std::vector<Centre>& centres, co
 
 /// The row of a thesis-family method from its entry in ThesisTables (catalogue.hpp).
 template <class E>
-MethodInfo thesis_row() {
+MethodInfo thesis_row(int batch_kernel) {
   using T = typename E::type;
   constexpr const auto& seq = sp::ops_of<T>;
   constexpr sp::CodeSlip slip = [] {
@@ -75,18 +75,18 @@ MethodInfo thesis_row() {
   const int k = static_cast<int>(seq.kicks());
   return {"thesis-" + std::string(E::tag), Family::Thesis, T::order, k, k,
           sp::describe<T>("thesis, frozen gyroscopic term"),
-          &run_splitting<sp::ThesisKernel, seq, slip>};
+          &run_splitting<sp::ThesisKernel, seq, slip>, nullptr, batch_kernel};
 }
 
 /// The row of an exact Lie-Poisson method from its entry in LiePoissonTables (catalogue.hpp).
 template <class E>
-MethodInfo lie_row() {
+MethodInfo lie_row(int batch_kernel) {
   using T = typename E::type;
   constexpr const auto& seq = sp::ops_of<T>;
   return {"lp-" + std::string(E::tag), Family::LiePoisson, T::order, static_cast<int>(seq.kicks()),
           static_cast<int>(seq.kicks_merged()),
           sp::describe<T>("exact Lie-Poisson"),
-          &run_splitting<sp::LiePoissonKernel, seq>};
+          &run_splitting<sp::LiePoissonKernel, seq>, nullptr, batch_kernel};
 }
 
 /// The Kepler split's assumption: Coulomb's law (its Kepler flow is built on -A/|R|).
@@ -117,7 +117,7 @@ MethodInfo kepler_row() {
 std::vector<MethodInfo> make_rows() {
   std::vector<MethodInfo> all = {
       {"rk4", Family::Odeint, 4, 4, 4, "classical Runge-Kutta (thesis 2.1; odeint runge_kutta4)",
-       &run_odeint_rk4},
+       &run_odeint_rk4, nullptr, sp::kBatchRk4},
       {"ab4", Family::Odeint, 4, 1, 1,
        "Adams-Bashforth 4 started by RK4 (thesis 2.2; odeint adams_bashforth<4>)",
        &run_odeint_ab4},
@@ -137,8 +137,10 @@ std::vector<MethodInfo> make_rows() {
        &run_gsl_rkf45},
 #endif
   };
-  sp::for_each(sp::ThesisTables{}, [&all]<class E>() { all.push_back(thesis_row<E>()); });
-  sp::for_each(sp::LiePoissonTables{}, [&all]<class E>() { all.push_back(lie_row<E>()); });
+  std::size_t table = 0;
+  sp::for_each(sp::ThesisTables{}, [&]<class E>() { all.push_back(thesis_row<E>(sp::batch_thesis_kernel(table++))); });
+  table = 0;
+  sp::for_each(sp::LiePoissonTables{}, [&]<class E>() { all.push_back(lie_row<E>(sp::batch_lie_kernel(table++))); });
   sp::for_each(sp::KeplerSplitTables{}, [&all]<class E>() { all.push_back(kepler_row<E>()); });
   return all;
 }
@@ -265,13 +267,15 @@ void check_takes(const MethodInfo& m, const Advance& how) {
   throw Error(m.name + " takes " + takes + ", not the way of advancing time given");
 }
 
+double steps_landing_on(double t_end, double h_max) { return std::max(1.0, std::ceil(t_end / h_max * (1.0 - 1e-12))); }
+
 FixedSteps fixed_steps_to(double t_end, double h_max) {
   require_positive(h_max, "the step h");
   require_positive(t_end, "the end time t_end");
-  const double n = std::ceil(t_end / h_max * (1.0 - 1e-12));
+  const double n = steps_landing_on(t_end, h_max);
   if (!(n <= 1e13)) throw Error("end time / step size asks for more than 1e13 steps");
-  const long steps = std::max(1L, static_cast<long>(n));
-  return {t_end / static_cast<double>(steps), steps};
+  const auto steps = static_cast<long>(n);
+  return {t_end / n, steps};
 }
 
 FixedSteps thesis_code_steps(double h, long steps, double t_end) {

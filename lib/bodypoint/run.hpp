@@ -200,6 +200,9 @@ struct MethodInfo {
   /// The driver: takes the Advance alternative of its kind (never Accuracy), already checked.
   RunResult (*run)(const Body&, const std::vector<Centre>&, const Advance&, const RunOptions&);
   SceneCheck check = nullptr;  ///< nullptr: runs every valid scene
+  /// The number of its kernel that runs vector lanes of trajectories in lockstep (batch.hpp;
+  /// splitting/catalogue.hpp numbers them); -1: none.
+  int batch_kernel = -1;
 };
 
 /// Why `m` refuses the scene (empty: it accepts it). `run` throws this reason; sweeps, studies,
@@ -287,6 +290,8 @@ Health assess(const RunResult& r, const Checks& checks = {});
 /// Fixed steps that land exactly on t_end: n = ceil(t_end / h_max) steps of t_end / n (a quotient
 /// within 1e-12 of a whole number counts as that number). Throws Error beyond 1e13 steps.
 FixedSteps fixed_steps_to(double t_end, double h_max);
+/// That n (at least 1), as a double, for t_end and h_max already checked: the one rule of both.
+double steps_landing_on(double t_end, double h_max);
 
 /// The thesis's published code asked for n steps of h (with t_end > 0: n = (int)(t_end / h), Java's
 /// truncation) runs `i = 1; do { step; i++; } while (i < n);`: n - 1 steps of exactly h. Under

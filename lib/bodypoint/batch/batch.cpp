@@ -31,8 +31,8 @@ namespace {
 struct Isa {
   std::size_t width;
   const char* name;
-  bool (*supports)(const char*);
-  long (*run)(const char*, const double*, std::size_t, double, long, double*);
+  bool (*supports)(int);
+  long (*run)(int, const double*, std::size_t, double, long, double*);
 };
 
 /// The units this CPU runs, widest first.
@@ -81,15 +81,14 @@ std::vector<std::size_t> widths() {
 const char* isa() { return isa_in_use().name; }
 
 bool accepts(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres) {
-  return isa_in_use().supports(std::string(method.name).c_str()) && body.p.B != 0.0 && centres.size() == 1 &&
+  return isa_in_use().supports(method.batch_kernel) && body.p.B != 0.0 && centres.size() == 1 &&
          centres.front().c.isZero(0.0) && centres.front().law == ForceLaw::coulomb;
 }
 
 std::vector<RunResult> run(const MethodInfo& method, const std::vector<Member>& members, const FixedSteps& spec,
                            std::size_t width) {
   const Isa& isa = width == 0 ? isa_in_use() : unit(width);
-  const std::string name(method.name);
-  if (!isa.supports(name.c_str())) throw Error(name + " has no batch kernel");
+  if (!isa.supports(method.batch_kernel)) throw Error(method.name + " has no batch kernel");
   if (members.empty() || members.size() > isa.width)
     throw Error("a batch holds 1 to " + std::to_string(isa.width) + " members, got " + std::to_string(members.size()));
   std::vector<double> in(members.size() * abi::kIn), out(members.size() * abi::kOut);
@@ -100,7 +99,7 @@ std::vector<RunResult> run(const MethodInfo& method, const std::vector<Member>& 
     for (int k = 0; k < 3; ++k) x[4 + k] = m.s0.R[k], x[7 + k] = m.s0.v[k], x[10 + k] = m.s0.w[k];
   }
   const auto t0 = std::chrono::steady_clock::now();
-  const long evals = isa.run(name.c_str(), in.data(), members.size(), spec.h, spec.steps, out.data());
+  const long evals = isa.run(method.batch_kernel, in.data(), members.size(), spec.h, spec.steps, out.data());
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::vector<RunResult> results(members.size());
   for (std::size_t i = 0; i < members.size(); ++i) {

@@ -317,60 +317,30 @@ long thesis(const Params& p, const Physical& s0, double h, long steps, std::size
   return run_splitting<Seq>(ThesisKernel{p}, s0, h, steps, count, out);
 }
 
-bool same(const char* a, const char* b) {
-  for (; *a && *a == *b; ++a, ++b) {
-  }
-  return *a == *b;
-}
-
-/// A method's name and batch runner; the name is built at compile time (this unit calls no library code).
-struct Row {
-  char name[32]{};
-  Runner run = nullptr;
+/// Every batch runner, numbered as the catalogue numbers them (splitting/catalogue.hpp kBatchRk4,
+/// batch_thesis_kernel, batch_lie_kernel): RK4, the thesis family's tables, the Lie-Poisson ones.
+struct Runners {
+  Runner run[sp::kBatchKernels];
 };
-constexpr Row row(std::string_view prefix, std::string_view tag, Runner run) {
-  Row r;
-  r.run = run;
-  std::size_t n = 0;
-  for (char c : prefix) r.name[n++] = c;
-  for (char c : tag) r.name[n++] = c;
-  return r;
+template <class... T, class... L>
+constexpr Runners all_runners(sp::List<T...> /*thesis*/, sp::List<L...> /*lie*/) {
+  return {{&run_rk4, &thesis<sp::ops_of<typename sp::entry_t<T>::type>>...,
+           &lie<sp::ops_of<typename sp::entry_t<L>::type>>...}};
 }
+constexpr Runners kRunners = all_runners(sp::ThesisTables{}, sp::LiePoissonTables{});
+static_assert(sizeof(kRunners.run) / sizeof(Runner) == 1 + sp::size(sp::ThesisTables{}) + sp::size(sp::LiePoissonTables{}));
 
-/// The rows of a family, generated from its list of tables (splitting/catalogue.hpp).
-template <std::size_t N>
-struct Rows {
-  Row rows[N];
-};
-template <class... E>
-constexpr Rows<sizeof...(E)> thesis_rows(sp::List<E...> /*list*/) {
-  return {{row("thesis-", sp::entry_t<E>::tag, &thesis<sp::ops_of<typename sp::entry_t<E>::type>>)...}};
-}
-template <class... E>
-constexpr Rows<sizeof...(E)> lie_rows(sp::List<E...> /*list*/) {
-  return {{row("lp-", sp::entry_t<E>::tag, &lie<sp::ops_of<typename sp::entry_t<E>::type>>)...}};
-}
-constexpr auto kThesisRows = thesis_rows(sp::ThesisTables{});
-constexpr auto kLieRows = lie_rows(sp::LiePoissonTables{});
-
-/// The batch runner of `method`, or nullptr.
-Runner runner(const char* name) {
-  if (same("rk4", name)) return run_rk4;
-  for (const Row& r : kThesisRows.rows)
-    if (same(r.name, name)) return r.run;
-  for (const Row& r : kLieRows.rows)
-    if (same(r.name, name)) return r.run;
-  return nullptr;
-}
+/// The batch runner numbered `kernel`, or nullptr.
+Runner runner(int kernel) { return kernel >= 0 && kernel < sp::kBatchKernels ? kRunners.run[kernel] : nullptr; }
 
 }  // namespace
 
 std::size_t width() { return W; }
 
-bool supports(const char* method) { return runner(method) != nullptr; }
+bool supports(int kernel) { return runner(kernel) != nullptr; }
 
-long run(const char* method, const double* in, std::size_t count, double h, long steps, double* out) {
-  const Runner r = runner(method);
+long run(int kernel, const double* in, std::size_t count, double h, long steps, double* out) {
+  const Runner r = runner(kernel);
   if (!r || count == 0 || count > W) return -1;
   Params p{lane_of(in, count, 0), lane_of(in, count, 1), lane_of(in, count, 2), lane_of(in, count, 3), {}};
   p.inv_D = 1.0 / (p.m * p.J - p.B * p.B);

@@ -22,6 +22,6 @@ void scalar_drift_functions(double x, double* out);
 #define BODYPOINT_BATCH_DECLARE(ns)                                                                          \
   namespace bodypoint::batch::ns {                                                                           \
   std::size_t width();                                                                                       \
-  bool supports(const char* method);                                                                         \
-  long run(const char* method, const double* in, std::size_t count, double h, long steps, double* out);    \
+  bool supports(int kernel);                                                                                 \
+  long run(int kernel, const double* in, std::size_t count, double h, long steps, double* out);            \
   }

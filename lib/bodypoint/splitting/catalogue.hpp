@@ -100,6 +100,12 @@ std::string describe(std::string_view family) {
   return std::string(family) + ": " + std::string(T::title) + " [" + std::string(T::citation) + "]";
 }
 
+/// The number of entries of a list.
+template <class... E>
+constexpr std::size_t size(List<E...> /*list*/) {
+  return sizeof...(E);
+}
+
 /// Calls f.template operator()<Use<...>>() for every entry of a list, in listing order.
 template <class... E, class F>
 constexpr void for_each(List<E...> /*list*/, F&& f) {
@@ -181,6 +187,15 @@ using TimeTransformedTables = filtered_t<IsSymmetricDriftFirst, AllTables, Drift
 /// each; the thesis calls Yoshida 4 "Forest-Ruth 4".
 using ThesisTables = List<Euler, VerletKdk, Use<Ruth3, "", CodeSlip::third_v_z>,
                           Use<Yoshida4, "fr4", CodeSlip::third_v_z>, Use<Yoshida6, "", CodeSlip::third_vw_z>>;
+
+/// The batch kernels' numbers (MethodInfo::batch_kernel; batch/batch_w.cpp runs them): RK4, then one
+/// per table of ThesisTables, then one per table of LiePoissonTables, each in its list's order.
+inline constexpr int kBatchRk4 = 0;
+constexpr int batch_thesis_kernel(std::size_t table) { return 1 + static_cast<int>(table); }
+constexpr int batch_lie_kernel(std::size_t table) {
+  return 1 + static_cast<int>(size(ThesisTables{}) + table);
+}
+inline constexpr int kBatchKernels = batch_lie_kernel(size(LiePoissonTables{}));
 
 /// The stage count a table type states is the one its coefficients give.
 template <class... T>
