@@ -452,22 +452,38 @@ void run_job_mpi(const SweepJob& job) {
   write_output(job, file.get(), journal.get(), rows);
 }
 
+/// The steps of a row on average: those of the step h, or, when h is swept, their mean over its values
+/// (h the smallest of them, for the calibration). Throws Error for a step sweep_steps refuses.
+FixedSteps mean_row_steps(const SweepSpec& spec) {
+  for (const Axis& a : spec.axes)
+    if (a.param == "h" && !a.values.empty()) {
+      double total = 0.0, h = a.values.front();
+      for (double value : a.values) {
+        total += static_cast<double>(sweep_steps(value, spec.steps, spec.t_end, spec.base.law).steps);
+        h = std::min(h, value);
+      }
+      return {h, static_cast<long>(std::ceil(total / static_cast<double>(a.values.size())))};
+    }
+  return sweep_steps(spec.h, spec.steps, spec.t_end, spec.base.law);
+}
+
 /// Runs the job and writes its CSV (or, for a shard, its rows file), through a journal when it has a file.
 /// Refuses a sweep whose calibrated time (every row of this shard, on its threads) exceeds the budget:
 /// each method's time per step on the first grid point, times the steps of every row.
 void check_sweep_budget(const SweepJob& job) {
   if (!(job.max_seconds > 0.0)) return;
   const std::size_t tasks = task_count(job.spec), methods = job.spec.methods.size();
-  const FixedSteps steps = sweep_steps(job.spec.h, job.spec.steps, job.spec.t_end, job.spec.base.law);
+  FixedSteps steps{};
+  Scene scene;
+  try {
+    steps = mean_row_steps(job.spec);
+    scene = thesis_scene(point_params(job.spec, grid_point(job.spec, 0)));
+  } catch (const Error&) {
+    return;  // validate_sweep names the step or the point
+  }
   const double runs_per_task = job.spec.estimate_error ? 1.0 + ErrorEstimate::kStepRatio : 1.0;  // and the companion
   if (static_cast<double>(tasks) * static_cast<double>(steps.steps) * runs_per_task * kMaxSecondsPerStep <= job.max_seconds)
     return;
-  Scene scene;
-  try {
-    scene = thesis_scene(point_params(job.spec, grid_point(job.spec, 0)));
-  } catch (const Error&) {
-    return;  // validate_sweep names the point
-  }
   double seconds = 0.0;
   for (std::size_t k = 0; k < methods; ++k) {
     const MethodInfo& m = *job.spec.methods[k];
