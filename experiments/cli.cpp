@@ -16,22 +16,6 @@
 
 namespace bodypoint::cli {
 
-ForceLaw parse_force_law(const std::string& name) {
-  if (name == "coulomb") return ForceLaw::coulomb;
-  if (name == "thesis-code") return ForceLaw::thesis_code;
-  if (name == "thesis-code-force") return ForceLaw::thesis_code_force;
-  throw Error("unknown --force-law '" + name + "' (coulomb, thesis-code, thesis-code-force)");
-}
-
-const char* force_law_name(ForceLaw law) {
-  switch (law) {
-    case ForceLaw::thesis_code: return "thesis-code";
-    case ForceLaw::thesis_code_force: return "thesis-code-force";
-    case ForceLaw::coulomb: break;
-  }
-  return "coulomb";
-}
-
 void add_scene_options(po::options_description& desc, SceneOptions& o) {
   SceneParams& p = o.params;
   for (const SceneParameter& q : scene_parameters()) {
@@ -54,17 +38,15 @@ void add_scene_options(po::options_description& desc, SceneOptions& o) {
 }
 
 SceneParams scene_params(const po::variables_map& vm, const SceneOptions& o) {
-  if (vm.count("b") && vm.count("d") && !vm["d"].defaulted()) throw Error("give --b or --d, not both (--b solves d)");
-  if (vm.count("v-inf") && vm.count("K1") && !vm["K1"].defaulted())
-    throw Error("give --v-inf or --K1, not both (--v-inf solves K1)");
-  if (vm.count("b") && !(std::isfinite(o.b) && o.b > 0.0)) throw Error("--b must be a finite number > 0");
-  if (vm.count("v-inf") && !(std::isfinite(o.v_inf) && o.v_inf > 0.0)) throw Error("--v-inf must be a finite number > 0");
-  if (vm.count("arrival-phase") && vm.count("phase") && !vm["phase"].defaulted())
-    throw Error("give --arrival-phase or --phase, not both (--arrival-phase solves phase)");
-  if (vm.count("arrival-phase") && !std::isfinite(o.arrival_phase)) throw Error("--arrival-phase must be a finite number");
-  if (!vm.count("b") && !vm.count("v-inf") && !vm.count("arrival-phase")) return o.params;
-  validate(thesis_scene(o.params));  // the scene's own errors first, in their words
-  return with_asymptotic_data(o.params, o.b, o.v_inf, o.arrival_phase);
+  // The parameters given explicitly, in the library's names (the options' dashes are underscores).
+  std::vector<std::string> given;
+  for (const SceneParameter& q : scene_parameters())
+    if (vm.count(std::string(q.name)) && !vm[std::string(q.name)].defaulted()) given.emplace_back(q.name);
+  AsymptoticData data;
+  if (vm.count("b")) data.b = o.b;
+  if (vm.count("v-inf")) data.v_inf = o.v_inf;
+  if (vm.count("arrival-phase")) data.arrival_phase = o.arrival_phase;
+  return with_asymptotic_data(o.params, data, given);
 }
 
 Scene make_scene(const po::variables_map& vm, const SceneOptions& o) {
@@ -217,23 +199,6 @@ bool parse(int argc, char** argv, const po::options_description& desc, po::varia
   return true;
 }
 
-std::vector<const MethodInfo*> parse_methods(const std::string& list) {
-  std::vector<const MethodInfo*> ms;
-  if (list == "all") {
-    for (const MethodInfo& m : methods()) ms.push_back(&m);
-    return ms;
-  }
-  if (list == "fixed") {
-    // The fixed-step methods of the thesis's studies (a force evaluation per stage). The Kepler split
-    // (kep-*) is named explicitly: its stage is a Kepler solve, ~16x a force evaluation, and the
-    // studies' 250,000-step runs would take it minutes per sweep point.
-    for (const MethodInfo& m : methods())
-      if (!has_variable_step(m) && m.family != Family::KeplerSplit) ms.push_back(&m);
-    return ms;
-  }
-  for (const std::string& n : split_list(list)) ms.push_back(&method_or_throw(n));
-  if (ms.empty()) throw Error("--methods is empty");
-  return ms;
-}
+std::vector<const MethodInfo*> parse_methods(const std::string& list) { return methods_named(list); }
 
 }  // namespace bodypoint::cli

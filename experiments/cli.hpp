@@ -26,8 +26,6 @@ struct SceneOptions {
 };
 void add_scene_options(po::options_description& desc, SceneOptions& o);
 /// --force-law NAME: coulomb, thesis-code or thesis-code-force (model.hpp, ForceLaw).
-ForceLaw parse_force_law(const std::string& name);
-const char* force_law_name(ForceLaw law);
 /// The thesis's parameters with --b and --v-inf applied (d and K1 solved for them; scattering.hpp).
 SceneParams scene_params(const po::variables_map& vm, const SceneOptions& o);
 /// The scene from --scene or from the thesis's parameters (never both).

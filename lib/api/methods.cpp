@@ -4,6 +4,7 @@
 #include "bodypoint/adaptive/methods.hpp"
 #include "bodypoint/io.hpp"
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,24 @@ const MethodInfo& method_or_throw(std::string_view name) {
   const std::string near = closest_method(name);
   throw Error("unknown method '" + std::string(name) + "'" + (near.empty() ? "" : " (did you mean " + near + "?)") +
               " (see 'bodypoint methods')");
+}
+
+std::vector<const MethodInfo*> methods_named(std::string_view list) {
+  std::vector<const MethodInfo*> ms;
+  const bool all = list == "all", fixed = list == "fixed";
+  if (all || fixed) {
+    for (const MethodInfo& m : methods())
+      if (all || (!has_variable_step(m) && m.family != Family::KeplerSplit)) ms.push_back(&m);
+    return ms;
+  }
+  for (std::size_t start = 0; start <= list.size();) {
+    const std::size_t comma = std::min(list.find(',', start), list.size());
+    const std::string_view name = list.substr(start, comma - start);
+    if (!name.empty()) ms.push_back(&method_or_throw(name));
+    start = comma + 1;
+  }
+  if (ms.empty()) throw Error("the method list is empty");
+  return ms;
 }
 
 }  // namespace bodypoint

@@ -63,6 +63,16 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
 }
 }  // namespace
 
+std::string unknown_name(std::string_view what, std::string_view word, const std::vector<std::string>& valid) {
+  constexpr std::size_t kSuggestEdits = 2;  // a typo: a letter missing, extra, wrong or two of them
+  const std::string near = closest_word(word, valid, kSuggestEdits);
+  std::string out = "unknown " + std::string(what) + " '" + std::string(word) + "'";
+  if (!near.empty()) out += " (did you mean '" + near + "'?)";
+  out += "; valid: ";
+  for (std::size_t i = 0; i < valid.size(); ++i) out += (i ? ", " : "") + valid[i];
+  return out;
+}
+
 std::string closest_word(std::string_view word, const std::vector<std::string>& candidates, std::size_t max_edits) {
   std::string best;
   std::size_t best_d = max_edits + 1;

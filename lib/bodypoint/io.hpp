@@ -51,7 +51,12 @@ std::string json_string(std::string_view s, bool html_safe = false);
 /// you mean" in messages.
 std::string closest_word(std::string_view word, const std::vector<std::string>& candidates, std::size_t max_edits);
 
+/// "unknown <what> 'word' (did you mean 'x'?); valid: a, b, c": the one wording of an unknown name.
+std::string unknown_name(std::string_view what, std::string_view word, const std::vector<std::string>& valid);
+
 /// The git revision this binary was built from.
 const char* git_revision();
+/// The project's version (CMakeLists.txt's project()).
+const char* version();
 
 }  // namespace bodypoint

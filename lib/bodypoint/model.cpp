@@ -1,5 +1,7 @@
 #include "bodypoint/model.hpp"
 
+#include "bodypoint/io.hpp"
+
 #include <cmath>
 #include <sstream>
 
@@ -135,10 +137,27 @@ const std::vector<SceneParameter>& scene_parameters() {
   return list;
 }
 
+const char* force_law_name(ForceLaw law) {
+  switch (law) {
+    case ForceLaw::thesis_code: return "thesis-code";
+    case ForceLaw::thesis_code_force: return "thesis-code-force";
+    case ForceLaw::coulomb: break;
+  }
+  return "coulomb";
+}
+
+ForceLaw parse_force_law(std::string_view name) {
+  for (const ForceLaw law : {ForceLaw::coulomb, ForceLaw::thesis_code, ForceLaw::thesis_code_force})
+    if (name == force_law_name(law)) return law;
+  throw Error(unknown_name("force law", name, {"coulomb", "thesis-code", "thesis-code-force"}));
+}
+
 double& scene_field(SceneParams& p, std::string_view name) {
   for (const SceneParameter& q : scene_parameters())
     if (q.name == name) return q.field(p);
-  throw Error("unknown scene parameter '" + std::string(name) + "'");
+  std::vector<std::string> names;
+  for (const SceneParameter& q : scene_parameters()) names.emplace_back(q.name);
+  throw Error(unknown_name("scene parameter", name, names));
 }
 
 }  // namespace bodypoint

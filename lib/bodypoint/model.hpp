@@ -53,6 +53,10 @@ struct BodyPoint {
 /// `thesis_code` also reinstates the code's third-kick index slip in Ruth 3, Forest-Ruth 4 and
 /// Yoshida 6 (see splitting/thesis.hpp); `thesis_code_force` is the force law alone.
 enum class ForceLaw { coulomb, thesis_code_force, thesis_code };
+/// A force law by its one name (coulomb, thesis-code, thesis-code-force: the command line's
+/// --force-law, a scene file's and the Python module's `law`); Error with the valid ones otherwise.
+ForceLaw parse_force_law(std::string_view name);
+const char* force_law_name(ForceLaw law);
 
 /// A fixed Coulomb centre at c with constant A (A < 0 repels, A > 0 attracts).
 struct Centre {

@@ -7,7 +7,9 @@
 #include "bodypoint/invariants.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
 #include <utility>
@@ -326,6 +328,23 @@ SceneParams with_asymptotic_data(SceneParams params, double b, double v_inf) {
       return params;
   }
   return params;
+}
+
+SceneParams with_asymptotic_data(const SceneParams& params, const AsymptoticData& data,
+                                 const std::vector<std::string>& given) {
+  const auto is_given = [&given](std::string_view name) { return std::find(given.begin(), given.end(), name) != given.end(); };
+  const std::pair<const std::optional<double>*, std::array<const char*, 2>> pairs[] = {
+      {&data.b, {"b", "d"}}, {&data.v_inf, {"v_inf", "K1"}}, {&data.arrival_phase, {"arrival_phase", "phase"}}};
+  for (const auto& [datum, names] : pairs)
+    if (*datum && is_given(names[1]))
+      throw Error(std::string("give ") + names[0] + " or " + names[1] + ", not both (" + names[0] + " solves " + names[1] + ")");
+  if (data.b) require_positive(*data.b, "the impact parameter b");
+  if (data.v_inf) require_positive(*data.v_inf, "the speed at infinity v_inf");
+  if (data.arrival_phase && !std::isfinite(*data.arrival_phase)) throw Error("the arrival phase arrival_phase must be a finite number");
+  if (!data.b && !data.v_inf && !data.arrival_phase) return params;
+  validate(thesis_scene(params));  // the scene's own errors first, in their words
+  constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
+  return with_asymptotic_data(params, data.b.value_or(kNone), data.v_inf.value_or(kNone), data.arrival_phase.value_or(kNone));
 }
 
 }  // namespace bodypoint

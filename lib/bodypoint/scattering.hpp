@@ -123,6 +123,18 @@ SceneParams with_asymptotic_data(SceneParams params, double b, double v_inf);
 /// v_inf (which do not depend on it): start_phase_for_arrival.
 SceneParams with_asymptotic_data(SceneParams params, double b, double v_inf, double arrival);
 
+/// Asymptotic data a thesis scene is given by (absent: not given), each in place of the start
+/// parameter it solves: b for d, v_inf for K1, arrival_phase for phase.
+struct AsymptoticData {
+  std::optional<double> b, v_inf, arrival_phase;
+};
+/// The thesis scene's parameters with `data` solved in: each datum checked (b and v_inf finite
+/// numbers > 0, the phase finite), refused beside the parameter it solves when that one is in
+/// `given` (the names of the parameters set explicitly), the scene itself validated first. Throws
+/// Error naming the quantity.
+SceneParams with_asymptotic_data(const SceneParams& params, const AsymptoticData& data,
+                                 const std::vector<std::string>& given);
+
 /// The helix's phase at arrival of the thesis's scene (rad, in [0, 2 pi)): its start phase (ThesisStart::
 /// phase) advanced by the turn of the spin about K1, -(B/D) int |K1| dt, along the guiding centre's
 /// far-field motion (G drifting at u along K1, K1 pushed by the force at G) from the start to G's

@@ -47,7 +47,7 @@ void only_keys(const toml::table& t, const std::set<std::string>& allowed, const
                const std::string& origin) {
   for (const auto& [k, _] : t)
     if (!allowed.count(std::string(k.str())))
-      fail(origin, where + ": unknown key '" + std::string(k.str()) + "'");
+      fail(origin, where + ": " + unknown_name("key", k.str(), {allowed.begin(), allowed.end()}));
 }
 
 const toml::array* array_of_tables(const toml::table& root, std::string_view key, const std::string& origin) {
@@ -82,12 +82,21 @@ void read_parameters(const toml::table& t, SceneParameter::Of of, SceneParams& p
 }
 
 Centre parse_centre(const toml::table& t, const std::string& where, const std::string& origin) {
-  only_keys(t, keys_of({SceneParameter::Of::centre}, {"position"}), where, origin);
+  only_keys(t, keys_of({SceneParameter::Of::centre}, {"position", "law"}), where, origin);
   SceneParams p;
   read_parameters(t, SceneParameter::Of::centre, p, where, origin);
   Centre c;
   c.A = p.A;
   if (t.contains("position")) c.c = vector3(t, "position", where, origin);
+  if (const toml::node* law = t.get("law")) {
+    const auto name = law->value<std::string>();
+    if (!name) fail(origin, where + ": 'law' must be a text (coulomb, thesis-code, thesis-code-force)");
+    try {
+      c.law = parse_force_law(*name);
+    } catch (const Error& e) {
+      fail(origin, where + ": " + e.what());
+    }
+  }
   return c;
 }
 

@@ -179,7 +179,7 @@ TEST(Cli, BadInputGivesOneLineErrorNonZeroExitAndNoOutputFile) {
       {"--scene /nonexistent.toml", "cannot open scene file"},
       {"--scene " + bad_scene.string() + " --d 3", "cannot be combined with --scene"},
       {"--h abc", "invalid"},
-      {"--force-law newton", "unknown --force-law 'newton'"},
+      {"--force-law newton", "unknown force law 'newton'"},
       {"--force-law thesis-code --method logh-y4 --h 0.1", "assumes Coulomb's law"},
       {"--force-law thesis-code --tol 1e-6 --t-end 5", "the accuracy mode (tol) assumes Coulomb's law"},
       {"--scene " + bad_scene.string() + " --force-law thesis-code", "cannot be combined with --scene"},
@@ -376,8 +376,8 @@ TEST(Cli, StopAtEndsTheRunAtTheEvent) {
   EXPECT_EQ(json_num(never.out, "t_end"), 4.0);
   test::expect_refused("simulate --steps 10 ", {{"--stop-at nowhere", "unknown event 'nowhere'"},
                                                 {"--stop-at closest", "cannot stop at its closest approach"},
-                                                {"--b 1 --d 2", "give --b or --d, not both"},
-                                                {"--v-inf 0", "--v-inf must be a finite number > 0"}});
+                                                {"--b 1 --d 2", "give b or d, not both"},
+                                                {"--v-inf 0", "the speed at infinity v_inf must be a finite number > 0"}});
 }
 
 }  // namespace

@@ -100,7 +100,7 @@ TEST(Sweep, BadRangesAreRejected) {
       {"--param d --from 5 --to 10 --step -1", "never reaches --to"},
       {"--param d --from 5 --to 10 --step 0", "--step must not be zero"},
       {"--param q --from 5 --to 10 --step 1", "unknown parameter 'q'"},
-      {"--param d --from 5 --to 10 --step 1 --methods ''", "--methods is empty"},
+      {"--param d --from 5 --to 10 --step 1 --methods ''", "the method list is empty"},
       {"--param d --from 5 --to 10 --step 1 --methods lp-y5", "unknown method 'lp-y5'"},
       {"--param d --values 1,x", "'x' is not a number"},
       {"--param d --from 5 --to 10", "give --step"},

@@ -32,6 +32,11 @@ std::string closest_method(std::string_view name);
 /// Throws Error("unknown method ...") for a name not in methods(), suggesting closest_method.
 const MethodInfo& method_or_throw(std::string_view name);
 
+/// The methods a list names: "all", "fixed" (every fixed-step method but the Kepler split, whose stage
+/// is a Kepler solve: the thesis's studies' set) or names separated by commas. Error for an unknown
+/// name or an empty list.
+std::vector<const MethodInfo*> methods_named(std::string_view list);
+
 /// `--method auto`: a one-centre material point: ks; a body far from every centre for the whole run
 /// (straight-line estimate of the closest approach, potential there below the time-step constant c):
 /// Lie-Poisson; only repelling centres: logH; any attracting centre: TTL. The table by measured cost:
