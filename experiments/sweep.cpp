@@ -4,6 +4,7 @@
 
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
+#include "bodypoint/record.hpp"
 #include "budget.hpp"
 #include "cli.hpp"
 #include "mpi_sweep.hpp"
@@ -68,28 +69,7 @@ unsigned thread_count(long requested) {
   return std::max(1u, std::thread::hardware_concurrency());
 }
 
-std::string format_row(const SweepSpec& spec, const SweepRow& r) {
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  const InvariantStats s = r.result.invariants ? *r.result.invariants : InvariantStats{nan, nan, nan};
-  // A run that stopped reads "refused" as one that was not run: neither has a state.
-  const std::string_view status = r.outcome == Outcome::failed ? "refused" : outcome_name(r.outcome);
-  CsvLine row;
-  for (double v : r.point) row.num(v);
-  row.text(r.method->name).num(s.max_rel_dE).num(s.max_rel_dK2sq).num(s.max_abs_dK2Q);
-  row.num(r.result.final.R.x()).num(r.result.final.R.y()).num(r.result.final.R.z());
-  row.count(r.result.force_evals).num(r.result.wall_s).text(std::string(status)).quoted(r.reason);
-  row.num(r.error.known() ? r.error.value : nan).count(r.error.force_evals).quoted(r.error.basis);
-  row.quoted(join(r.warnings, "; "));
-  if (spec.scattering) {  // NaN where there is no value (no minimum, no asymptotes, a run that did not finish)
-    const Scattering sc = r.scattering ? *r.scattering : Scattering{};
-    row.num(r.r_min).num(r.t_min).num(sc.deflection).num(sc.out_of_plane).num(sc.b).num(sc.v_inf).num(sc.time_delay);
-    row.num(r.asymptote_error);
-    row.num(r.scattering ? sc.K1_turn : nan).num(r.scattering ? sc.spin_turn : nan);
-    row.num(sc.K1_end.x()).num(sc.K1_end.y()).num(sc.K1_end.z());
-    row.quoted(r.scattering ? sc.asymptotes : std::string("none: the run did not finish"));
-  }
-  return row.str();
-}
+std::string format_row(const SweepSpec& spec, const SweepRow& r) { return csv_row(sweep_record(spec, r)); }
 
 std::vector<std::string> run_sweep_unit(const SweepSpec& spec, const std::vector<std::size_t>& unit) {
   std::vector<std::string> rows;
@@ -127,14 +107,10 @@ std::vector<std::string> run_sweep(const SweepSpec& spec, const SweepControl& co
 }
 
 std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& command) {
-  std::string names, varied, values;
+  std::string varied;
   bool sweeps_h = false;
   for (std::size_t a = 0; a < spec.axes.size(); ++a) {
-    if (a) {
-      names += ",";
-      varied += ", ";
-    }
-    names += spec.axes[a].param;
+    if (a) varied += ", ";
     varied += spec.axes[a].param;
     sweeps_h = sweeps_h || spec.axes[a].param == "h";
   }
@@ -146,12 +122,9 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
   // The column names come first, the description after them as comments (numpy's
   // genfromtxt(names=True, comments="#") takes the first line for the names; pandas' read_csv(comment="#")
   // the first line that is not a comment).
-  std::string columns =
-      names + ",method,max_rel_dE,max_rel_dK2sq,max_abs_dK2Q,Rx,Ry,Rz,force_evals,wall_s,status,reason,err_estimate,"
-              "estimate_force_evals,err_basis,warning" +
-      (spec.scattering ? ",r_min,t_min,deflection,out_of_plane,b_in,v_inf_in,time_delay,asymptote_error,K1_turn,spin_turn,K1x,K1y,K1z,"
-                         "asymptotes"
-                       : "");
+  SweepRow probe;  // the columns are the record's keys (record.hpp), whatever the row holds
+  probe.point.resize(spec.axes.size());
+  std::string columns = csv_header(sweep_record(spec, probe));
   return {std::move(columns),
           "# bodypoint sweep, revision " + std::string(git_revision()),
           "# command: " + command,
@@ -182,7 +155,8 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
                                 " K1_turn, spin_turn ="
                                 " angles K1 and K2 turned over the run (rad); K1x,K1y,K1z = final K1;"
                                 " asymptotes = kepler | guiding-centre | none: why (docs/physics.md, Scattering)"
-                              : "")};
+                              : "") +
+              "; steps, t_end = the run's steps and end time; vx,vy,vz, wx,wy,wz = final velocity and angular velocity"};
 }
 
 std::string sweep_key(const SweepSpec& spec) {

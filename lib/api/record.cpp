@@ -27,12 +27,7 @@ double step_of(const BodyResult& r, const Advance& how) {
 
 Record event_hits(const BodyResult& r, const std::vector<Event>& events) {
   std::vector<Record> hits;
-  for (const EventHit& h : r.events) {
-    Record e;
-    e.text("event", events[h.event].label()).number("t", h.t).number("r", h.distance);
-    e.vector("R", h.s.R).vector("v", h.s.v).vector("w", h.s.w);
-    hits.push_back(std::move(e));
-  }
+  for (const EventHit& h : r.events) hits.push_back(event_record(h, events));
   Record out;
   out.records("events", std::move(hits)).count("event_force_evals", r.event_force_evals);
   if (std::any_of(events.begin(), events.end(), [](const Event& e) { return e.stop; })) {
@@ -86,6 +81,13 @@ Record& Record::text(std::string key, std::string s) {
   v.text = std::move(s);
   return add(*this, std::move(key), std::move(v));
 }
+Record& Record::note(std::string key, std::string s) {
+  Value v;
+  v.kind = Value::Kind::text;
+  v.free_text = true;
+  v.text = std::move(s);
+  return add(*this, std::move(key), std::move(v));
+}
 Record& Record::vector(std::string key, const Vec3& x) {
   Value v;
   v.kind = Value::Kind::vector;
@@ -129,18 +131,24 @@ const Value* Record::find(std::string_view key) const {
   return nullptr;
 }
 
+Record event_record(const EventHit& h, const std::vector<Event>& events) {
+  Record e;
+  e.text("event", events[h.event].label()).number("t", h.t).number("r", h.distance);
+  return e.vector("R", h.s.R).vector("v", h.s.v).vector("w", h.s.w);
+}
+
 Record body_record(const BodyResult& r, const Advance& how, const std::vector<Event>& events) {
   Record out;
   if (r.method) out.text("method", std::string(r.method->name));
   else out.null("method");
-  out.text("outcome", std::string(outcome_name(r.outcome))).text("reason", r.reason).number("h", step_of(r, how));
+  out.text("outcome", std::string(outcome_name(r.outcome))).note("reason", r.reason).number("h", step_of(r, how));
   if (const auto* c = std::get_if<ControlledSteps>(&how)) out.number("tol", c->tol);
   if (const auto* a = r.accuracy ? &*r.accuracy : nullptr) {
     out.number("tol", a->tol).number("h_chosen", a->step).count("search_runs", a->runs);
     out.count("search_force_evals", a->force_evals).number("search_wall_s", a->wall_s);
   }
   if (!r.chosen.empty()) out.text("chosen", r.chosen);
-  out.number("err_estimate", r.error.value).text("err_basis", r.error.basis).count("estimate_force_evals", r.error.force_evals);
+  out.number("err_estimate", r.error.value).note("err_basis", r.error.basis).count("estimate_force_evals", r.error.force_evals);
   out.texts("warnings", r.warnings).count("steps", r.run.steps).number("t_end", r.run.t_end);
   out.vector("R", r.run.final.R).vector("v", r.run.final.v).vector("w", r.run.final.w);
   if (const auto& inv = r.run.invariants) {
@@ -156,16 +164,65 @@ Record body_record(const BodyResult& r, const Advance& how, const std::vector<Ev
 Record encounter_record(const Encounter& e) {
   const Scattering& sc = e.scattering;
   Record out;
-  out.text("outcome", std::string(outcome_name(e.outcome))).text("reason", e.reason).text("asymptotes", sc.asymptotes);
+  out.text("outcome", std::string(outcome_name(e.outcome))).note("reason", e.reason).note("asymptotes", sc.asymptotes);
   out.number("deflection", sc.deflection).number("out_of_plane", sc.out_of_plane).number("b", sc.b);
   out.number("v_inf", sc.v_inf).number("time_delay", sc.time_delay).number("asymptote_error", e.asymptote_error);
-  out.text("asymptote_basis", e.asymptote_basis);
+  out.note("asymptote_basis", e.asymptote_basis);
   if (sc.in) out.vector("direction_in", sc.in->direction).vector("direction_out", sc.out->direction);
   out.number("r_min", e.r_min).number("t_min", e.t_min).number("K1_turn", sc.K1_turn).number("spin_turn", sc.spin_turn);
   out.vector("K1_start", sc.K1_start).vector("K1_end", sc.K1_end).vector("K2_start", sc.K2_start).vector("K2_end", sc.K2_end);
   out.number("E_start", sc.E_start).number("E_end", sc.E_end);
   if (sc.has_K2Q) out.vector("K2Q_start", sc.K2Q_start).vector("K2Q_end", sc.K2Q_end);
   return out;
+}
+
+Record sweep_record(const SweepSpec& spec, const SweepRow& r) {
+  constexpr double nan = Scattering::kNaN;
+  const InvariantStats s = r.result.invariants ? *r.result.invariants : InvariantStats{nan, nan, nan};
+  const State& f = r.result.final;
+  Record out;
+  for (std::size_t a = 0; a < spec.axes.size(); ++a) out.number(spec.axes[a].param, a < r.point.size() ? r.point[a] : nan);
+  out.text("method", r.method ? std::string(r.method->name) : std::string());
+  out.number("max_rel_dE", s.max_rel_dE).number("max_rel_dK2sq", s.max_rel_dK2sq).number("max_abs_dK2Q", s.max_abs_dK2Q);
+  out.number("Rx", f.R.x()).number("Ry", f.R.y()).number("Rz", f.R.z());
+  // A run that stopped reads "refused" as one that was not run: neither has a state.
+  const std::string_view status = r.outcome == Outcome::failed ? "refused" : outcome_name(r.outcome);
+  out.count("force_evals", r.result.force_evals).number("wall_s", r.result.wall_s).text("status", std::string(status));
+  out.note("reason", r.reason).number("err_estimate", r.error.value).count("estimate_force_evals", r.error.force_evals);
+  std::string warnings;
+  for (const std::string& w : r.warnings) warnings += (warnings.empty() ? "" : "; ") + w;
+  out.note("err_basis", r.error.basis).note("warning", warnings);
+  if (spec.scattering) {  // NaN where there is no value (no minimum, no asymptotes, a run that did not finish)
+    const Scattering sc = r.scattering ? *r.scattering : Scattering{};
+    out.number("r_min", r.r_min).number("t_min", r.t_min).number("deflection", sc.deflection);
+    out.number("out_of_plane", sc.out_of_plane).number("b_in", sc.b).number("v_inf_in", sc.v_inf);
+    out.number("time_delay", sc.time_delay).number("asymptote_error", r.asymptote_error);
+    out.number("K1_turn", r.scattering ? sc.K1_turn : nan).number("spin_turn", r.scattering ? sc.spin_turn : nan);
+    out.number("K1x", sc.K1_end.x()).number("K1y", sc.K1_end.y()).number("K1z", sc.K1_end.z());
+    out.note("asymptotes", r.scattering ? sc.asymptotes : std::string("none: the run did not finish"));
+  }
+  out.count("steps", r.result.steps).number("t_end", r.result.t_end);
+  out.number("vx", f.v.x()).number("vy", f.v.y()).number("vz", f.v.z()).number("wx", f.w.x()).number("wy", f.w.y()).number("wz", f.w.z());
+  return out;
+}
+
+std::string csv_header(const Record& r) {
+  CsvLine line;
+  for (const Field& f : r.fields) line.text(f.key);
+  return line.str();
+}
+
+std::string csv_row(const Record& r) {
+  CsvLine line;
+  for (const Field& f : r.fields) {
+    const Value& v = f.value;
+    if (v.kind == Value::Kind::number) line.num(v.number);
+    else if (v.kind == Value::Kind::count) line.count(v.count);
+    else if (v.kind == Value::Kind::text && v.free_text) line.quoted(v.text);
+    else if (v.kind == Value::Kind::text) line.text(v.text);
+    else throw Error("the CSV column '" + f.key + "' is not a number or a text");
+  }
+  return line.str();
 }
 
 void write_json(std::ostream& os, const Record& r) {

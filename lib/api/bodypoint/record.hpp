@@ -4,6 +4,7 @@
 #pragma once
 
 #include "bodypoint/bodypoint.hpp"
+#include "bodypoint/sweep.hpp"
 
 #include <iosfwd>
 #include <string>
@@ -19,6 +20,7 @@ struct Record;
 struct Value {
   enum class Kind { null, number, count, text, vector, texts, record, records };
   Kind kind = Kind::null;
+  bool free_text = false;  ///< a text of words (a reason), quoted in CSV; otherwise a name
   double number = 0.0;
   long count = 0;
   std::string text;
@@ -38,7 +40,8 @@ struct Record {
 
   Record& number(std::string key, double x);
   Record& count(std::string key, long n);
-  Record& text(std::string key, std::string s);
+  Record& text(std::string key, std::string s);  ///< a name: a method, an outcome
+  Record& note(std::string key, std::string s);  ///< free text: a reason, a basis
   Record& vector(std::string key, const Vec3& v);
   Record& texts(std::string key, std::vector<std::string> list);
   Record& record(std::string key, Record r);
@@ -63,12 +66,25 @@ struct Record {
 ///   included), events (event, t, r, R, v, w), event_force_evals and, with a stop event, stopped_by.
 Record body_record(const BodyResult& r, const Advance& how, const std::vector<Event>& events);
 
+/// A located event: event (its label), t, r (the distance to its centre, or to the nearest), R, v, w.
+Record event_record(const EventHit& hit, const std::vector<Event>& events);
+
 /// An encounter (measure_encounter): outcome, reason, asymptotes, deflection, out_of_plane, b,
 /// v_inf, time_delay, asymptote_error, asymptote_basis, direction_in/out (with asymptotes), r_min,
 /// t_min, K1_turn, spin_turn, K1, K2 and E at both ends, K2Q at both ends when defined.
 Record encounter_record(const Encounter& e);
 
+/// One row of a sweep (sweep.hpp), the columns of `bodypoint sweep`'s CSV and of the Python module's
+/// sweep(): the point's parameters, method, the invariants' deviations, Rx..Rz, force_evals, wall_s,
+/// status, reason, err_estimate, estimate_force_evals, err_basis, warning, with SweepSpec::scattering
+/// the encounter's columns, then steps, t_end, vx..vz, wx..wz.
+Record sweep_record(const SweepSpec& spec, const SweepRow& row);
+
 /// The record as one JSON object on one line.
 void write_json(std::ostream& os, const Record& r);
+/// The record's keys, and its values, as one CSV line each (fmt numbers, names bare, free text quoted);
+/// a record of numbers, counts and texts only.
+std::string csv_header(const Record& r);
+std::string csv_row(const Record& r);
 
 }  // namespace bodypoint
