@@ -32,7 +32,7 @@ constexpr const char* usage =
     "  timing     run time against the number of steps (median of repeats)\n"
     "  study      regenerate the thesis's studies (d, L, h, Kx sweeps, timing, table 4.1, appendix 1)\n"
     "  view       write a self-contained HTML page that animates a run in 3D (three.js)\n"
-    "Run 'bodypoint <command> --help' for the options of a command.";
+    "Run 'bodypoint <command> --help' for the options of a command; 'bodypoint --version' for the version.";
 
 #ifdef BODYPOINT_MPI_PROGRAM
 /// Started by an MPI launcher: hand this process over to the build of the same program with MPI
@@ -76,6 +76,10 @@ int main(int argc, char** argv) {
   if (argc < 2) {  // an error: the one-line reason, then the usage, on standard error
     std::cerr << "bodypoint: error: no command given\n" << usage << "\n";
     return 2;
+  }
+  if (std::strcmp(argv[1], "--version") == 0) {
+    std::cout << "bodypoint " << bodypoint::version() << " (revision " << bodypoint::git_revision() << ")\n";
+    return 0;
   }
   if (std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0) {
     std::cout << usage << "\n";

@@ -4,6 +4,8 @@
 // library's one-line reason; the GIL is released while integrating. The Python-side docs and the
 // keyword interface are in bodypoint/__init__.py; this file holds only the conversions.
 #include "bodypoint/bodypoint.hpp"
+#include "bodypoint/invariants.hpp"
+#include "bodypoint/io.hpp"
 #include "bodypoint/record.hpp"
 #include "bodypoint/sweep.hpp"
 
@@ -16,6 +18,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace py = pybind11;
@@ -32,21 +35,24 @@ py::array_t<double> vec(const Vec3& x) {
   return a;
 }
 
-Vec3 to_vec(const py::handle& o, const char* what) {
-  const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(o);
-  if (!a || a.ndim() != 1 || a.shape(0) != 3) throw Error(std::string(what) + " must be a sequence of 3 numbers");
-  return Vec3(a.at(0), a.at(1), a.at(2));
+/// A keyword's number: an int, a float or a numpy number, never a bool or a text (Error naming it).
+double number_of(const py::handle& v, const std::string& name) {
+  if (PyBool_Check(v.ptr()) || !PyNumber_Check(v.ptr()) || PyUnicode_Check(v.ptr()) || PyBytes_Check(v.ptr()))
+    throw Error(name + " must be a number, got " + std::string(py::str(py::type::of(v).attr("__name__"))));
+  return py::float_(py::reinterpret_borrow<py::object>(v)).cast<double>();
 }
 
-double number(const py::dict& d, const char* key, double fallback) {
-  return d.contains(key) ? d[key].cast<double>() : fallback;
+/// A keyword's text (Error naming it otherwise).
+std::string text_of(const py::handle& v, const std::string& name) {
+  if (!PyUnicode_Check(v.ptr())) throw Error(name + " must be a text, got " + std::string(py::str(py::type::of(v).attr("__name__"))));
+  return v.cast<std::string>();
 }
 
 py::dict centre_dict(const Centre& c) {
   py::dict d;
-  d["c"] = vec(c.c);
+  d["position"] = vec(c.c);
   d["A"] = c.A;
-  d["law"] = c.law == ForceLaw::coulomb ? "coulomb" : "thesis_code";
+  d["law"] = force_law_name(c.law);
   return d;
 }
 
@@ -62,45 +68,45 @@ py::dict body_dict(const Body& b) {
   return d;
 }
 
-Centre centre_from(const py::dict& d) {
-  Centre c;
-  if (d.contains("c")) c.c = to_vec(d["c"], "a centre's c");
-  c.A = number(d, "A", 0.0);
-  if (d.contains("law")) {
-    const auto law = d["law"].cast<std::string>();
-    if (law == "coulomb") c.law = ForceLaw::coulomb;
-    else if (law == "thesis_code") c.law = ForceLaw::thesis_code;
-    else throw Error("a centre's law must be 'coulomb' or 'thesis_code', got '" + law + "'");
-  }
-  return c;
+/// A scene from the Python module's lists of dicts: written as a scene file's text (bodypoint/__init__.py,
+/// _scene_toml) and read by the library's one reader (scene_file.hpp), so the keys, their checks and
+/// the messages are the scene files'.
+Scene scene_from(const py::object& centres, const py::object& bodies) {
+  const auto text = py::module_::import("bodypoint").attr("_scene_toml")(centres, bodies).cast<std::string>();
+  return parse_scene(text, "bodypoint.Scene");
 }
 
-Body body_from(const py::dict& d) {
-  Body b;
-  b.p.m = number(d, "m", 1.0);
-  b.p.B = number(d, "B", 0.0);
-  b.p.J = number(d, "J", 1.0);
-  if (!d.contains("R") || !d.contains("v")) throw Error("a body needs its start R and velocity v");
-  b.s0.R = to_vec(d["R"], "a body's R");
-  b.s0.v = to_vec(d["v"], "a body's v");
-  b.s0.w = d.contains("w") ? to_vec(d["w"], "a body's w") : Vec3::Zero();
-  if (d.contains("name")) b.name = d["name"].cast<std::string>();
-  return b;
+/// The names thesis_scene() takes: the scene parameters, the asymptotic data and the force law.
+std::vector<std::string> thesis_keywords() {
+  std::vector<std::string> names;
+  for (const SceneParameter& p : scene_parameters()) names.emplace_back(p.name);
+  for (const char* extra : {"b", "v_inf", "arrival_phase", "force_law"}) names.emplace_back(extra);
+  return names;
 }
 
 /// The thesis's scene from keyword parameters (model.hpp scene_parameters(); b and v_inf: asymptotic data).
 Scene thesis_from(const py::dict& kw) {
   SceneParams sp;
-  double b = kNaN, v_inf = kNaN, arrival = kNaN;
+  AsymptoticData data;
+  std::vector<std::string> given;
+  const std::vector<std::string> valid = thesis_keywords();
   for (const auto& [k, v] : kw) {
     const auto key = k.cast<std::string>();
-    if (key == "b") b = v.cast<double>();
-    else if (key == "v_inf") v_inf = v.cast<double>();
-    else if (key == "arrival_phase") arrival = v.cast<double>();
-    else scene_field(sp, key) = v.cast<double>();
+    if (std::find(valid.begin(), valid.end(), key) == valid.end()) throw Error("thesis_scene: " + unknown_name("keyword", key, valid));
+    if (key == "force_law") {
+      sp.law = parse_force_law(text_of(v, key));
+      continue;
+    }
+    const double x = number_of(v, key);
+    if (key == "b") data.b = x;
+    else if (key == "v_inf") data.v_inf = x;
+    else if (key == "arrival_phase") data.arrival_phase = x;
+    else {
+      scene_field(sp, key) = x;
+      given.push_back(key);
+    }
   }
-  if (!std::isnan(b) || !std::isnan(v_inf) || !std::isnan(arrival)) sp = with_asymptotic_data(sp, b, v_inf, arrival);
-  return thesis_scene(sp);
+  return thesis_scene(with_asymptotic_data(sp, data, given));
 }
 
 /// A record of the library's (record.hpp) as a dict: the keys of `simulate --json`, numbers that are
@@ -140,10 +146,22 @@ Advance advance_of_keywords(const MethodInfo* m, std::optional<double> h, std::o
   return advance_for(m, request);
 }
 
+/// Events by the library's one parser (parse_event): `events` located, `stop_at` ending a run.
+std::vector<Event> events_of(const std::vector<std::string>& events, const std::vector<std::string>& stop_at) {
+  std::vector<Event> out;
+  for (const std::string& e : events) out.push_back(parse_event(e));
+  for (const std::string& e : stop_at) {
+    out.push_back(parse_event(e));
+    out.back().stop = true;
+  }
+  return out;
+}
+
 py::dict integrate_py(const Scene& scene, const std::string& method, std::optional<double> h,
                       std::optional<long> steps, std::optional<double> t_end, std::optional<double> tol,
                       bool invariants, double omega_c, const std::vector<std::string>& event_names,
-                      double max_energy_error, bool estimate_error, double max_error) {
+                      const std::vector<std::string>& stop_at, double max_energy_error, bool estimate_error,
+                      double max_error) {
   const MethodInfo* m = method == "auto" ? nullptr : &method_or_throw(method);
   const bool code_loop = std::any_of(scene.centres.begin(), scene.centres.end(),
                                      [](const Centre& c) { return c.law == ForceLaw::thesis_code; });
@@ -154,7 +172,7 @@ py::dict integrate_py(const Scene& scene, const std::string& method, std::option
   o.max_energy_error = max_energy_error;
   o.estimate_error = estimate_error;
   o.max_error = max_error;
-  for (const std::string& e : event_names) o.events.push_back(parse_event(e));
+  o.events = events_of(event_names, stop_at);
   Result r;
   {
     py::gil_scoped_release free;
@@ -171,66 +189,148 @@ py::dict integrate_py(const Scene& scene, const std::string& method, std::option
   return d;
 }
 
-/// Each body's state at the given times (increasing, >= 0), by a Stepper landing on every one.
-py::list trajectory_py(const Scene& scene, const std::string& method, double step, const std::vector<double>& times,
-                       double omega_c) {
+/// Each body's state at the given times (increasing, >= 0), by a Stepper landing on every one. With a
+/// tolerance (method auto or any method the accuracy mode takes) the method, its step and its
+/// time-step constant are the accuracy mode's for a run to the last time, whose estimate is reported.
+/// A segment that is not ok ends the body's rows there (NaN after), with its outcome and reason.
+py::list trajectory_py(const Scene& scene, const std::string& method, std::optional<double> step,
+                       const std::vector<double>& times, double omega_c, std::optional<double> tol) {
+  if (times.empty()) throw Error("times is empty");
   for (std::size_t k = 0; k < times.size(); ++k)
     if (!std::isfinite(times[k]) || times[k] < 0.0 || (k > 0 && !(times[k] > times[k - 1])))
       throw Error("times must be finite, >= 0 and increasing");
-  validate(scene);
+  if (tol && step) throw Error("give a step or a tolerance tol, not both (tol chooses the step)");
+  if (!tol && !step) throw Error("give a step (h, ds or a peer's tolerance per step) or a tolerance tol");
+  const MethodInfo* named = method == "auto" ? nullptr : &method_or_throw(method);
+  if (!tol && !named) throw Error("method auto needs a tolerance tol");
   py::list out;
   for (const Body& body : scene.bodies) {
+    py::dict d;
+    d["name"] = body.name;
+    const MethodInfo* m = named;
+    double h = step.value_or(0.0), c = omega_c;
+    if (tol) {
+      Options o;
+      o.track_invariants = false;
+      BodyResult r;
+      {
+        py::gil_scoped_release free;
+        r = integrate_body(body, scene.centres, named, Accuracy{*tol, times.back() > 0.0 ? times.back() : 1.0}, o);
+      }
+      if (!r.accuracy) throw Error((body.name.empty() ? std::string("body") : body.name) + ": " + r.reason);
+      m = r.method;
+      h = r.accuracy->step;
+      c = r.accuracy->omega_c;
+      d["tol"] = *tol;
+      d["h_chosen"] = h;
+      d["err_estimate"] = r.accuracy->err_estimate;
+      d["search_force_evals"] = r.accuracy->force_evals;
+    }
     const std::size_t n = times.size();
-    py::array_t<double> t(static_cast<py::ssize_t>(n));
+    py::array_t<double> t(static_cast<py::ssize_t>(n)), E(static_cast<py::ssize_t>(n));
     py::array_t<double> R({static_cast<py::ssize_t>(n), py::ssize_t{3}}), v({static_cast<py::ssize_t>(n), py::ssize_t{3}}),
         w({static_cast<py::ssize_t>(n), py::ssize_t{3}});
     auto tm = t.mutable_unchecked<1>();
+    auto Em = E.mutable_unchecked<1>();
     auto Rm = R.mutable_unchecked<2>();
     auto vm = v.mutable_unchecked<2>();
     auto wm = w.mutable_unchecked<2>();
-    Options o;
-    o.track_invariants = false;
-    o.omega_c = omega_c;
-    Stepper s(method, body, scene.centres, step, o);
-    std::string failure;
+    Options o;  // invariants tracked: each segment's steps are judged (a step that turns the spin by > pi)
+    o.omega_c = c;
+    Stepper s(*m, body, scene.centres, h, o);
+    const CentreList field{scene.centres};
+    Outcome outcome = Outcome::ok;
+    double max_rel_dE = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {  // rows after a segment that was not ok keep no state
+      const auto i = static_cast<py::ssize_t>(k);
+      tm(i) = times[k];
+      Em(i) = kNaN;
+      for (py::ssize_t j = 0; j < 3; ++j) Rm(i, j) = vm(i, j) = wm(i, j) = kNaN;
+    }
     {
       py::gil_scoped_release free;
-      for (std::size_t k = 0; k < n && failure.empty(); ++k) {
-        if (times[k] > s.time() && s.advance_to(times[k]) != Outcome::ok) failure = s.reason();
+      const double E0 = energy(body.p, field, body.s0), scale = energy_scale(body.p, field, body.s0);
+      for (std::size_t k = 0; k < n; ++k) {
+        if (outcome == Outcome::ok && times[k] > s.time()) outcome = s.advance_to(times[k]);
+        const bool have = outcome == Outcome::ok || outcome == Outcome::unresolved || outcome == Outcome::inaccurate;
+        if (!have) break;
         const State& x = s.state();
-        tm(static_cast<py::ssize_t>(k)) = times[k];
+        const auto i = static_cast<py::ssize_t>(k);
+        Em(i) = energy(body.p, field, x);
+        max_rel_dE = std::max(max_rel_dE, std::abs(Em(i) - E0) / scale);
         for (py::ssize_t j = 0; j < 3; ++j) {
-          const auto i = static_cast<py::ssize_t>(k);
           Rm(i, j) = x.R[static_cast<Eigen::Index>(j)];
           vm(i, j) = x.v[static_cast<Eigen::Index>(j)];
           wm(i, j) = x.w[static_cast<Eigen::Index>(j)];
         }
+        if (outcome != Outcome::ok) break;
       }
     }
-    if (!failure.empty()) throw Error((body.name.empty() ? std::string("body") : body.name) + ": " + failure);
-    py::dict d;
-    d["name"] = body.name;
+    d["method"] = m->name;
+    d["outcome"] = std::string(outcome_name(outcome));
+    d["reason"] = outcome == Outcome::ok ? std::string() : s.reason();
     d["t"] = t;
     d["R"] = R;
     d["v"] = v;
     d["w"] = w;
+    d["E"] = E;
+    d["max_rel_dE"] = max_rel_dE;
     d["force_evals"] = s.force_evals();
+    d["steps"] = s.steps();
     out.append(d);
   }
   return out;
 }
 
+/// The rows' records (record.hpp: the columns of `bodypoint sweep`'s CSV) as columns: numbers as float
+/// arrays (NaN where there is none), counts as int arrays, texts as lists.
+py::dict sweep_columns(const SweepSpec& spec, const std::vector<SweepRow>& rows) {
+  SweepRow probe;
+  probe.point.resize(spec.axes.size());
+  const Record keys = sweep_record(spec, probe);
+  const auto n = static_cast<py::ssize_t>(rows.size());
+  std::vector<py::array_t<double>> numbers(keys.fields.size());
+  std::vector<py::array_t<long>> counts(keys.fields.size());
+  std::vector<py::list> texts(keys.fields.size());
+  for (std::size_t c = 0; c < keys.fields.size(); ++c) {
+    if (keys.fields[c].value.kind == Value::Kind::number) numbers[c] = py::array_t<double>(n);
+    if (keys.fields[c].value.kind == Value::Kind::count) counts[c] = py::array_t<long>(n);
+  }
+  for (py::ssize_t i = 0; i < n; ++i) {
+    const Record r = sweep_record(spec, rows[static_cast<std::size_t>(i)]);
+    for (std::size_t c = 0; c < r.fields.size(); ++c) {
+      const Value& v = r.fields[c].value;
+      if (v.kind == Value::Kind::number) numbers[c].mutable_at(i) = v.number;
+      else if (v.kind == Value::Kind::count) counts[c].mutable_at(i) = v.count;
+      else texts[c].append(v.text);
+    }
+  }
+  py::dict cols;
+  for (std::size_t c = 0; c < keys.fields.size(); ++c) {
+    const Value::Kind kind = keys.fields[c].value.kind;
+    cols[py::str(keys.fields[c].key)] = kind == Value::Kind::number  ? py::object(numbers[c])
+                                        : kind == Value::Kind::count ? py::object(counts[c])
+                                                                     : py::object(texts[c]);
+  }
+  return cols;
+}
+
 /// A sweep or grid of the thesis's scene as columns (sweep.hpp).
 py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>& axes,
                   const std::vector<std::string>& methods, const py::dict& base, double h, long steps, double t_end,
-                  double tol, unsigned threads, double max_energy_error, bool estimate_error, double max_error) {
+                  double tol, unsigned threads, double max_energy_error, bool estimate_error, double max_error,
+                  bool scattering, const std::string& force_law) {
   SweepSpec s;
   s.max_energy_error = max_energy_error;
   s.estimate_error = estimate_error;
   s.max_error = max_error;
   for (const auto& [param, values] : axes) s.axes.push_back({param, values});
-  for (const std::string& m : methods) s.methods.push_back(&method_or_throw(m));
-  for (const auto& [k, v] : base) scene_field(s.base, k.cast<std::string>()) = v.cast<double>();
+  for (const std::string& list : methods)
+    for (const MethodInfo* m : methods_named(list)) s.methods.push_back(m);
+  for (const auto& [k, v] : base) scene_field(s.base, k.cast<std::string>()) = number_of(v, k.cast<std::string>());
+  s.base.law = parse_force_law(force_law);
+  s.scattering = scattering;
+  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
   s.h = h;
   s.steps = t_end > 0.0 ? 0 : steps;
   s.t_end = t_end;
@@ -240,42 +340,7 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
     py::gil_scoped_release free;
     rows = run_sweep_rows(s, threads);
   }
-  const auto n = static_cast<py::ssize_t>(rows.size());
-  py::dict cols;
-  std::vector<py::array_t<double>> point(s.axes.size(), py::array_t<double>(n));
-  for (auto& p : point) p = py::array_t<double>(n);
-  py::list method, outcome, reason;
-  const char* names[] = {"t_end", "Rx", "Ry", "Rz", "vx", "vy", "vz", "wx", "wy", "wz", "max_rel_dE", "max_rel_dK2sq", "max_abs_dK2Q",
-                         "err_estimate"};
-  py::list err_basis;
-  std::vector<py::array_t<double>> num;
-  for (std::size_t c = 0; c < std::size(names); ++c) num.emplace_back(n);
-  py::array_t<long> force_evals(n), nsteps(n);
-  for (py::ssize_t i = 0; i < n; ++i) {
-    const SweepRow& r = rows[static_cast<std::size_t>(i)];
-    for (std::size_t a = 0; a < point.size(); ++a) point[a].mutable_at(i) = r.point[a];
-    method.append(r.method->name);
-    outcome.append(std::string(outcome_name(r.outcome)));
-    reason.append(r.reason);
-    const State& f = r.result.final;
-    const auto& inv = r.result.invariants;
-    const double v[] = {r.result.t_end, f.R.x(), f.R.y(), f.R.z(), f.v.x(), f.v.y(), f.v.z(), f.w.x(), f.w.y(), f.w.z(),
-                        inv ? inv->max_rel_dE : kNaN, inv ? inv->max_rel_dK2sq : kNaN,
-                        inv && inv->has_K2Q ? inv->max_abs_dK2Q : kNaN, r.error.known() ? r.error.value : kNaN};
-    err_basis.append(r.error.basis);
-    for (std::size_t c = 0; c < std::size(names); ++c) num[c].mutable_at(i) = v[c];
-    force_evals.mutable_at(i) = r.result.force_evals;
-    nsteps.mutable_at(i) = r.result.steps;
-  }
-  for (std::size_t a = 0; a < point.size(); ++a) cols[py::str(s.axes[a].param)] = point[a];
-  cols["method"] = method;
-  cols["outcome"] = outcome;
-  cols["reason"] = reason;
-  cols["steps"] = nsteps;
-  cols["force_evals"] = force_evals;
-  cols["err_basis"] = err_basis;
-  for (std::size_t c = 0; c < std::size(names); ++c) cols[names[c]] = num[c];
-  return cols;
+  return sweep_columns(s, rows);
 }
 
 /// The encounter's record with its run's (`run`: method, steps, t_end, err_estimate, force_evals, ...).
@@ -293,20 +358,53 @@ py::dict encounter_py(const Scene& scene, const std::string& method, double tol,
   return to_py(encounter_record(r.encounter).record("run", body_record(r.run, how, r.events)));
 }
 
+/// A Stepper of one body of a scene, with its events' labels kept for the hits' records.
+struct PyStepper {
+  PyStepper(const Scene& scene, std::size_t body, const std::string& method, double step, const std::vector<std::string>& events,
+            const std::vector<std::string>& stop_at, double omega_c)
+      : stepper(make(scene, body, method, step, events_of(events, stop_at), omega_c)), labels(events_of(events, stop_at)) {}
+  static Stepper make(const Scene& scene, std::size_t body, const std::string& method, double step, std::vector<Event> events,
+                      double omega_c) {
+    if (body >= scene.bodies.size())
+      throw Error("body must be an index 0.." + std::to_string(scene.bodies.size() - 1) + ", got " + std::to_string(body));
+    Options o;
+    o.track_invariants = false;
+    o.omega_c = omega_c;
+    o.events = std::move(events);
+    return Stepper(method, scene.bodies[body], scene.centres, step, o);
+  }
+  std::string advance_to(double t) {
+    Outcome o{};
+    {
+      py::gil_scoped_release free;
+      o = stepper.advance_to(t);
+    }
+    return std::string(outcome_name(o));
+  }
+  py::dict state() const {
+    py::dict d;
+    d["t"] = stepper.time();
+    d["R"] = vec(stepper.state().R);
+    d["v"] = vec(stepper.state().v);
+    d["w"] = vec(stepper.state().w);
+    return d;
+  }
+  py::list hits() const {
+    py::list l;
+    for (const EventHit& h : stepper.events()) l.append(to_py(event_record(h, labels)));
+    return l;
+  }
+  Stepper stepper;
+  std::vector<Event> labels;
+};
+
 }  // namespace
 
 PYBIND11_MODULE(_bodypoint, mod) {
   mod.doc() = "bodypoint: integrator of a body-point (translation and rotation) in Coulomb fields";
   py::register_exception<Error>(mod, "Error", PyExc_ValueError);
   py::class_<Scene>(mod, "Scene", "Fixed Coulomb centres and independent body-points (docs/physics.md).")
-      .def(py::init([](const std::vector<py::dict>& centres, const std::vector<py::dict>& bodies) {
-             Scene s;
-             for (const py::dict& c : centres) s.centres.push_back(centre_from(c));
-             for (const py::dict& b : bodies) s.bodies.push_back(body_from(b));
-             validate(s);
-             return s;
-           }),
-           py::arg("centres"), py::arg("bodies"))
+      .def(py::init(&scene_from), py::arg("centres"), py::arg("bodies"))
       .def_property_readonly("centres", [](const Scene& s) {
         py::list l;
         for (const Centre& c : s.centres) l.append(centre_dict(c));
@@ -327,7 +425,7 @@ PYBIND11_MODULE(_bodypoint, mod) {
   mod.def("_parse_scene", [](const std::string& text) { return parse_scene(text, "<string>"); }, py::arg("text"));
   mod.def("_arrival_phase", [](const py::dict& kw) {
     SceneParams sp;
-    for (const auto& [k, v] : kw) scene_field(sp, k.cast<std::string>()) = v.cast<double>();
+    for (const auto& [k, v] : kw) scene_field(sp, k.cast<std::string>()) = number_of(v, k.cast<std::string>());
     return arrival_phase(sp);
   });
   mod.def("_scene_parameters", [] {
@@ -353,10 +451,27 @@ PYBIND11_MODULE(_bodypoint, mod) {
   mod.attr("DEFAULT_MAX_ERROR") = kDefaultMaxError;
   mod.def("_integrate", &integrate_py, py::arg("scene"), py::arg("method"), py::arg("h"), py::arg("steps"),
           py::arg("t_end"), py::arg("tol"), py::arg("invariants"), py::arg("omega_c"), py::arg("events"),
-          py::arg("max_energy_error"), py::arg("estimate_error"), py::arg("max_error"));
+          py::arg("stop_at"), py::arg("max_energy_error"), py::arg("estimate_error"), py::arg("max_error"));
   mod.def("_trajectory", &trajectory_py, py::arg("scene"), py::arg("method"), py::arg("step"), py::arg("times"),
-          py::arg("omega_c"));
+          py::arg("omega_c"), py::arg("tol"));
   mod.def("_sweep", &sweep_py, py::arg("axes"), py::arg("methods"), py::arg("base"), py::arg("h"), py::arg("steps"),
-          py::arg("t_end"), py::arg("tol"), py::arg("threads"), py::arg("max_energy_error"), py::arg("estimate_error"), py::arg("max_error"));
+          py::arg("t_end"), py::arg("tol"), py::arg("threads"), py::arg("max_energy_error"), py::arg("estimate_error"), py::arg("max_error"),
+          py::arg("scattering"), py::arg("force_law"));
+  py::class_<PyStepper>(mod, "_Stepper")
+      .def(py::init<const Scene&, std::size_t, const std::string&, double, const std::vector<std::string>&,
+                    const std::vector<std::string>&, double>(),
+           py::arg("scene"), py::arg("body"), py::arg("method"), py::arg("step"), py::arg("events"), py::arg("stop_at"),
+           py::arg("omega_c"))
+      .def("advance_to", &PyStepper::advance_to, py::arg("t"))
+      .def_property_readonly("time", [](const PyStepper& s) { return s.stepper.time(); })
+      .def_property_readonly("state", &PyStepper::state)
+      .def_property_readonly("events", &PyStepper::hits)
+      .def_property_readonly("stopped", [](const PyStepper& s) { return s.stepper.stopped(); })
+      .def_property_readonly("force_evals", [](const PyStepper& s) { return s.stepper.force_evals(); })
+      .def_property_readonly("steps", [](const PyStepper& s) { return s.stepper.steps(); })
+      .def_property_readonly("reason", [](const PyStepper& s) { return s.stepper.reason(); })
+      .def_property_readonly("method", [](const PyStepper& s) { return s.stepper.method().name; });
+  mod.attr("__revision__") = git_revision();
+  mod.attr("__version__") = version();
   mod.def("_encounter", &encounter_py, py::arg("scene"), py::arg("method"), py::arg("tol"), py::arg("t_end"));
 }

@@ -95,19 +95,26 @@ def test_sweep_columns_equal_the_command_line_sweep():
     assert n == 4 and all(len(v) == n for v in cols.values())
     text = cli("sweep", "--param", "d", "--values", "5,10", "--methods", "lp-y4,rk4", "--steps", "1000")
     rows = list(csv.DictReader(line for line in io.StringIO(text) if not line.startswith("#")))
-    assert [r["method"] for r in rows] == list(cols["method"])
+    # One record of a sweep row (record.hpp) writes both: the same columns, in order, and values.
+    assert list(rows[0].keys()) == list(cols.keys())
     for i, r in enumerate(rows):
-        assert float(r["d"]) == cols["d"][i]
-        for c in ("Rx", "Ry", "Rz", "max_rel_dE", "max_abs_dK2Q"):
-            assert float(r[c]) == cols[c][i], c
-        assert int(r["force_evals"]) == cols["force_evals"][i]
+        for c, value in r.items():
+            if c == "wall_s":
+                continue
+            mine = cols[c][i]
+            if isinstance(mine, str):
+                assert value == mine, c
+            elif math.isnan(float(mine)):
+                assert value == "nan", c
+            else:
+                assert float(value) == mine, c
 
 
 def test_grid_is_every_combination_last_axis_fastest():
     cols = bp.sweep({"d": [5, 10], "L": [100, 200, 300]}, "lp-y4", steps=100, threads=2)
     assert list(cols["d"]) == [5, 5, 5, 10, 10, 10]
     assert list(cols["L"]) == [100, 200, 300] * 2
-    assert set(cols["outcome"]) == {"ok"}
+    assert set(cols["status"]) == {"ok"}
 
 
 def test_flags_and_the_energy_bound_equal_the_command_line():
@@ -126,7 +133,7 @@ def test_flags_and_the_energy_bound_equal_the_command_line():
                           "--max-energy-error", "inf", "--max-error", "inf"))
     assert_same_fields(free["bodies"][0], want)
     cols = bp.sweep({"h": [1e-4]}, "thesis-euler", t_end=50, max_energy_error=bp._core.DEFAULT_MAX_ENERGY_ERROR)
-    assert list(cols["outcome"]) == ["inaccurate"]
+    assert list(cols["status"]) == ["inaccurate"]
 
 
 def test_rutherford_deflection_for_a_material_point():
@@ -212,3 +219,119 @@ def test_an_encounter_has_the_command_lines_scattering_fields():
     assert_same_fields(got, want["scattering"])
     assert got["run"]["method"] == want["method"] and got["run"]["t_end"] == want["t_end"]
     assert got["run"]["stopped_by"] == want["stopped_by"] == "departure"
+
+
+# --- Issue #43: strict scenes, one error type, the library's objects ---
+
+@pytest.mark.parametrize("make, words", [
+    (lambda: bp.Scene(centres=[{"positon": [10, 0, 0], "A": -2.0}], bodies=[{"R": [0, 5, 0], "v": [1, 0, 0]}]),
+     "unknown key 'positon' (did you mean 'position'?)"),
+    (lambda: bp.Scene(centres=[{"A": -2.0}], bodies=[{"R": [0, 5, 0], "v": [1, 0, 0], "wz": 1.0}]),
+     "unknown key 'wz'"),
+    (lambda: bp.Scene(centres=[{"A": "x"}], bodies=[{"R": [0, 5, 0], "v": [1, 0, 0]}]), "'A' must be a number"),
+    (lambda: bp.Scene(centres=[{"A": -2.0, "law": "thesis_code"}], bodies=[{"R": [0, 5, 0], "v": [1, 0, 0]}]),
+     "did you mean 'thesis-code'?"),
+    (lambda: bp.Scene(centres=[{"A": -2.0}], bodies=[{"R": [0, 5], "v": [1, 0, 0]}]), "'R' must be an array of 3 numbers"),
+    (lambda: bp.thesis_scene(d="10"), "d must be a number, got str"),
+    (lambda: bp.thesis_scene(B=True), "B must be a number, got bool"),
+    (lambda: bp.thesis_scene(dd=10), "unknown keyword 'dd' (did you mean 'd'?)"),
+    (lambda: bp.thesis_scene(b=float("nan")), "the impact parameter b must be a finite number > 0"),
+    (lambda: bp.thesis_scene(b=5, d=3), "give b or d, not both"),
+    (lambda: bp.thesis_scene(force_law="newton"), "unknown force law 'newton'"),
+    (lambda: bp.integrate(bp.thesis_scene(), "lp-y4", h="0.01", t_end=1), "h must be a number, got str"),
+    (lambda: bp.integrate(bp.thesis_scene(), "lp-y4", h=1e-3), "give an end time t_end or a number of steps"),
+    (lambda: bp.integrate(bp.thesis_scene(), "lp-y4", h=0.01, steps=10.5), "steps must be a whole number"),
+    (lambda: bp.integrate("scene", "lp-y4", h=0.01, t_end=1), "scene must be a bodypoint.Scene"),
+    (lambda: bp.integrate(bp.thesis_scene(), "lp-y5", h=0.01, t_end=1), "did you mean lp-y4?"),
+    (lambda: bp.integrate(bp.thesis_scene(), "lp-y4", h=0.01, t_end=1, events=["r=abc"]), "'abc' is not a finite number"),
+    (lambda: bp.integrate(bp.thesis_scene(), "lp-y4", h=0.01, t_end=1, events=["r=5garbage"]), "is not a finite number"),
+    (lambda: bp.integrate(bp.thesis_scene(), "lp-y4", h=0.01, t_end=1, events=["closest:99999999999999999999"]),
+     "the centre must be an index"),
+    (lambda: bp.sweep({"d": [5]}, "lp-y4", steps=10, dd=3), "unknown scene parameter 'dd' (did you mean 'd'?)"),
+    (lambda: bp.sweep({"d": [5]}, "", steps=10), "the method list is empty"),
+    (lambda: bp.Stepper(bp.thesis_scene(), "lp-y4", 0.01, body=3), "body must be an index"),
+])
+def test_bad_input_raises_bodypoint_error_naming_the_quantity(make, words):
+    with pytest.raises(bp.Error) as e:
+        make()
+    assert words in str(e.value)
+
+
+def test_scene_dicts_take_the_scene_files_keys_and_forms():
+    toml = bp.read_scene(os.path.join(SOURCE, "scenes", "two-centres.toml"))
+    same = bp.Scene(centres=toml.centres, bodies=toml.bodies)  # what a scene gives back, it takes
+    assert [c["position"].tolist() for c in same.centres] == [c["position"].tolist() for c in toml.centres]
+    for got, want in zip(same.bodies, toml.bodies):
+        assert got["R"].tolist() == want["R"].tolist() and got["w"].tolist() == want["w"].tolist()
+    # The thesis's start form (d, L, K1, Kx, Kz) as in a scene file, and the force law by its one name.
+    s = bp.Scene(centres=[{"A": -2.0, "law": "thesis-code"}],
+                 bodies=[{"m": 1, "B": 0.7, "J": 1, "d": 10, "L": 200, "K1": 5, "Kx": 2, "Kz": 5}])
+    assert s.bodies[0]["R"].tolist() == bp.thesis_scene().bodies[0]["R"].tolist()
+    assert s.centres[0]["law"] == "thesis-code"
+    assert bp.thesis_scene(force_law="thesis-code").centres[0]["law"] == "thesis-code"
+
+
+def test_events_take_every_form_of_the_command_line_and_stop_a_run():
+    scene = bp.thesis_scene()
+    r = bp.integrate(scene, "lp-kl8", h=0.01, t_end=60, events=["x=0", "plane=0,0,1,0"], stop_at=["r=100"])
+    b = r["bodies"][0]
+    want = json.loads(cli("simulate", "--method", "lp-kl8", "--h", "0.01", "--t-end", "60", "--event", "x=0",
+                          "plane=0,0,1,0", "--stop-at", "r=100", "--json"))
+    assert b["stopped_by"] == want["stopped_by"] == "r=100"
+    assert [e["event"] for e in b["events"]] == [e["event"] for e in want["events"]]
+    assert [e["t"] for e in b["events"]] == [e["t"] for e in want["events"]]
+    assert b["t_end"] == want["t_end"] < 60
+
+
+def test_stepper_continues_as_one_run_and_after_a_stop():
+    scene = bp.thesis_scene()
+    s = bp.Stepper(scene, "rk4", 1e-3)
+    assert s.advance_to(20) == bp.Outcome.ok and s.advance_to(50) == "ok"
+    one = bp.integrate(scene, "rk4", h=1e-3, t_end=50, estimate_error=False)["bodies"][0]
+    # rk4 merges nothing across steps: segments that land on 20 and 50 are the run's steps, bit for bit
+    assert s.state["R"].tolist() == one["R"].tolist() and s.state["w"].tolist() == one["w"].tolist()
+    assert s.steps == one["steps"] and s.force_evals == one["force_evals"]
+    stop = bp.Stepper(scene, "lp-kl8", 0.01, stop_at=["r=100"])
+    assert stop.advance_to(60) == "ok" and stop.stopped and stop.time < 60
+    assert abs(np.linalg.norm(stop.state["R"]) - 100) < 1e-9 and stop.events[0]["event"] == "r=100"
+    first = stop.time
+    assert stop.advance_to(60) == "ok" and stop.stopped and stop.time > first  # r = 100 again, on the way out
+    assert stop.advance_to(60) == "ok" and stop.time == 60 and not stop.stopped
+    assert [e["event"] for e in stop.events] == ["r=100", "r=100"]
+
+
+def test_outcome_enum_and_version():
+    assert {o.value for o in bp.Outcome} >= {"ok", "diverged", "unresolved", "inaccurate", "collision", "refused"}
+    assert bp.integrate(bp.thesis_scene(), "lp-y4", h=1e-3, t_end=1)["outcome"] == bp.Outcome.ok
+    assert bp.__version__ == cli("--version").split()[1]
+    assert len(bp.__revision__) >= 7
+
+
+def test_sweep_takes_method_lists_scattering_and_the_force_law():
+    fixed = bp.sweep({"d": [10]}, "fixed", steps=10)
+    text = cli("sweep", "--param", "d", "--values", "10", "--methods", "fixed", "--steps", "10")
+    rows = list(csv.DictReader(line for line in io.StringIO(text) if not line.startswith("#")))
+    assert list(fixed["method"]) == [r["method"] for r in rows] and len(rows) > 20
+    cols = bp.sweep({"b": [1.0]}, "lp-kl8", h=0.01, t_end=100, scattering=True, B=0.7)
+    assert cols["deflection"][0] > 0 and cols["asymptotes"][0] == "guiding-centre"
+    code = bp.sweep({"d": [10]}, "thesis-fr4", steps=100, force_law="thesis-code", estimate_error=False)
+    coulomb = bp.sweep({"d": [10]}, "thesis-fr4", steps=100, estimate_error=False)
+    assert code["steps"][0] == 99 and coulomb["steps"][0] == 100  # the code's loop: n - 1 steps
+
+
+def test_trajectory_reports_its_outcome_energy_and_takes_the_accuracy_mode():
+    scene = bp.thesis_scene()
+    times = np.linspace(0, 50, 6)
+    coarse = bp.trajectory(scene, "lp-y4", 10, times)[0]  # integrate(h=10) says unresolved: so does this
+    assert coarse["outcome"] == bp.Outcome.unresolved and "turned the spin" in coarse["reason"]
+    assert np.isnan(coarse["R"][-1]).all()  # the rows after the segment that was not ok hold no state
+    fine = bp.trajectory(scene, "lp-y4", 0.01, times)[0]
+    assert fine["outcome"] == "ok" and fine["E"].shape == (6,) and fine["max_rel_dE"] < 1e-10
+    tol = 1e-8
+    auto = bp.trajectory(scene, "auto", None, times, tol=tol)[0]
+    one = bp.integrate(scene, tol=tol, t_end=50)["bodies"][0]
+    assert auto["method"] == one["method"] and auto["h_chosen"] == one["h_chosen"] and auto["err_estimate"] <= tol
+    # the same step followed through landing segments: the run's state to well within the tolerance
+    assert np.linalg.norm(auto["R"][-1] - one["R"]) / np.linalg.norm(one["R"]) < tol
+    with pytest.raises(bp.Error, match="not both"):
+        bp.trajectory(scene, "lp-y4", 0.01, times, tol=tol)

@@ -13,11 +13,118 @@ anything that happens to a valid run is reported in its ``outcome`` and ``reason
     r["bodies"][0]["R"]                            # numpy array, position at t = 50
     r = bp.integrate(scene, tol=1e-10, t_end=50)   # accuracy mode: method and step chosen
 """
+import enum as _enum
+import json as _json
+import numbers as _numbers
+
 from ._bodypoint import Error, Scene
 from . import _bodypoint as _core
 
-__all__ = ["Error", "Scene", "methods", "scene_parameters", "thesis_scene", "read_scene", "parse_scene",
-           "integrate", "trajectory", "sweep", "encounter"]
+__all__ = ["Error", "Scene", "Outcome", "Stepper", "methods", "scene_parameters", "thesis_scene", "read_scene",
+           "parse_scene", "integrate", "trajectory", "sweep", "encounter", "__version__"]
+
+__version__ = _core.__version__  # the project's (CMakeLists.txt); the build's git revision is __revision__
+__revision__ = _core.__revision__
+
+
+class Outcome(str, _enum.Enum):
+    """What happened to a run (docs/physics.md, "Resolution and accuracy flags"). A str: an outcome
+    compares equal to its name, as the dicts hold it (``r["outcome"] == Outcome.ok``)."""
+    ok = "ok"
+    diverged = "diverged"
+    unresolved = "unresolved"
+    inaccurate = "inaccurate"
+    collision = "collision"
+    incomplete = "incomplete"
+    refused = "refused"
+    failed = "failed"
+
+
+def _number(name, value, *, optional=False):
+    """value as a float, or bodypoint.Error naming the quantity (a bool or a text is not a number)."""
+    if value is None and optional:
+        return None
+    if isinstance(value, bool) or not isinstance(value, _numbers.Real):
+        raise Error(f"{name} must be a number, got {type(value).__name__}")
+    return float(value)
+
+
+def _count(name, value, *, optional=False):
+    """value as an int (a float with a whole value, such as 1e5, counts), or bodypoint.Error."""
+    if value is None and optional:
+        return None
+    if isinstance(value, bool) or not isinstance(value, _numbers.Real):
+        raise Error(f"{name} must be a whole number, got {type(value).__name__}")
+    if isinstance(value, _numbers.Integral):
+        return int(value)
+    if not float(value).is_integer():
+        raise Error(f"{name} must be a whole number, got {value!r}")
+    return int(value)
+
+
+def _text(name, value):
+    if not isinstance(value, str):
+        raise Error(f"{name} must be a text, got {type(value).__name__}")
+    return value
+
+
+def _texts(name, values):
+    """A list of texts; a single text is a list of one."""
+    if isinstance(values, str):
+        return [values]
+    try:
+        return [_text(name, v) for v in values]
+    except TypeError:
+        raise Error(f"{name} must be a text or a list of texts, got {type(values).__name__}") from None
+
+
+def _scene(scene):
+    if not isinstance(scene, Scene):
+        raise Error(f"scene must be a bodypoint.Scene (thesis_scene(), read_scene(), Scene(...)), got {type(scene).__name__}")
+    return scene
+
+
+# Defaults of a body given as a dict (a scene file states them): a material point of unit mass and
+# moment of inertia, not spinning.
+_BODY_DEFAULTS = {"m": 1.0, "B": 0.0, "J": 1.0}
+
+
+def _toml_value(where, key, value):
+    """A value of a Scene dict as scene-file (TOML) text: a number, a text or a sequence of numbers."""
+    if isinstance(value, str):
+        return _json.dumps(value)
+    if isinstance(value, (bool, bytes)) or value is None:
+        raise Error(f"bodypoint.Scene: {where}: '{key}' must be a number or a sequence of 3 numbers, got {value!r}")
+    if isinstance(value, _numbers.Real):
+        x = float(value)
+        return "nan" if x != x else ("inf" if x == float("inf") else ("-inf" if x == -float("inf") else repr(x)))
+    try:
+        items = list(value)
+    except TypeError:
+        raise Error(f"bodypoint.Scene: {where}: '{key}' must be a number or a sequence of 3 numbers, "
+                    f"got {type(value).__name__}") from None
+    return "[" + ", ".join(_toml_value(where, key, x) for x in items) + "]"
+
+
+def _scene_toml(centres, bodies):
+    """The scene-file text of a Scene's dicts (the library reads it: the scene files' keys and checks)."""
+    lines = []
+    for kind, entries in (("centre", centres), ("body", bodies)):
+        for i, entry in enumerate(entries):
+            where = f"{kind} {i + 1}"
+            if not isinstance(entry, dict):
+                raise Error(f"bodypoint.Scene: {where} must be a dict, got {type(entry).__name__}")
+            entry = dict(entry)
+            if kind == "body":
+                entry = {**_BODY_DEFAULTS, **entry}
+                if ("R" in entry or "v" in entry) and "w" not in entry:
+                    entry["w"] = (0.0, 0.0, 0.0)
+            lines.append(f"[[{kind}]]")
+            for key, value in entry.items():
+                if not isinstance(key, str):
+                    raise Error(f"bodypoint.Scene: {where}: a key must be a text, got {key!r}")
+                lines.append(f"{_json.dumps(key)} = {_toml_value(where, key, value)}")
+    return "\n".join(lines) + "\n"
 
 
 def methods():
@@ -53,8 +160,8 @@ def parse_scene(text):
 
 
 def integrate(scene, method="auto", *, h=None, steps=None, t_end=None, tol=None, invariants=True,
-              omega_c=-1.0, events=(), max_energy_error=_core.DEFAULT_MAX_ENERGY_ERROR, estimate_error=True,
-              max_error=_core.DEFAULT_MAX_ERROR):
+              omega_c=-1.0, events=(), stop_at=(), max_energy_error=_core.DEFAULT_MAX_ENERGY_ERROR,
+              estimate_error=True, max_error=_core.DEFAULT_MAX_ERROR):
     """Integrates every body of the scene; returns a dict (outcome, reason, force_evals, wall_s, bodies).
 
     How time advances follows the method's kind, as on the command line:
@@ -70,8 +177,10 @@ def integrate(scene, method="auto", *, h=None, steps=None, t_end=None, tol=None,
     largest deviations (max_rel_dE, max_rel_dK2sq, max_abs_dK2Q), force_evals (the delivered run's),
     total_force_evals (with the accuracy mode's search, the error estimate and the events), the
     accuracy mode's search (tol, h_chosen, search_runs, search_force_evals) and its choice (chosen),
-    and the events asked for (the forms of the command line's --event), located on the method's own
-    steps: events (event, t, r, R, v, w), event_force_evals.
+    and the events asked for (the forms of the command line's --event: closest, closest:K, local-min,
+    r=V, r:K=V, x=X, y=Y, z=Z, plane=nx,ny,nz,offset, departure, arrival), located on the method's own
+    steps: events (event, t, r, R, v, w), event_force_evals; ``stop_at``: events that end the run at
+    their first hit (stopped_by).
     Each body's ``err_estimate`` is the estimated relative error of its final state, max(|dR|/|R|,
     |dv|/|v|): from a companion run at half the step (a tenth of a peer's tolerance; it costs about twice
     the run), or the accuracy mode's; None when there is none, ``err_basis`` saying how it was obtained
@@ -82,36 +191,60 @@ def integrate(scene, method="auto", *, h=None, steps=None, t_end=None, tol=None,
     ``max_energy_error``, or an estimated error above ``max_error``; float("inf") lifts a bound),
     "collision"; or "refused"/"failed" without a run (docs/physics.md, "Resolution and accuracy flags").
     """
-    return _core._integrate(scene, method, h, steps, t_end, tol, invariants, omega_c, list(events),
-                            float(max_energy_error), bool(estimate_error), float(max_error))
+    return _core._integrate(_scene(scene), _text("method", method), _number("h", h, optional=True),
+                            _count("steps", steps, optional=True), _number("t_end", t_end, optional=True),
+                            _number("tol", tol, optional=True), bool(invariants), _number("omega_c", omega_c),
+                            _texts("events", events), _texts("stop_at", stop_at),
+                            _number("max_energy_error", max_energy_error), bool(estimate_error),
+                            _number("max_error", max_error))
 
 
-def trajectory(scene, method, step, times, *, omega_c=-1.0):
-    """Each body's state at the given times (increasing, >= 0): a list of dicts with t (n,) and R, v, w
-    (n, 3) numpy arrays. ``step``: the step h of a fixed-step method (the largest step <= h that lands on
-    every requested time), the fictitious step ds of a time-transformed one, or the tolerance per step
-    of a step-size-controlled peer."""
-    return _core._trajectory(scene, method, float(step), [float(t) for t in times], omega_c)
+def trajectory(scene, method, step=None, times=(), *, tol=None, omega_c=-1.0):
+    """Each body's state at the given times (increasing, >= 0), by a Stepper landing on every one.
+
+    ``step``: the step h of a fixed-step method (the largest step <= h that lands on every requested
+    time), the fictitious step ds of a time-transformed one, or the tolerance per step of a
+    step-size-controlled peer. Or ``tol`` (method "auto" or any method the accuracy mode takes): the
+    method, its step and time-step constant are the accuracy mode's for a run to the last time
+    (``h_chosen``, ``err_estimate`` of that run, ``search_force_evals``), then followed segment by segment.
+    A list of dicts per body: name, method, outcome and reason (a segment that was not ok ends the rows
+    there: NaN after it; "unresolved" and "inaccurate" keep the state that was computed), t (n,), R, v,
+    w (n, 3), E (n,) the energy at each time, max_rel_dE its largest deviation from the start's,
+    force_evals, steps."""
+    return _core._trajectory(_scene(scene), _text("method", method), _number("step", step, optional=True),
+                             [_number("a time", t) for t in times], _number("omega_c", omega_c),
+                             _number("tol", tol, optional=True))
 
 
-def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, threads=1, max_energy_error=_core.DEFAULT_MAX_ENERGY_ERROR,
-          estimate_error=True, max_error=_core.DEFAULT_MAX_ERROR, **base):
+def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, threads=None, scattering=False,
+          force_law="coulomb", max_energy_error=_core.DEFAULT_MAX_ENERGY_ERROR, estimate_error=True,
+          max_error=_core.DEFAULT_MAX_ERROR, **base):
     """Runs the thesis's scene over a grid of parameters and methods; returns columns.
 
     ``axes``: {parameter: values} in order (one axis, or a grid of every combination, the last axis
-    fastest); a parameter is h, one of scene_parameters(), b or v_inf. ``methods``: names.
-    ``base``: fixed scene parameters. Steps of h: ``steps`` of them, or to ``t_end``. The result has a
-    column per axis, method, outcome, reason, steps, force_evals, t_end, Rx..wz and the invariants'
-    deviations, err_estimate and err_basis (integrate()'s), one row per (grid point, method), grid point
-    major; outcome as integrate()'s, with the bounds ``max_energy_error`` and ``max_error``.
+    fastest); a parameter is h, one of scene_parameters(), b or v_inf. ``methods``: names, a list of
+    names separated by commas, "fixed" (every fixed-step method but the Kepler split) or "all", as
+    ``bodypoint sweep --methods`` takes them. ``base``: fixed scene parameters; ``force_law`` as
+    thesis_scene()'s. Steps of h: ``steps`` of them, or to ``t_end``. ``threads``: every core unless
+    given. The columns are those of ``bodypoint sweep``'s CSV (docs/guide.md): one per axis, method,
+    max_rel_dE, max_rel_dK2sq, max_abs_dK2Q, Rx..Rz, force_evals, wall_s, status (an Outcome's name,
+    "refused" for a run that did not start or stopped), reason, err_estimate, estimate_force_evals,
+    err_basis, warning; with ``scattering=True`` the encounter's (r_min, t_min, deflection,
+    out_of_plane, b_in, v_inf_in, time_delay, asymptote_error, K1_turn, spin_turn, K1x..K1z,
+    asymptotes); then steps, t_end, vx..vz, wx..wz. One row per (grid point, method), grid point major.
     """
-    if isinstance(methods, str):
-        methods = [methods]
-    if not steps and not t_end:
+    if steps == 0 and t_end == 0.0:
         raise Error("give steps or t_end")
-    return _core._sweep([(k, [float(v) for v in vals]) for k, vals in dict(axes).items()], list(methods), base,
-                        float(h), int(steps), float(t_end), float(tol), int(threads), float(max_energy_error),
-                        bool(estimate_error), float(max_error))
+    try:
+        axes = list(dict(axes).items())
+    except (TypeError, ValueError):
+        raise Error(f"axes must be a dict {{parameter: values}}, got {type(axes).__name__}") from None
+    columns = [(_text("an axis' parameter", k), [_number(f"a value of {k}", v) for v in vals]) for k, vals in axes]
+    return _core._sweep(columns, _texts("methods", methods), base, _number("h", h), _count("steps", steps),
+                        _number("t_end", t_end), _number("tol", tol),
+                        0 if threads is None else _count("threads", threads), _number("max_energy_error", max_energy_error),
+                        bool(estimate_error), _number("max_error", max_error), bool(scattering),
+                        _text("force_law", force_law))
 
 
 def encounter(scene, *, t_end=None, method="auto", tol=1e-10):
@@ -127,4 +260,41 @@ def encounter(scene, *, t_end=None, method="auto", tol=1e-10):
     ``run`` holds the run's own fields, as integrate() gives a body's (method, steps, t_end,
     err_estimate, force_evals, total_force_evals, events, ...).
     A run that is not ok (refused, diverged, ...) raises bodypoint.Error."""
-    return _core._encounter(scene, method, tol, float("nan") if t_end is None else t_end)
+    return _core._encounter(_scene(scene), _text("method", method), _number("tol", tol),
+                            float("nan") if t_end is None else _number("t_end", t_end))
+
+
+class Stepper:
+    """One body of a scene advanced segment by segment, as the library's Stepper (bodypoint.hpp).
+
+        s = bp.Stepper(scene, "lp-kl8", 0.01, stop_at=["r=5"])
+        s.advance_to(50)          # an Outcome; stops early at the first hit of a stop event
+        s.stopped, s.time, s.state["R"], s.events
+        s.advance_to(50)          # continues from the stop
+
+    ``step``: a fixed-step method's largest step (each segment lands on its end), the fictitious step
+    ds of a time-transformed one, or a step-size-controlled peer's tolerance per step. A one-step
+    method continues exactly as one run of the same steps; ab4 restarts its history at each segment.
+    ``events`` / ``stop_at``: as integrate()'s. A segment has no error estimate.
+    """
+
+    def __init__(self, scene, method, step, *, body=0, events=(), stop_at=(), omega_c=-1.0):
+        self._s = _core._Stepper(_scene(scene), _count("body", body), _text("method", method), _number("step", step),
+                                 _texts("events", events), _texts("stop_at", stop_at), _number("omega_c", omega_c))
+
+    def advance_to(self, t):
+        """Integrates from time to t (> time); returns the segment's Outcome (refused or failed leave
+        the stepper where it was: ``reason`` says why)."""
+        return Outcome(self._s.advance_to(_number("t", t)))
+
+    time = property(lambda self: self._s.time, doc="the current time")
+    state = property(lambda self: self._s.state, doc="the current state: t, R, v, w")
+    events = property(lambda self: self._s.events, doc="events located so far: event, t, r, R, v, w")
+    stopped = property(lambda self: self._s.stopped, doc="a stop event ended the last segment")
+    force_evals = property(lambda self: self._s.force_evals, doc="force evaluations so far")
+    steps = property(lambda self: self._s.steps, doc="steps so far")
+    reason = property(lambda self: self._s.reason, doc="why the last segment that was not ok was not")
+    method = property(lambda self: self._s.method, doc="the method's name")
+
+    def __repr__(self):
+        return f"<bodypoint.Stepper {self.method} at t = {self.time!r}>"
