@@ -18,9 +18,10 @@ case "${1:-}" in
   *) echo "usage: scripts/setup.sh [--minimal]" >&2; exit 2 ;;
 esac
 
-# The library, the command line and the Python module (pybind11 on Debian's python3, numpy arrays).
+# The library, the command line and the Python module (pybind11 on Debian's python3, numpy arrays;
+# pandas, which docs/guide.md's sweeps use; python3-venv for `pip install .` into a virtual environment).
 packages=(cmake ninja-build g++ git libeigen3-dev libboost-dev libboost-program-options-dev
-          libtomlplusplus-dev libgsl-dev python3-numpy python3-dev pybind11-dev)
+          libtomlplusplus-dev libgsl-dev python3-numpy python3-dev pybind11-dev python3-pandas python3-venv)
 if ((!minimal)); then
   # Tests and benchmarks (GoogleTest, Google Benchmark, pytest), the figures (matplotlib) and:
   packages+=(libgtest-dev libbenchmark-dev python3-pytest python3-matplotlib
