@@ -49,7 +49,7 @@ SceneParams scene_params(const po::variables_map& vm, const SceneOptions& o) {
   return with_asymptotic_data(o.params, data, given);
 }
 
-Scene make_scene(const po::variables_map& vm, const SceneOptions& o) {
+Scene make_scene(const po::variables_map& vm, SceneOptions& o) {
   if (vm.count("scene")) {
     std::vector<std::string> keys{"force-law", "b", "v-inf", "arrival-phase"};
     for (const SceneParameter& q : scene_parameters()) keys.emplace_back(q.name);
@@ -60,7 +60,8 @@ Scene make_scene(const po::variables_map& vm, const SceneOptions& o) {
     register_input(o.scene_file);  // no output of this run may replace it
     return scene;
   }
-  return thesis_scene(scene_params(vm, o));
+  o.params = scene_params(vm, o);  // with b, v_inf or the arrival phase: d, K1 or phase as solved
+  return thesis_scene(o.params);
 }
 
 void add_step_options(po::options_description& desc, StepOptions& o) {

@@ -25,11 +25,10 @@ struct SceneOptions {
   double arrival_phase = std::numeric_limits<double>::quiet_NaN();  ///< --arrival-phase: the start phase solved for it
 };
 void add_scene_options(po::options_description& desc, SceneOptions& o);
-/// --force-law NAME: coulomb, thesis-code or thesis-code-force (model.hpp, ForceLaw).
 /// The thesis's parameters with --b and --v-inf applied (d and K1 solved for them; scattering.hpp).
 SceneParams scene_params(const po::variables_map& vm, const SceneOptions& o);
-/// The scene from --scene or from the thesis's parameters (never both).
-Scene make_scene(const po::variables_map& vm, const SceneOptions& o);
+/// The scene from --scene or from the thesis's parameters (never both); o.params becomes the solved ones.
+Scene make_scene(const po::variables_map& vm, SceneOptions& o);
 
 /// Step options: --h and --steps or --t-end.
 struct StepOptions {

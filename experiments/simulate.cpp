@@ -25,7 +25,11 @@ namespace {
 
 std::string scene_header(const po::variables_map& vm, const SceneOptions& o) {
   if (vm.count("scene")) return "scene=" + o.scene_file;
-  return describe(o.params);
+  std::string data;  // the asymptotic data the scene was given by (describe shows what they solved)
+  if (vm.count("b")) data += " b=" + fmt(o.b);
+  if (vm.count("v-inf")) data += " v_inf=" + fmt(o.v_inf);
+  if (vm.count("arrival-phase")) data += " arrival_phase=" + fmt(o.arrival_phase);
+  return describe(o.params) + (data.empty() ? "" : " (solved for" + data + ")");
 }
 
 std::string search_line(const BodyResult& b) {

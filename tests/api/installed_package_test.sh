@@ -23,6 +23,8 @@ cmake --install "$build" --prefix "$work/prefix" >>"$work/lib.log"
 test -f "$work/prefix/include/bodypoint/bodypoint.hpp"
 if [ -e "$work/prefix/include/bodypoint/detail" ]; then echo "FAIL: internal headers (detail/) installed"; exit 1; fi
 ls "$work"/prefix/lib*/cmake/bodypoint/bodypointConfigVersion.cmake >/dev/null
+# The command is installed with it and runs from there.
+"$work/prefix/bin/bodypoint" --version | grep -q '^bodypoint [0-9]' || { echo "FAIL: prefix/bin/bodypoint --version"; exit 1; }
 # The commands are built on the installed API: every project header they include is installed.
 for h in $(grep -ho '#include "bodypoint/[^"]*"' "$src"/experiments/*.cpp "$src"/experiments/*.hpp | sort -u | cut -d'"' -f2); do
   if [ ! -f "$work/prefix/include/$h" ]; then echo "FAIL: experiments/ includes $h, which the install leaves out"; exit 1; fi
