@@ -169,6 +169,7 @@ class FictitiousLoop {
         outputs_until(obs, prev, a.t, st.steps);
         obs.observe(st.steps, a.t, x, !to_time && st.steps == cap);
       }
+      splitting::poll(obs, st.steps);
     }
     if (to_time) finish(x, t_over, cap, obs, st);
     st_ = st;

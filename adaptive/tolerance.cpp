@@ -178,6 +178,7 @@ class Search {
     const Advance how = step_advance(m_, h, t_end_, samples ? dt_out_ : 0.0);
     RunOptions o;
     o.omega_c = automatic_omega_c(b_, c_, h_c);
+    o.cancel = delivery_.cancel;
     o.track_invariants = may_deliver && delivery_.track_invariants;
     Level l;
     SampleSink keep;
@@ -222,6 +223,8 @@ class Search {
         estimate_ = pair_estimate(coarse, fine);
         return fine;
       } catch (const SearchLimit&) {
+        throw;
+      } catch (const StoppedOnRequest&) {
         throw;
       } catch (const Error&) {
         if (k >= kMaxLevels) throw;

@@ -130,6 +130,7 @@ Options companion_options(const Body& body, const std::vector<Centre>& centres, 
   o.max_energy_error = std::numeric_limits<double>::infinity();
   o.max_error = std::numeric_limits<double>::infinity();
   o.omega_c = options.omega_c;
+  o.cancel = options.cancel;
   if (const auto* f = std::get_if<FictitiousSteps>(&how); f && o.omega_c < 0.0)
     o.omega_c = adaptive::automatic_omega_c(body, centres, f->ds);
   // A run cut at a stop event is compared with its companion cut at the same event.

@@ -125,12 +125,13 @@ detail::Advancer advancer(const BodyResult& r, const Body& body, const std::vect
     step = controlled->h0;
     tol = controlled->tol;
   }
-  return [&m, body, &centres, step, tol, c](const State& s, double tau, long& evals) {
+  return [&m, body, &centres, step, tol, c, cancel = options.cancel](const State& s, double tau, long& evals) {
     Body from = body;
     from.s0 = s;
     Options sub;
     sub.track_invariants = false;
     sub.omega_c = c;
+    sub.cancel = cancel;
     Advance a;
     if (is_time_transformed(m)) a = FictitiousSteps{step, EndTime{tau}};
     else if (is_step_controlled(m)) a = ControlledSteps{std::min(step, tau), tau, tol};

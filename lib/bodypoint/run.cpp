@@ -269,6 +269,8 @@ void check_takes(const MethodInfo& m, const Advance& how) {
 
 double steps_landing_on(double t_end, double h_max) { return std::max(1.0, std::ceil(t_end / h_max * (1.0 - 1e-12))); }
 
+void detail::stop_on_request() { throw StoppedOnRequest(); }
+
 FixedSteps fixed_steps_to(double t_end, double h_max) {
   require_positive(h_max, "the step h");
   require_positive(t_end, "the end time t_end");

@@ -13,6 +13,7 @@
 #include "bodypoint/model.hpp"
 
 #include <functional>
+#include <atomic>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -181,6 +182,18 @@ struct RunOptions {
   /// Time-transformed methods: the constant c of the time-step function (logH: Pi + c, TTL:
   /// sum |A_i|/r_i + c), so the physical step is at most ds/c; < 0: chosen from the scene.
   double omega_c = -1.0;
+  /// When given, polled every kPollStride steps of every loop (searches, companions and event
+  /// refinements included): once another thread or a signal handler sets it, the run ends as
+  /// Outcome::failed with the reason kStoppedOnRequest. The Python module's Ctrl-C and max_seconds.
+  const std::atomic<bool>* cancel = nullptr;
+};
+/// Steps between two polls of RunOptions::cancel (at most a few hundred microseconds of any method).
+inline constexpr long kPollStride = 256;
+/// The reason of a run that RunOptions::cancel ended.
+inline constexpr const char* kStoppedOnRequest = "stopped on request (an interrupt or the time budget)";
+/// What a loop throws when RunOptions::cancel is set: no search retries it (integrate_body: failed).
+struct StoppedOnRequest : Error {
+  StoppedOnRequest() : Error(kStoppedOnRequest) {}
 };
 /// Throws Error unless every >= 1 and omega_c is finite (< 0: automatic).
 void check(const RunOptions& options);

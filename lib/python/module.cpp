@@ -14,6 +14,11 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <csignal>
+#include <mutex>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -109,6 +114,80 @@ Scene thesis_from(const py::dict& kw) {
   return thesis_scene(with_asymptotic_data(sp, data, given));
 }
 
+/// What stops a call into the library early: Ctrl-C (SIGINT, in the main thread: the handler in place
+/// is put back after the call) and a budget of max_seconds of wall-clock time (a watchdog thread). Both
+/// set the flag the runs poll (RunOptions::cancel, every kPollStride steps); raise() then turns a
+/// stopped call into KeyboardInterrupt or bodypoint.Error, with the GIL held.
+class Interruptible {
+ public:
+  explicit Interruptible(double max_seconds) : max_seconds_(max_seconds) {
+    if (!(max_seconds > 0.0)) throw Error("max_seconds must be a number > 0 (inf: no budget), got " + fmt(max_seconds));
+    const bool main_thread =
+        py::module_::import("threading").attr("current_thread")().is(py::module_::import("threading").attr("main_thread")());
+    if (main_thread && g_target.load() == nullptr) {
+      g_target.store(&flag_);
+      struct sigaction mine {};
+      mine.sa_handler = [](int) {
+        g_interrupted.store(true);
+        if (std::atomic<bool>* f = g_target.load()) f->store(true);
+      };
+      sigemptyset(&mine.sa_mask);
+      installed_ = ::sigaction(SIGINT, &mine, &previous_) == 0;
+      if (!installed_) g_target.store(nullptr);
+    }
+    if (std::isfinite(max_seconds))
+      watchdog_ = std::thread([this] {
+        std::unique_lock<std::mutex> lock(mutex_);
+        if (!done_cv_.wait_for(lock, std::chrono::duration<double>(max_seconds_), [this] { return done_; })) {
+          timed_out_ = true;
+          flag_.store(true);
+        }
+      });
+  }
+  ~Interruptible() { finish(); }
+  Interruptible(const Interruptible&) = delete;
+  Interruptible& operator=(const Interruptible&) = delete;
+
+  [[nodiscard]] const std::atomic<bool>* flag() const { return &flag_; }
+
+  /// Ends the guard (the handler back, the watchdog joined) and raises what stopped the call, if anything.
+  void raise() {
+    finish();
+    if (interrupted_) {
+      PyErr_SetNone(PyExc_KeyboardInterrupt);
+      throw py::error_already_set();
+    }
+    if (timed_out_)
+      throw Error("stopped after max_seconds = " + fmt(max_seconds_) + " s of wall-clock time (the call's budget)");
+  }
+
+ private:
+  void finish() {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      done_ = true;
+    }
+    done_cv_.notify_all();
+    if (watchdog_.joinable()) watchdog_.join();
+    if (installed_) {
+      ::sigaction(SIGINT, &previous_, nullptr);
+      installed_ = false;
+      interrupted_ = g_interrupted.exchange(false);
+      g_target.store(nullptr);
+    }
+  }
+
+  static inline std::atomic<std::atomic<bool>*> g_target{nullptr};
+  static inline std::atomic<bool> g_interrupted{false};
+  double max_seconds_;
+  std::atomic<bool> flag_{false};
+  struct sigaction previous_ {};
+  bool installed_ = false, interrupted_ = false, timed_out_ = false, done_ = false;
+  std::mutex mutex_;
+  std::condition_variable done_cv_;
+  std::thread watchdog_;
+};
+
 /// A record of the library's (record.hpp) as a dict: the keys of `simulate --json`, numbers that are
 /// not finite as None, vectors as numpy arrays.
 py::object to_py(const Value& v);
@@ -161,7 +240,7 @@ py::dict integrate_py(const Scene& scene, const std::string& method, std::option
                       std::optional<long> steps, std::optional<double> t_end, std::optional<double> tol,
                       bool invariants, double omega_c, const std::vector<std::string>& event_names,
                       const std::vector<std::string>& stop_at, double max_energy_error, bool estimate_error,
-                      double max_error) {
+                      double max_error, double max_seconds) {
   const MethodInfo* m = method == "auto" ? nullptr : &method_or_throw(method);
   const bool code_loop = std::any_of(scene.centres.begin(), scene.centres.end(),
                                      [](const Centre& c) { return c.law == ForceLaw::thesis_code; });
@@ -173,11 +252,14 @@ py::dict integrate_py(const Scene& scene, const std::string& method, std::option
   o.estimate_error = estimate_error;
   o.max_error = max_error;
   o.events = events_of(event_names, stop_at);
+  Interruptible stop(max_seconds);
+  o.cancel = stop.flag();
   Result r;
   {
     py::gil_scoped_release free;
     r = integrate(scene, m, how, o);
   }
+  stop.raise();
   py::dict d;
   d["outcome"] = std::string(outcome_name(r.outcome));
   d["reason"] = r.reason;
@@ -194,7 +276,7 @@ py::dict integrate_py(const Scene& scene, const std::string& method, std::option
 /// time-step constant are the accuracy mode's for a run to the last time, whose estimate is reported.
 /// A segment that is not ok ends the body's rows there (NaN after), with its outcome and reason.
 py::list trajectory_py(const Scene& scene, const std::string& method, std::optional<double> step,
-                       const std::vector<double>& times, double omega_c, std::optional<double> tol) {
+                       const std::vector<double>& times, double omega_c, std::optional<double> tol, double max_seconds) {
   if (times.empty()) throw Error("times is empty");
   for (std::size_t k = 0; k < times.size(); ++k)
     if (!std::isfinite(times[k]) || times[k] < 0.0 || (k > 0 && !(times[k] > times[k - 1])))
@@ -203,6 +285,7 @@ py::list trajectory_py(const Scene& scene, const std::string& method, std::optio
   if (!tol && !step) throw Error("give a step (h, ds or a peer's tolerance per step) or a tolerance tol");
   const MethodInfo* named = method == "auto" ? nullptr : &method_or_throw(method);
   if (!tol && !named) throw Error("method auto needs a tolerance tol");
+  Interruptible stop(max_seconds);
   py::list out;
   for (const Body& body : scene.bodies) {
     py::dict d;
@@ -212,11 +295,13 @@ py::list trajectory_py(const Scene& scene, const std::string& method, std::optio
     if (tol) {
       Options o;
       o.track_invariants = false;
+      o.cancel = stop.flag();
       BodyResult r;
       {
         py::gil_scoped_release free;
         r = integrate_body(body, scene.centres, named, Accuracy{*tol, times.back() > 0.0 ? times.back() : 1.0}, o);
       }
+      stop.raise();
       if (!r.accuracy) throw Error((body.name.empty() ? std::string("body") : body.name) + ": " + r.reason);
       m = r.method;
       h = r.accuracy->step;
@@ -237,6 +322,7 @@ py::list trajectory_py(const Scene& scene, const std::string& method, std::optio
     auto wm = w.mutable_unchecked<2>();
     Options o;  // invariants tracked: each segment's steps are judged (a step that turns the spin by > pi)
     o.omega_c = c;
+    o.cancel = stop.flag();
     Stepper s(*m, body, scene.centres, h, o);
     const CentreList field{scene.centres};
     Outcome outcome = Outcome::ok;
@@ -266,6 +352,7 @@ py::list trajectory_py(const Scene& scene, const std::string& method, std::optio
         if (outcome != Outcome::ok) break;
       }
     }
+    stop.raise();
     d["method"] = m->name;
     d["outcome"] = std::string(outcome_name(outcome));
     d["reason"] = outcome == Outcome::ok ? std::string() : s.reason();
@@ -319,7 +406,7 @@ py::dict sweep_columns(const SweepSpec& spec, const std::vector<SweepRow>& rows)
 py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>& axes,
                   const std::vector<std::string>& methods, const py::dict& base, double h, long steps, double t_end,
                   double tol, unsigned threads, double max_energy_error, bool estimate_error, double max_error,
-                  bool scattering, const std::string& force_law) {
+                  bool scattering, const std::string& force_law, double max_seconds) {
   SweepSpec s;
   s.max_energy_error = max_energy_error;
   s.estimate_error = estimate_error;
@@ -335,24 +422,32 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
   s.steps = t_end > 0.0 ? 0 : steps;
   s.t_end = t_end;
   s.tol = tol;
+  Interruptible stop(max_seconds);
+  s.cancel = stop.flag();
   std::vector<SweepRow> rows;
-  {
+  try {
     py::gil_scoped_release free;
     rows = run_sweep_rows(s, threads);
+  } catch (const Error&) {
+    stop.raise();  // stopped: KeyboardInterrupt or the budget's error
+    throw;
   }
   return sweep_columns(s, rows);
 }
 
 /// The encounter's record with its run's (`run`: method, steps, t_end, err_estimate, force_evals, ...).
-py::dict encounter_py(const Scene& scene, const std::string& method, double tol, double t_end) {
+py::dict encounter_py(const Scene& scene, const std::string& method, double tol, double t_end, double max_seconds) {
   const MethodInfo* m = method == "auto" ? nullptr : &method_or_throw(method);
   Options o;
   o.track_invariants = false;
+  Interruptible stop(max_seconds);
+  o.cancel = stop.flag();
   EncounterResult r;
   {
     py::gil_scoped_release free;
     r = encounter(scene.bodies.front(), scene.centres, m, tol, t_end, o);
   }
+  stop.raise();
   if (r.run.outcome != Outcome::ok) throw Error(r.run.reason);
   const Advance how = Accuracy{tol, r.run.run.t_end};
   return to_py(encounter_record(r.encounter).record("run", body_record(r.run, how, r.events)));
@@ -373,12 +468,16 @@ struct PyStepper {
     o.events = std::move(events);
     return Stepper(method, scene.bodies[body], scene.centres, step, o);
   }
-  std::string advance_to(double t) {
+  std::string advance_to(double t, double max_seconds) {
+    Interruptible stop(max_seconds);
+    stepper.cancel_with(stop.flag());
     Outcome o{};
     {
       py::gil_scoped_release free;
       o = stepper.advance_to(t);
     }
+    stepper.cancel_with(nullptr);
+    stop.raise();
     return std::string(outcome_name(o));
   }
   py::dict state() const {
@@ -451,18 +550,19 @@ PYBIND11_MODULE(_bodypoint, mod) {
   mod.attr("DEFAULT_MAX_ERROR") = kDefaultMaxError;
   mod.def("_integrate", &integrate_py, py::arg("scene"), py::arg("method"), py::arg("h"), py::arg("steps"),
           py::arg("t_end"), py::arg("tol"), py::arg("invariants"), py::arg("omega_c"), py::arg("events"),
-          py::arg("stop_at"), py::arg("max_energy_error"), py::arg("estimate_error"), py::arg("max_error"));
+          py::arg("stop_at"), py::arg("max_energy_error"), py::arg("estimate_error"), py::arg("max_error"),
+          py::arg("max_seconds"));
   mod.def("_trajectory", &trajectory_py, py::arg("scene"), py::arg("method"), py::arg("step"), py::arg("times"),
-          py::arg("omega_c"), py::arg("tol"));
+          py::arg("omega_c"), py::arg("tol"), py::arg("max_seconds"));
   mod.def("_sweep", &sweep_py, py::arg("axes"), py::arg("methods"), py::arg("base"), py::arg("h"), py::arg("steps"),
           py::arg("t_end"), py::arg("tol"), py::arg("threads"), py::arg("max_energy_error"), py::arg("estimate_error"), py::arg("max_error"),
-          py::arg("scattering"), py::arg("force_law"));
+          py::arg("scattering"), py::arg("force_law"), py::arg("max_seconds"));
   py::class_<PyStepper>(mod, "_Stepper")
       .def(py::init<const Scene&, std::size_t, const std::string&, double, const std::vector<std::string>&,
                     const std::vector<std::string>&, double>(),
            py::arg("scene"), py::arg("body"), py::arg("method"), py::arg("step"), py::arg("events"), py::arg("stop_at"),
            py::arg("omega_c"))
-      .def("advance_to", &PyStepper::advance_to, py::arg("t"))
+      .def("advance_to", &PyStepper::advance_to, py::arg("t"), py::arg("max_seconds"))
       .def_property_readonly("time", [](const PyStepper& s) { return s.stepper.time(); })
       .def_property_readonly("state", &PyStepper::state)
       .def_property_readonly("events", &PyStepper::hits)
@@ -473,5 +573,6 @@ PYBIND11_MODULE(_bodypoint, mod) {
       .def_property_readonly("method", [](const PyStepper& s) { return s.stepper.method().name; });
   mod.attr("__revision__") = git_revision();
   mod.attr("__version__") = version();
-  mod.def("_encounter", &encounter_py, py::arg("scene"), py::arg("method"), py::arg("tol"), py::arg("t_end"));
+  mod.def("_encounter", &encounter_py, py::arg("scene"), py::arg("method"), py::arg("tol"), py::arg("t_end"),
+          py::arg("max_seconds"));
 }

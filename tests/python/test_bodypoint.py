@@ -6,8 +6,10 @@ import io
 import json
 import math
 import os
+import signal
 import subprocess
 import threading
+import time
 
 import numpy as np
 import pytest
@@ -335,3 +337,37 @@ def test_trajectory_reports_its_outcome_energy_and_takes_the_accuracy_mode():
     assert np.linalg.norm(auto["R"][-1] - one["R"]) / np.linalg.norm(one["R"]) < tol
     with pytest.raises(bp.Error, match="not both"):
         bp.trajectory(scene, "lp-y4", 0.01, times, tol=tol)
+
+
+# Each stopped call below would run for minutes; it must return well before (the runs poll every 256
+# steps, a fraction of a millisecond). A generous bound: a loaded CI machine, not a timing target.
+STOP_BOUND_S = 10.0
+LONG_CALLS = {
+    "integrate": lambda s, **kw: bp.integrate(s, "lp-y4", h=1e-6, t_end=1e4, **kw),
+    "accuracy": lambda s, **kw: bp.integrate(s, tol=1e-13, t_end=1e5, **kw),
+    "trajectory": lambda s, **kw: bp.trajectory(s, "rk4", 1e-6, [0, 1e4], **kw),
+    "sweep": lambda s, **kw: bp.sweep({"d": [5, 10]}, "lp-y4,logh-y4", steps=3 * 10**7, **kw),
+    "encounter": lambda s, **kw: bp.encounter(s, t_end=1e7, **kw),
+    "stepper": lambda s, **kw: bp.Stepper(s, "gsl-rk8pd", 1e-14).advance_to(1e5, **kw),
+}
+
+
+@pytest.mark.parametrize("name", sorted(LONG_CALLS))
+def test_every_call_stops_at_its_budget(name):
+    t0 = time.monotonic()
+    with pytest.raises(bp.Error, match="stopped after max_seconds = 0.2 s"):
+        LONG_CALLS[name](bp.thesis_scene(), max_seconds=0.2)
+    assert time.monotonic() - t0 < STOP_BOUND_S
+
+
+@pytest.mark.parametrize("name", sorted(LONG_CALLS))
+def test_every_call_stops_at_ctrl_c(name):
+    timer = threading.Timer(0.2, lambda: os.kill(os.getpid(), signal.SIGINT))
+    t0 = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        LONG_CALLS[name](bp.thesis_scene())
+    timer.join()
+    assert time.monotonic() - t0 < STOP_BOUND_S
+    # Python's own handler is back: the next call runs to its end
+    assert bp.integrate(bp.thesis_scene(), "lp-y4", h=1e-3, t_end=1)["outcome"] == "ok"

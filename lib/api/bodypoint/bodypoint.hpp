@@ -313,6 +313,8 @@ class Stepper {
   /// True once an event with stop = true ended a segment: time() is the event's, and advance_to
   /// continues from there only when asked again.
   [[nodiscard]] bool stopped() const { return stopped_; }
+  /// The flag the next segments poll (RunOptions::cancel; nullptr: none), to stop one from outside.
+  void cancel_with(const std::atomic<bool>* flag) { options_.cancel = flag; }
 
  private:
   const MethodInfo* method_;

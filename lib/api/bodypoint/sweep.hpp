@@ -65,6 +65,9 @@ struct SweepSpec {
   double max_energy_error = kDefaultMaxEnergyError;  ///< Options::max_energy_error of every run
   bool estimate_error = true;                        ///< Options::estimate_error of every run
   double max_error = kDefaultMaxError;               ///< Options::max_error of every run
+  /// RunOptions::cancel of every run, also polled between units (a batch of vector lanes runs to its end,
+  /// so rows of more than 1e6 steps then run alone): once set, run_sweep_rows throws Error(kStoppedOnRequest).
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 /// Number of (grid point, method) tasks; Error above 1e9.

@@ -63,6 +63,24 @@ inline Grid grid_of(const FixedSteps& f) { return {f.h, f.steps, 0.0}; }
 inline Grid grid_of(const ControlledSteps&) { return {}; }
 inline Grid grid_of(const FictitiousSteps& f) { return {0.0, f.steps(), f.dt_out}; }
 
+/// Throws Error(kStoppedOnRequest) (out of line: the loops keep only the poll's load and branch).
+[[noreturn]] void stop_on_request();
+
+/// The poll of RunOptions::cancel that every step loop makes through its observer (`obs.poll(i)`).
+struct CancelPoll {
+  const std::atomic<bool>* cancel = nullptr;
+  void poll(long i) const {
+    if (cancel && i % kPollStride == 0 && cancel->load(std::memory_order_relaxed)) [[unlikely]]
+      stop_on_request();
+  }
+};
+
+/// The observer of a run that observes nothing but may be cancelled.
+struct Unobserved : splitting::NullObserver {
+  CancelPoll cancel;
+  void poll(long i) const { cancel.poll(i); }
+};
+
 /// Unwinds a step loop from its observer when the sink says Flow::stop; observe() catches it, so it
 /// never leaves a run.
 struct SinkStopped {
@@ -79,7 +97,8 @@ class Monitor {
 
   Monitor(const BodyPoint& p, const Field& f, const State& s0, const RunOptions& options, Grid grid,
           ToPhysical to_physical)
-      : inv_(p, f, s0), grid_(grid), every_(options.every), sink_(options.sink), to_physical_(std::move(to_physical)) {
+      : inv_(p, f, s0), grid_(grid), every_(options.every), sink_(options.sink), cancel_{options.cancel},
+        to_physical_(std::move(to_physical)) {
     if (sink_ && (*sink_)(Sample{0, 0.0, s0, 0.0, 0.0, 0.0}) == Flow::stop) throw SinkStopped{0, 0.0, s0};
   }
 
@@ -102,6 +121,7 @@ class Monitor {
     hand(Sample{i, t, s, inv_.last_rel_dE(), inv_.last_rel_dK2sq(), inv_.last_abs_dK2Q()});
   }
   [[nodiscard]] bool wants_times() const { return sink_ && grid_.dt_out > 0.0; }
+  void poll(long i) const { cancel_.poll(i); }
 
   [[nodiscard]] const InvariantStats& stats() const { return inv_.stats(); }
 
@@ -122,6 +142,7 @@ class Monitor {
   Grid grid_;
   long every_;
   const SampleSink* sink_;
+  CancelPoll cancel_;
   ToPhysical to_physical_;
 };
 
@@ -172,6 +193,7 @@ template <class Says, class X, class TryStep, class Observer>
     rejected_in_a_row = 0;
     check_adaptive_rate(st.steps, t, t_end);
     if constexpr (Observer::active) obs.observe(st.steps, t, x, t >= t_end);
+    splitting::poll(obs, st.steps);
     if (!std::isfinite(x[0])) break;
   }
   return x;
@@ -199,7 +221,8 @@ RunResult observe(const BodyPoint& p, const Field& field, const State& s0, const
     r.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
     r.invariants = mon.stats();
   } else {
-    splitting::NullObserver none;
+    Unobserved none;
+    none.cancel.cancel = options.cancel;
     const auto t0 = Clock::now();
     r.final = loop(none);
     r.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();

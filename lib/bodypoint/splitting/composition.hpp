@@ -189,6 +189,12 @@ struct NullObserver {
   void operator()(long, const X&) const {}
 };
 
+/// Calls obs.poll(i) after step i where the observer has one (a run's cancellation, run_support.hpp).
+template <class Observer>
+inline void poll(const Observer& obs, long i) {
+  if constexpr (requires { obs.poll(i); }) obs.poll(i);
+}
+
 /// Kernel concept: `state_type`, `drift(x, tau)`, `kick(x, tau)`, `begin_step(x)`, `third(x, tau)` for
 /// sequences with a third part,
 /// `static constexpr bool mergeable` (false when a step depends on the state at its start), and for
@@ -221,6 +227,7 @@ void integrate(Kernel& k, typename Kernel::state_type& x, double h, long n, Obse
       F = k.force(x);
       k.apply_kick(x, Seq.ops[M - 1].c * h, F);
       if constexpr (Observer::active) obs(i + 1, x);
+      poll(obs, i + 1);
     }
   } else if constexpr (merge_drift) {
     if (n <= 0) return;
@@ -230,12 +237,14 @@ void integrate(Kernel& k, typename Kernel::state_type& x, double h, long n, Obse
       Op last = Seq.ops[M - 1];
       if (i + 1 < n) last.c += Seq.ops[0].c;
       apply(last, h);
+      poll(obs, i + 1);
     }
   } else {
     for (long i = 0; i < n; ++i) {
       k.begin_step(x);
       for (std::size_t j = 0; j < M; ++j) apply(Seq.ops[j], h);
       if constexpr (Observer::active) obs(i + 1, x);
+      poll(obs, i + 1);
     }
   }
 }

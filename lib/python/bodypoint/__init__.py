@@ -21,7 +21,11 @@ from ._bodypoint import Error, Scene
 from . import _bodypoint as _core
 
 __all__ = ["Error", "Scene", "Outcome", "Stepper", "methods", "scene_parameters", "thesis_scene", "read_scene",
-           "parse_scene", "integrate", "trajectory", "sweep", "encounter", "__version__"]
+           "parse_scene", "integrate", "trajectory", "sweep", "encounter", "DEFAULT_MAX_SECONDS", "__version__"]
+
+# A call's budget of wall-clock time unless given, the command line's (a day): past it the call raises
+# bodypoint.Error; Ctrl-C raises KeyboardInterrupt within a fraction of a second (the runs poll it).
+DEFAULT_MAX_SECONDS = 86400.0
 
 __version__ = _core.__version__  # the project's (CMakeLists.txt); the build's git revision is __revision__
 __revision__ = _core.__revision__
@@ -161,7 +165,7 @@ def parse_scene(text):
 
 def integrate(scene, method="auto", *, h=None, steps=None, t_end=None, tol=None, invariants=True,
               omega_c=-1.0, events=(), stop_at=(), max_energy_error=_core.DEFAULT_MAX_ENERGY_ERROR,
-              estimate_error=True, max_error=_core.DEFAULT_MAX_ERROR):
+              estimate_error=True, max_error=_core.DEFAULT_MAX_ERROR, max_seconds=DEFAULT_MAX_SECONDS):
     """Integrates every body of the scene; returns a dict (outcome, reason, force_evals, wall_s, bodies).
 
     How time advances follows the method's kind, as on the command line:
@@ -196,10 +200,10 @@ def integrate(scene, method="auto", *, h=None, steps=None, t_end=None, tol=None,
                             _number("tol", tol, optional=True), bool(invariants), _number("omega_c", omega_c),
                             _texts("events", events), _texts("stop_at", stop_at),
                             _number("max_energy_error", max_energy_error), bool(estimate_error),
-                            _number("max_error", max_error))
+                            _number("max_error", max_error), _number("max_seconds", max_seconds))
 
 
-def trajectory(scene, method, step=None, times=(), *, tol=None, omega_c=-1.0):
+def trajectory(scene, method, step=None, times=(), *, tol=None, omega_c=-1.0, max_seconds=DEFAULT_MAX_SECONDS):
     """Each body's state at the given times (increasing, >= 0), by a Stepper landing on every one.
 
     ``step``: the step h of a fixed-step method (the largest step <= h that lands on every requested
@@ -213,12 +217,12 @@ def trajectory(scene, method, step=None, times=(), *, tol=None, omega_c=-1.0):
     force_evals, steps."""
     return _core._trajectory(_scene(scene), _text("method", method), _number("step", step, optional=True),
                              [_number("a time", t) for t in times], _number("omega_c", omega_c),
-                             _number("tol", tol, optional=True))
+                             _number("tol", tol, optional=True), _number("max_seconds", max_seconds))
 
 
 def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, threads=None, scattering=False,
           force_law="coulomb", max_energy_error=_core.DEFAULT_MAX_ENERGY_ERROR, estimate_error=True,
-          max_error=_core.DEFAULT_MAX_ERROR, **base):
+          max_error=_core.DEFAULT_MAX_ERROR, max_seconds=DEFAULT_MAX_SECONDS, **base):
     """Runs the thesis's scene over a grid of parameters and methods; returns columns.
 
     ``axes``: {parameter: values} in order (one axis, or a grid of every combination, the last axis
@@ -244,10 +248,10 @@ def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, threads=None,
                         _number("t_end", t_end), _number("tol", tol),
                         0 if threads is None else _count("threads", threads), _number("max_energy_error", max_energy_error),
                         bool(estimate_error), _number("max_error", max_error), bool(scattering),
-                        _text("force_law", force_law))
+                        _text("force_law", force_law), _number("max_seconds", max_seconds))
 
 
-def encounter(scene, *, t_end=None, method="auto", tol=1e-10):
+def encounter(scene, *, t_end=None, method="auto", tol=1e-10, max_seconds=DEFAULT_MAX_SECONDS):
     """The first body's encounter in the accuracy mode (docs/physics.md, Scattering).
 
     Without t_end the run stops when the body has left (its guiding centre back at its start distance),
@@ -261,7 +265,8 @@ def encounter(scene, *, t_end=None, method="auto", tol=1e-10):
     err_estimate, force_evals, total_force_evals, events, ...).
     A run that is not ok (refused, diverged, ...) raises bodypoint.Error."""
     return _core._encounter(_scene(scene), _text("method", method), _number("tol", tol),
-                            float("nan") if t_end is None else _number("t_end", t_end))
+                            float("nan") if t_end is None else _number("t_end", t_end),
+                            _number("max_seconds", max_seconds))
 
 
 class Stepper:
@@ -282,10 +287,11 @@ class Stepper:
         self._s = _core._Stepper(_scene(scene), _count("body", body), _text("method", method), _number("step", step),
                                  _texts("events", events), _texts("stop_at", stop_at), _number("omega_c", omega_c))
 
-    def advance_to(self, t):
+    def advance_to(self, t, *, max_seconds=DEFAULT_MAX_SECONDS):
         """Integrates from time to t (> time); returns the segment's Outcome (refused or failed leave
-        the stepper where it was: ``reason`` says why)."""
-        return Outcome(self._s.advance_to(_number("t", t)))
+        the stepper where it was: ``reason`` says why). Ctrl-C or max_seconds stop the segment (the
+        stepper stays where it was) and raise KeyboardInterrupt or bodypoint.Error."""
+        return Outcome(self._s.advance_to(_number("t", t), _number("max_seconds", max_seconds)))
 
     time = property(lambda self: self._s.time, doc="the current time")
     state = property(lambda self: self._s.state, doc="the current state: t, R, v, w")
