@@ -118,6 +118,7 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
   std::string fixed = "# fixed: " + describe(spec.base) + (grid ? " (the varied ones excepted)" : " (the varied one excepted)");
   if (!sweeps_h) fixed += " h=" + fmt(spec.h);
   fixed += spec.t_end > 0 ? " t_end=" + fmt(spec.t_end) : " steps=" + std::to_string(spec.steps);
+  if (spec.accuracy) fixed += " accuracy=" + fmt(*spec.accuracy) + " (the accuracy mode: each row's step searched for it)";
   if (spec.base.law == ForceLaw::thesis_code) fixed += " (the code's loop: n - 1 steps of exactly h)";
   // The column names come first, the description after them as comments (numpy's
   // genfromtxt(names=True, comments="#") takes the first line for the names; pandas' read_csv(comment="#")
@@ -168,6 +169,7 @@ std::string sweep_key(const SweepSpec& spec) {
   }
   for (const MethodInfo* m : spec.methods) s.append("|").append(m->name);
   if (spec.scattering) s.append("|scattering");
+  if (spec.accuracy) s.append("|accuracy=").append(fmt(*spec.accuracy));
   s.append("|").append(spec.estimate_error ? fmt(spec.max_error) : "no-estimate").append("|").append(fmt(spec.max_energy_error));
   return hex64(fnv1a(s));
 }
@@ -339,6 +341,8 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
        "NAME=log:FROM:TO:POINTS or NAME=a,b,c; repeat for each (every combination is run)")
       ("methods", po::value(&methods_arg)->default_value(methods_arg), "comma-separated names, 'fixed' (every fixed-step method but the Kepler split kep-*) or 'all'")
       ("tol", po::value(&job.spec.tol)->default_value(job.spec.tol), "adaptive methods: error tolerance")
+      ("accuracy", po::value<double>(), "the accuracy mode: every method but the step-size-controlled peers delivers this "
+       "relative error of the final state at --t-end, its step searched per row (columns h_chosen, search_force_evals)")
       ("threads", po::value(&job.threads)->default_value(0), "worker threads (0: all cores)")
       ("out", po::value(&job.out), "CSV file (default: standard output); with --shard, this shard's rows file")
       ("resume", po::bool_switch(&job.resume), "finish an interrupted run of the same sweep and --out from its journal")
@@ -368,6 +372,7 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
   }
   apply_fixed_data(vm, so, job.spec);
   apply_steps(vm, st, job.spec);
+  if (vm.count("accuracy")) job.spec.accuracy = vm["accuracy"].as<double>();
   job.command = science_command(argc, argv);
   job.max_seconds = vm["max-seconds"].as<double>();
   return job;
@@ -445,7 +450,7 @@ FixedSteps mean_row_steps(const SweepSpec& spec) {
 /// Refuses a sweep whose calibrated time (every row of this shard, on its threads) exceeds the budget:
 /// each method's time per step on the first grid point, times the steps of every row.
 void check_sweep_budget(const SweepJob& job) {
-  if (!(job.max_seconds > 0.0)) return;
+  if (!(job.max_seconds > 0.0) || job.spec.accuracy) return;  // a search's cost is not known beforehand
   const std::size_t tasks = task_count(job.spec), methods = job.spec.methods.size();
   FixedSteps steps{};
   Scene scene;

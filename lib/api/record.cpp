@@ -202,6 +202,10 @@ Record sweep_record(const SweepSpec& spec, const SweepRow& r) {
     out.note("asymptotes", r.scattering ? sc.asymptotes : std::string("none: the run did not finish"));
   }
   out.count("steps", r.result.steps).number("t_end", r.result.t_end);
+  if (spec.accuracy) {  // the accuracy mode's choice and cost (the row's own run is its delivered one)
+    out.number("h_chosen", r.accuracy ? r.accuracy->step : nan);
+    out.count("search_force_evals", r.accuracy ? r.accuracy->force_evals : 0);
+  }
   out.number("vx", f.v.x()).number("vy", f.v.y()).number("vz", f.v.z()).number("wx", f.w.x()).number("wy", f.w.y()).number("wz", f.w.z());
   return out;
 }

@@ -1,6 +1,7 @@
 // bodypoint: sweeps and grids (sweep.hpp).
 #include "bodypoint/sweep.hpp"
 
+#include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/batch.hpp"
 #include "bodypoint/threads.hpp"
 #include "bodypoint/io.hpp"
@@ -53,6 +54,7 @@ SweepRow result_row(SweepRow row, BodyResult r) {
   row.reason = std::move(r.reason);
   row.error = std::move(r.error);
   row.warnings = std::move(r.warnings);
+  row.accuracy = r.accuracy;
   return row;
 }
 
@@ -163,6 +165,7 @@ Advance to_common_end(const MethodInfo& method, const FixedSteps& f, double tol)
 }
 
 Advance point_advance(const SweepSpec& spec, const MethodInfo& method, const std::vector<double>& point) {
+  if (spec.accuracy && !is_step_controlled(method)) return Accuracy{*spec.accuracy, spec.t_end};
   return to_common_end(method, sweep_steps(point_h(spec, point), spec.steps, spec.t_end, spec.base.law), spec.tol);
 }
 
@@ -180,6 +183,12 @@ void validate_sweep(const SweepSpec& spec) {
   check_energy_bound(spec.max_energy_error);
   check_error_bound(spec.max_error);
   if (spec.axes.empty()) throw Error("the sweep has no varied parameter");
+  if (spec.accuracy) {
+    adaptive::check_tolerance(*spec.accuracy);
+    if (!(spec.t_end > 0.0)) throw Error("the accuracy mode delivers its tolerance at an end time: give t_end");
+    for (const Axis& a : spec.axes)
+      if (a.param == "h") throw Error("the accuracy mode chooses the step: h cannot be a varied parameter");
+  }
   for (const Axis& a : spec.axes) {
     if (a.values.empty()) throw Error("the sweep has no values of " + a.param);
     // NaN stands for "not given" among the asymptotic data: a NaN value would compute another scene.
@@ -239,7 +248,7 @@ constexpr double kMaxUnpolledBatchSteps = 1e6;
 
 std::vector<std::vector<std::size_t>> plan_units(const SweepSpec& spec, const std::vector<std::size_t>& todo, bool simd) {
   std::vector<std::vector<std::size_t>> units;
-  const std::size_t M = spec.methods.size(), lanes = simd && !spec.scattering ? batch::width() : 1;
+  const std::size_t M = spec.methods.size(), lanes = simd && !spec.scattering && !spec.accuracy ? batch::width() : 1;
   std::map<std::pair<std::size_t, double>, std::vector<std::size_t>> open;  // (method, h) -> a filling batch
   for (std::size_t i : todo) {
     const MethodInfo& method = *spec.methods[i % M];

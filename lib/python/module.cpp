@@ -271,16 +271,63 @@ py::dict integrate_py(const Scene& scene, const std::string& method, std::option
   return d;
 }
 
-/// Each body's state at the given times (increasing, >= 0), by a Stepper landing on every one. With a
-/// tolerance (method auto or any method the accuracy mode takes) the method, its step and its
-/// time-step constant are the accuracy mode's for a run to the last time, whose estimate is reported.
-/// A segment that is not ok ends the body's rows there (NaN after), with its outcome and reason.
-py::list trajectory_py(const Scene& scene, const std::string& method, std::optional<double> step,
-                       const std::vector<double>& times, double omega_c, std::optional<double> tol, double max_seconds) {
+/// One body followed through the given times by a Stepper (invariants tracked: each segment's steps are
+/// judged, a step that turns the spin by more than pi flagged). After a segment that is not ok
+/// ("unresolved" and "inaccurate" keep the state computed) the rows hold NaN.
+struct Followed {
+  std::vector<State> states;
+  std::vector<double> E;
+  Outcome outcome = Outcome::ok;
+  std::string reason;
+  double max_rel_dE = 0.0;
+  long force_evals = 0, steps = 0;
+};
+Followed follow(const Body& body, const std::vector<Centre>& centres, const MethodInfo& m, double h, double c,
+                const std::vector<double>& times, const std::atomic<bool>* cancel) {
+  Options o;
+  o.omega_c = c;
+  o.cancel = cancel;
+  Stepper s(m, body, centres, h, o);
+  const CentreList field{centres};
+  const State none{Vec3::Constant(kNaN), Vec3::Constant(kNaN), Vec3::Constant(kNaN)};
+  Followed f{std::vector<State>(times.size(), none), std::vector<double>(times.size(), kNaN)};
+  const double E0 = energy(body.p, field, body.s0), scale = energy_scale(body.p, field, body.s0);
+  for (std::size_t k = 0; k < times.size(); ++k) {
+    if (f.outcome == Outcome::ok && times[k] > s.time()) f.outcome = s.advance_to(times[k]);
+    if (f.outcome != Outcome::ok && f.outcome != Outcome::unresolved && f.outcome != Outcome::inaccurate) break;
+    f.states[k] = s.state();
+    f.E[k] = energy(body.p, field, s.state());
+    f.max_rel_dE = std::max(f.max_rel_dE, std::abs(f.E[k] - E0) / scale);
+    if (f.outcome != Outcome::ok) break;
+  }
+  if (f.outcome != Outcome::ok) f.reason = s.reason();
+  f.force_evals = s.force_evals();
+  f.steps = s.steps();
+  return f;
+}
+
+/// An (n, 3) array of one vector of each state.
+py::array_t<double> rows_of(const std::vector<State>& states, Vec3 State::*part) {
+  py::array_t<double> a({static_cast<py::ssize_t>(states.size()), py::ssize_t{3}});
+  auto m = a.mutable_unchecked<2>();
+  for (std::size_t k = 0; k < states.size(); ++k)
+    for (py::ssize_t j = 0; j < 3; ++j) m(static_cast<py::ssize_t>(k), j) = (states[k].*part)[static_cast<Eigen::Index>(j)];
+  return a;
+}
+
+void check_times(const std::vector<double>& times) {
   if (times.empty()) throw Error("times is empty");
   for (std::size_t k = 0; k < times.size(); ++k)
     if (!std::isfinite(times[k]) || times[k] < 0.0 || (k > 0 && !(times[k] > times[k - 1])))
       throw Error("times must be finite, >= 0 and increasing");
+}
+
+/// Each body's state at the given times (increasing, >= 0), by a Stepper landing on every one. With a
+/// tolerance (method auto or any method the accuracy mode takes) the method, its step and its
+/// time-step constant are the accuracy mode's for a run to the last time, whose estimate is reported.
+py::list trajectory_py(const Scene& scene, const std::string& method, std::optional<double> step,
+                       const std::vector<double>& times, double omega_c, std::optional<double> tol, double max_seconds) {
+  check_times(times);
   if (tol && step) throw Error("give a step or a tolerance tol, not both (tol chooses the step)");
   if (!tol && !step) throw Error("give a step (h, ds or a peer's tolerance per step) or a tolerance tol");
   const MethodInfo* named = method == "auto" ? nullptr : &method_or_throw(method);
@@ -311,59 +358,23 @@ py::list trajectory_py(const Scene& scene, const std::string& method, std::optio
       d["err_estimate"] = r.accuracy->err_estimate;
       d["search_force_evals"] = r.accuracy->force_evals;
     }
-    const std::size_t n = times.size();
-    py::array_t<double> t(static_cast<py::ssize_t>(n)), E(static_cast<py::ssize_t>(n));
-    py::array_t<double> R({static_cast<py::ssize_t>(n), py::ssize_t{3}}), v({static_cast<py::ssize_t>(n), py::ssize_t{3}}),
-        w({static_cast<py::ssize_t>(n), py::ssize_t{3}});
-    auto tm = t.mutable_unchecked<1>();
-    auto Em = E.mutable_unchecked<1>();
-    auto Rm = R.mutable_unchecked<2>();
-    auto vm = v.mutable_unchecked<2>();
-    auto wm = w.mutable_unchecked<2>();
-    Options o;  // invariants tracked: each segment's steps are judged (a step that turns the spin by > pi)
-    o.omega_c = c;
-    o.cancel = stop.flag();
-    Stepper s(*m, body, scene.centres, h, o);
-    const CentreList field{scene.centres};
-    Outcome outcome = Outcome::ok;
-    double max_rel_dE = 0.0;
-    for (std::size_t k = 0; k < n; ++k) {  // rows after a segment that was not ok keep no state
-      const auto i = static_cast<py::ssize_t>(k);
-      tm(i) = times[k];
-      Em(i) = kNaN;
-      for (py::ssize_t j = 0; j < 3; ++j) Rm(i, j) = vm(i, j) = wm(i, j) = kNaN;
-    }
+    Followed f;
     {
       py::gil_scoped_release free;
-      const double E0 = energy(body.p, field, body.s0), scale = energy_scale(body.p, field, body.s0);
-      for (std::size_t k = 0; k < n; ++k) {
-        if (outcome == Outcome::ok && times[k] > s.time()) outcome = s.advance_to(times[k]);
-        const bool have = outcome == Outcome::ok || outcome == Outcome::unresolved || outcome == Outcome::inaccurate;
-        if (!have) break;
-        const State& x = s.state();
-        const auto i = static_cast<py::ssize_t>(k);
-        Em(i) = energy(body.p, field, x);
-        max_rel_dE = std::max(max_rel_dE, std::abs(Em(i) - E0) / scale);
-        for (py::ssize_t j = 0; j < 3; ++j) {
-          Rm(i, j) = x.R[static_cast<Eigen::Index>(j)];
-          vm(i, j) = x.v[static_cast<Eigen::Index>(j)];
-          wm(i, j) = x.w[static_cast<Eigen::Index>(j)];
-        }
-        if (outcome != Outcome::ok) break;
-      }
+      f = follow(body, scene.centres, *m, h, c, times, stop.flag());
     }
     stop.raise();
     d["method"] = m->name;
-    d["outcome"] = std::string(outcome_name(outcome));
-    d["reason"] = outcome == Outcome::ok ? std::string() : s.reason();
-    d["t"] = t;
-    d["R"] = R;
-    d["v"] = v;
-    d["w"] = w;
-    d["E"] = E;
-    d["max_rel_dE"] = max_rel_dE;
-    d["force_evals"] = s.force_evals();
-    d["steps"] = s.steps();
+    d["outcome"] = std::string(outcome_name(f.outcome));
+    d["reason"] = f.reason;
+    d["t"] = py::array_t<double>(static_cast<py::ssize_t>(times.size()), times.data());
+    d["R"] = rows_of(f.states, &State::R);
+    d["v"] = rows_of(f.states, &State::v);
+    d["w"] = rows_of(f.states, &State::w);
+    d["E"] = py::array_t<double>(static_cast<py::ssize_t>(f.E.size()), f.E.data());
+    d["max_rel_dE"] = f.max_rel_dE;
+    d["force_evals"] = f.force_evals;
+    d["steps"] = f.steps;
     out.append(d);
   }
   return out;
@@ -406,7 +417,7 @@ py::dict sweep_columns(const SweepSpec& spec, const std::vector<SweepRow>& rows)
 py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>& axes,
                   const std::vector<std::string>& methods, const py::dict& base, double h, long steps, double t_end,
                   double tol, unsigned threads, double max_energy_error, bool estimate_error, double max_error,
-                  bool scattering, const std::string& force_law, double max_seconds) {
+                  bool scattering, const std::string& force_law, std::optional<double> accuracy, double max_seconds) {
   SweepSpec s;
   s.max_energy_error = max_energy_error;
   s.estimate_error = estimate_error;
@@ -417,6 +428,7 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
   for (const auto& [k, v] : base) scene_field(s.base, k.cast<std::string>()) = number_of(v, k.cast<std::string>());
   s.base.law = parse_force_law(force_law);
   s.scattering = scattering;
+  s.accuracy = accuracy;
   if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
   s.h = h;
   s.steps = t_end > 0.0 ? 0 : steps;
@@ -497,11 +509,8 @@ struct PyStepper {
   std::vector<Event> labels;
 };
 
-}  // namespace
-
-PYBIND11_MODULE(_bodypoint, mod) {
-  mod.doc() = "bodypoint: integrator of a body-point (translation and rotation) in Coulomb fields";
-  py::register_exception<Error>(mod, "Error", PyExc_ValueError);
+/// The Scene class and the functions that make scenes or list the catalogue.
+void bind_scenes(py::module_& mod) {
   py::class_<Scene>(mod, "Scene", "Fixed Coulomb centres and independent body-points (docs/physics.md).")
       .def(py::init(&scene_from), py::arg("centres"), py::arg("bodies"))
       .def_property_readonly("centres", [](const Scene& s) {
@@ -518,7 +527,6 @@ PYBIND11_MODULE(_bodypoint, mod) {
         return "<bodypoint.Scene: " + std::to_string(s.centres.size()) + " centre(s), " + std::to_string(s.bodies.size()) +
                " body-point(s)>";
       });
-
   mod.def("_thesis_scene", &thesis_from, py::arg("params"));
   mod.def("_read_scene", &read_scene_file, py::arg("path"));
   mod.def("_parse_scene", [](const std::string& text) { return parse_scene(text, "<string>"); }, py::arg("text"));
@@ -546,17 +554,10 @@ PYBIND11_MODULE(_bodypoint, mod) {
     }
     return l;
   });
-  mod.attr("DEFAULT_MAX_ENERGY_ERROR") = kDefaultMaxEnergyError;  // the bounds of a run called ok
-  mod.attr("DEFAULT_MAX_ERROR") = kDefaultMaxError;
-  mod.def("_integrate", &integrate_py, py::arg("scene"), py::arg("method"), py::arg("h"), py::arg("steps"),
-          py::arg("t_end"), py::arg("tol"), py::arg("invariants"), py::arg("omega_c"), py::arg("events"),
-          py::arg("stop_at"), py::arg("max_energy_error"), py::arg("estimate_error"), py::arg("max_error"),
-          py::arg("max_seconds"));
-  mod.def("_trajectory", &trajectory_py, py::arg("scene"), py::arg("method"), py::arg("step"), py::arg("times"),
-          py::arg("omega_c"), py::arg("tol"), py::arg("max_seconds"));
-  mod.def("_sweep", &sweep_py, py::arg("axes"), py::arg("methods"), py::arg("base"), py::arg("h"), py::arg("steps"),
-          py::arg("t_end"), py::arg("tol"), py::arg("threads"), py::arg("max_energy_error"), py::arg("estimate_error"), py::arg("max_error"),
-          py::arg("scattering"), py::arg("force_law"), py::arg("max_seconds"));
+}
+
+/// The Stepper class (bodypoint/__init__.py wraps it).
+void bind_stepper(py::module_& mod) {
   py::class_<PyStepper>(mod, "_Stepper")
       .def(py::init<const Scene&, std::size_t, const std::string&, double, const std::vector<std::string>&,
                     const std::vector<std::string>&, double>(),
@@ -571,8 +572,28 @@ PYBIND11_MODULE(_bodypoint, mod) {
       .def_property_readonly("steps", [](const PyStepper& s) { return s.stepper.steps(); })
       .def_property_readonly("reason", [](const PyStepper& s) { return s.stepper.reason(); })
       .def_property_readonly("method", [](const PyStepper& s) { return s.stepper.method().name; });
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_bodypoint, mod) {
+  mod.doc() = "bodypoint: integrator of a body-point (translation and rotation) in Coulomb fields";
+  py::register_exception<Error>(mod, "Error", PyExc_ValueError);
+  bind_scenes(mod);
+  bind_stepper(mod);
+  mod.attr("DEFAULT_MAX_ENERGY_ERROR") = kDefaultMaxEnergyError;  // the bounds of a run called ok
+  mod.attr("DEFAULT_MAX_ERROR") = kDefaultMaxError;
   mod.attr("__revision__") = git_revision();
   mod.attr("__version__") = version();
+  mod.def("_integrate", &integrate_py, py::arg("scene"), py::arg("method"), py::arg("h"), py::arg("steps"),
+          py::arg("t_end"), py::arg("tol"), py::arg("invariants"), py::arg("omega_c"), py::arg("events"),
+          py::arg("stop_at"), py::arg("max_energy_error"), py::arg("estimate_error"), py::arg("max_error"),
+          py::arg("max_seconds"));
+  mod.def("_trajectory", &trajectory_py, py::arg("scene"), py::arg("method"), py::arg("step"), py::arg("times"),
+          py::arg("omega_c"), py::arg("tol"), py::arg("max_seconds"));
+  mod.def("_sweep", &sweep_py, py::arg("axes"), py::arg("methods"), py::arg("base"), py::arg("h"), py::arg("steps"),
+          py::arg("t_end"), py::arg("tol"), py::arg("threads"), py::arg("max_energy_error"), py::arg("estimate_error"), py::arg("max_error"),
+          py::arg("scattering"), py::arg("force_law"), py::arg("accuracy"), py::arg("max_seconds"));
   mod.def("_encounter", &encounter_py, py::arg("scene"), py::arg("method"), py::arg("tol"), py::arg("t_end"),
           py::arg("max_seconds"));
 }

@@ -88,6 +88,10 @@ TEST(Reliability, EveryIssueExampleEndsWithItsReason) {
       {"timing --values 1e10", "the timing study would take about"},
       {"timing --values 1000 --warmup 9223372036854775807", "the timing study would take about"},
       {"sweep --param d --values 5,6 --methods lp-y4 --steps 10000000000 --max-seconds 10", "the sweep would take about"},
+      // Issue #43: the sweep's accuracy mode needs an end and chooses the step itself.
+      {"sweep --param h --values 0.1 --methods lp-y4 --t-end 5 --accuracy 1e-8", "the accuracy mode chooses the step"},
+      {"sweep --param d --values 5 --methods lp-y4 --steps 10 --accuracy 1e-8", "give t_end"},
+      {"sweep --param d --values 5 --methods lp-y4 --t-end 5 --accuracy 1e-30", "tol"},
       // Issue #39: a swept step is calibrated at its own values, not at the default h (5e10 steps here).
       {"sweep --param h --values 1e-9,1e-3 --methods lp-y4 --t-end 50 --max-seconds 60", "the sweep would take about"},
       // Issue #24: options that were silently ignored.

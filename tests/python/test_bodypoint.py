@@ -8,6 +8,7 @@ import math
 import os
 import signal
 import subprocess
+import sys
 import threading
 import time
 
@@ -371,3 +372,36 @@ def test_every_call_stops_at_ctrl_c(name):
     assert time.monotonic() - t0 < STOP_BOUND_S
     # Python's own handler is back: the next call runs to its end
     assert bp.integrate(bp.thesis_scene(), "lp-y4", h=1e-3, t_end=1)["outcome"] == "ok"
+
+
+def test_installs_into_a_fresh_venv_offline_and_runs_the_guides_examples():
+    """pip install . and cmake --install --prefix into fresh virtual environments in a temporary folder,
+    with no package index, then every Python example of docs/guide.md and README.md from there."""
+    build = os.environ.get("BODYPOINT_BUILD_DIR")
+    if not build:
+        pytest.skip("BODYPOINT_BUILD_DIR (ctest sets it) names the build to install from")
+    try:
+        import ensurepip, pandas, venv  # noqa: F401  (Debian's python3-venv and python3-pandas)
+    except ImportError as missing:
+        pytest.skip(f"{missing.name} is not installed (scripts/setup.sh installs it)")
+    script = os.path.join(SOURCE, "tests", "python", "install_venv.sh")
+    out = subprocess.run(["bash", script, sys.executable, SOURCE, build], capture_output=True, text=True,
+                         stdin=subprocess.DEVNULL)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert "pip: the examples ran with" in out.stdout and "cmake: the examples ran with" in out.stdout
+
+
+def test_sweep_in_the_accuracy_mode_equals_integrate_per_row():
+    tol = 1e-8
+    cols = bp.sweep({"d": [5, 10]}, "lp-y4,logh-y4,gsl-rk8pd", t_end=50, accuracy=tol)
+    assert list(cols["status"]) == ["ok"] * 6
+    for i, (d, method) in enumerate(zip(cols["d"], cols["method"])):
+        peer = method == "gsl-rk8pd"  # the peer keeps the sweep's tolerance per step (tol, 1e-10)
+        one = bp.integrate(bp.thesis_scene(d=d), method, tol=1e-10 if peer else tol, t_end=50)["bodies"][0]
+        assert [cols["Rx"][i], cols["Ry"][i], cols["Rz"][i]] == one["R"].tolist(), method
+        if not peer:
+            assert cols["err_estimate"][i] <= tol and cols["h_chosen"][i] == one["h_chosen"]
+    with pytest.raises(bp.Error, match="the accuracy mode chooses the step"):
+        bp.sweep({"h": [0.1]}, "lp-y4", t_end=50, accuracy=tol)
+    with pytest.raises(bp.Error, match="give t_end"):
+        bp.sweep({"d": [5]}, "lp-y4", steps=100, accuracy=tol)

@@ -58,6 +58,9 @@ struct SweepSpec {
   long steps = 0;           ///< fixed number of steps, or 0 when t_end is fixed
   double t_end = 0;         ///< fixed end time (steps = ceil(t_end/h), h = t_end/steps), or 0
   double tol = kDefaultStepTolerance;  ///< step-size-controlled methods: tolerance per step
+  /// The accuracy mode (Accuracy): every method but the step-size-controlled peers delivers this
+  /// relative error of the final state at t_end (needed), its step searched per row; no vector lanes.
+  std::optional<double> accuracy = std::nullopt;
   /// Also report each run's encounter (SweepRow::scattering): each task then runs alone through
   /// integrate_body (no vector lanes) with the encounter's events; it stops when the body has left
   /// (the departure event) or at the sweep's end, and is incomplete if it had not left by then.
@@ -80,6 +83,8 @@ SceneParams point_params(const SweepSpec& spec, const std::vector<double>& point
 /// on t_end (fixed_steps_to); under ForceLaw::thesis_code the code's count instead (thesis_code_steps:
 /// n - 1 steps of exactly h). Error for an h that is not a finite number > 0 or fewer than one step.
 FixedSteps sweep_steps(double h, long steps, double t_end, ForceLaw law = ForceLaw::coulomb);
+/// A task's way of advancing time: to_common_end of its point's sweep_steps, or with SweepSpec::accuracy
+/// (for every method but the step-size-controlled peers) Accuracy{accuracy, t_end}.
 /// Every method to one end time T = f.h f.steps: fixed-step methods take f, time-transformed ones
 /// fictitious steps ds = f.h to T, step-size-controlled ones run to T from a first trial step f.h at
 /// tolerance tol per step (the rule of sweeps, the timing study and the step benchmarks).
@@ -112,6 +117,7 @@ struct SweepRow {
   /// asymptotes' model error in the deflection (Encounter::asymptote_error).
   std::optional<Scattering> scattering;
   double r_min = Scattering::kNaN, t_min = Scattering::kNaN, asymptote_error = Scattering::kNaN;
+  std::optional<AccuracyReport> accuracy;  ///< with SweepSpec::accuracy: what the search chose and cost
 };
 
 /// The tasks of `todo` in units: batches of up to batch::width() tasks of one method and step whose

@@ -220,7 +220,7 @@ def trajectory(scene, method, step=None, times=(), *, tol=None, omega_c=-1.0, ma
                              _number("tol", tol, optional=True), _number("max_seconds", max_seconds))
 
 
-def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, threads=None, scattering=False,
+def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, accuracy=None, threads=None, scattering=False,
           force_law="coulomb", max_energy_error=_core.DEFAULT_MAX_ENERGY_ERROR, estimate_error=True,
           max_error=_core.DEFAULT_MAX_ERROR, max_seconds=DEFAULT_MAX_SECONDS, **base):
     """Runs the thesis's scene over a grid of parameters and methods; returns columns.
@@ -229,7 +229,10 @@ def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, threads=None,
     fastest); a parameter is h, one of scene_parameters(), b or v_inf. ``methods``: names, a list of
     names separated by commas, "fixed" (every fixed-step method but the Kepler split) or "all", as
     ``bodypoint sweep --methods`` takes them. ``base``: fixed scene parameters; ``force_law`` as
-    thesis_scene()'s. Steps of h: ``steps`` of them, or to ``t_end``. ``threads``: every core unless
+    thesis_scene()'s. Steps of h: ``steps`` of them, or to ``t_end``; ``tol``: the step-size-controlled
+    peers' tolerance per step. ``accuracy``: the accuracy mode, every other method delivering this
+    relative error of the final state at ``t_end`` (its step searched per row: columns h_chosen,
+    search_force_evals). ``threads``: every core unless
     given. The columns are those of ``bodypoint sweep``'s CSV (docs/guide.md): one per axis, method,
     max_rel_dE, max_rel_dK2sq, max_abs_dK2Q, Rx..Rz, force_evals, wall_s, status (an Outcome's name,
     "refused" for a run that did not start or stopped), reason, err_estimate, estimate_force_evals,
@@ -248,7 +251,8 @@ def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, threads=None,
                         _number("t_end", t_end), _number("tol", tol),
                         0 if threads is None else _count("threads", threads), _number("max_energy_error", max_energy_error),
                         bool(estimate_error), _number("max_error", max_error), bool(scattering),
-                        _text("force_law", force_law), _number("max_seconds", max_seconds))
+                        _text("force_law", force_law), _number("accuracy", accuracy, optional=True),
+                        _number("max_seconds", max_seconds))
 
 
 def encounter(scene, *, t_end=None, method="auto", tol=1e-10, max_seconds=DEFAULT_MAX_SECONDS):
