@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# ctest PythonInstallsIntoAVenv: the two ways README gives to install the module, each into a fresh
+# tests/python/test_bodypoint.py (test_installs_into_a_fresh_venv_offline...): the two ways README gives to install the module, each into a fresh
 # virtual environment in a temporary folder, offline, then docs/guide.md's and README's Python examples
 # run by the venv's interpreter from the installed module (not the build tree):
 #   pip install .                                   (lib/python/build_backend.py; BODYPOINT_BUILD_DIR
