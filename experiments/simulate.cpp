@@ -131,14 +131,8 @@ void add_simulate_options(po::options_description& desc, SimulateOptions& o) {
 
 /// The output options, checked against the plan and the scene, set in plan.how and plan.options.
 void apply_output_options(const po::variables_map& vm, const SimulateOptions& o, const Scene& scene, RunPlan& plan) {
-  if (plan.search && vm.count("omega-c")) throw Error("--tol uses the automatic time-step constant: drop --omega-c");
-  if (vm.count("omega-c")) {
-    // Given, it is used: so it must be a constant c >= 0 of a method that takes one.
-    require_non_negative(o.omega_c, "the time-step constant omega_c");
-    if (plan.method && (!is_time_transformed(*plan.method) || plan.method->family == Family::Regularised))
-      throw Error("--omega-c is the time-step constant of the time-transformed methods (logh-*, ttl-*); " +
-                  plan.method->name + " does not take it");
-  }
+  // Given, it is used: so it must be a constant c >= 0 of a method that takes one.
+  if (vm.count("omega-c")) check_time_step_constant(o.omega_c, plan.method, plan.search);
   if (vm.count("dt-out")) {
     require_positive(o.dt_out, "the output interval dt_out");
     if (!vm.count("out")) throw Error("--dt-out needs --out");

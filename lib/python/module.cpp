@@ -238,7 +238,7 @@ std::vector<Event> events_of(const std::vector<std::string>& events, const std::
 
 py::dict integrate_py(const Scene& scene, const std::string& method, std::optional<double> h,
                       std::optional<long> steps, std::optional<double> t_end, std::optional<double> tol,
-                      bool invariants, double omega_c, const std::vector<std::string>& event_names,
+                      bool invariants, std::optional<double> omega_c, const std::vector<std::string>& event_names,
                       const std::vector<std::string>& stop_at, double max_energy_error, bool estimate_error,
                       double max_error, double max_seconds) {
   const MethodInfo* m = method == "auto" ? nullptr : &method_or_throw(method);
@@ -247,7 +247,8 @@ py::dict integrate_py(const Scene& scene, const std::string& method, std::option
   const Advance how = advance_of_keywords(m, h, steps, t_end, tol, code_loop);
   Options o;
   o.track_invariants = invariants;
-  o.omega_c = omega_c;
+  if (omega_c) check_time_step_constant(*omega_c, m, std::holds_alternative<Accuracy>(how));
+  o.omega_c = omega_c.value_or(-1.0);
   o.max_energy_error = max_energy_error;
   o.estimate_error = estimate_error;
   o.max_error = max_error;
@@ -290,7 +291,9 @@ Followed follow(const Body& body, const std::vector<Centre>& centres, const Meth
   Stepper s(m, body, centres, h, o);
   const CentreList field{centres};
   const State none{Vec3::Constant(kNaN), Vec3::Constant(kNaN), Vec3::Constant(kNaN)};
-  Followed f{std::vector<State>(times.size(), none), std::vector<double>(times.size(), kNaN)};
+  Followed f;
+  f.states.assign(times.size(), none);
+  f.E.assign(times.size(), kNaN);
   const double E0 = energy(body.p, field, body.s0), scale = energy_scale(body.p, field, body.s0);
   for (std::size_t k = 0; k < times.size(); ++k) {
     if (f.outcome == Outcome::ok && times[k] > s.time()) f.outcome = s.advance_to(times[k]);
@@ -326,19 +329,21 @@ void check_times(const std::vector<double>& times) {
 /// tolerance (method auto or any method the accuracy mode takes) the method, its step and its
 /// time-step constant are the accuracy mode's for a run to the last time, whose estimate is reported.
 py::list trajectory_py(const Scene& scene, const std::string& method, std::optional<double> step,
-                       const std::vector<double>& times, double omega_c, std::optional<double> tol, double max_seconds) {
+                       const std::vector<double>& times, std::optional<double> omega_c, std::optional<double> tol,
+                       double max_seconds) {
   check_times(times);
   if (tol && step) throw Error("give a step or a tolerance tol, not both (tol chooses the step)");
   if (!tol && !step) throw Error("give a step (h, ds or a peer's tolerance per step) or a tolerance tol");
   const MethodInfo* named = method == "auto" ? nullptr : &method_or_throw(method);
   if (!tol && !named) throw Error("method auto needs a tolerance tol");
+  if (omega_c) check_time_step_constant(*omega_c, named, tol.has_value());
   Interruptible stop(max_seconds);
   py::list out;
   for (const Body& body : scene.bodies) {
     py::dict d;
     d["name"] = body.name;
     const MethodInfo* m = named;
-    double h = step.value_or(0.0), c = omega_c;
+    double h = step.value_or(0.0), c = omega_c.value_or(-1.0);
     if (tol) {
       Options o;
       o.track_invariants = false;
@@ -468,17 +473,19 @@ py::dict encounter_py(const Scene& scene, const std::string& method, double tol,
 /// A Stepper of one body of a scene, with its events' labels kept for the hits' records.
 struct PyStepper {
   PyStepper(const Scene& scene, std::size_t body, const std::string& method, double step, const std::vector<std::string>& events,
-            const std::vector<std::string>& stop_at, double omega_c)
+            const std::vector<std::string>& stop_at, std::optional<double> omega_c)
       : stepper(make(scene, body, method, step, events_of(events, stop_at), omega_c)), labels(events_of(events, stop_at)) {}
   static Stepper make(const Scene& scene, std::size_t body, const std::string& method, double step, std::vector<Event> events,
-                      double omega_c) {
+                      std::optional<double> omega_c) {
     if (body >= scene.bodies.size())
       throw Error("body must be an index 0.." + std::to_string(scene.bodies.size() - 1) + ", got " + std::to_string(body));
     Options o;
     o.track_invariants = false;
-    o.omega_c = omega_c;
+    const MethodInfo& m = method_or_throw(method);
+    if (omega_c) check_time_step_constant(*omega_c, &m, false);
+    o.omega_c = omega_c.value_or(-1.0);
     o.events = std::move(events);
-    return Stepper(method, scene.bodies[body], scene.centres, step, o);
+    return Stepper(m, scene.bodies[body], scene.centres, step, o);
   }
   std::string advance_to(double t, double max_seconds) {
     Interruptible stop(max_seconds);
@@ -560,7 +567,7 @@ void bind_scenes(py::module_& mod) {
 void bind_stepper(py::module_& mod) {
   py::class_<PyStepper>(mod, "_Stepper")
       .def(py::init<const Scene&, std::size_t, const std::string&, double, const std::vector<std::string>&,
-                    const std::vector<std::string>&, double>(),
+                    const std::vector<std::string>&, std::optional<double>>(),
            py::arg("scene"), py::arg("body"), py::arg("method"), py::arg("step"), py::arg("events"), py::arg("stop_at"),
            py::arg("omega_c"))
       .def("advance_to", &PyStepper::advance_to, py::arg("t"), py::arg("max_seconds"))

@@ -98,6 +98,7 @@ TEST(Reliability, EveryIssueExampleEndsWithItsReason) {
       {"simulate --method logh-y4 --h 0.1 --t-end 1 --omega-c -5", "the time-step constant omega_c must be a finite number >= 0"},
       {"simulate --method logh-y4 --h 0.1 --t-end 1 --omega-c nan", "the time-step constant omega_c must be a finite number >= 0"},
       {"simulate --method lp-y4 --steps 10 --omega-c 0.1", "lp-y4 does not take it"},
+      {"simulate --tol 1e-8 --t-end 5 --omega-c 0.1", "the accuracy mode chooses the time-step constant omega_c itself"},
       {"work-precision --tols 1e-4", "--tols is for --by-tol"},
       {"work-precision --scenes ,", "--scenes is empty"},
       // Issue #24: the advice fits the method; limits refused before any work.

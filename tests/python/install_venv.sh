@@ -5,6 +5,8 @@
 #   pip install .                                   (lib/python/build_backend.py; BODYPOINT_BUILD_DIR
 #                                                    reuses this build instead of compiling again)
 #   cmake --install BUILD --component python --prefix VENV
+# and pip into the user site of PYTHON itself (a temporary PYTHONUSERBASE; Debian's pip needs
+# --break-system-packages for it, PEP 668).
 # usage: tests/python/install_venv.sh PYTHON SOURCE BUILD
 set -euo pipefail
 python="$1" source="$2" build="$3"
@@ -20,6 +22,18 @@ for doc in ("docs/guide.md", "README.md"):
         print(block)
 print("import bodypoint, sys; sys.stdout.write(bodypoint.__file__)")
 PY
+user="$tmp/user"
+if "$python" -m pip --version > /dev/null 2>&1; then
+  PYTHONUSERBASE="$user" BODYPOINT_BUILD_DIR="$build" "$python" -m pip install --user --break-system-packages \
+    --no-index --no-cache-dir --quiet "$source"
+  where=$(cd "$source" && PYTHONUSERBASE="$user" env -u PYTHONPATH "$python" "$examples" | tail -n 1)
+  case "$where" in
+    "$user"/*) echo "user: the examples ran with $where" ;;
+    *) echo "user: the examples imported bodypoint from '$where', not from the user site" >&2; exit 1 ;;
+  esac
+else
+  echo "user: skipped, $python has no pip (Debian: python3-pip)"
+fi
 for way in pip cmake; do
   venv="$tmp/$way"
   "$python" -m venv --system-site-packages "$venv"  # numpy from Debian's python3-numpy

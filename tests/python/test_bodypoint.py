@@ -250,6 +250,16 @@ def test_an_encounter_has_the_command_lines_scattering_fields():
     (lambda: bp.integrate(bp.thesis_scene(), "lp-y4", h=0.01, t_end=1, events=["r=5garbage"]), "is not a finite number"),
     (lambda: bp.integrate(bp.thesis_scene(), "lp-y4", h=0.01, t_end=1, events=["closest:99999999999999999999"]),
      "the centre must be an index"),
+    (lambda: bp.integrate(bp.thesis_scene(), "lp-y4", h=0.01, t_end=1, events=["r=1e400"]), "is not a finite number"),
+    (lambda: bp.integrate(bp.thesis_scene(), "logh-y4", h=0.01, t_end=1, omega_c=float("nan")),
+     "the time-step constant omega_c must be a finite number >= 0"),
+    (lambda: bp.integrate(bp.thesis_scene(), "logh-y4", h=0.01, t_end=1, omega_c=-5),
+     "the time-step constant omega_c must be a finite number >= 0"),
+    (lambda: bp.integrate(bp.thesis_scene(), "logh-y4", h=0.01, t_end=1, omega_c=float("inf")),
+     "the time-step constant omega_c must be a finite number >= 0"),
+    (lambda: bp.integrate(bp.thesis_scene(), "lp-y4", h=0.01, t_end=1, omega_c=1.0), "lp-y4 does not take it"),
+    (lambda: bp.integrate(bp.thesis_scene(), tol=1e-8, t_end=1, omega_c=1.0), "the accuracy mode chooses"),
+    (lambda: bp.Stepper(bp.thesis_scene(), "rk4", 0.01, omega_c=1.0), "rk4 does not take it"),
     (lambda: bp.sweep({"d": [5]}, "lp-y4", steps=10, dd=3), "unknown scene parameter 'dd' (did you mean 'd'?)"),
     (lambda: bp.sweep({"d": [5]}, "", steps=10), "the method list is empty"),
     (lambda: bp.Stepper(bp.thesis_scene(), "lp-y4", 0.01, body=3), "body must be an index"),
@@ -376,7 +386,8 @@ def test_every_call_stops_at_ctrl_c(name):
 
 def test_installs_into_a_fresh_venv_offline_and_runs_the_guides_examples():
     """pip install . and cmake --install --prefix into fresh virtual environments in a temporary folder,
-    with no package index, then every Python example of docs/guide.md and README.md from there."""
+    and pip install --user into a temporary user site, with no package index, then every Python example
+    of docs/guide.md and README.md from each."""
     build = os.environ.get("BODYPOINT_BUILD_DIR")
     if not build:
         pytest.skip("BODYPOINT_BUILD_DIR (ctest sets it) names the build to install from")
@@ -389,6 +400,7 @@ def test_installs_into_a_fresh_venv_offline_and_runs_the_guides_examples():
                          stdin=subprocess.DEVNULL)
     assert out.returncode == 0, out.stderr[-2000:]
     assert "pip: the examples ran with" in out.stdout and "cmake: the examples ran with" in out.stdout
+    assert "user: the examples ran with" in out.stdout, out.stdout  # the setup installs python3-pip
 
 
 def test_sweep_in_the_accuracy_mode_equals_integrate_per_row():

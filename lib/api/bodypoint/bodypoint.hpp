@@ -112,6 +112,12 @@ inline constexpr double kDefaultMaxError = 1e-2;
 /// Throws Error unless max_error is a number > 0 (infinity: no bound).
 void check_error_bound(double max_error);
 
+/// A time-step constant c a caller gives (RunOptions::omega_c; not giving one is -1, automatic),
+/// checked for the run it is given to: a finite number >= 0, for a time-transformed method (logh-*,
+/// ttl-*; ks has none) run by its fictitious step, not in the accuracy mode (which chooses c itself).
+/// Error naming the quantity otherwise.
+void check_time_step_constant(double omega_c, const MethodInfo* method, bool accuracy);
+
 /// What a run asks for besides the way of advancing time and what it observes (RunOptions: invariants,
 /// samples, the time-step constant c): events to locate and the bound of the accuracy flag.
 struct Options : RunOptions {

@@ -164,7 +164,7 @@ def parse_scene(text):
 
 
 def integrate(scene, method="auto", *, h=None, steps=None, t_end=None, tol=None, invariants=True,
-              omega_c=-1.0, events=(), stop_at=(), max_energy_error=_core.DEFAULT_MAX_ENERGY_ERROR,
+              omega_c=None, events=(), stop_at=(), max_energy_error=_core.DEFAULT_MAX_ENERGY_ERROR,
               estimate_error=True, max_error=_core.DEFAULT_MAX_ERROR, max_seconds=DEFAULT_MAX_SECONDS):
     """Integrates every body of the scene; returns a dict (outcome, reason, force_evals, wall_s, bodies).
 
@@ -176,6 +176,8 @@ def integrate(scene, method="auto", *, h=None, steps=None, t_end=None, tol=None,
       step-size-controlled peers (odeint-*, gsl-*): ``tol`` per step to t_end, first trial step h;
       ``tol`` with any other method, or method "auto": the accuracy mode, the final state's relative
           error at most tol at t_end (the step, and for "auto" the method, are chosen).
+    ``omega_c``: the time-step constant c of logh-* and ttl-* (physical step <= ds/c; default: from the
+    scene's spin-orbit rate), refused for any other method and in the accuracy mode.
     Each body's dict has its name and the keys of ``bodypoint simulate --json`` (docs/guide.md, "Output
     fields"): method, outcome, reason, h, the final R, v, w (numpy arrays), t_end, steps, the invariants'
     largest deviations (max_rel_dE, max_rel_dK2sq, max_abs_dK2Q), force_evals (the delivered run's),
@@ -197,13 +199,13 @@ def integrate(scene, method="auto", *, h=None, steps=None, t_end=None, tol=None,
     """
     return _core._integrate(_scene(scene), _text("method", method), _number("h", h, optional=True),
                             _count("steps", steps, optional=True), _number("t_end", t_end, optional=True),
-                            _number("tol", tol, optional=True), bool(invariants), _number("omega_c", omega_c),
+                            _number("tol", tol, optional=True), bool(invariants), _number("omega_c", omega_c, optional=True),
                             _texts("events", events), _texts("stop_at", stop_at),
                             _number("max_energy_error", max_energy_error), bool(estimate_error),
                             _number("max_error", max_error), _number("max_seconds", max_seconds))
 
 
-def trajectory(scene, method, step=None, times=(), *, tol=None, omega_c=-1.0, max_seconds=DEFAULT_MAX_SECONDS):
+def trajectory(scene, method, step=None, times=(), *, tol=None, omega_c=None, max_seconds=DEFAULT_MAX_SECONDS):
     """Each body's state at the given times (increasing, >= 0), by a Stepper landing on every one.
 
     ``step``: the step h of a fixed-step method (the largest step <= h that lands on every requested
@@ -216,7 +218,7 @@ def trajectory(scene, method, step=None, times=(), *, tol=None, omega_c=-1.0, ma
     w (n, 3), E (n,) the energy at each time, max_rel_dE its largest deviation from the start's,
     force_evals, steps."""
     return _core._trajectory(_scene(scene), _text("method", method), _number("step", step, optional=True),
-                             [_number("a time", t) for t in times], _number("omega_c", omega_c),
+                             [_number("a time", t) for t in times], _number("omega_c", omega_c, optional=True),
                              _number("tol", tol, optional=True), _number("max_seconds", max_seconds))
 
 
@@ -287,9 +289,10 @@ class Stepper:
     ``events`` / ``stop_at``: as integrate()'s. A segment has no error estimate.
     """
 
-    def __init__(self, scene, method, step, *, body=0, events=(), stop_at=(), omega_c=-1.0):
+    def __init__(self, scene, method, step, *, body=0, events=(), stop_at=(), omega_c=None):
         self._s = _core._Stepper(_scene(scene), _count("body", body), _text("method", method), _number("step", step),
-                                 _texts("events", events), _texts("stop_at", stop_at), _number("omega_c", omega_c))
+                                 _texts("events", events), _texts("stop_at", stop_at),
+                                 _number("omega_c", omega_c, optional=True))
 
     def advance_to(self, t, *, max_seconds=DEFAULT_MAX_SECONDS):
         """Integrates from time to t (> time); returns the segment's Outcome (refused or failed leave
