@@ -44,7 +44,11 @@ py::array_t<double> vec(const Vec3& x) {
 double number_of(const py::handle& v, const std::string& name) {
   if (PyBool_Check(v.ptr()) || !PyNumber_Check(v.ptr()) || PyUnicode_Check(v.ptr()) || PyBytes_Check(v.ptr()))
     throw Error(name + " must be a number, got " + std::string(py::str(py::type::of(v).attr("__name__"))));
-  return py::float_(py::reinterpret_borrow<py::object>(v)).cast<double>();
+  try {
+    return py::float_(py::reinterpret_borrow<py::object>(v)).cast<double>();
+  } catch (const py::error_already_set&) {  // an int beyond a double's range
+    throw Error(name + " must be a finite number, got " + std::string(py::str(v)).substr(0, 40));
+  }
 }
 
 /// A keyword's text (Error naming it otherwise).

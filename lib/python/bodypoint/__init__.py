@@ -50,7 +50,10 @@ def _number(name, value, *, optional=False):
         return None
     if isinstance(value, bool) or not isinstance(value, _numbers.Real):
         raise Error(f"{name} must be a number, got {type(value).__name__}")
-    return float(value)
+    try:
+        return float(value)
+    except OverflowError:
+        raise Error(f"{name} must be a finite number, got {value!r:.40}") from None
 
 
 def _count(name, value, *, optional=False):
@@ -59,10 +62,10 @@ def _count(name, value, *, optional=False):
         return None
     if isinstance(value, bool) or not isinstance(value, _numbers.Real):
         raise Error(f"{name} must be a whole number, got {type(value).__name__}")
-    if isinstance(value, _numbers.Integral):
-        return int(value)
-    if not float(value).is_integer():
+    if not isinstance(value, _numbers.Integral) and not _number(name, value).is_integer():
         raise Error(f"{name} must be a whole number, got {value!r}")
+    if abs(int(value)) >= 2**63:  # a C++ long
+        raise Error(f"{name} must be below 2^63, got {value!r:.40}")
     return int(value)
 
 
@@ -100,7 +103,7 @@ def _toml_value(where, key, value):
     if isinstance(value, (bool, bytes)) or value is None:
         raise Error(f"bodypoint.Scene: {where}: '{key}' must be a number or a sequence of 3 numbers, got {value!r}")
     if isinstance(value, _numbers.Real):
-        x = float(value)
+        x = _number(f"bodypoint.Scene: {where}: '{key}'", value)
         return "nan" if x != x else ("inf" if x == float("inf") else ("-inf" if x == -float("inf") else repr(x)))
     try:
         items = list(value)
