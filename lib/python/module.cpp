@@ -435,6 +435,11 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
   for (const std::string& list : methods)
     for (const MethodInfo* m : methods_named(list)) s.methods.push_back(m);
   for (const auto& [k, v] : base) scene_field(s.base, k.cast<std::string>()) = number_of(v, k.cast<std::string>());
+  // A datum swept beside the parameter it solves would silently replace it (the command line's rule).
+  for (const auto& [datum, solved] : {std::pair{"b", "d"}, {"v_inf", "K1"}, {"arrival_phase", "phase"}})
+    for (const Axis& a : s.axes)
+      if (a.param == datum && base.contains(solved))
+        throw Error(std::string("give ") + datum + " or " + solved + ", not both (" + datum + " solves " + solved + ")");
   s.base.law = parse_force_law(force_law);
   s.scattering = scattering;
   s.accuracy = accuracy;

@@ -17,6 +17,8 @@ import enum as _enum
 import json as _json
 import numbers as _numbers
 
+from numpy import bool_ as _np_bool
+
 from ._bodypoint import Error, Scene
 from . import _bodypoint as _core
 
@@ -69,6 +71,21 @@ def _count(name, value, *, optional=False):
     return int(value)
 
 
+def _flag(name, value):
+    """A yes/no keyword: True or False (a text such as "no" would read as True)."""
+    if not isinstance(value, (bool, _np_bool)):
+        raise Error(f"{name} must be True or False, got {value!r:.40}")
+    return bool(value)
+
+
+def _threads(value):
+    """A thread count: 1 to 1024 (None: every core), the command line's range."""
+    n = _count("threads", value)
+    if not 1 <= n <= 1024:
+        raise Error(f"threads must be 1 to 1024 (None: every core), got {n}")
+    return n
+
+
 def _text(name, value):
     if not isinstance(value, str):
         raise Error(f"{name} must be a text, got {type(value).__name__}")
@@ -117,6 +134,8 @@ def _scene_toml(centres, bodies):
     """The scene-file text of a Scene's dicts (the library reads it: the scene files' keys and checks)."""
     lines = []
     for kind, entries in (("centre", centres), ("body", bodies)):
+        if isinstance(entries, (str, bytes, dict)) or not hasattr(entries, "__iter__"):
+            raise Error(f"bodypoint.Scene: the {kind} entries must be a list of dicts, got {type(entries).__name__}")
         for i, entry in enumerate(entries):
             where = f"{kind} {i + 1}"
             if not isinstance(entry, dict):
@@ -202,9 +221,9 @@ def integrate(scene, method="auto", *, h=None, steps=None, t_end=None, tol=None,
     """
     return _core._integrate(_scene(scene), _text("method", method), _number("h", h, optional=True),
                             _count("steps", steps, optional=True), _number("t_end", t_end, optional=True),
-                            _number("tol", tol, optional=True), bool(invariants), _number("omega_c", omega_c, optional=True),
+                            _number("tol", tol, optional=True), _flag("invariants", invariants), _number("omega_c", omega_c, optional=True),
                             _texts("events", events), _texts("stop_at", stop_at),
-                            _number("max_energy_error", max_energy_error), bool(estimate_error),
+                            _number("max_energy_error", max_energy_error), _flag("estimate_error", estimate_error),
                             _number("max_error", max_error), _number("max_seconds", max_seconds))
 
 
@@ -254,8 +273,9 @@ def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, accuracy=None
     columns = [(_text("an axis' parameter", k), [_number(f"a value of {k}", v) for v in vals]) for k, vals in axes]
     return _core._sweep(columns, _texts("methods", methods), base, _number("h", h), _count("steps", steps),
                         _number("t_end", t_end), _number("tol", tol),
-                        0 if threads is None else _count("threads", threads), _number("max_energy_error", max_energy_error),
-                        bool(estimate_error), _number("max_error", max_error), bool(scattering),
+                        0 if threads is None else _threads(threads), _number("max_energy_error", max_energy_error),
+                        _flag("estimate_error", estimate_error), _number("max_error", max_error),
+                        _flag("scattering", scattering),
                         _text("force_law", force_law), _number("accuracy", accuracy, optional=True),
                         _number("max_seconds", max_seconds))
 
