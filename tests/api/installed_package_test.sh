@@ -69,6 +69,10 @@ ex, cli = lines("final_state"), json.load(open(f"{work}/final_state.json"))
 for v in "Rvw":
     check([float(x) for x in ex[v][0]] == cli[v], f"final_state {v} equals simulate's bit for bit")
 check(float(ex["max_rel_dE"][0][0]) < kEnergyBound, f"final_state energy error below {kEnergyBound}")
+# The installed record.hpp writes what simulate --json prints: every field, timings aside.
+record = json.loads(next(line for line in open(f"{work}/final_state.txt") if line.startswith("json "))[5:])
+check(all(record[k] == v for k, v in cli.items() if not k.endswith("wall_s")) and record.keys() == cli.keys(),
+      "final_state's record equals simulate --json field by field")
 
 # 2. close_encounter: the accuracy mode through the API is simulate --tol's run.
 ex, cli = lines("close_encounter"), json.load(open(f"{work}/close_encounter.json"))

@@ -26,6 +26,8 @@
 //     method's own steps; scattering.hpp turns a run into an encounter's observables (deflection,
 //     asymptotes, impact parameter, spin turn).
 //   - Stepper: one body advanced segment by segment (advance_to), queried and continued.
+//   - <bodypoint/record.hpp>: a run's results as named fields (JSON, CSV rows), as the command line
+//     and the Python module write them; RunOptions::cancel stops a run from another thread.
 //
 // Invalid input (a scene that breaks a rule of validate(), a step that is not a finite number > 0, an
 // unknown method name) throws bodypoint::Error with a one-line reason naming the quantity; anything
