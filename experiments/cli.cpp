@@ -121,12 +121,6 @@ std::string describe(const SceneParams& p) {
   return os.str();
 }
 
-std::string join(const std::vector<std::string>& items, const std::string& sep) {
-  std::string out;
-  for (const std::string& item : items) out += (out.empty() ? "" : sep) + item;
-  return out;
-}
-
 std::vector<std::string> split_list(const std::string& s) {
   std::vector<std::string> out;
   std::stringstream ss(s);
@@ -199,7 +193,5 @@ bool parse(int argc, char** argv, const po::options_description& desc, po::varia
   set_deadline(budget, "stopped after --max-seconds " + fmt(budget) + " s of wall-clock time (the run's budget); no output written");
   return true;
 }
-
-std::vector<const MethodInfo*> parse_methods(const std::string& list) { return methods_named(list); }
 
 }  // namespace bodypoint::cli

@@ -103,9 +103,6 @@ int cmd_timing(int argc, char** argv);
 int cmd_study(int argc, char** argv);
 int cmd_view(int argc, char** argv);
 
-/// "A=.. m=.. B=.. J=.. K1=.. Kx=.. Kz=.. d=.. L=..": the thesis's parameters, for output headers.
-/// items joined by sep.
-std::string join(const std::vector<std::string>& items, const std::string& sep);
 std::string describe(const SceneParams& p);
 
 /// The non-empty items of a comma-separated list.
@@ -119,7 +116,5 @@ std::vector<double> parse_numbers(const std::string& list, const std::string& op
 /// "bodypoint <argv...>", for output headers.
 std::string command_line(int argc, char** argv);
 
-/// Method list from 'all', 'fixed' (every fixed-step method but the Kepler split) or comma-separated names.
-std::vector<const MethodInfo*> parse_methods(const std::string& list);
 
 }  // namespace bodypoint::cli

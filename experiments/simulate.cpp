@@ -226,6 +226,9 @@ class TrajectoryFile {
 struct SimulatedBody {
   BodyResult run;
   std::optional<State> reference;
+  /// With the reference: |R - R_ref| and the relative error as --tol measures it, max(|dR|/|R_ref|, |dv|/|v_ref|).
+  [[nodiscard]] double err_R() const { return (run.run.final.R - reference->R).norm(); }
+  [[nodiscard]] double err_rel() const { return adaptive::state_distance(run.run.final, *reference); }
 };
 
 /// One body: budget, run (with the progress bar), health, and the reference state when asked for.
@@ -265,9 +268,8 @@ Record simulated_record(const SimulatedBody& b, const Advance& how, const std::v
                         const std::optional<Encounter>& e) {
   Record r = body_record(b.run, how, events);
   if (b.reference) {
-    const State& final = b.run.run.final;
     Record ref;
-    ref.number("err_R", (final.R - b.reference->R).norm()).number("err_rel", adaptive::state_distance(final, *b.reference));
+    ref.number("err_R", b.err_R()).number("err_rel", b.err_rel());
     ref.vector("R_ref", b.reference->R).vector("v_ref", b.reference->v);
     r.insert_before(r.find("accepted_steps") ? "accepted_steps" : "force_evals", ref);
   }
@@ -317,8 +319,7 @@ void report_body(const SimulatedBody& body, const std::string& name) {
   std::cout << "  " << error_line(run.error) << "\n";
   if (body.reference)
     std::cout << std::setprecision(3) << std::scientific << "  |R - R_ref| (odeint rkf78, long double) = "
-              << (r.final.R - body.reference->R).norm() << ", relative error (as estimated) = "
-              << adaptive::state_distance(r.final, *body.reference) << "\n" << std::defaultfloat;
+              << body.err_R() << ", relative error (as estimated) = " << body.err_rel() << "\n" << std::defaultfloat;
   std::cout << "  force evaluations = " << r.force_evals << ", wall time = " << std::setprecision(3) << r.wall_s
             << " s\n";
 }

@@ -16,6 +16,7 @@
 #include "process.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
+#include "bodypoint/threads.hpp"
 #include "bodypoint/observables.hpp"
 #include "cli.hpp"
 #include "errata.hpp"
@@ -56,7 +57,7 @@ void write_sweep(const StudyContext& c, const std::string& name, SweepSpec spec,
   std::string file = name;
   if (c.published) {
     spec.base.law = ForceLaw::thesis_code;
-    spec.methods = parse_methods("thesis-euler,thesis-verlet,thesis-ruth3,thesis-fr4,thesis-y6,rk4,ab4");
+    spec.methods = methods_named("thesis-euler,thesis-verlet,thesis-ruth3,thesis-fr4,thesis-y6,rk4,ab4");
     file = "published_" + name;
     note += "; as published: A = -0.5, the thesis code's force law F = -A R/|R|^1.5, third-kick slip and loop (n - 1 "
             "steps of n)";
@@ -75,7 +76,7 @@ void write_sweep(const StudyContext& c, const std::string& name, SweepSpec spec,
 SweepSpec thesis_sweep(const std::string& param) {
   SweepSpec s;
   s.axes = {{param, {}}};
-  s.methods = parse_methods("fixed");
+  s.methods = methods_named("fixed");
   s.h = 1e-4;
   s.steps = 250000;
   // Chapter 4 measures the invariants' errors, as the thesis did: no companion run (it would triple the
@@ -125,7 +126,7 @@ void study_dL_map(const StudyContext& c) {
 
 void study_timing(const StudyContext& c) {
   TimingSpec t;
-  t.methods = parse_methods("fixed");
+  t.methods = methods_named("fixed");
   t.h = 1e-4;
   t.repeats = c.quick ? 1 : 3;
   t.warmup = c.quick ? 0 : 1;

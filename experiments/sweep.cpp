@@ -4,6 +4,7 @@
 
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
+#include "bodypoint/threads.hpp"
 #include "bodypoint/record.hpp"
 #include "budget.hpp"
 #include "cli.hpp"
@@ -60,15 +61,6 @@ std::vector<double> log_range(double from, double to, long points) {
   return v;
 }
 
-unsigned thread_count(long requested) {
-  if (requested < 0) throw Error("--threads must be >= 0");
-  // More threads than this are not a machine, and each costs a stack: refused before any is made.
-  constexpr long kMaxThreads = 1024;
-  if (requested > kMaxThreads) throw Error("--threads must be at most " + std::to_string(kMaxThreads));
-  if (requested > 0) return static_cast<unsigned>(requested);
-  return std::max(1u, std::thread::hardware_concurrency());
-}
-
 std::string format_row(const SweepSpec& spec, const SweepRow& r) { return csv_row(sweep_record(spec, r)); }
 
 std::vector<std::string> run_sweep_unit(const SweepSpec& spec, const std::vector<std::size_t>& unit) {
@@ -123,9 +115,7 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
   // The column names come first, the description after them as comments (numpy's
   // genfromtxt(names=True, comments="#") takes the first line for the names; pandas' read_csv(comment="#")
   // the first line that is not a comment).
-  SweepRow probe;  // the columns are the record's keys (record.hpp), whatever the row holds
-  probe.point.resize(spec.axes.size());
-  std::string columns = csv_header(sweep_record(spec, probe));
+  std::string columns = csv_header(sweep_record(spec));  // the record's keys (record.hpp)
   return {std::move(columns),
           "# bodypoint sweep, revision " + std::string(git_revision()),
           "# command: " + command,
@@ -361,15 +351,16 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
   if (vm.count("shard")) parse_shard(shard, job);
   if (job.resume && job.out.empty()) throw Error("--resume needs --out (the journal is <out>.journal)");
   if (job.sharded && job.out.empty()) throw Error("--shard needs --out (the shard's rows file)");
-  job.spec.methods = parse_methods(methods_arg);
+  job.spec.methods = methods_named(methods_arg);
   job.spec.base = so.params;
   // A value given is used, or refused: the tolerance per step whatever the methods, d or K1 beside
   // the asymptotic data solved for them.
   if (!vm["tol"].defaulted()) require_positive(job.spec.tol, "the tolerance per step tol");
-  for (const Axis& a : job.spec.axes) {
-    if (a.param == "b" && vm.count("d") && !vm["d"].defaulted()) throw Error("give --b or --d, not both (b solves d)");
-    if (a.param == "v_inf" && vm.count("K1") && !vm["K1"].defaulted()) throw Error("give --v-inf or --K1, not both (v_inf solves K1)");
-  }
+  std::vector<std::string> swept, given;
+  for (const Axis& a : job.spec.axes) swept.push_back(a.param);
+  for (const SceneParameter& q : scene_parameters())
+    if (vm.count(std::string(q.name)) && !vm[std::string(q.name)].defaulted()) given.emplace_back(q.name);
+  check_data_beside_solved(swept, given);
   apply_fixed_data(vm, so, job.spec);
   apply_steps(vm, st, job.spec);
   if (vm.count("accuracy")) job.spec.accuracy = vm["accuracy"].as<double>();

@@ -59,7 +59,5 @@ std::string sweep_key(const SweepSpec& spec);
 void write_sweep_csv(std::ostream& os, const SweepSpec& spec, const std::vector<std::string>& rows,
                      const std::string& command);
 
-/// Number of worker threads: --threads, or the hardware concurrency.
-unsigned thread_count(long requested);
 
 }  // namespace bodypoint::cli

@@ -110,7 +110,7 @@ int cmd_timing(int argc, char** argv) {
     return 0;
   if (vm.count("scene")) throw Error("timing uses the thesis's scene parameters; --scene is not supported");
   spec.base = so.params;
-  spec.methods = parse_methods(methods_arg);
+  spec.methods = methods_named(methods_arg);
   std::vector<double> ns;
   if (vm.count("values")) {
     ns = parse_numbers(values, "--values");

@@ -274,14 +274,6 @@ void settle(Outcome& outcome, std::string& reason, std::vector<std::string>& war
 
 namespace bodypoint {
 
-void check_time_step_constant(double omega_c, const MethodInfo* method, bool accuracy) {
-  require_non_negative(omega_c, "the time-step constant omega_c");
-  if (accuracy) throw Error("the accuracy mode chooses the time-step constant omega_c itself: do not give it");
-  if (method && (!is_time_transformed(*method) || method->family == Family::Regularised))
-    throw Error("the time-step constant omega_c is for the time-transformed methods (logh-*, ttl-*); " + method->name +
-                " does not take it");
-}
-
 void check_error_bound(double max_error) {
   if (!(max_error > 0.0))
     throw Error("the bound on the estimated error max_error must be a number > 0 (infinity: no bound), got " +

@@ -338,6 +338,14 @@ BodyResult integrate_estimated(const Body& body, const std::vector<Centre>& cent
 
 }  // namespace
 
+void check_time_step_constant(double omega_c, const MethodInfo* method, bool accuracy) {
+  require_non_negative(omega_c, "the time-step constant omega_c");
+  if (accuracy) throw Error("the accuracy mode chooses the time-step constant omega_c itself: do not give it");
+  if (method && (!is_time_transformed(*method) || method->family == Family::Regularised))
+    throw Error("the time-step constant omega_c is for the time-transformed methods (logh-*, ttl-*); " + method->name +
+                " does not take it");
+}
+
 BodyResult integrate_body(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
                           const Advance& how, const Options& options) {
   check_request(Scene{centres, {body}}, method, how, options);

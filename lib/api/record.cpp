@@ -189,9 +189,7 @@ Record sweep_record(const SweepSpec& spec, const SweepRow& r) {
   const std::string_view status = r.outcome == Outcome::failed ? "refused" : outcome_name(r.outcome);
   out.count("force_evals", r.result.force_evals).number("wall_s", r.result.wall_s).text("status", std::string(status));
   out.note("reason", r.reason).number("err_estimate", r.error.value).count("estimate_force_evals", r.error.force_evals);
-  std::string warnings;
-  for (const std::string& w : r.warnings) warnings += (warnings.empty() ? "" : "; ") + w;
-  out.note("err_basis", r.error.basis).note("warning", warnings);
+  out.note("err_basis", r.error.basis).note("warning", join(r.warnings, "; "));
   if (spec.scattering) {  // NaN where there is no value (no minimum, no asymptotes, a run that did not finish)
     const Scattering sc = r.scattering ? *r.scattering : Scattering{};
     out.number("r_min", r.r_min).number("t_min", r.t_min).number("deflection", sc.deflection);
@@ -209,6 +207,8 @@ Record sweep_record(const SweepSpec& spec, const SweepRow& r) {
   out.number("vx", f.v.x()).number("vy", f.v.y()).number("vz", f.v.z()).number("wx", f.w.x()).number("wy", f.w.y()).number("wz", f.w.z());
   return out;
 }
+
+Record sweep_record(const SweepSpec& spec) { return sweep_record(spec, SweepRow{}); }
 
 std::string csv_header(const Record& r) {
   CsvLine line;

@@ -63,14 +63,18 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
 }
 }  // namespace
 
+std::string join(const std::vector<std::string>& items, std::string_view sep) {
+  std::string out;
+  for (const std::string& item : items) out.append(out.empty() ? "" : sep).append(item);
+  return out;
+}
+
 std::string unknown_name(std::string_view what, std::string_view word, const std::vector<std::string>& valid) {
   constexpr std::size_t kSuggestEdits = 2;  // a typo: a letter missing, extra, wrong or two of them
   const std::string near = closest_word(word, valid, kSuggestEdits);
   std::string out = "unknown " + std::string(what) + " '" + std::string(word) + "'";
   if (!near.empty()) out += " (did you mean '" + near + "'?)";
-  out += "; valid: ";
-  for (std::size_t i = 0; i < valid.size(); ++i) out += (i ? ", " : "") + valid[i];
-  return out;
+  return out + "; valid: " + join(valid, ", ");
 }
 
 std::string closest_word(std::string_view word, const std::vector<std::string>& candidates, std::size_t max_edits) {

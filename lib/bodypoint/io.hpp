@@ -51,6 +51,9 @@ std::string json_string(std::string_view s, bool html_safe = false);
 /// you mean" in messages.
 std::string closest_word(std::string_view word, const std::vector<std::string>& candidates, std::size_t max_edits);
 
+/// The items with `sep` between them.
+std::string join(const std::vector<std::string>& items, std::string_view sep);
+
 /// "unknown <what> 'word' (did you mean 'x'?); valid: a, b, c": the one wording of an unknown name.
 std::string unknown_name(std::string_view what, std::string_view word, const std::vector<std::string>& valid);
 

@@ -7,7 +7,6 @@
 #include "bodypoint/invariants.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -330,14 +329,22 @@ SceneParams with_asymptotic_data(SceneParams params, double b, double v_inf) {
   return params;
 }
 
+void check_data_beside_solved(const std::vector<std::string>& data, const std::vector<std::string>& given) {
+  const auto has = [](const std::vector<std::string>& names, std::string_view name) {
+    return std::find(names.begin(), names.end(), name) != names.end();
+  };
+  for (const auto& [datum, solved] : {std::pair{"b", "d"}, {"v_inf", "K1"}, {"arrival_phase", "phase"}})
+    if (has(data, datum) && has(given, solved))
+      throw Error(std::string("give ") + datum + " or " + solved + ", not both (" + datum + " solves " + solved + ")");
+}
+
 SceneParams with_asymptotic_data(const SceneParams& params, const AsymptoticData& data,
                                  const std::vector<std::string>& given) {
-  const auto is_given = [&given](std::string_view name) { return std::find(given.begin(), given.end(), name) != given.end(); };
-  const std::pair<const std::optional<double>*, std::array<const char*, 2>> pairs[] = {
-      {&data.b, {"b", "d"}}, {&data.v_inf, {"v_inf", "K1"}}, {&data.arrival_phase, {"arrival_phase", "phase"}}};
-  for (const auto& [datum, names] : pairs)
-    if (*datum && is_given(names[1]))
-      throw Error(std::string("give ") + names[0] + " or " + names[1] + ", not both (" + names[0] + " solves " + names[1] + ")");
+  std::vector<std::string> named;
+  if (data.b) named.emplace_back("b");
+  if (data.v_inf) named.emplace_back("v_inf");
+  if (data.arrival_phase) named.emplace_back("arrival_phase");
+  check_data_beside_solved(named, given);
   if (data.b) require_positive(*data.b, "the impact parameter b");
   if (data.v_inf) require_positive(*data.v_inf, "the speed at infinity v_inf");
   if (data.arrival_phase && !std::isfinite(*data.arrival_phase)) throw Error("the arrival phase arrival_phase must be a finite number");

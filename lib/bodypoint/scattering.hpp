@@ -128,6 +128,10 @@ SceneParams with_asymptotic_data(SceneParams params, double b, double v_inf, dou
 struct AsymptoticData {
   std::optional<double> b, v_inf, arrival_phase;
 };
+/// Refuses an asymptotic datum (b, v_inf, arrival_phase) in `data` (given or swept) beside the
+/// parameter it solves (d, K1, phase) in `given` (set explicitly): "give b or d, not both".
+void check_data_beside_solved(const std::vector<std::string>& data, const std::vector<std::string>& given);
+
 /// The thesis scene's parameters with `data` solved in: each datum checked (b and v_inf finite
 /// numbers > 0, the phase finite), refused beside the parameter it solves when that one is in
 /// `given` (the names of the parameters set explicitly), the scene itself validated first. Throws

@@ -3,11 +3,25 @@
 // start instead of ending the process in std::terminate with its temporaries and locks in place.
 #pragma once
 
+#include "bodypoint/model.hpp"
+
+#include <algorithm>
+#include <string>
 #include <system_error>
 #include <thread>
 #include <vector>
 
 namespace bodypoint {
+
+/// The worker threads asked for (the command line's --threads, the Python module's threads): 0 is
+/// every core; more than 1024 are not a machine, and each costs a stack: refused before any is made.
+inline unsigned thread_count(long requested) {
+  constexpr long kMaxThreads = 1024;
+  if (requested < 0) throw Error("threads must be >= 0 (0: every core), got " + std::to_string(requested));
+  if (requested > kMaxThreads) throw Error("threads must be at most " + std::to_string(kMaxThreads));
+  if (requested > 0) return static_cast<unsigned>(requested);
+  return std::max(1u, std::thread::hardware_concurrency());
+}
 
 class WorkerThreads {
  public:

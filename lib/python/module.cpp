@@ -8,6 +8,7 @@
 #include "bodypoint/io.hpp"
 #include "bodypoint/record.hpp"
 #include "bodypoint/sweep.hpp"
+#include "bodypoint/threads.hpp"
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -392,9 +393,7 @@ py::list trajectory_py(const Scene& scene, const std::string& method, std::optio
 /// The rows' records (record.hpp: the columns of `bodypoint sweep`'s CSV) as columns: numbers as float
 /// arrays (NaN where there is none), counts as int arrays, texts as lists.
 py::dict sweep_columns(const SweepSpec& spec, const std::vector<SweepRow>& rows) {
-  SweepRow probe;
-  probe.point.resize(spec.axes.size());
-  const Record keys = sweep_record(spec, probe);
+  const Record keys = sweep_record(spec);
   const auto n = static_cast<py::ssize_t>(rows.size());
   std::vector<py::array_t<double>> numbers(keys.fields.size());
   std::vector<py::array_t<long>> counts(keys.fields.size());
@@ -425,7 +424,7 @@ py::dict sweep_columns(const SweepSpec& spec, const std::vector<SweepRow>& rows)
 /// A sweep or grid of the thesis's scene as columns (sweep.hpp).
 py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>& axes,
                   const std::vector<std::string>& methods, const py::dict& base, double h, long steps, double t_end,
-                  double tol, unsigned threads, double max_energy_error, bool estimate_error, double max_error,
+                  double tol, long threads, double max_energy_error, bool estimate_error, double max_error,
                   bool scattering, const std::string& force_law, std::optional<double> accuracy, double max_seconds) {
   SweepSpec s;
   s.max_energy_error = max_energy_error;
@@ -436,24 +435,24 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
     for (const MethodInfo* m : methods_named(list)) s.methods.push_back(m);
   for (const auto& [k, v] : base) scene_field(s.base, k.cast<std::string>()) = number_of(v, k.cast<std::string>());
   // A datum swept beside the parameter it solves would silently replace it (the command line's rule).
-  for (const auto& [datum, solved] : {std::pair{"b", "d"}, {"v_inf", "K1"}, {"arrival_phase", "phase"}})
-    for (const Axis& a : s.axes)
-      if (a.param == datum && base.contains(solved))
-        throw Error(std::string("give ") + datum + " or " + solved + ", not both (" + datum + " solves " + solved + ")");
+  std::vector<std::string> swept, given;
+  for (const Axis& a : s.axes) swept.push_back(a.param);
+  for (const auto& [k, v] : base) given.push_back(k.cast<std::string>());
+  check_data_beside_solved(swept, given);
   s.base.law = parse_force_law(force_law);
   s.scattering = scattering;
   s.accuracy = accuracy;
-  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
   s.h = h;
   s.steps = t_end > 0.0 ? 0 : steps;
   s.t_end = t_end;
   s.tol = tol;
+  const unsigned workers = thread_count(threads);
   Interruptible stop(max_seconds);
   s.cancel = stop.flag();
   std::vector<SweepRow> rows;
   try {
     py::gil_scoped_release free;
-    rows = run_sweep_rows(s, threads);
+    rows = run_sweep_rows(s, workers);
   } catch (const Error&) {
     stop.raise();  // stopped: KeyboardInterrupt or the budget's error
     throw;
@@ -483,7 +482,7 @@ py::dict encounter_py(const Scene& scene, const std::string& method, double tol,
 struct PyStepper {
   PyStepper(const Scene& scene, std::size_t body, const std::string& method, double step, const std::vector<std::string>& events,
             const std::vector<std::string>& stop_at, std::optional<double> omega_c)
-      : stepper(make(scene, body, method, step, events_of(events, stop_at), omega_c)), labels(events_of(events, stop_at)) {}
+      : labels(events_of(events, stop_at)), stepper(make(scene, body, method, step, labels, omega_c)) {}
   static Stepper make(const Scene& scene, std::size_t body, const std::string& method, double step, std::vector<Event> events,
                       std::optional<double> omega_c) {
     if (body >= scene.bodies.size())
@@ -521,8 +520,8 @@ struct PyStepper {
     for (const EventHit& h : stepper.events()) l.append(to_py(event_record(h, labels)));
     return l;
   }
+  std::vector<Event> labels;  // before stepper: it is made from them
   Stepper stepper;
-  std::vector<Event> labels;
 };
 
 /// The Scene class and the functions that make scenes or list the catalogue.

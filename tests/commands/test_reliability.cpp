@@ -79,7 +79,8 @@ TEST(Reliability, EveryIssueExampleEndsWithItsReason) {
       {"sweep --param b --values nan --steps 10", "the sweep's values of b must be a finite number > 0"},
       {"sweep --param v_inf --values 1,nan --steps 10", "the sweep's values of v_inf must be a finite number > 0"},
       {"sweep --param L --values 100,inf --steps 10", "the sweep's values of L must be finite numbers"},
-      {"sweep --param b --values 1,2 --d 3 --steps 10", "give --b or --d, not both"},
+      {"sweep --param b --values 1,2 --d 3 --steps 10", "give b or d, not both"},
+      {"sweep --param arrival_phase --values 1,2 --phase 3 --steps 10", "give arrival_phase or phase, not both"},
       {"sweep --param d --values 5 --steps 10 --shard ''", "--shard takes K/N"},
       {"simulate --b 1e300 --steps 10", "no start distance d gives the impact parameter b = 1e+300"},
       {"simulate --method lp-y4 --h 0.1 --t-end 20 --event plane=1e308,1e308,0,0", "the plane's normal is too long"},
@@ -103,7 +104,7 @@ TEST(Reliability, EveryIssueExampleEndsWithItsReason) {
       {"work-precision --scenes ,", "--scenes is empty"},
       // Issue #24: the advice fits the method; limits refused before any work.
       {"simulate --method odeint-dopri5 --tol 5 --t-end 1", "too loose for this scene (reduce --tol)"},
-      {"sweep --param d --values 1 --steps 10 --threads 5000", "--threads must be at most 1024"},
+      {"sweep --param d --values 1 --steps 10 --threads 5000", "threads must be at most 1024"},
       {"merge --input /dev/zero", "is not a regular file"},
       {"simulate --steps 10 --out -", "give a file name"},
       // A name of another run's journal or lock: that run's live file would be replaced.

@@ -79,6 +79,8 @@ Record encounter_record(const Encounter& e);
 /// status, reason, err_estimate, estimate_force_evals, err_basis, warning, with SweepSpec::scattering
 /// the encounter's columns, then steps, t_end, vx..vz, wx..wz.
 Record sweep_record(const SweepSpec& spec, const SweepRow& row);
+/// The sweep's columns: the record of a row that holds nothing, for its keys and their kinds.
+Record sweep_record(const SweepSpec& spec);
 
 /// The record as one JSON object on one line.
 void write_json(std::ostream& os, const Record& r);

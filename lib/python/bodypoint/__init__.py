@@ -78,14 +78,6 @@ def _flag(name, value):
     return bool(value)
 
 
-def _threads(value):
-    """A thread count: 1 to 1024 (None: every core), the command line's range."""
-    n = _count("threads", value)
-    if not 1 <= n <= 1024:
-        raise Error(f"threads must be 1 to 1024 (None: every core), got {n}")
-    return n
-
-
 def _text(name, value):
     if not isinstance(value, str):
         raise Error(f"{name} must be a text, got {type(value).__name__}")
@@ -258,7 +250,7 @@ def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, accuracy=None
     peers' tolerance per step. ``accuracy``: the accuracy mode, every other method delivering this
     relative error of the final state at ``t_end`` (its step searched per row: columns h_chosen,
     search_force_evals). ``threads``: every core unless
-    given. The columns are those of ``bodypoint sweep``'s CSV (docs/guide.md): one per axis, method,
+    given (0 too, as on the command line). The columns are those of ``bodypoint sweep``'s CSV (docs/guide.md): one per axis, method,
     max_rel_dE, max_rel_dK2sq, max_abs_dK2Q, Rx..Rz, force_evals, wall_s, status (an Outcome's name,
     "refused" for a run that did not start or stopped), reason, err_estimate, estimate_force_evals,
     err_basis, warning; with ``scattering=True`` the encounter's (r_min, t_min, deflection,
@@ -274,7 +266,7 @@ def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, accuracy=None
     columns = [(_text("an axis' parameter", k), [_number(f"a value of {k}", v) for v in vals]) for k, vals in axes]
     return _core._sweep(columns, _texts("methods", methods), base, _number("h", h), _count("steps", steps),
                         _number("t_end", t_end), _number("tol", tol),
-                        0 if threads is None else _threads(threads), _number("max_energy_error", max_energy_error),
+                        0 if threads is None else _count("threads", threads), _number("max_energy_error", max_energy_error),
                         _flag("estimate_error", estimate_error), _number("max_error", max_error),
                         _flag("scattering", scattering),
                         _text("force_law", force_law), _number("accuracy", accuracy, optional=True),
