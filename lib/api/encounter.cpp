@@ -39,7 +39,7 @@ std::string unfinished(const Body& body, const std::vector<Centre>& centres, con
   return "";
 }
 
-/// The first hit of an event of `kind` through `value` (not a stop), or nullptr.
+/// The first hit (with `last`: the last) of an event of `kind` through `value` (not a stop), or nullptr.
 const EventHit* marker(const std::vector<EventHit>& hits, const std::vector<Event>& events, Event::Kind kind, double value,
                        bool last) {
   const EventHit* found = nullptr;
