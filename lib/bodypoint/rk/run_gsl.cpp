@@ -27,12 +27,8 @@ using detail::observe;
 
 
 template <class System>
-int gsl_rhs(double t, const double y[], double f[], void* params) {
-  const auto& sys = *static_cast<const System*>(params);
-  OdeState<double> x, dx;
-  std::copy(y, y + 9, x.begin());
-  sys(x, dx, t);
-  std::copy(dx.begin(), dx.end(), f);
+int gsl_rhs(double /*t*/, const double y[], double f[], void* params) {
+  static_cast<const System*>(params)->eval(y, f);  // on GSL's arrays, as a plain C function would
   return GSL_SUCCESS;
 }
 
