@@ -1,12 +1,14 @@
 // `bodypoint timing`: run time against the number of steps n for each method (thesis fig. 4.12-4.13),
-// measured properly: warm-up runs, repeats, median and spread per point, one thread, and nothing
-// but the step loop inside the timed region (no invariants, no output).
+// measured under the commands' timing rules (stopwatch.hpp): warm-up runs, repeats interleaved across
+// the methods at each n, wall and CPU time, median and spread per point, one thread, and nothing but
+// the run inside the timed region (no invariants, no output).
 #include "process.hpp"
 #include "timing.hpp"
 
 #include "bodypoint/io.hpp"
 #include "budget.hpp"
 #include "cli.hpp"
+#include "stopwatch.hpp"
 #include "sweep.hpp"
 
 #include <algorithm>
@@ -23,10 +25,13 @@ void check_timing_budget(const TimingSpec& spec, double max_seconds) {
   if (!(max_seconds > 0.0)) return;
   double steps = 0.0;
   for (long n : spec.ns) steps += static_cast<double>(n);
-  const double runs = static_cast<double>(spec.warmup) + static_cast<double>(spec.repeats);
-  if (steps * runs * static_cast<double>(spec.methods.size()) * kMaxSecondsPerStep <= max_seconds) return;
+  const double runs = static_cast<double>(std::max(spec.warmup, 1L)) + static_cast<double>(spec.repeats);
+  // A timed repeat lasts at least kMinRepeatSeconds (a batch of runs when one is shorter).
+  const double batches = static_cast<double>(spec.repeats) * static_cast<double>(spec.ns.size()) *
+                         static_cast<double>(spec.methods.size()) * kMinRepeatSeconds;
+  if (steps * runs * static_cast<double>(spec.methods.size()) * kMaxSecondsPerStep + batches <= max_seconds) return;
   const Scene scene = thesis_scene(spec.base);
-  double seconds = 0.0;
+  double seconds = batches;
   for (const MethodInfo* m : spec.methods)
     seconds += estimated_seconds(*m, scene.bodies.front(), scene.centres, spec.h, steps, runs);
   if (seconds > max_seconds)
@@ -48,22 +53,19 @@ std::vector<TimingRow> run_timing(const TimingSpec& spec, bool progress) {
   std::vector<TimingRow> rows;
   std::size_t done = 0;
   const std::size_t total = spec.ns.size() * spec.methods.size();
-  for (long n : spec.ns) {
+  const TimingRules rules{spec.warmup, spec.repeats, kMinRepeatSeconds};
+  for (long n : spec.ns) {  // at each n, the methods' repeats interleaved
+    std::vector<std::function<void()>> runs;
+    std::vector<long> evals;
     for (const MethodInfo* m : spec.methods) {
       const Advance how = to_common_end(*m, FixedSteps{spec.h, n}, spec.tol);  // every method to t = h n
-      const Options quiet = unobserved();
-      for (long w = 0; w < spec.warmup; ++w) run_or_throw(*m, scene.bodies.front(), scene.centres, how, quiet);
-      std::vector<double> t;
-      long evals = 0;
-      for (long r = 0; r < spec.repeats; ++r) {
-        const RunResult res = run_or_throw(*m, scene.bodies.front(), scene.centres, how, quiet);
-        t.push_back(res.wall_s);
-        evals = res.force_evals;
-      }
-      std::sort(t.begin(), t.end());
-      rows.push_back({n, m, t[t.size() / 2], t.front(), t.back(), spec.repeats, evals});
-      if (progress) std::cerr << "\r" << ++done << "/" << total << std::flush;
+      evals.push_back(run_or_throw(*m, scene.bodies.front(), scene.centres, how, unobserved()).force_evals);
+      runs.push_back([m, &scene, how] { run_or_throw(*m, scene.bodies.front(), scene.centres, how, unobserved()); });
     }
+    const std::vector<Timing> t = time_interleaved(runs, rules);
+    for (std::size_t i = 0; i < spec.methods.size(); ++i) rows.push_back({n, spec.methods[i], t[i], evals[i]});
+    done += spec.methods.size();
+    if (progress) std::cerr << "\r" << done << "/" << total << std::flush;
   }
   if (progress) std::cerr << "\n";
   return rows;
@@ -72,15 +74,15 @@ std::vector<TimingRow> run_timing(const TimingSpec& spec, bool progress) {
 void write_timing_csv(std::ostream& os, const TimingSpec& spec, const std::vector<TimingRow>& rows,
                       const std::string& command) {
   const SceneParams& p = spec.base;
-  os << "n,method,median_s,min_s,max_s,repeats,force_evals\n"
+  os << "n,method,median_s,min_s,max_s,cpu_s,spread,repeats,flag,force_evals\n"
      << "# bodypoint timing, revision " << git_revision() << "\n"
      << "# command: " << command << "\n"
      << "# scene: " << describe(p) << " h=" << fmt(spec.h) << "\n"
-     << "# " << spec.warmup << " warm-up run(s), then " << spec.repeats
-     << " timed repeats of the step loop alone (no invariants, no output), one thread\n";
+     << "# a call is one run (no invariants, no output), one thread\n"
+     << timing_rules_note(TimingRules{spec.warmup, spec.repeats, kMinRepeatSeconds});
   for (const TimingRow& r : rows)
-    os << CsvLine().count(r.n).text(r.method->name).num(r.median_s).num(r.min_s).num(r.max_s).count(r.repeats)
-              .count(r.force_evals).str()
+    os << CsvLine().count(r.n).text(r.method->name).num(r.time.wall_s).num(r.time.min_wall_s).num(r.time.max_wall_s)
+              .num(r.time.cpu_s).num(r.time.spread()).count(r.time.repeats).quoted(r.time.flag()).count(r.force_evals).str()
        << '\n';
 }
 
@@ -101,7 +103,7 @@ int cmd_timing(int argc, char** argv) {
       ("step", po::value(&step)->default_value(step), "increment of n")
       ("values", po::value(&values), "explicit comma-separated values of n instead")
       ("methods", po::value(&methods_arg)->default_value(methods_arg), "comma-separated names, 'fixed' (every fixed-step method but the Kepler split kep-*) or 'all'")
-      ("repeats", po::value(&spec.repeats)->default_value(spec.repeats), "timed repeats per point (median, min, max)")
+      ("repeats", po::value(&spec.repeats)->default_value(spec.repeats), "timed repeats per point, interleaved across the methods (median, min, max, spread)")
       ("warmup", po::value(&spec.warmup)->default_value(spec.warmup), "untimed runs before the repeats")
       ("out", po::value(&out), "CSV file (default: standard output)");
   po::variables_map vm;

@@ -4,6 +4,7 @@
 #include "bodypoint/model.hpp"
 #include "bodypoint/bodypoint.hpp"
 #include "bodypoint/run.hpp"
+#include "stopwatch.hpp"
 
 #include <ostream>
 #include <string>
@@ -25,8 +26,7 @@ struct TimingSpec {
 struct TimingRow {
   long n;
   const MethodInfo* method;
-  double median_s, min_s, max_s;
-  long repeats;
+  Timing time;  ///< per run, under the timing rules (stopwatch.hpp)
   long force_evals;
 };
 

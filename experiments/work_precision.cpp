@@ -4,9 +4,10 @@
 // For each scene the reference is Boost.Odeint rkf78 in long double at tolerance 1e-18; its own error
 // is estimated as the larger of its distance to the same integration at tolerance 1e-15 and to the
 // 10th-order Lie-Poisson method at a small step (two independent cross-checks). For each method a
-// ladder of steps (halving h) or tolerances (dividing by 10) is run; each configuration is timed as
-// the median of several repeats with no invariant tracking and no output inside the timed region, and
-// run once more, untimed, to measure max_rel_dE.
+// ladder of steps (halving h) or tolerances (dividing by 10) is run once, untimed, for its error, and
+// once more with invariant tracking for max_rel_dE; then every configuration of the scene is timed
+// under the commands' timing rules (stopwatch.hpp: warm-up, repeats interleaved across all of them,
+// wall and CPU time, median and spread, a flag where the time does not count).
 #include "process.hpp"
 #include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/io.hpp"
@@ -16,9 +17,11 @@
 #include "bodypoint/scenes.hpp"
 #include "by_tol.hpp"
 #include "cli.hpp"
+#include "stopwatch.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <iomanip>
 #include <iostream>
 #include <limits>
@@ -32,27 +35,24 @@ namespace {
 struct Row {
   std::string scene, method;
   double h = 0, tol = 0;  // one of them set
-  double err_R = 0, err_rel = 0, max_rel_dE = 0, wall_s = 0;
+  double err_R = 0, err_rel = 0, max_rel_dE = 0;
   long force_evals = 0;
+  Timing time;                  ///< from the scene's interleaved timing (stopwatch.hpp)
+  std::function<void()> run;    ///< the configuration's run, as timed
 };
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
 
 /// Small-step run of the highest-order splitting, as a cross-check of the reference.
 double splitting_check_step(const std::string& scene) { return scene == "close" ? 5e-4 : 5e-3; }
 
 struct Options {
-  long repeats = 3;
-  double min_timed_s = 0.02;  ///< repeat a configuration until this much time has been measured
+  TimingRules timing;
   double max_evals = 2e7;     ///< stop a ladder when a run would exceed this many force evaluations
   double floor = 1e-13;       ///< stop a ladder after two runs in a row below this relative error
 };
 
-Row measure(const NamedScene& ns, const MethodInfo& m, const Body& body, const State& ref, double h,
-            double tol, const Options& o) {
+/// One configuration run once, untimed: its error, force evaluations and energy error. The time comes
+/// later, from the scene's interleaved timing of every configuration (time_scene).
+Row measure(const NamedScene& ns, const MethodInfo& m, const Body& body, const State& ref, double h, double tol) {
   Advance how;
   double step = h;  // the step of the row: h, or the fictitious step ds
   if (is_time_transformed(m)) {
@@ -64,14 +64,7 @@ Row measure(const NamedScene& ns, const MethodInfo& m, const Body& body, const S
     step = ns.t_end / static_cast<double>(steps);
     how = FixedSteps{step, steps};
   }
-  std::vector<double> times;
-  RunResult r;
-  double total = 0;
-  while ((long)times.size() < o.repeats || (total < o.min_timed_s && times.size() < 50)) {
-    r = run_or_throw(m, body, ns.scene.centres, how, unobserved());
-    times.push_back(r.wall_s);
-    total += r.wall_s;
-  }
+  const RunResult r = run_or_throw(m, body, ns.scene.centres, how, unobserved());
   const RunResult ri = run_or_throw(m, body, ns.scene.centres, how, bodypoint::Options{});
   Row row;
   row.scene = ns.name;
@@ -83,8 +76,16 @@ Row measure(const NamedScene& ns, const MethodInfo& m, const Body& body, const S
   row.err_rel = row.err_R / ref.R.norm();
   row.max_rel_dE = ri.invariants ? ri.invariants->max_rel_dE : 0.0;
   row.force_evals = r.force_evals;
-  row.wall_s = median(times);
+  row.run = [&m, body, centres = ns.scene.centres, how] { run_or_throw(m, body, centres, how, unobserved()); };
   return row;
+}
+
+/// Times every configuration of one scene (rows [first, end)), interleaved (stopwatch.hpp).
+void time_scene(std::vector<Row>& rows, std::size_t first, const TimingRules& rules) {
+  std::vector<std::function<void()>> runs;
+  for (std::size_t i = first; i < rows.size(); ++i) runs.push_back(rows[i].run);
+  const std::vector<Timing> t = time_interleaved(runs, rules);
+  for (std::size_t i = first; i < rows.size(); ++i) rows[i].time = t[i - first];
 }
 
 struct WorkPrecisionArgs {
@@ -98,13 +99,15 @@ void add_work_precision_options(po::options_description& desc, WorkPrecisionArgs
   desc.add_options()
       ("scenes", po::value(&a.scenes)->default_value(a.scenes), "comma-separated: thesis,close,material,long,two-centres or all")
       ("methods", po::value(&a.methods)->default_value(a.methods), "comma-separated method names or all")
-      ("repeats", po::value(&a.o.repeats)->default_value(a.o.repeats), "timed repeats per configuration (median reported)")
+      ("repeats", po::value(&a.o.timing.repeats)->default_value(a.o.timing.repeats), "timed repeats per configuration, "
+       "interleaved across the configurations (median and spread reported; fewer than 5 flag every time)")
       ("max-evals", po::value(&a.o.max_evals)->default_value(a.o.max_evals), "largest run of a ladder, in force evaluations")
       ("by-tol", po::bool_switch(&a.by_tol), "second view: auto and every step-size-controlled peer with the same "
        "requested tolerance; delivered error, whether it met TOL, and time")
       ("tols", po::value(&a.tols)->default_value(a.tols), "with --by-tol: the tolerances")
-      ("quick", po::bool_switch(&a.quick), "coarse: scenes thesis and material, 1 repeat, runs up to 1e6 force evaluations")
-      ("out", po::value(&a.out), "CSV: scene, method, h, tol, err_R, err_rel, max_rel_dE, force_evals, wall_s")
+      ("quick", po::bool_switch(&a.quick), "coarse: scenes thesis and material, repeats of one call, runs up to 1e6 force evaluations")
+      ("out", po::value(&a.out), "CSV: scene, method, h, tol, err_R, err_rel, max_rel_dE, force_evals, wall_s, cpu_s, "
+       "spread, repeats, flag")
       ("summary", po::value(&a.summary), "also write the summary table (Markdown) to this file");
 }
 
@@ -112,11 +115,11 @@ void add_work_precision_options(po::options_description& desc, WorkPrecisionArgs
 void settle(const po::variables_map& vm, WorkPrecisionArgs& a) {
   if (a.quick) {
     if (vm["scenes"].defaulted()) a.scenes = "thesis,material";
-    a.o.repeats = 1;
-    a.o.min_timed_s = 0.0;
+    a.o.timing.min_repeat_s = 0.0;
     if (vm["max-evals"].defaulted()) a.o.max_evals = 1e6;
   }
-  if (a.o.repeats < 1) throw Error("--repeats must be >= 1");
+  if (a.o.timing.repeats < 1) throw Error("--repeats must be >= 1");
+  if (a.o.timing.repeats > 1'000'000) throw Error("--repeats must be at most 1e6");
   if (!(a.o.max_evals >= 1)) throw Error("--max-evals must be >= 1");
   // Options that would be ignored or would write an empty table are refused.
   if (!vm["tols"].defaulted() && !a.by_tol) throw Error("--tols is for --by-tol");
@@ -166,7 +169,7 @@ void run_ladder(const NamedScene& ns, const MethodInfo& m, const State& ref, con
   }
   auto try_measure = [&](double h, double tol, Row& row) {
     try {
-      row = measure(ns, m, body, ref, h, tol, o);
+      row = measure(ns, m, body, ref, h, tol);
       return true;
     } catch (const Error& e) {
       std::cerr << "  " << ns.name << " " << m.name << (tol > 0 ? " tol=" : " h=") << fmt(tol > 0 ? tol : h)
@@ -175,13 +178,27 @@ void run_ladder(const NamedScene& ns, const MethodInfo& m, const State& ref, con
     }
   };
   int below = 0, failures = 0;
+  // A peer's ladder has no evaluation cap: it ends at its tolerance 1e-14 or below the floor, so a
+  // peer that delivers a target is never cut to "-" by a budget of ours.
+  const bool capped = !is_peer(m);
   auto keep = [&](const Row& r) {  // true: the ladder goes on
     rows.push_back(r);
     below = r.err_rel < o.floor ? below + 1 : 0;
-    return below < 2 && static_cast<double>(r.force_evals) <= o.max_evals;
+    return below < 2 && (!capped || static_cast<double>(r.force_evals) <= o.max_evals);
   };
   Row r;
-  if (is_time_transformed(m)) {
+  if (m.family == Family::Regularised) {
+    // Exact in its fictitious time: one configuration, the run of one fictitious step to t_end (the
+    // first ds, doubled from 0.2, whose run takes a single step); a ladder would time one answer many times.
+    for (double ds = 0.2; ds <= 1e6; ds *= 2) {
+      if (!try_measure(ds, 0, r)) break;
+      const RunResult one = run_or_throw(m, body, ns.scene.centres, FictitiousSteps{ds, EndTime{ns.t_end}}, unobserved());
+      if (one.steps <= 1) {
+        rows.push_back(r);
+        break;
+      }
+    }
+  } else if (is_time_transformed(m)) {
     for (double ds = 0.2; ds >= 1e-5; ds /= 2) {
       if (!try_measure(ds, 0, r)) {
         if (++failures > 2) break;  // too coarse for the encounter three times
@@ -190,28 +207,36 @@ void run_ladder(const NamedScene& ns, const MethodInfo& m, const State& ref, con
       if (!keep(r)) break;
     }
   } else if (is_step_controlled(m)) {
-    for (double tol = 1e-3; tol >= 1e-14; tol /= 10)
+    double best = std::numeric_limits<double>::infinity();
+    int stalled = 0;  // decades in a row that did not halve the best error: the peer's round-off floor
+    for (double tol = 1e-3; tol >= 1e-14; tol /= 10) {
       if (!try_measure(0, tol, r) || !keep(r)) break;  // a tolerance the controller cannot meet
+      stalled = r.err_rel < 0.5 * best ? 0 : stalled + 1;
+      best = std::min(best, r.err_rel);
+      if (stalled >= 2) break;
+    }
   } else {
     for (double h = 0.5; ns.t_end / h * std::max(1, m.evals_per_step) <= o.max_evals; h /= 2) {
-      rows.push_back(measure(ns, m, body, ref, h, 0, o));
+      rows.push_back(measure(ns, m, body, ref, h, 0));
       below = rows.back().err_rel < o.floor ? below + 1 : 0;
       if (below >= 2) break;
     }
   }
 }
 
-void write_rows(std::ostream& os, const std::vector<Row>& rows, const std::string& refs) {
-  os << "scene,method,h,tol,err_R,err_rel,max_rel_dE,force_evals,wall_s\n"
+void write_rows(std::ostream& os, const std::vector<Row>& rows, const std::string& refs, const TimingRules& rules) {
+  os << "scene,method,h,tol,err_R,err_rel,max_rel_dE,force_evals,wall_s,cpu_s,spread,repeats,flag\n"
      << "# bodypoint work-precision, revision " << git_revision() << "\n"
      << "# err_R = |R(t_end) - R_ref| against odeint rkf78 in long double at tol 1e-18; err_rel = err_R/|R_ref|\n"
-     << "# wall_s = median over repeats of the step loop alone (no invariants, no output)\n";
+     << "# a call is one run without invariants or output\n"
+     << timing_rules_note(rules);
   std::istringstream ref_lines(refs);
   for (std::string line; std::getline(ref_lines, line);) os << "# " << line << "\n";
   os << "# h is the fictitious step ds for time-transformed methods (logh-*, ttl-*, ks)\n";
   for (const Row& r : rows)
     os << CsvLine().text(r.scene).text(r.method).num_if(r.h > 0, r.h).num_if(r.tol > 0, r.tol).num(r.err_R)
-              .num(r.err_rel).num(r.max_rel_dE).count(r.force_evals).num(r.wall_s).str()
+              .num(r.err_rel).num(r.max_rel_dE).count(r.force_evals).num(r.time.wall_s).num(r.time.cpu_s)
+              .num(r.time.spread()).count(r.time.repeats).quoted(r.time.flag()).str()
        << '\n';
 }
 
@@ -225,24 +250,25 @@ std::string config_of(const Row& r) {
 
 /// The cheapest configuration of ours and of the peers reaching `target` on a scene, counting a row
 /// only when the next finer configuration (the next row of its ladder) reaches it too, so that a
-/// lucky cancellation at one step does not count.
+/// lucky cancellation at one step does not count. The exact regularised flow (ks) has one configuration.
 std::pair<const Row*, const Row*> best_at(const std::vector<Row>& rows, const std::string& scene, double target) {
   const Row* ours = nullptr;
   const Row* peer = nullptr;
-  for (std::size_t i = 0; i + 1 < rows.size(); ++i) {
+  for (std::size_t i = 0; i < rows.size(); ++i) {
     const Row& r = rows[i];
-    const Row& next = rows[i + 1];
     if (r.scene != scene || !(r.err_rel <= target)) continue;
-    if (next.scene != r.scene || next.method != r.method || !(next.err_rel <= target)) continue;
+    const bool exact = method_or_throw(r.method).family == Family::Regularised;
+    const Row* next = i + 1 < rows.size() ? &rows[i + 1] : nullptr;
+    if (!exact && !(next && next->scene == r.scene && next->method == r.method && next->err_rel <= target)) continue;
     const Row*& slot = is_peer(method_or_throw(r.method)) ? peer : ours;
-    if (!slot || r.wall_s < slot->wall_s) slot = &r;
+    if (!slot || r.time.wall_s < slot->time.wall_s) slot = &r;
   }
   return {ours, peer};
 }
 
 std::string summary_table(const std::vector<NamedScene>& scenes, const std::vector<Row>& rows) {
   std::ostringstream sum;
-  sum << "| scene | target err_rel | best bodypoint method | config | time [ms] | best peer (Boost.Odeint, GSL) | config | time [ms] | speed-up |\n"
+  sum << "| scene | target err_rel | best bodypoint method | config | time [ms] | best peer (Boost.Odeint, GSL, logh-bs) | config | time [ms] | speed-up |\n"
       << "|---|---|---|---|---|---|---|---|---|\n";
   for (const NamedScene& ns : scenes)
     for (double target : {1e-4, 1e-7, 1e-10, 1e-13}) {
@@ -250,11 +276,10 @@ std::string summary_table(const std::vector<NamedScene>& scenes, const std::vect
       sum << "| " << ns.name << " | " << std::setprecision(0) << std::scientific << target << std::defaultfloat
           << std::setprecision(3) << " | ";
       for (const Row* r : {ours, peer}) {
-        if (r) sum << r->method << " | " << config_of(*r) << " | " << r->wall_s * 1e3 << " | ";
+        if (r) sum << r->method << " | " << config_of(*r) << " | " << time_cell(r->time) << " | ";
         else sum << "- | - | - | ";
       }
-      if (ours && peer) sum << std::setprecision(3) << peer->wall_s / ours->wall_s << "x |\n";
-      else sum << "- |\n";
+      sum << ratio_cell(ours ? &ours->time : nullptr, peer ? &peer->time : nullptr) << " |\n";
     }
   return sum.str();
 }
@@ -299,7 +324,7 @@ int cmd_work_precision(int argc, char** argv) {
       }
     }
     std::ostringstream sum;
-    run_by_tolerance(scenes, tols, a.o.repeats, csv ? &csv->stream() : nullptr, sum);
+    run_by_tolerance(scenes, tols, a.o.timing, csv ? &csv->stream() : nullptr, sum);
     report(sum.str(), " --by-tol", csv.get(), md.get());
     return 0;
   }
@@ -307,9 +332,12 @@ int cmd_work_precision(int argc, char** argv) {
   std::ostringstream refs;
   for (const NamedScene& ns : scenes) {
     const State ref = reference_of(ns, refs);
+    const std::size_t first = rows.size();
     for (const MethodInfo* m : ms) run_ladder(ns, *m, ref, a.o, rows);
+    std::cerr << "  " << ns.name << ": timing " << rows.size() - first << " configurations, interleaved\n";
+    time_scene(rows, first, a.o.timing);
   }
-  if (csv) write_rows(csv->stream(), rows, refs.str());
+  if (csv) write_rows(csv->stream(), rows, refs.str(), a.o.timing);
   report(summary_table(scenes, rows), "", csv.get(), md.get());
   return 0;
 }

@@ -213,15 +213,22 @@ TEST(Cli, WorkPrecisionQuickWritesRowsForEveryMethodAndASummary) {
   std::ifstream in(out);
   std::string line, header;
   std::map<std::string, int> rows;
+  bool rules_stated = false;
   while (std::getline(in, line)) {
+    if (line.rfind("# timing: ", 0) == 0) rules_stated = true;
     if (line.rfind("#", 0) == 0) continue;
     if (header.empty()) {
       header = line;
       continue;
     }
     rows[line.substr(0, line.find(',', line.find(',') + 1))]++;  // "scene,method"
+    // Every time was taken under the timing rules: 5 interleaved repeats at least (stopwatch.hpp).
+    const std::size_t flag = line.rfind(',');
+    const std::size_t repeats = line.rfind(',', flag - 1);
+    EXPECT_GE(std::stol(line.substr(repeats + 1, flag - repeats - 1)), 5) << line;
   }
-  EXPECT_EQ(header, "scene,method,h,tol,err_R,err_rel,max_rel_dE,force_evals,wall_s");
+  EXPECT_EQ(header, "scene,method,h,tol,err_R,err_rel,max_rel_dE,force_evals,wall_s,cpu_s,spread,repeats,flag");
+  EXPECT_TRUE(rules_stated) << "the CSV states the timing rules its times were taken under";
   for (const char* scene : {"thesis", "material"})
     for (const MethodInfo& m : methods()) {
       const NamedScene ns = named_scene(scene);
