@@ -11,6 +11,7 @@
 // time; for ks the exact advance), without touching the main integration.
 #include "bodypoint/adaptive/methods.hpp"
 
+#include "bodypoint/adaptive/extrapolated.hpp"
 #include "bodypoint/adaptive/ks.hpp"
 #include "bodypoint/adaptive/time_transformed.hpp"
 #include "bodypoint/detail/run_support.hpp"
@@ -362,6 +363,9 @@ std::vector<MethodInfo> methods() {
   all.push_back({"ks", Family::Regularised, 0, 0, 0,
                  "Kustaanheimo-Stiefel regularisation, exact in fictitious time (B = 0, one centre), fictitious step ds",
                  &run_ks, &ks_check});
+  all.push_back({"logh-bs", Family::Extrapolated, 0, 0, 0,
+                 "logH leapfrog with Bulirsch-Stoer extrapolation (Mikkola's codes; repulsive scenes); a tolerance per step",
+                 &run_logh_bs, &logh_bs_check});
   return all;
 }
 

@@ -88,8 +88,10 @@ struct RunResult {
 /// odeint steppers (rk4, ab4); OdeintAdaptive: step-size-controlled odeint steppers (--tol);
 /// Gsl: GSL's step-size-controlled steppers (--tol; peers, present when built with GSL);
 /// TimeTransformed: fixed fictitious step ds, variable physical step (logh-*, ttl-*);
-/// Regularised: the Kustaanheimo-Stiefel flow, exact in its fictitious time (ks).
-enum class Family { Thesis, LiePoisson, KeplerSplit, Odeint, OdeintAdaptive, Gsl, TimeTransformed, Regularised };
+/// Regularised: the Kustaanheimo-Stiefel flow, exact in its fictitious time (ks);
+/// Extrapolated: the logH leapfrog with Bulirsch-Stoer extrapolation and a tolerance per step (logh-bs;
+/// a peer, as Mikkola's codes integrate).
+enum class Family { Thesis, LiePoisson, KeplerSplit, Odeint, OdeintAdaptive, Gsl, TimeTransformed, Regularised, Extrapolated };
 
 /// The family's name as `bodypoint methods --markdown` prints it.
 constexpr std::string_view family_name(Family f) {
@@ -102,6 +104,7 @@ constexpr std::string_view family_name(Family f) {
     case Family::Gsl: return "GSL adaptive";
     case Family::TimeTransformed: return "time-transformed";
     case Family::Regularised: return "regularised";
+    case Family::Extrapolated: return "logH extrapolated";
   }
   return "?";
 }
@@ -117,6 +120,7 @@ constexpr std::string_view family_key(Family f) {
     case Family::Gsl: return "gsl";
     case Family::TimeTransformed: return "time-transformed";
     case Family::Regularised: return "regularised";
+    case Family::Extrapolated: return "extrapolated";
   }
   return "?";
 }
@@ -227,13 +231,15 @@ std::string refusal(const MethodInfo& m, const Body& body, const std::vector<Cen
 const std::vector<MethodInfo>& core_methods();
 
 /// True for methods that choose their own steps from a tolerance per step (ControlledSteps):
-/// Boost.Odeint's and GSL's controlled steppers.
+/// Boost.Odeint's and GSL's controlled steppers, and logh-bs.
 inline bool is_step_controlled(const MethodInfo& m) {
-  return m.family == Family::OdeintAdaptive || m.family == Family::Gsl;
+  return m.family == Family::OdeintAdaptive || m.family == Family::Gsl || m.family == Family::Extrapolated;
 }
-/// True for the general-purpose peers (Boost.Odeint, GSL) that bodypoint's own methods compete with.
+/// True for the peers that bodypoint's own methods compete with: the general-purpose ones (Boost.Odeint,
+/// GSL) and the time-transformed one of Mikkola's codes (logh-bs).
 inline bool is_peer(const MethodInfo& m) {
-  return m.family == Family::Odeint || m.family == Family::OdeintAdaptive || m.family == Family::Gsl;
+  return m.family == Family::Odeint || m.family == Family::OdeintAdaptive || m.family == Family::Gsl ||
+         m.family == Family::Extrapolated;
 }
 /// True for methods with a fixed fictitious step (FictitiousSteps): time-transformed and regularised.
 inline bool is_time_transformed(const MethodInfo& m) {
@@ -290,6 +296,10 @@ struct Checks {
   bool energy_is_integral = true;  ///< false under the thesis code's force law: E is not conserved there
   bool orbit_exact = false;        ///< the method's stages solve the motion about the centre exactly
   bool spin_exact = false;         ///< free flight, solved exactly by the method's drift (any spin angle)
+  /// A step is an extrapolated macro step (logh-bs): its n substeps are compared and extrapolated under
+  /// the tolerance, so what one macro step turns the spin or the direction to a centre by does not say
+  /// that a rotation went unresolved (as for every peer, its error estimate judges its accuracy).
+  bool macro_steps = false;
 };
 /// Throws Error unless max_energy_error is a bound assess() can hold a run to: > 0, not NaN
 /// (infinity turns the accuracy flag off).

@@ -95,7 +95,8 @@ bool measured_here(Family f, double B) {
     case Family::Regularised: return false;
     // Peers with their own step control: their order is theirs, not a claim of this project.
     case Family::OdeintAdaptive:
-    case Family::Gsl: return false;
+    case Family::Gsl:
+    case Family::Extrapolated: return false;
   }
   return false;
 }
