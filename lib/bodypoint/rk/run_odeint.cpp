@@ -118,6 +118,9 @@ RunResult run_odeint_rk4(const Body& b, const std::vector<Centre>& c, const Adva
 RunResult run_odeint_ab4(const Body& b, const std::vector<Centre>& c, const Advance& s, const RunOptions& k) {
   return run_odeint<rk::Ab4>(b, c, s, k);
 }
+RunResult run_thesis_ab4(const Body& b, const std::vector<Centre>& c, const Advance& s, const RunOptions& k) {
+  return run_odeint<rk::ThesisAb4>(b, c, s, k);
+}
 RunResult run_odeint_dopri5(const Body& b, const std::vector<Centre>& c, const Advance& s, const RunOptions& k) {
   return run_odeint_adaptive<rk::Dopri5>(b, c, s, k);
 }

@@ -9,6 +9,7 @@ namespace bodypoint {
 
 RunResult run_odeint_rk4(const Body&, const std::vector<Centre>&, const Advance&, const RunOptions&);
 RunResult run_odeint_ab4(const Body&, const std::vector<Centre>&, const Advance&, const RunOptions&);
+RunResult run_thesis_ab4(const Body&, const std::vector<Centre>&, const Advance&, const RunOptions&);
 RunResult run_odeint_dopri5(const Body&, const std::vector<Centre>&, const Advance&, const RunOptions&);
 RunResult run_odeint_rkf78(const Body&, const std::vector<Centre>&, const Advance&, const RunOptions&);
 RunResult run_odeint_bs(const Body&, const std::vector<Centre>&, const Advance&, const RunOptions&);
