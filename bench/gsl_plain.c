@@ -2,9 +2,10 @@
  *
  * A stand-alone C program: the body-point's equations of motion (docs/physics.md, "Equations of
  * motion") as a plain C right-hand side, integrated by GSL's driver (gsl_odeiv2_driver_apply) with the
- * standard control eps_abs = eps_rel = tol, exactly as bodypoint's gsl-* peers set it. bench/gsl_peer.py
- * runs it beside `bodypoint`'s gsl-rk8pd / gsl-rkf45 on the same scene, interleaved, and checks that
- * the peer costs no more than this program at equal force evaluations.
+ * standard control eps_abs = eps_rel = tol, exactly as bodypoint's gsl-* peers set it. bench/gsl_peer.cpp
+ * calls its integration (gsl_plain_run, compiled with GSL_PLAIN_LIBRARY) beside bodypoint's gsl-rk8pd /
+ * gsl-rkf45 in one process, interleaved, and checks that the peer costs no more than it at equal force
+ * evaluations; built alone it is the command below, for checks by hand.
  *
  *   gsl_plain STEPPER TOL T_END REPEATS m B J  Rx Ry Rz vx vy vz wx wy wz  [cx cy cz A]...
  *
@@ -53,11 +54,6 @@ static int rhs(double t, const double y[], double f[], void* params) {
   return GSL_SUCCESS;
 }
 
-static double seconds(clockid_t clock) {
-  struct timespec ts;
-  clock_gettime(clock, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* One integration from y0 to t_end with the driver d (reset to the first trial step 1e-3); returns the
  * driver's status, y the final state. */
@@ -70,7 +66,32 @@ static int integrate(gsl_odeiv2_driver* d, double t_end, const double y0[9], dou
   return status;
 }
 
+/* One integration from y0 (m, B, J; n centres as cx, cy, cz, A) to t_end with GSL's rk8pd or rkf45 at
+ * tol, as a C user writes it: allocate the driver, apply it, free it. Returns the force evaluations
+ * (-1: the driver failed), y the final state. */
+long gsl_plain_run(int rk8pd, double tol, double t_end, double m, double B, double J, const double y0[9],
+                   int n, const double (*centres)[4], double y[9]);
+long gsl_plain_run(int rk8pd, double tol, double t_end, double m, double B, double J, const double y0[9],
+                   int n, const double (*centres)[4], double y[9]) {
+  const double D = m * J - B * B;
+  Body body = {J / D, B * B / D, B / D, m * B / D, n, {{0}}, 0};
+  for (int k = 0; k < n && k < MAX_CENTRES; ++k) memcpy(body.c[k], centres[k], sizeof body.c[k]);
+  gsl_odeiv2_system sys = {rhs, NULL, 9, &body};
+  gsl_odeiv2_driver* d =
+      gsl_odeiv2_driver_alloc_y_new(&sys, rk8pd ? gsl_odeiv2_step_rk8pd : gsl_odeiv2_step_rkf45, 1e-3, tol, tol);
+  const int status = integrate(d, t_end, y0, y);
+  gsl_odeiv2_driver_free(d);
+  return status == GSL_SUCCESS ? body.evals : -1;
+}
+
+#ifndef GSL_PLAIN_LIBRARY
 #define MIN_REPEAT_S 2e-3
+
+static double seconds(clockid_t clock) {
+  struct timespec ts;
+  clock_gettime(clock, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
 
 static double number(const char* s, const char* what) {
   char* end = NULL;
@@ -130,3 +151,4 @@ int main(int argc, char** argv) {
   gsl_odeiv2_driver_free(d);
   return 0;
 }
+#endif /* GSL_PLAIN_LIBRARY */
