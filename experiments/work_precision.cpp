@@ -48,6 +48,7 @@ struct Options {
   TimingRules timing;
   double max_evals = 2e7;     ///< stop a ladder when a run would exceed this many force evaluations
   double floor = 1e-13;       ///< stop a ladder after two runs in a row below this relative error
+  bool cap_peers = false;     ///< --quick: max_evals ends the peers' ladders too (never in a full run)
 };
 
 /// One configuration run once, untimed: its error, force evaluations and energy error. The time comes
@@ -105,7 +106,8 @@ void add_work_precision_options(po::options_description& desc, WorkPrecisionArgs
       ("by-tol", po::bool_switch(&a.by_tol), "second view: auto and every step-size-controlled peer with the same "
        "requested tolerance; delivered error, whether it met TOL, and time")
       ("tols", po::value(&a.tols)->default_value(a.tols), "with --by-tol: the tolerances")
-      ("quick", po::bool_switch(&a.quick), "coarse: scenes thesis and material, repeats of one call, runs up to 1e6 force evaluations")
+      ("quick", po::bool_switch(&a.quick), "coarse: scenes thesis and material, repeats of one call, every ladder (the peers' too) up to 1e6 force "
+       "evaluations")
       ("out", po::value(&a.out), "CSV: scene, method, h, tol, err_R, err_rel, max_rel_dE, force_evals, wall_s, cpu_s, "
        "spread, repeats, flag")
       ("summary", po::value(&a.summary), "also write the summary table (Markdown) to this file");
@@ -116,6 +118,7 @@ void settle(const po::variables_map& vm, WorkPrecisionArgs& a) {
   if (a.quick) {
     if (vm["scenes"].defaulted()) a.scenes = "thesis,material";
     a.o.timing.min_repeat_s = 0.0;
+    a.o.cap_peers = true;  // coarse: scene long's low-order peers down to tol 1e-14 took 130 of 270 s
     if (vm["max-evals"].defaulted()) a.o.max_evals = 1e6;
   }
   if (a.o.timing.repeats < 1) throw Error("--repeats must be >= 1");
@@ -178,9 +181,9 @@ void run_ladder(const NamedScene& ns, const MethodInfo& m, const State& ref, con
     }
   };
   int below = 0, failures = 0;
-  // A peer's ladder has no evaluation cap: it ends at its tolerance 1e-14 or below the floor, so a
-  // peer that delivers a target is never cut to "-" by a budget of ours.
-  const bool capped = !is_peer(m);
+  // A peer's ladder has no evaluation cap but in --quick: it ends at its tolerance 1e-14, below the
+  // floor or at its round-off floor, so a peer that delivers a target is never cut to "-" by a budget.
+  const bool capped = !is_peer(m) || o.cap_peers;
   auto keep = [&](const Row& r) {  // true: the ladder goes on
     rows.push_back(r);
     below = r.err_rel < o.floor ? below + 1 : 0;
@@ -224,12 +227,14 @@ void run_ladder(const NamedScene& ns, const MethodInfo& m, const State& ref, con
   }
 }
 
-void write_rows(std::ostream& os, const std::vector<Row>& rows, const std::string& refs, const TimingRules& rules) {
+void write_rows(std::ostream& os, const std::vector<Row>& rows, const std::string& refs, const Options& o) {
   os << "scene,method,h,tol,err_R,err_rel,max_rel_dE,force_evals,wall_s,cpu_s,spread,repeats,flag\n"
      << "# bodypoint work-precision, revision " << git_revision() << "\n"
      << "# err_R = |R(t_end) - R_ref| against odeint rkf78 in long double at tol 1e-18; err_rel = err_R/|R_ref|\n"
      << "# a call is one run without invariants or output\n"
-     << timing_rules_note(rules);
+     << timing_rules_note(o.timing)
+     << "# ladders: bodypoint's methods end above " << fmt(o.max_evals) << " force evaluations; the peers' "
+     << (o.cap_peers ? "too (--quick)" : "at tol 1e-14 or their round-off floor, with no budget") << "\n";
   std::istringstream ref_lines(refs);
   for (std::string line; std::getline(ref_lines, line);) os << "# " << line << "\n";
   os << "# h is the fictitious step ds for time-transformed methods (logh-*, ttl-*, ks)\n";
@@ -337,7 +342,7 @@ int cmd_work_precision(int argc, char** argv) {
     std::cerr << "  " << ns.name << ": timing " << rows.size() - first << " configurations, interleaved\n";
     time_scene(rows, first, a.o.timing);
   }
-  if (csv) write_rows(csv->stream(), rows, refs.str(), a.o.timing);
+  if (csv) write_rows(csv->stream(), rows, refs.str(), a.o);
   report(summary_table(scenes, rows), "", csv.get(), md.get());
   return 0;
 }
