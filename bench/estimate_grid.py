@@ -8,12 +8,17 @@ the delivered error (against Boost.Odeint rkf78 in long double); the worst ratio
 the force evaluations of all searches and of their delivered runs. docs/developers.md ("Limits,
 measured") quotes it for the search's geometry as it is and for the variants that were tried.
 
+With --out, every run is also written (atomically) as a CSV row: the scene, TOL, the method auto chose,
+the delivered error, the estimate, or the reason of a refusal (paper/build.sh hands it to the paper).
+
 Usage (from the repository, after the build; about a minute on 2 cores):
-    /usr/bin/python3 bench/estimate_grid.py [build/bin/bodypoint] [--tols 1e-4,1e-7,1e-10]
+    /usr/bin/python3 bench/estimate_grid.py [build/bin/bodypoint] [--tols 1e-4,1e-7,1e-10] [--out FILE.csv]
 """
 import argparse
+import csv
 import itertools
 import json
+import os
 import subprocess
 from concurrent.futures import ThreadPoolExecutor
 
@@ -21,6 +26,8 @@ D = [0.02, 0.1, 0.5, 1, 3, 8, 15, 30]
 KZ = [0.1, 1, 3, 5]
 B = [0.3, 0.6, 0.8, 0.9]
 KX = [2, -1]
+# --quick (the quick paper build): every other value of each axis, 32 scenes.
+QUICK = {"D": D[::2], "KZ": KZ[::2], "B": B[::2], "KX": KX}
 TOLS = ["1e-4", "1e-7", "1e-10"]
 T_END = "80"
 # Below this both the reference's error and the run's round-off are of the size of the error itself.
@@ -30,24 +37,44 @@ FACTOR = 3.0
 
 
 def one(binary, tol, scene):
+    """The run's JSON record, or the one-line reason it was refused (a str)."""
     run = subprocess.run([binary, "simulate", "--tol", tol, *scene, "--t-end", T_END, "--reference", "--json",
                           "--quiet"], capture_output=True, text=True)
     if run.returncode != 0:
-        return None
+        return run.stderr.strip().splitlines()[-1] if run.stderr.strip() else f"exit {run.returncode}"
     return json.loads(run.stdout)
 
 
-def main(binary, tols):
+def write_rows(path, jobs, results):
+    tmp = path + ".tmp"
+    with open(tmp, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["d", "Kz", "B", "Kx", "tol", "status", "method", "err", "err_estimate", "force_evals",
+                    "search_force_evals", "reason"])
+        for (tol, scene), r in zip(jobs, results):
+            d, kz, b, kx = scene[1::2]
+            if isinstance(r, str):
+                w.writerow([d, kz, b, kx, tol, "refused", "", "", "", "", "", r])
+            else:
+                w.writerow([d, kz, b, kx, tol, "ok", r["method"], r["err_rel"], r["err_estimate"], r["force_evals"],
+                            r["search_force_evals"], ""])
+    os.replace(tmp, path)
+
+
+def main(binary, tols, out=None, quick=False):
+    axes = (QUICK["D"], QUICK["KZ"], QUICK["B"], QUICK["KX"]) if quick else (D, KZ, B, KX)
     scenes = [["--d", str(d), "--Kz", str(kz), "--B", str(b), "--Kx", str(kx)]
-              for d, kz, b, kx in itertools.product(D, KZ, B, KX)]
+              for d, kz, b, kx in itertools.product(*axes)]
     jobs = [(tol, s) for s in scenes for tol in tols]
     with ThreadPoolExecutor(2) as pool:
         results = list(pool.map(lambda j: one(binary, *j), jobs))
     refused = missed = under = over = 0
     worst = 0.0
     search = delivered = 0
+    if out:
+        write_rows(out, jobs, results)
     for (tol, _), r in zip(jobs, results):
-        if r is None:
+        if isinstance(r, str):
             refused += 1
             continue
         est, err = r["err_estimate"], r["err_rel"]
@@ -68,5 +95,7 @@ if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("binary", nargs="?", default="build/bin/bodypoint")
     parser.add_argument("--tols", default=",".join(TOLS), help="comma-separated requested tolerances")
+    parser.add_argument("--out", help="also write every run as a CSV row to this file")
+    parser.add_argument("--quick", action="store_true", help="every other value of each axis (32 scenes)")
     args = parser.parse_args()
-    main(args.binary, args.tols.split(","))
+    main(args.binary, args.tols.split(","), args.out, args.quick)

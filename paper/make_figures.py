@@ -13,6 +13,7 @@ physics: it only draws what the drivers measured.
 import csv
 import math
 import os
+import re
 import sys
 
 from catalogue import families, family, load as load_catalogue
@@ -22,15 +23,16 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-plt.rcParams.update({"font.size": 8, "axes.titlesize": 8, "legend.fontsize": 6, "figure.dpi": 100,
-                     "pdf.fonttype": 42, "savefig.bbox": "tight"})
+plt.rcParams.update({"font.size": 8, "axes.titlesize": 8, "legend.fontsize": 7, "xtick.labelsize": 7,
+                     "ytick.labelsize": 7, "figure.dpi": 100, "pdf.fonttype": 42, "savefig.bbox": "tight"})
 
 THESIS_SEVEN = ["thesis-euler", "thesis-verlet", "thesis-ruth3", "thesis-fr4", "thesis-y6", "rk4", "ab4"]
 # Families of the work-precision figures, in drawing order, with a colour each; a family the catalogue
 # adds is drawn after them in the next free colour (family_colours).
 FAMILIES = [("thesis's seven", "tab:red"), ("Lie-Poisson", "tab:blue"), ("time-transformed", "tab:green"),
-            ("KS", "tab:purple"), ("Kepler split", "tab:cyan"), ("Boost.Odeint", "tab:orange"), ("GSL", "tab:brown")]
-SPARE_COLOURS = ["tab:pink", "tab:olive", "tab:gray", "black", "gold", "navy"]
+            ("KS", "tab:purple"), ("Kepler split", "tab:cyan"), ("Boost.Odeint", "tab:orange"), ("GSL", "tab:brown"),
+            ("logH+BS", "tab:pink")]
+SPARE_COLOURS = ["tab:olive", "tab:gray", "black", "gold", "navy"]
 
 
 def family_colours():
@@ -43,6 +45,12 @@ def family_colours():
 DIVERGED = 1e2
 # Width of a figure spanning the text, in inches (the article's text block is 6.3 in).
 WIDE = 6.3
+# The text block of paper/bodypoint.tex (a4paper, margin=2.3cm), in inches: what \textwidth and
+# \textheight are when save() checks a figure's text at the size it is printed.
+TEXTWIDTH = (21.0 - 2 * 2.3) / 2.54
+TEXTHEIGHT = (29.7 - 2 * 2.3) / 2.54
+# No text of a figure is smaller than this at print size (points).
+MIN_PRINT_PT = 7.0
 
 
 
@@ -77,7 +85,19 @@ def capped(v):
     return float("nan") if not v > 0 else min(v, DIVERGED)
 
 
-def save(fig, path, listing, what):
+def save(fig, path, listing, what, width=1.0, max_height=None):
+    """Writes the figure; `width` is the share of \\textwidth it is included at (and `max_height` the
+    share of \\textheight that may limit it, as keepaspectratio does). Stops the build when any of its
+    text would print smaller than MIN_PRINT_PT."""
+    fig.canvas.draw()
+    box = fig.get_tightbbox(fig.canvas.get_renderer())  # inches, as savefig's bbox "tight" crops
+    scale = width * TEXTWIDTH / box.width
+    if max_height is not None:
+        scale = min(scale, max_height * TEXTHEIGHT / box.height)
+    sizes = [t.get_fontsize() for t in fig.findobj(matplotlib.text.Text) if t.get_visible() and t.get_text().strip()]
+    if sizes and min(sizes) * scale < MIN_PRINT_PT - 0.05:
+        sys.exit(f"make_figures.py: {os.path.basename(path)} prints text at {min(sizes) * scale:.1f} pt "
+                 f"(below {MIN_PRINT_PT:g} pt at print size)")
     fig.savefig(path)
     plt.close(fig)
     listing.append((os.path.basename(path), what))
@@ -160,7 +180,7 @@ def timing_figure(res, figs, listing):
     groups = by_method(rows)
     panels = [("thesis's seven", ["thesis-euler", "thesis-fr4", "thesis-y6", "rk4", "ab4"], ["thesis-verlet", "thesis-ruth3"]),
               ("exact Lie-Poisson", ["lp-verlet", "lp-y4", "lp-kl6", "lp-kl8"], [])]
-    fig, axes = plt.subplots(1, 2, figsize=(WIDE * 2 / 3, 2.9), sharey=True)
+    fig, axes = plt.subplots(1, 2, figsize=(WIDE * 2 / 3, 2.9))  # a scale per panel
     for ax, (title, named, grey) in zip(axes, panels):
         colour = iter(PANEL_COLOURS)
         for m in grey + named:
@@ -175,21 +195,22 @@ def timing_figure(res, figs, listing):
         ax.set_title(title)
         ax.legend(ncol=1, loc="upper center", bbox_to_anchor=(0.5, -0.22), frameon=False)
     axes[0].set_ylabel("median run time [ms]")
-    save(fig, os.path.join(figs, "fig_timing.pdf"), listing, "thesis fig. 4.12-4.13: run time against n")
+    fig.tight_layout()
+    save(fig, os.path.join(figs, "fig_timing.pdf"), listing, "thesis fig. 4.12-4.13: run time against n", width=0.67)
 
 
 def appendix_figure(res, figs, listing):
     index = read_csv(os.path.join(res, "appendix1", "index.csv"))
     # Six rows of five, a full page: each panel with its own ticks (the sets span very different scales).
-    fig, axes = plt.subplots(6, 5, figsize=(WIDE, 8.6))
+    fig, axes = plt.subplots(6, 5, figsize=(WIDE, 8.4))
     for ax, row in zip(axes.flat, index):
-        ax.tick_params(labelsize=5, length=2, pad=1)
+        ax.tick_params(labelsize=7, length=2, pad=1)
         ax.locator_params(nbins=3)
         label = f"P1.{row['figure']}"
         if not row["file"]:
             ax.set_xticks([])
             ax.set_yticks([])
-            ax.text(0.5, 0.5, "D <= 0:\nnot run", ha="center", va="center", fontsize=6, transform=ax.transAxes)
+            ax.text(0.5, 0.5, "D <= 0:\nnot run", ha="center", va="center", fontsize=7, transform=ax.transAxes)
         else:
             traj = read_csv(os.path.join(res, "appendix1", row["file"]))
             xs = [num(r["Rx"]) for r in traj]
@@ -202,12 +223,13 @@ def appendix_figure(res, figs, listing):
                 label += " (leaves)"
             if row["status"] != "ok":
                 label += f" ({row['status']})"
-        ax.set_title(label, fontsize=6, pad=2)
-    fig.supxlabel("x", fontsize=7)
-    fig.supylabel("y", fontsize=7)
+        ax.set_title(label, fontsize=7, pad=2)
+    fig.supxlabel("x", fontsize=8)
+    fig.supylabel("y", fontsize=8)
     fig.tight_layout(pad=0.4, h_pad=0.6, w_pad=0.4)
     save(fig, os.path.join(figs, "fig_appendix1.pdf"), listing,
-         "thesis appendix 1 (fig. P1.1-P1.30): trajectories in the (x, y) plane, thesis-euler, h = 1e-4")
+         "thesis appendix 1 (fig. P1.1-P1.30): trajectories in the (x, y) plane, thesis-euler, h = 1e-4",
+         max_height=0.86)
 
 
 def pareto(points):
@@ -220,27 +242,43 @@ def pareto(points):
     return front
 
 
-def place_labels(ax, labels, fontsize=5):
+def place_labels(ax, labels, fontsize=7):
     """Annotates each (x, y, text, colour) beside its point, moving a label down in steps of a line
     until its box overlaps no label placed before it (labels of neighbouring fronts collided)."""
     ax.autoscale_view()
     to_pt = 72.0 / ax.figure.dpi
     char_w, line_h = 0.55 * fontsize, 1.25 * fontsize  # points
     placed = []  # boxes (x0, y0, x1, y1) in points
+    right_edge = ax.get_window_extent().x1 * to_pt
     for x, y, text, colour in labels:
         px, py = (v * to_pt for v in ax.transData.transform((x, y)))
+        width = char_w * len(text)
+        # Left of the point where the label would cross the axes' right edge (it widened the figure).
+        dx = 3.0 if px + 3.0 + width <= right_edge else -3.0 - width
         dy = 3.0
         for _ in range(12):
-            box = (px + 3.0, py + dy, px + 3.0 + char_w * len(text), py + dy + line_h)
+            box = (px + dx, py + dy, px + dx + width, py + dy + line_h)
             if not any(box[0] < b[2] and b[0] < box[2] and box[1] < b[3] and b[1] < box[3] for b in placed):
                 break
             dy -= line_h
         placed.append(box)
-        ax.annotate(text, (x, y), fontsize=fontsize, color=colour, xytext=(3, dy), textcoords="offset points")
+        ax.annotate(text, (x, y), fontsize=fontsize, color=colour, xytext=(dx, dy), textcoords="offset points")
+
+
+def reference_errors(path):
+    """{scene: relative error of its long-double reference}, from work-precision's CSV header."""
+    out = {}
+    with open(path) as f:
+        for line in f:
+            m = re.match(r"# reference (\S+): .* \(relative (\S+)\)", line)
+            if m:
+                out[m.group(1)] = float(m.group(2))
+    return out
 
 
 def work_precision_figures(res, figs, listing):
     rows = read_csv(os.path.join(res, "work_precision.csv"))
+    unresolved = reference_errors(os.path.join(res, "work_precision.csv"))
     scenes = scenes_of(rows)
     for scene in scenes:
         fig, ax = plt.subplots(figsize=(WIDE / 2, 2.8))
@@ -264,12 +302,14 @@ def work_precision_figures(res, figs, listing):
                 labels.append((t, e, lab, colour))
         ax.set_xscale("log")
         ax.set_yscale("log")
+        if scene in unresolved:  # errors the reference cannot resolve: greyed
+            ax.axhspan(ax.get_ylim()[0], unresolved[scene], color="0.88", zorder=0, linewidth=0)
         place_labels(ax, labels)
         ax.set_xlabel("run time [ms]")
         ax.set_ylabel("final-position error |dR|/|R|")
         ax.set_title(f"scene {scene}: Pareto front per family")
-        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=3, frameon=False)  # off the labels
-        save(fig, os.path.join(figs, f"fig_wp_{scene}.pdf"), listing, f"work-precision on scene {scene}")
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2, frameon=False)  # off the labels
+        save(fig, os.path.join(figs, f"fig_wp_{scene}.pdf"), listing, f"work-precision on scene {scene}", width=0.49)
 
 
 def by_tol_figure(res, figs, listing):
@@ -290,7 +330,10 @@ def by_tol_figure(res, figs, listing):
         ax.set_title(scene)
         ax.set_xlabel("requested TOL")
     axes[0][0].set_ylabel("delivered error")
-    axes[0][0].legend(loc="lower right")
+    handles, names = axes[0][0].get_legend_handles_labels()
+    fig.tight_layout()
+    # Below the panels and their axis labels, off the data.
+    fig.legend(handles, names, loc="upper center", bbox_to_anchor=(0.5, -0.01), ncol=4, frameon=False)
     save(fig, os.path.join(figs, "fig_by_tol.pdf"), listing, "delivered error against requested TOL")
 
 
@@ -311,7 +354,8 @@ def far_field_figure(res, figs, listing):
     ax.set_xlabel("spin angle per step [rad]")
     ax.set_ylabel("relative error at t = 80")
     ax.legend(loc="lower right")
-    save(fig, os.path.join(figs, "fig_far_field.pdf"), listing, "far pass: error against the spin angle per step")
+    save(fig, os.path.join(figs, "fig_far_field.pdf"), listing, "far pass: error against the spin angle per step",
+         width=0.55)
 
 
 def map_figure(res, figs, listing):
@@ -339,7 +383,7 @@ def map_figure(res, figs, listing):
             grid[Ls.index(num(r["L"]))][ds.index(num(r["d"]))] = math.log10(v) if ok else float("nan")
         image = ax.pcolormesh(ds, Ls, grid, cmap=cmap, vmin=-16, vmax=0, shading="nearest")
         ax.grid(False)
-        ax.set_title(m, pad=2, fontsize=6)
+        ax.set_title(m, pad=2, fontsize=7)
     for ax in axes.flat[len(methods):]:
         ax.axis("off")
     for ax in axes[-1]:
@@ -390,13 +434,13 @@ def scattering_figure(res, figs, listing):
             bins = [r for r in xs if r["series"] == name and r["covered"] == "1" and num(r["dsigma_domega"]) > 0]
             axes[1].errorbar([num(r["theta"]) for r in bins], [num(r["dsigma_domega"]) for r in bins],
                              yerr=[min(num(r["quadrature_error"]), 0.9 * num(r["dsigma_domega"])) for r in bins],
-                             fmt="o-", markersize=2, capsize=1.5, **style)
+                             fmt="o", markersize=2, capsize=1.5, **style)
             if i == 0:
                 axes[1].plot([num(r["theta"]) for r in bins], [num(r["dsigma_rutherford_gc"]) for r in bins],
                              color="grey", linewidth=2.5, alpha=0.35, zorder=0, label="Rutherford (guiding centre)")
-        for ax, (xl, yl) in zip(axes, [("impact parameter b", "deflection theta (rad)"),
-                                       ("deflection theta (rad)", "dsigma/dOmega (beam)"),
-                                       ("impact parameter b", "closest approach r_min")]):
+        for ax, (xl, yl) in zip(axes, [(r"impact parameter $b$", r"deflection $\theta$ [rad]"),
+                                       (r"deflection $\theta$ [rad]", r"$d\sigma/d\Omega$ (beam)"),
+                                       (r"impact parameter $b$", r"closest approach $r_{\min}$")]):
             ax.set_xscale("log")
             ax.set_yscale("log")
             ax.set_xlabel(xl)
