@@ -184,7 +184,7 @@ def timing_figure(res, figs, listing):
     for ax, (title, named, grey) in zip(axes, panels):
         colour = iter(PANEL_COLOURS)
         for m in grey + named:
-            rs = groups.get(m, [])
+            rs = [r for r in groups.get(m, []) if not r.get("flag")]  # a flagged time is not drawn
             xs, ys = [num(r["n"]) for r in rs], [num(r["median_s"]) * 1e3 for r in rs]
             if m in grey:
                 ax.plot(xs, ys, color="0.65", linewidth=0.5, label=f"other drift/kick ({len(grey)})" if m == grey[0] else None)
@@ -285,7 +285,7 @@ def work_precision_figures(res, figs, listing):
         labels = []  # (time, error, text, colour) of the methods named on the fronts
         for fam, colour in family_colours():
             pts = [(num(r["wall_s"]) * 1e3, num(r["err_rel"]), r["method"]) for r in rows
-                   if r["scene"] == scene and family(r["method"]) == fam]
+                   if r["scene"] == scene and family(r["method"]) == fam and not r.get("flag")]  # flagged: no time
             pts = [p for p in pts if p[0] > 0 and 0 < p[1] < 1]
             front = pareto(pts)
             if not front:

@@ -559,10 +559,9 @@ def methods_table(res, out, M):
         M.add("NsPerEvalHighMethod", tt(hi), math_mode=False)
         M.add("NsPerEvalMedian", f"{statistics.median(per_eval.values()):.0f}")
     both = [m for m in bns if m in tns]
-    if both:
-        gap = [max(bns[m], tns[m]) / min(bns[m], tns[m]) for m in both]
-        M.add("BenchTimingGap", f"{max(gap):.2f}")
-        M.add("BenchTimingGapMedian", f"{statistics.median(gap):.2f}")
+    gap = [max(bns[m], tns[m]) / min(bns[m], tns[m]) for m in both]
+    M.add("BenchTimingGap", f"{max(gap):.2f}" if gap else "n/a")
+    M.add("BenchTimingGapMedian", f"{statistics.median(gap):.2f}" if gap else "n/a")
 
 
 def md_table(path):
@@ -643,6 +642,7 @@ def close_table(res, out, M):
                 ok = [r for r in rows if family(r["method"]) == fam and num(r["err_rel"]) <= float(target)]
                 if not ok:
                     f.write(f"{power} & {fam} & none & & & \\\\\n")
+                    M.add(f"CloseEvals{camel(fam)}{target_word(target)}", "none reaching it", math_mode=False)
                     continue
                 best = min(ok, key=lambda r: num(r["wall_s"]))
                 t = "\\emph{flagged}" if best["flag"] else f"{num(best['wall_s']) * 1e3:.3g}"
@@ -667,9 +667,8 @@ def by_tol(res, out, M):
     M.add("AutoRuns", count(len(auto)))
     M.add("AutoMet", count(len(met)))
     ratios = [num(r["err_estimate"]) / num(r["err"]) for r in met if num(r["err"]) > 0]
-    if ratios:
-        M.add("AutoEstLow", sci(min(ratios)))
-        M.add("AutoEstHigh", sci(max(ratios)))
+    M.add("AutoEstLow", sci(min(ratios)) if ratios else "n/a")
+    M.add("AutoEstHigh", sci(max(ratios)) if ratios else "n/a")
     peers = [r for r in rows if r["kind"] == "at-tol"]
     M.add("PeerRuns", count(len(peers)))
     M.add("PeerMet", count(sum(1 for r in peers if r["met"] == "yes")))
@@ -695,17 +694,13 @@ def by_tol(res, out, M):
         clause = (f"; against the fastest of those that did, \\cmd{{auto}} is ${sci(min(at_tol))}$ to "
                   f"${sci(max(at_tol))}$ times as fast")
     M.add("AutoVsPeerAtTolSpin", clause, math_mode=False)
-    spinning_alone = [r for scene, rs in alone.items() if scene != "material" for r in rs]
-    if spinning_alone:
-        M.add("AutoAloneSpinLow", sci(min(spinning_alone)))
-        M.add("AutoAloneSpinHigh", sci(max(spinning_alone)))
-    spinning = [r for scene, rs in ratios.items() if scene != "material" for r in rs]
-    if spinning:
-        M.add("AutoVsPeerSpinLow", sci(min(spinning)))
-        M.add("AutoVsPeerSpinHigh", sci(max(spinning)))
-    if ratios.get("material"):
-        M.add("AutoVsPeerMaterialLow", sci(min(ratios["material"])))
-        M.add("AutoVsPeerMaterialHigh", sci(max(ratios["material"])))
+    # A ratio whose times do not count (flagged) is left out; none left: "n/a".
+    def low_high(name, values):
+        M.add(f"{name}Low", sci(min(values)) if values else "n/a")
+        M.add(f"{name}High", sci(max(values)) if values else "n/a")
+    low_high("AutoAloneSpin", [r for scene, rs in alone.items() if scene != "material" for r in rs])
+    low_high("AutoVsPeerSpin", [r for scene, rs in ratios.items() if scene != "material" for r in rs])
+    low_high("AutoVsPeerMaterial", ratios.get("material", []))
     with open(os.path.join(out, "tab_by_tol.tex"), "w") as f:
         for row in body:
             f.write(" & ".join(latex_cell(row[i]) for i in keep) + " \\\\\n")
