@@ -106,8 +106,7 @@ void add_work_precision_options(po::options_description& desc, WorkPrecisionArgs
       ("by-tol", po::bool_switch(&a.by_tol), "second view: auto and every step-size-controlled peer with the same "
        "requested tolerance; delivered error, whether it met TOL, and time")
       ("tols", po::value(&a.tols)->default_value(a.tols), "with --by-tol: the tolerances")
-      ("quick", po::bool_switch(&a.quick), "coarse: scenes thesis and material, repeats of one call, every ladder (the peers' too) up to 1e6 force "
-       "evaluations")
+      ("quick", po::bool_switch(&a.quick), "coarse: scenes thesis and material, every ladder (the peers' too) up to 1e6 force evaluations")
       ("out", po::value(&a.out), "CSV: scene, method, h, tol, err_R, err_rel, max_rel_dE, force_evals, wall_s, cpu_s, "
        "spread, repeats, flag")
       ("summary", po::value(&a.summary), "also write the summary table (Markdown) to this file");
@@ -117,7 +116,6 @@ void add_work_precision_options(po::options_description& desc, WorkPrecisionArgs
 void settle(const po::variables_map& vm, WorkPrecisionArgs& a) {
   if (a.quick) {
     if (vm["scenes"].defaulted()) a.scenes = "thesis,material";
-    a.o.timing.min_repeat_s = 0.0;
     a.o.cap_peers = true;  // coarse: scene long's low-order peers down to tol 1e-14 took 130 of 270 s
     if (vm["max-evals"].defaulted()) a.o.max_evals = 1e6;
   }
