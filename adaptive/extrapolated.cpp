@@ -20,6 +20,7 @@
 // round-off. Scenes: every centre repulsive (logH needs Pi > 0), Coulomb's law.
 #include "bodypoint/adaptive/extrapolated.hpp"
 
+#include "bodypoint/adaptive/landing.hpp"
 #include "bodypoint/adaptive/time_transformed.hpp"
 #include "bodypoint/detail/run_support.hpp"
 
@@ -171,28 +172,15 @@ std::string stalled(double t) {
 template <class K>
 TimeState land(const Extrapolator<K>& ex, const TimeState& x, double H, int columns, double t_over, double t_end) {
   const double t0 = x.time();
-  double lo = 0.0, f_lo = t0 - t_end, hi = H, f_hi = t_over - t_end;
+  const double f_lo = t0 - t_end, f_hi = t_over - t_end;
   const double tol = 4.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t_end));
   TimeState y = x;
-  int side = 0;
-  for (int it = 0; it < 60; ++it) {
-    const double mid = lo - f_lo * (hi - lo) / (f_hi - f_lo);
-    const double s = (mid > lo && mid < hi) ? mid : 0.5 * (lo + hi);
-    y = unpack(ex.step(x, s, columns, columns, true).y, x);
-    const double f = y.time() - t_end;
-    if (std::abs(f) <= tol) break;
-    if (f > 0) {
-      hi = s;
-      f_hi = f;
-      if (side == 1) f_lo *= 0.5;
-      side = 1;
-    } else {
-      lo = s;
-      f_lo = f;
-      if (side == -1) f_hi *= 0.5;
-      side = -1;
-    }
-  }
+  land_step(
+      [&](double s) {
+        y = unpack(ex.step(x, s, columns, columns, true).y, x);
+        return y.time() - t_end;
+      },
+      0.0, f_lo, H, f_hi, tol);
   y.t = t_end;
   y.t_err = 0.0;
   return y;

@@ -13,6 +13,7 @@
 
 #include "bodypoint/adaptive/extrapolated.hpp"
 #include "bodypoint/adaptive/ks.hpp"
+#include "bodypoint/adaptive/landing.hpp"
 #include "bodypoint/adaptive/time_transformed.hpp"
 #include "bodypoint/detail/run_support.hpp"
 #include "bodypoint/splitting/catalogue.hpp"
@@ -88,36 +89,20 @@ namespace {
 template <const auto& Seq, class K>
 TimeState step_to_time(K& k, const TimeState& from, double ds, double target, double t_full) {
   splitting::NullObserver none;
-  const double gap = target - from.time();
-  double lo = 0.0, f_lo = -gap, hi = ds;
+  const double f_lo = from.time() - target, f_hi = t_full - target;
   TimeState x = from;
-  double f_hi = t_full - target;
   const double tol = 4.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(target));
-  int side = 0;
   if (std::abs(f_hi) <= tol) {  // the whole step lands on the target
-    sp::integrate<Seq>(k, x, hi, 1, none);
+    sp::integrate<Seq>(k, x, ds, 1, none);
     return x;
   }
-  for (int it = 0; it < 60; ++it) {
-    const double mid = lo - f_lo * (hi - lo) / (f_hi - f_lo);
-    const double next = (mid > lo && mid < hi) ? mid : 0.5 * (lo + hi);
-    TimeState y = from;
-    sp::integrate<Seq>(k, y, next, 1, none);
-    const double f = y.time() - target;
-    if (std::abs(f) <= tol) return y;
-    if (f > 0) {
-      hi = next;
-      f_hi = f;
-      if (side == 1) f_lo *= 0.5;
-      side = 1;
-    } else {
-      lo = next;
-      f_lo = f;
-      if (side == -1) f_hi *= 0.5;
-      side = -1;
-    }
-    x = y;
-  }
+  land_step(
+      [&](double s) {
+        x = from;
+        sp::integrate<Seq>(k, x, s, 1, none);
+        return x.time() - target;
+      },
+      0.0, f_lo, ds, f_hi, tol);
   return x;
 }
 
