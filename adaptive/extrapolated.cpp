@@ -45,13 +45,10 @@ constexpr int kStartColumns = 4;
 constexpr double kSafety = 0.94, kSafetyOrder = 0.65, kMinFactor = 0.02, kMaxFactor = 4.0;
 /// Rejections in a row before the run stops with the reason.
 constexpr int kMaxRejections = 60;
-/// Macro steps before the run stops (a tolerance or scene that needs more is out of reach).
-constexpr long kMaxMacroSteps = 200'000'000;
 
 /// The extrapolated variables: R, K1, K2, t, g.
 using Vec = std::array<double, 11>;
 
-template <class K>
 Vec pack(const TimeState& x) {
   const Vec3 R = x.q.R - x.q.R_err, K1 = x.q.K1 - x.q.K1_err;
   return {R.x(), R.y(), R.z(), K1.x(), K1.y(), K1.z(), x.q.K2.x(), x.q.K2.y(), x.q.K2.z(), x.time(), x.g};
@@ -105,7 +102,7 @@ struct Extrapolator {
       bad.fill(std::numeric_limits<double>::quiet_NaN());
       return bad;
     }
-    return pack<K>(x);
+    return pack(x);
   }
 
   /// The scaled error of the difference a - b: max_i |a_i - b_i| / (tol (1 + |a_i|)).
@@ -195,7 +192,7 @@ TimeState run_macro_steps(K& k, TimeState x, const ControlledSteps& spec, Obs& o
   int rejected = 0;
   long macro = 0;
   while (x.time() < spec.t_end) {
-    if (++macro > kMaxMacroSteps) throw Error("logh-bs: more than 2e8 macro steps before t_end; loosen the tolerance");
+    if (++macro > detail::kMaxAdaptiveSteps) throw Error("logh-bs: more than 2e8 macro steps before t_end; loosen the tolerance");
     splitting::poll(obs, macro);  // a cancellation is seen between rejected steps too
     const auto a = ex.step(x, H, std::max(2, target - 1), std::min(kMaxColumns, target + 1));
     if (a.columns == 0) {  // rejected at every column allowed
@@ -212,7 +209,7 @@ TimeState run_macro_steps(K& k, TimeState x, const ControlledSteps& spec, Obs& o
     x = y;
     st.add(dt);
     detail::check_adaptive_rate(st.steps, x.time(), spec.t_end);  // a rate that cannot reach t_end stops the run
-    if constexpr (Obs::active) obs.observe(st.steps, x.time(), pack<K>(x), x.time() >= spec.t_end);
+    if constexpr (Obs::active) obs.observe(st.steps, x.time(), pack(x), x.time() >= spec.t_end);
     // Order and step by the work per unit step (force evaluations over the step each column's error
     // allows): one column fewer when that is cheaper, one more when the accepted one was cheaper than
     // the one below it, else the same.

@@ -3,21 +3,21 @@
 // in one process, so that both sides share the machine's state.
 //
 // For each named scene (thesis, close, material, two-centres), stepper and TOL 1e-4, 1e-7, 1e-10: both
-// sides are called once (their final states must agree to the tolerance, their force evaluations
-// nearly), then kRounds rounds each time a batch of plain calls and a batch of bodypoint calls
-// (a batch lasts at least kMinBatchSeconds), alternating which goes first. The ratio of a round is
-// bodypoint's time per force evaluation over the plain program's; the row reports the medians of both
-// times, their spreads (interquartile range over the median) and the median of the rounds' ratios.
-// Exits 1 when a median ratio exceeds 1 + kPeerMargin (the issue's bound: within 10 %).
+// sides are called once (their final states and force evaluations compared), then timed under the
+// commands' timing rules (experiments/stopwatch.hpp: warm-up, kRounds repeats interleaved, batches of
+// >= kMinBatchSeconds, wall and CPU time, median, spread, flag). The ratio is bodypoint's median time per
+// force evaluation over the plain program's. Exits 1 when a ratio exceeds 1 + kPeerMargin (the issue's
+// bound: within 10 %).
 //
 //   gsl_peer [--csv FILE]      Markdown table on standard output
+#include "stopwatch.hpp"
+
 #include "bodypoint/methods.hpp"
 #include "bodypoint/model.hpp"
 #include "bodypoint/run.hpp"
 #include "bodypoint/scenes.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -36,36 +36,16 @@ using namespace bodypoint;
 /// bodypoint's peer may cost at most this share more per force evaluation than the plain C program.
 constexpr double kPeerMargin = 0.10;
 /// Interleaved rounds (the timing rules ask for at least 5).
-constexpr int kRounds = 15;
+constexpr long kRounds = 15;
 /// A timed batch lasts at least this long.
 constexpr double kMinBatchSeconds = 5e-3;
-
-double quantile(std::vector<double> v, double q) {
-  std::sort(v.begin(), v.end());
-  const double x = q * static_cast<double>(v.size() - 1);
-  const auto i = static_cast<std::size_t>(x);
-  return i + 1 < v.size() ? v[i] + (x - static_cast<double>(i)) * (v[i + 1] - v[i]) : v[i];
-}
-
-double spread(const std::vector<double>& v) { return (quantile(v, 0.75) - quantile(v, 0.25)) / quantile(v, 0.5); }
-
-/// Seconds per call of f over a batch of `calls`.
-double time_batch(const std::function<void()>& f, long calls) {
-  const auto t0 = std::chrono::steady_clock::now();
-  for (long i = 0; i < calls; ++i) f();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / static_cast<double>(calls);
-}
-
-long batch_for(const std::function<void()>& f) {
-  const double one = time_batch(f, 1);
-  return one >= kMinBatchSeconds ? 1 : static_cast<long>(std::ceil(kMinBatchSeconds / std::max(one, 1e-9)));
-}
 
 struct Row {
   std::string scene, stepper;
   double tol;
   long evals, plain_evals;
-  double ours_s, ours_spread, plain_s, plain_spread, ratio, state_diff;
+  cli::Timing ours, plain;
+  double ratio, state_diff;
 };
 
 Row measure(const NamedScene& ns, const std::string& stepper, double tol) {
@@ -90,23 +70,9 @@ Row measure(const NamedScene& ns, const std::string& stepper, double tol) {
   ours();
   if (plain_evals < 0) throw Error("gsl_plain: the driver failed");
   const double diff = (r.final.R - Vec3(y[0], y[1], y[2])).norm() / r.final.R.norm();
-  const long plain_batch = batch_for(plain), ours_batch = batch_for(ours);
-  std::vector<double> t_plain, t_ours, ratios;
-  for (int k = 0; k < kRounds; ++k) {
-    double a, b;
-    if (k % 2 == 0) {
-      a = time_batch(plain, plain_batch);
-      b = time_batch(ours, ours_batch);
-    } else {
-      b = time_batch(ours, ours_batch);
-      a = time_batch(plain, plain_batch);
-    }
-    t_plain.push_back(a);
-    t_ours.push_back(b);
-    ratios.push_back((b / static_cast<double>(r.force_evals)) / (a / static_cast<double>(plain_evals)));
-  }
-  return {ns.name, stepper, tol, r.force_evals, plain_evals, quantile(t_ours, 0.5), spread(t_ours),
-          quantile(t_plain, 0.5), spread(t_plain), quantile(ratios, 0.5), diff};
+  const std::vector<cli::Timing> t = cli::time_interleaved({plain, ours}, {1, kRounds, kMinBatchSeconds});
+  const double ratio = (t[1].wall_s / static_cast<double>(r.force_evals)) / (t[0].wall_s / static_cast<double>(plain_evals));
+  return {ns.name, stepper, tol, r.force_evals, plain_evals, t[1], t[0], ratio, diff};
 }
 
 }  // namespace
@@ -125,32 +91,35 @@ int main(int argc, char** argv) {
     std::vector<Row> rows;
     double worst = 0.0;
     std::printf("| scene | stepper | TOL | force evals (bodypoint, plain) | bodypoint [ms] | spread | plain C [ms] "
-                "| spread | bodypoint / plain per evaluation | final states differ by |\n"
-                "|---|---|---|---|---|---|---|---|---|---|\n");
+                "| spread | bodypoint / plain per evaluation | final states differ by | flag |\n"
+                "|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (const char* scene : {"thesis", "close", "material", "two-centres"})
       for (const char* stepper : {"rk8pd", "rkf45"})
         for (double tol : {1e-4, 1e-7, 1e-10}) {
           const Row w = measure(named_scene(scene), stepper, tol);
           worst = std::max(worst, w.ratio);
-          std::printf("| %s | %s | %.0e | %ld, %ld | %.3g | %.0f%% | %.3g | %.0f%% | %.3f | %.1e |\n", w.scene.c_str(),
-                      w.stepper.c_str(), w.tol, w.evals, w.plain_evals, w.ours_s * 1e3, w.ours_spread * 100,
-                      w.plain_s * 1e3, w.plain_spread * 100, w.ratio, w.state_diff);
+          const std::string flag = w.ours.flag() + (w.plain.flag().empty() ? "" : " plain: " + w.plain.flag());
+          std::printf("| %s | %s | %.0e | %ld, %ld | %.3g | %.0f%% | %.3g | %.0f%% | %.3f | %.1e | %s |\n",
+                      w.scene.c_str(), w.stepper.c_str(), w.tol, w.evals, w.plain_evals, w.ours.wall_s * 1e3,
+                      w.ours.spread() * 100, w.plain.wall_s * 1e3, w.plain.spread() * 100, w.ratio, w.state_diff,
+                      flag.c_str());
           std::fflush(stdout);
           rows.push_back(w);
         }
-    std::printf("\nworst ratio %.3f (bound %.2f); %d rounds alternating the two sides, batches of >= %g ms; "
-                "times: medians per call; ratio: median of the rounds' ratios per force evaluation\n",
-                worst, 1.0 + kPeerMargin, kRounds, kMinBatchSeconds * 1e3);
+    std::printf("\nworst ratio %.3f (bound %.2f); %d repeats interleaved (experiments/stopwatch.hpp), batches of >= "
+                "%g ms; times: medians per call; ratio: of the medians per force evaluation\n",
+                worst, 1.0 + kPeerMargin, static_cast<int>(kRounds), kMinBatchSeconds * 1e3);
     if (!csv.empty()) {
       const std::string tmp = csv + ".tmp";
       {
         std::ofstream f(tmp);
-        f << "scene,stepper,tol,force_evals,plain_force_evals,wall_s,spread,plain_wall_s,plain_spread,ratio_per_eval,"
-             "state_diff\n";
+        f << "scene,stepper,tol,force_evals,plain_force_evals,wall_s,cpu_s,spread,plain_wall_s,plain_cpu_s,"
+             "plain_spread,ratio_per_eval,state_diff,flag\n";
         for (const Row& w : rows)
           f << w.scene << ',' << w.stepper << ',' << w.tol << ',' << w.evals << ',' << w.plain_evals << ','
-            << w.ours_s << ',' << w.ours_spread << ',' << w.plain_s << ',' << w.plain_spread << ',' << w.ratio << ','
-            << w.state_diff << '\n';
+            << w.ours.wall_s << ',' << w.ours.cpu_s << ',' << w.ours.spread() << ',' << w.plain.wall_s << ','
+            << w.plain.cpu_s << ',' << w.plain.spread() << ',' << w.ratio << ',' << w.state_diff << ",\""
+            << w.ours.flag() << (w.plain.flag().empty() ? "" : " plain: " + w.plain.flag()) << "\"\n";
         if (!f) throw Error("cannot write " + tmp);
       }
       if (std::rename(tmp.c_str(), csv.c_str()) != 0) throw Error("cannot rename " + tmp + " to " + csv);

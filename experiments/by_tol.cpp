@@ -56,11 +56,6 @@ constexpr double kLadderFloor = 1e-13;
 /// ladder went on to 1e-15 at about 1e8 force evaluations a run).
 constexpr int kLadderStalls = 3;
 
-double median_of(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
 std::vector<std::string> peer_names() {
   std::vector<std::string> out;
   for (const MethodInfo& m : methods())
@@ -281,7 +276,7 @@ void time_rows(std::vector<TolRow>& rows, std::size_t first, const TimingRules& 
     if (!rows[i].run) continue;
     rows[i].time = t[k++];
     if (rows[i].delivered_samples && !rows[i].delivered_samples->empty())
-      rows[i].delivered_wall_s = median_of(*rows[i].delivered_samples);
+      rows[i].delivered_wall_s = median(*rows[i].delivered_samples);
   }
 }
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <ctime>
 #include <iomanip>
+#include <utility>
 #include <sstream>
 
 namespace bodypoint::cli {
@@ -43,6 +44,18 @@ double quantile(std::vector<double> v, double q) {
   return i + 1 < v.size() ? v[i] + (x - static_cast<double>(i)) * (v[i + 1] - v[i]) : v[i];
 }
 
+}  // namespace
+
+double median(std::vector<double> v) { return quantile(std::move(v), 0.5); }
+
+void check_rules(const TimingRules& rules) {
+  if (rules.repeats < 1) throw Error("--repeats must be >= 1");
+  if (rules.repeats > 1'000'000) throw Error("--repeats must be at most 1e6");
+  if (rules.warmup < 0) throw Error("--warmup must be >= 0");
+}
+
+namespace {
+
 std::string percent(double share) {
   std::ostringstream os;
   os << std::fixed << std::setprecision(share >= 0.1 ? 0 : 1) << share * 100.0 << " %";
@@ -64,9 +77,7 @@ std::string Timing::flag() const {
 }
 
 std::vector<Timing> time_interleaved(const std::vector<std::function<void()>>& configs, const TimingRules& rules) {
-  if (rules.repeats < 1) throw Error("--repeats must be >= 1");
-  if (rules.repeats > 1'000'000) throw Error("--repeats must be at most 1e6");  // each keeps its time
-  if (rules.warmup < 0) throw Error("--warmup must be >= 0");
+  check_rules(rules);
   std::vector<long> calls(configs.size(), 1);
   for (std::size_t i = 0; i < configs.size(); ++i) {
     // The last warm-up call (at least one) is timed: the batch size, calls reaching min_repeat_s.
@@ -85,8 +96,8 @@ std::vector<Timing> time_interleaved(const std::vector<std::function<void()>>& c
   std::vector<Timing> out(configs.size());
   for (std::size_t i = 0; i < configs.size(); ++i) {
     Timing& t = out[i];
-    t.wall_s = quantile(wall[i], 0.5);
-    t.cpu_s = quantile(cpu[i], 0.5);
+    t.wall_s = median(wall[i]);
+    t.cpu_s = median(cpu[i]);
     t.q1_wall_s = quantile(wall[i], 0.25);
     t.q3_wall_s = quantile(wall[i], 0.75);
     t.min_wall_s = *std::min_element(wall[i].begin(), wall[i].end());

@@ -55,6 +55,14 @@ struct Timing {
   [[nodiscard]] std::string flag() const;
 };
 
+/// Throws Error unless the rules can be followed: 1 <= repeats <= 1e6 (each repeat keeps its time for
+/// the median: 1e15 of them ran, and allocated, without end), warmup >= 0. The commands check their
+/// options with it before any work; time_interleaved checks again.
+void check_rules(const TimingRules& rules);
+
+/// The median of v (the mean of the middle two for an even count).
+double median(std::vector<double> v);
+
 /// Runs each configuration rules.warmup times, then rules.repeats rounds each timing every
 /// configuration once, in order; returns one Timing per configuration.
 std::vector<Timing> time_interleaved(const std::vector<std::function<void()>>& configs, const TimingRules& rules);

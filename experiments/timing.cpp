@@ -42,10 +42,8 @@ void check_timing_budget(const TimingSpec& spec, double max_seconds) {
 std::vector<TimingRow> run_timing(const TimingSpec& spec, bool progress) {
   if (spec.methods.empty()) throw Error("the method list is empty");
   if (spec.ns.empty()) throw Error("no values of n");
-  if (spec.repeats < 1) throw Error("--repeats must be >= 1");
-  // Each repeat keeps its time for the median: 1e15 of them ran (and allocated) without end.
-  if (spec.repeats > 1'000'000) throw Error("--repeats must be at most 1e6");
-  if (spec.warmup < 0) throw Error("--warmup must be >= 0");
+  const TimingRules rules{spec.warmup, spec.repeats, kMinRepeatSeconds};
+  check_rules(rules);
   for (long n : spec.ns)
     if (n < 1) throw Error("n must be >= 1, got " + std::to_string(n));
   check_timing_budget(spec, spec.max_seconds);
@@ -53,7 +51,6 @@ std::vector<TimingRow> run_timing(const TimingSpec& spec, bool progress) {
   std::vector<TimingRow> rows;
   std::size_t done = 0;
   const std::size_t total = spec.ns.size() * spec.methods.size();
-  const TimingRules rules{spec.warmup, spec.repeats, kMinRepeatSeconds};
   for (long n : spec.ns) {  // at each n, the methods' repeats interleaved
     std::vector<std::function<void()>> runs;
     std::vector<long> evals;
