@@ -55,17 +55,31 @@ eigen=/usr/include/eigen3/Eigen/src/Core/util/Macros.h
   echo "kernel=$(uname -sr)"
 } > "$results/platform.txt"
 
+# Where the time goes: each step's wall seconds, in order (the README states the full build's).
+: > "$results/build_stages.txt"
+stage_start=$(date +%s)
+stage() {
+  local now
+  now=$(date +%s)
+  echo "$1 $((now - stage_start))" >> "$results/build_stages.txt"
+  stage_start=$now
+}
+
 q=()
 [ $mode = quick ] && q=(--quick)
 # --resume: an interrupted build continues its sweeps from their journals (rows of this same build).
 $bin study "${q[@]}" --resume --results "$results"
+stage study
 $bin study "${q[@]}" --name stress --results "$results"
+stage stress
 $bin study "${q[@]}" --name scattering --results "$results"
+stage scattering
 # The (d, L) stability map (thesis resolution in the full build), timed: its wall time is a number of
 # the paper.
 map_start=$(date +%s.%N)
 $bin study "${q[@]}" --resume --name dL-map --results "$results"
 awk -v a="$(date +%s.%N)" -v b="$map_start" -v n="$(nproc)" 'BEGIN { print a - b, n }' > "$results/dL_map_seconds.txt"
+stage dL-map
 
 # Google Benchmark under the same rules: 5 repetitions in random interleaving, medians (and their
 # coefficient of variation) only.
@@ -80,15 +94,19 @@ else
 fi
 $bin work-precision "${wp[@]}" --out "$results/work_precision.csv" --summary "$results/work_precision_summary.md" \
   > "$results/work_precision_summary.txt"
+stage work-precision
 $bin work-precision --by-tol "${by_tol[@]}" --out "$results/by_tol.csv" --summary "$results/by_tol_summary.md" \
   > "$results/by_tol_summary.txt"
+stage by-tol
 # The accuracy mode's honesty on 256 scenes it was not tuned on, at three tolerances (768 runs, about
 # 20 s), against long-double references (no timing, two processes at a time).
 "$py" bench/estimate_grid.py "$bin" --out "$results/estimate_grid.csv" > "$results/estimate_grid.txt"
+stage estimate-grid
 # Where a spinning body's steps go on the close scene (auto and the peers), and the far field's
 # resonances against the spin angle per step (the Python module, from the build tree).
 PYTHONPATH="${BODYPOINT_BUILD_DIR:-build}/python" "$py" bench/far_field.py "$bin" --out-dir "$results" \
   > "$results/far_field.md"
+stage far-field
 # GSL as bodypoint drives it against GSL with a plain C right-hand side and its driver, in one process
 # (bench/gsl_peer.cpp; the paper prints the ratios per force evaluation, also when one exceeds the
 # 10 % bound).
@@ -96,6 +114,7 @@ if [ -x "$bindir/gsl_peer" ]; then
   "$bindir/gsl_peer" --csv "$results/gsl_peer.csv" > "$results/gsl_peer.md" ||
     echo "paper/build.sh: GSL's peer above the plain C program's cost by more than 10 % (results/gsl_peer.md; the paper says so)" >&2
 fi
+stage gsl-peer
 # Google Benchmark's medians keep their names; the coefficient of variation rows (_cv) are the spread.
 bench_medians() {
   grep -v '^"BM_[A-Za-z]*/.*_\(mean\|stddev\)"' "$1" | sed 's#_median"#"#' > "$1.2" && mv "$1.2" "$1"
@@ -105,15 +124,18 @@ bench_medians() {
   > "$results/bench_steps.csv.tmp" 2>/dev/null
 bench_medians "$results/bench_steps.csv.tmp"
 mv "$results/bench_steps.csv.tmp" "$results/bench_steps.csv"
+stage bench-steps
 # Sweep throughput per core: the scalar loop against batches of vector lanes.
 "$bindir/bench_batch" "${bench[@]}" --benchmark_format=csv > "$results/bench_batch.csv.tmp" 2>/dev/null
 bench_medians "$results/bench_batch.csv.tmp"
 mv "$results/bench_batch.csv.tmp" "$results/bench_batch.csv"
+stage bench-batch
 # One sweep run scalar, in lanes, on 2 threads, 2 MPI ranks and 2 shards: throughput and efficiency.
 scale=()
 [ $mode = quick ] && scale=(--quick)
 scripts/ensemble-scaling.sh "${scale[@]}" --build "${BODYPOINT_BUILD_DIR:-build}" --csv "$results/scaling.csv" \
   > "$results/scaling.md"
+stage scaling
 
 # The catalogue: the scripts group methods by the families it gives (paper/catalogue.py).
 "$bin" methods --csv > "$results/methods.csv.tmp"
