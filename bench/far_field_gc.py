@@ -29,18 +29,16 @@ Usage (from the repository, after the build):
     PYTHONPATH=build/python /usr/bin/python3 bench/far_field_gc.py [--nodes Q] [--out CSV]
 """
 import argparse
-import csv
 import math
-import os
 
 import numpy as np
 import bodypoint as bp
 
-T_END = 80.0
-M, B, J, K1_0 = 1.0, 0.7, 1.0, 5.0
+# The far passes, their reference, error measure and CSV writing are far_field.py's (the same folder).
+from far_field import B, J, K1 as K1_0, M, SPIN_RATE, T_END, distance, write_csv
+
 D = M * J - B * B
 S = B / D                       # K2 turns about K1 at the rate S |K1|
-SPIN_RATE = S * K1_0
 ANGLES = [0.5, 1.0, 2.0, 3.14, 5.0, 6.28, 10.0, 12.57, 20.0, 30.0, 40.0, 55.0, 70.0, 100.0]
 CENTRES = [(np.zeros(3), -2.0)]  # the thesis scene's centre: A = -2 at the origin
 PICARD_TOL = 1e-15               # y is converged when an iteration changes it by less (relative)
@@ -103,15 +101,6 @@ def field_taylor(g):
         T3 += -A * (-3.0 * dd[None] / r5[:, None, None, None, None] + 15.0 * dxx / r7[:, None, None, None, None]
                     - 105.0 * xxxx / r9[:, None, None, None, None])
     return T0, T1, T2, T3
-
-
-def force(R):
-    F = np.zeros_like(R)
-    for c, A in CENTRES:
-        x = R - c
-        r = np.sqrt(dot(x, x))
-        F += -A * x / (r ** 3)[..., None]
-    return F
 
 
 def chebyshev_grid(n):
@@ -187,9 +176,9 @@ def velocity(K1, K2):
     return (J * K1 - B * K2) / D
 
 
-def run(scene_kw, q, angle, field_iterations):
+def run(scene, q, angle, field_iterations):
     """The prototype on the pass from t = 0 to T_END at a step of `angle` rad of spin (the last one lands)."""
-    s = bp.Stepper(bp.thesis_scene(**scene_kw), "lp-y4", 0.1).state
+    s = bp.Stepper(scene, "lp-y4", 0.1).state  # the scene's initial state
     R, v, w = (np.asarray(s[k], dtype=float) for k in ("R", "v", "w"))
     K1, K2 = M * v + B * w, B * v + J * w
     h_nominal = angle / (S * np.linalg.norm(K1))
@@ -199,10 +188,6 @@ def run(scene_kw, q, angle, field_iterations):
     for _ in range(n):
         R, K1, K2 = step(R, K1, K2, h)
     return R, velocity(K1, K2), step.evals, np.mean(step.iterations), max(step.iterations), h
-
-
-def distance(R, v, ref):
-    return max(np.linalg.norm(R - ref["R"]) / np.linalg.norm(ref["R"]), np.linalg.norm(v - ref["v"]) / np.linalg.norm(ref["v"]))
 
 
 # What the same passes cost the best exact splitting at fixed steps (below the resonance at pi) and GSL's
@@ -226,7 +211,7 @@ def others(scene, ref):
                 r = bp.integrate(scene, method, tol=value, t_end=T_END, h=0.01, invariants=False, estimate_error=False)
                 label = f"tol = {value:g}"
             b = r["bodies"][0]
-            err = distance(b["R"], b["v"], ref)
+            err = distance(b, ref)
             per_rad = b["force_evals"] / (SPIN_RATE * T_END)
             print(f"| {method} | {label} | {err:.2e} | {b['force_evals']} | {per_rad:.2f} |")
             rows.append([method, kind, repr(value), repr(err), b["force_evals"], repr(per_rad)])
@@ -251,25 +236,21 @@ def main():
         print("|---|---|---|---|---|---|---|")
         prev = None
         for angle in ANGLES:
-            R, v, evals, it_mean, it_max, h = run(dict(m=M, B=B, J=J, K1=K1_0, **kw), args.nodes, angle,
+            R, v, evals, it_mean, it_max, h = run(scene, args.nodes, angle,
                                                 args.field_iterations)
-            err = distance(R, v, ref)
+            err = distance({"R": R, "v": v}, ref)
             order = "" if prev is None else f"{math.log(err / prev[1]) / math.log(h / prev[0]):.1f}"
             prev = (h, err)
             per_rad = evals / (SPIN_RATE * T_END)
-            print(f"| {S * K1_0 * h:.3g} | {h:.4g} | {err:.2e} | {order} | {evals} | {per_rad:.2f} | {it_mean:.1f} / {it_max} |")
-            rows.append([kw["Kz"], args.nodes, args.field_iterations, repr(S * K1_0 * h), repr(h), repr(err), evals, repr(per_rad), it_mean, it_max])
+            print(f"| {SPIN_RATE * h:.3g} | {h:.4g} | {err:.2e} | {order} | {evals} | {per_rad:.2f} | {it_mean:.1f} / {it_max} |")
+            rows.append([kw["Kz"], args.nodes, args.field_iterations, repr(SPIN_RATE * h), repr(h), repr(err), evals, repr(per_rad), it_mean, it_max])
         print(f"\nthe same pass: {SPLITTING} at fixed steps and {PEER} at a tolerance per step")
         print("| method | step | error | force evals | per radian |")
         print("|---|---|---|---|---|")
         others(scene, ref)
     if args.out:
-        tmp = args.out + ".tmp"
-        with open(tmp, "w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow(["Kz", "q", "field_iterations", "spin_angle", "h", "err", "field_evals", "per_radian", "picard_mean", "picard_max"])
-            w.writerows(rows)
-        os.replace(tmp, args.out)
+        write_csv(args.out, ["Kz", "q", "field_iterations", "spin_angle", "h", "err", "field_evals", "per_radian",
+                             "picard_mean", "picard_max"], rows)
 
 
 if __name__ == "__main__":

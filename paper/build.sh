@@ -55,13 +55,15 @@ eigen=/usr/include/eigen3/Eigen/src/Core/util/Macros.h
   echo "kernel=$(uname -sr)"
 } > "$results/platform.txt"
 
-# Where the time goes: each step's wall seconds, in order (the README states the full build's).
+# Where the time goes: each step's wall seconds, in order, into build_stages.txt; the last step's in
+# stage_seconds.
 : > "$results/build_stages.txt"
-stage_start=$(date +%s)
+stage_start=$(date +%s.%N)
 stage() {
   local now
-  now=$(date +%s)
-  echo "$1 $((now - stage_start))" >> "$results/build_stages.txt"
+  now=$(date +%s.%N)
+  stage_seconds=$(awk -v a="$now" -v b="$stage_start" 'BEGIN { print a - b }')
+  echo "$1 $stage_seconds" >> "$results/build_stages.txt"
   stage_start=$now
 }
 
@@ -76,10 +78,9 @@ $bin study "${q[@]}" --name scattering --results "$results"
 stage scattering
 # The (d, L) stability map (thesis resolution in the full build), timed: its wall time is a number of
 # the paper.
-map_start=$(date +%s.%N)
 $bin study "${q[@]}" --resume --name dL-map --results "$results"
-awk -v a="$(date +%s.%N)" -v b="$map_start" -v n="$(nproc)" 'BEGIN { print a - b, n }' > "$results/dL_map_seconds.txt"
 stage dL-map
+echo "$stage_seconds $(nproc)" > "$results/dL_map_seconds.txt"
 
 # Google Benchmark under the same rules: 5 repetitions in random interleaving, medians (and their
 # coefficient of variation) only.
