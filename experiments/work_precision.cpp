@@ -96,7 +96,7 @@ void time_scene(std::vector<Row>& rows, std::size_t first, const TimingRules& ru
 struct WorkPrecisionArgs {
   std::string scenes = "all", methods = "all", out, summary;
   std::string tols = "1e-4,1e-5,1e-6,1e-7,1e-8,1e-9,1e-10,1e-11,1e-12";
-  bool quick = false, by_tol = false;
+  bool quick = false, by_tol = false, list_scenes = false;
   Options o;
 };
 
@@ -110,6 +110,7 @@ void add_work_precision_options(po::options_description& desc, WorkPrecisionArgs
       ("by-tol", po::bool_switch(&a.by_tol), "second view: auto and every step-size-controlled peer with the same "
        "requested tolerance; delivered error, whether it met TOL, and time")
       ("tols", po::value(&a.tols)->default_value(a.tols), "with --by-tol: the tolerances")
+      ("list-scenes", po::bool_switch(&a.list_scenes), "print the named scenes that 'all' means, one per line, and exit")
       ("quick", po::bool_switch(&a.quick), "coarse: scenes thesis and material, every ladder (the peers' too) up to 1e6 force evaluations")
       ("out", po::value(&a.out), "CSV: scene, method, h, tol, err_R, err_rel, max_rel_dE, force_evals, wall_s, cpu_s, "
        "spread, repeats, flag")
@@ -311,6 +312,10 @@ int cmd_work_precision(int argc, char** argv) {
              "usage: bodypoint work-precision [options]\n"
              "Final-position error against run time for every method on named scenes."))
     return 0;
+  if (a.list_scenes) {
+    for (const std::string& n : named_scene_names()) std::cout << n << "\n";
+    return 0;
+  }
   settle(vm, a);
   const std::vector<std::string> scene_names = a.scenes == "all" ? named_scene_names() : split_list(a.scenes);
   const std::vector<const MethodInfo*> ms = chosen_methods(a.methods);

@@ -4,6 +4,8 @@
 #
 #   paper/build.sh            thesis grids, every named scene, into paper/results/
 #   paper/build.sh --quick    the same recipes, scenes and sections on coarse grids into paper/results-quick/
+#   paper/build.sh --resume   (with or without --quick) an interrupted build goes on from its first
+#                             unfinished step (the full build takes hours: it can be run in sittings)
 #
 # Steps: bodypoint study (d, L, h, Kx sweeps, timing, force evaluations, appendix 1, errata, the sweeps
 # as published, stress, the (d, L) map, scattering), bodypoint work-precision (ladders and --by-tol),
@@ -19,20 +21,45 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 mode=full
+resume=0
+for arg in "$@"; do
+  case "$arg" in
+    --quick) mode=quick ;;
+    --resume) resume=1 ;;
+    *) echo "usage: paper/build.sh [--quick] [--resume]" >&2; exit 2 ;;
+  esac
+done
 results=paper/results
-if [ "${1:-}" = "--quick" ]; then
-  mode=quick
-  results=paper/results-quick
-elif [ -n "${1:-}" ]; then
-  echo "usage: paper/build.sh [--quick]" >&2
-  exit 2
-fi
+[ $mode = quick ] && results=paper/results-quick
 [ "${BODYPOINT_NO_SETUP:-0}" = 1 ] || scripts/setup.sh >/dev/null
 bindir="${BODYPOINT_BUILD_DIR:-build}/bin"
 bin=$bindir/bodypoint
 py="${PYTHON:-/usr/bin/python3}"  # Debian's python3 with python3-matplotlib
-start=$(date +%s)
 mkdir -p "$results"
+
+# --resume: a build interrupted (killed, or its machine needed) goes on from its first unfinished
+# step, keeping the finished steps' results, provided they come from the same mode, revision, binary and
+# CPU (build_state.txt); each step's time is its own, so the stated build time is the sum of the steps.
+stages="$results/build_stages.txt"
+state="$results/build_state.txt"
+revision=$(git rev-parse HEAD 2>/dev/null || echo unknown)
+git diff --quiet HEAD 2>/dev/null || revision="$revision+uncommitted"
+identity="mode=$mode revision=$revision binary=$(sha256sum "$bin" | cut -c1-16) cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1)"
+sittings=1
+if [ $resume = 1 ]; then
+  if [ ! -f "$state" ] || [ ! -f "$stages" ]; then
+    echo "paper/build.sh: --resume: $results holds no interrupted build (no build_state.txt); run without --resume" >&2
+    exit 2
+  fi
+  if [ "$(head -1 "$state")" != "$identity" ]; then
+    echo "paper/build.sh: --resume: $results was made by another build ($(head -1 "$state")), not by this one ($identity); run without --resume" >&2
+    exit 2
+  fi
+  sittings=$(( $(sed -n 's/^sittings=//p' "$state") + 1 ))
+else
+  : > "$stages"
+fi
+{ echo "$identity"; echo "sittings=$sittings"; } > "$state.tmp" && mv "$state.tmp" "$state"
 
 # The machine and the software every timing of this build ran on (paper: "Reproducing this document").
 builddir="${BODYPOINT_BUILD_DIR:-build}"
@@ -40,7 +67,7 @@ cache_value() { sed -n "s/^$1:[A-Z]*=//p" "$builddir/CMakeCache.txt" | head -1; 
 header_value() { sed -n "s/^#define $2 *\(.*\)$/\1/p" "$1" 2>/dev/null | head -1; }
 cxx=$(cache_value CMAKE_CXX_COMPILER)
 eigen=/usr/include/eigen3/Eigen/src/Core/util/Macros.h
-{
+[ $resume = 1 ] || {
   echo "cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1)"
   echo "mhz=$(sed -n 's/^cpu MHz[[:space:]]*: //p' /proc/cpuinfo | head -1)"
   echo "cores=$(nproc)"
@@ -55,95 +82,143 @@ eigen=/usr/include/eigen3/Eigen/src/Core/util/Macros.h
   echo "kernel=$(uname -sr)"
 } > "$results/platform.txt"
 
-# Where the time goes: each step's wall seconds, in order, into build_stages.txt; the last step's in
-# stage_seconds.
-: > "$results/build_stages.txt"
-stage_start=$(date +%s.%N)
-stage() {
-  local now
-  now=$(date +%s.%N)
-  stage_seconds=$(awk -v a="$now" -v b="$stage_start" 'BEGIN { print a - b }')
-  echo "$1 $stage_seconds" >> "$results/build_stages.txt"
-  stage_start=$now
+# Where the time goes: each step's wall seconds, in order, into build_stages.txt.
+now() { date +%s.%N; }
+since() { awk -v a="$(now)" -v b="$1" 'BEGIN { print a - b }'; }
+# step NAME COMMAND...: runs the step unless --resume finds it finished; logs its wall seconds.
+step() {
+  local name=$1 t0
+  shift
+  if [ $resume = 1 ] && grep -q "^$name " "$stages"; then
+    echo "paper/build.sh: $name finished in an earlier sitting, kept"
+    return
+  fi
+  t0=$(now)
+  "$@"
+  echo "$name $(since "$t0")" >> "$stages"
 }
 
 q=()
 [ $mode = quick ] && q=(--quick)
 # --resume: an interrupted build continues its sweeps from their journals (rows of this same build).
-$bin study "${q[@]}" --resume --results "$results"
-stage study
-$bin study "${q[@]}" --name stress --results "$results"
-stage stress
-$bin study "${q[@]}" --name scattering --results "$results"
-stage scattering
+step study "$bin" study "${q[@]}" --resume --results "$results"
+step stress "$bin" study "${q[@]}" --name stress --results "$results"
+step scattering "$bin" study "${q[@]}" --name scattering --results "$results"
 # The (d, L) stability map (thesis resolution in the full build), timed: its wall time is a number of
 # the paper.
-$bin study "${q[@]}" --resume --name dL-map --results "$results"
-stage dL-map
-echo "$stage_seconds $(nproc)" > "$results/dL_map_seconds.txt"
+dL_map() {
+  local t0
+  t0=$(now)
+  "$bin" study "${q[@]}" --resume --name dL-map --results "$results"
+  echo "$(since "$t0") $(nproc)" > "$results/dL_map_seconds.txt"
+}
+step dL-map dL_map
 
 # Google Benchmark under the same rules: 5 repetitions in random interleaving, medians (and their
 # coefficient of variation) only.
 bench=(--benchmark_repetitions=5 --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true)
 if [ $mode = quick ]; then
-  wp=(--quick --scenes all --max-evals 3e5)
+  wp=(--quick --max-evals 3e5)
   by_tol=(--tols 1e-4,1e-7,1e-10 --scenes thesis,close,material,two-centres)
   bench+=(--benchmark_min_time=0.01)
 else
   wp=()
   by_tol=()
 fi
-$bin work-precision "${wp[@]}" --out "$results/work_precision.csv" --summary "$results/work_precision_summary.md" \
-  > "$results/work_precision_summary.txt"
-stage work-precision
-$bin work-precision --by-tol "${by_tol[@]}" --out "$results/by_tol.csv" --summary "$results/by_tol_summary.md" \
-  > "$results/by_tol_summary.txt"
-stage by-tol
+# Work-precision one scene at a time (each scene's configurations are timed interleaved; a scene is
+# the unit a resumed build keeps), then one CSV and one summary of every scene.
+mkdir -p "$results/wp"
+wp_scene() {
+  "$bin" work-precision "${wp[@]}" --scenes "$1" --out "$results/wp/$1.csv" --summary "$results/wp/$1_summary.md" \
+    > /dev/null
+}
+wp_files=()
+for scene in $("$bin" work-precision --list-scenes); do
+  step "work-precision:$scene" wp_scene "$scene"
+  wp_files+=("$scene")
+done
+"$py" - "$results" "${wp_files[@]}" <<'PY'
+import os, sys
+res, scenes = sys.argv[1], sys.argv[2:]
+csvs = [open(os.path.join(res, "wp", s + ".csv")).read().splitlines() for s in scenes]
+sums = [open(os.path.join(res, "wp", s + "_summary.md")).read().splitlines() for s in scenes]
+# The CSV: the first scene's header and notes, every scene's reference line, every scene's rows.
+first = csvs[0]
+notes = [l for l in first[1:] if l.startswith("#")]
+refs = [l for c in csvs for l in c[1:] if l.startswith("# reference ")]
+cut = max(i for i, l in enumerate(notes) if l.startswith("# reference "))
+head = [first[0]] + [l for l in notes[:cut + 1] if not l.startswith("# reference ")] + refs + notes[cut + 1:]
+rows = [l for c in csvs for l in c[1:] if not l.startswith("#")]
+# The summary: the first scene's comment and table head, every scene's table rows.
+table = sums[0][:3] + [l for s in sums for l in s[3:] if l.startswith("| ")]
+for name, lines in [("work_precision.csv", head + rows), ("work_precision_summary.md", table),
+                    ("work_precision_summary.txt", table[1:])]:
+    path = os.path.join(res, name)
+    with open(path + ".tmp", "w") as f:
+        f.write("\n".join(lines) + "\n")
+    os.replace(path + ".tmp", path)
+PY
+by_tol_step() {
+  "$bin" work-precision --by-tol "${by_tol[@]}" --out "$results/by_tol.csv" --summary "$results/by_tol_summary.md" \
+    > "$results/by_tol_summary.txt"
+}
+step by-tol by_tol_step
 # The accuracy mode's honesty on 256 scenes it was not tuned on, at three tolerances (768 runs, about
 # 20 s), against long-double references (no timing, two processes at a time).
-"$py" bench/estimate_grid.py "$bin" --out "$results/estimate_grid.csv" > "$results/estimate_grid.txt"
-stage estimate-grid
+estimate_grid() { "$py" bench/estimate_grid.py "$bin" --out "$results/estimate_grid.csv" > "$results/estimate_grid.txt"; }
+step estimate-grid estimate_grid
 # Where a spinning body's steps go on the close scene (auto and the peers), and the far field's
 # resonances against the spin angle per step (the Python module, from the build tree).
-PYTHONPATH="${BODYPOINT_BUILD_DIR:-build}/python" "$py" bench/far_field.py "$bin" --out-dir "$results" \
-  > "$results/far_field.md"
-stage far-field
+far_field() {
+  PYTHONPATH="${BODYPOINT_BUILD_DIR:-build}/python" "$py" bench/far_field.py "$bin" --out-dir "$results" \
+    > "$results/far_field.md"
+}
+step far-field far_field
 # GSL as bodypoint drives it against GSL with a plain C right-hand side and its driver, in one process
 # (bench/gsl_peer.cpp; the paper prints the ratios per force evaluation, also when one exceeds the
 # 10 % bound).
-if [ -x "$bindir/gsl_peer" ]; then
-  "$bindir/gsl_peer" --csv "$results/gsl_peer.csv" > "$results/gsl_peer.md" ||
-    echo "paper/build.sh: GSL's peer above the plain C program's cost by more than 10 % (results/gsl_peer.md; the paper says so)" >&2
-fi
-stage gsl-peer
+gsl_peer() {
+  if [ -x "$bindir/gsl_peer" ]; then
+    "$bindir/gsl_peer" --csv "$results/gsl_peer.csv" > "$results/gsl_peer.md" ||
+      echo "paper/build.sh: GSL's peer above the plain C program's cost by more than 10 % (results/gsl_peer.md; the paper says so)" >&2
+  fi
+}
+step gsl-peer gsl_peer
 # Google Benchmark's medians keep their names; the coefficient of variation rows (_cv) are the spread.
 bench_medians() {
   grep -v '^"BM_[A-Za-z]*/.*_\(mean\|stddev\)"' "$1" | sed 's#_median"#"#' > "$1.2" && mv "$1.2" "$1"
 }
 # Cost per step of every method on the thesis scene.
-"$bindir/bench_steps" --benchmark_filter='BM_Step/.*/thesis' "${bench[@]}" --benchmark_format=csv \
-  > "$results/bench_steps.csv.tmp" 2>/dev/null
-bench_medians "$results/bench_steps.csv.tmp"
-mv "$results/bench_steps.csv.tmp" "$results/bench_steps.csv"
-stage bench-steps
+bench_steps() {
+  "$bindir/bench_steps" --benchmark_filter='BM_Step/.*/thesis' "${bench[@]}" --benchmark_format=csv \
+    > "$results/bench_steps.csv.tmp" 2>/dev/null
+  bench_medians "$results/bench_steps.csv.tmp"
+  mv "$results/bench_steps.csv.tmp" "$results/bench_steps.csv"
+}
+step bench-steps bench_steps
 # Sweep throughput per core: the scalar loop against batches of vector lanes.
-"$bindir/bench_batch" "${bench[@]}" --benchmark_format=csv > "$results/bench_batch.csv.tmp" 2>/dev/null
-bench_medians "$results/bench_batch.csv.tmp"
-mv "$results/bench_batch.csv.tmp" "$results/bench_batch.csv"
-stage bench-batch
+bench_batch() {
+  "$bindir/bench_batch" "${bench[@]}" --benchmark_format=csv > "$results/bench_batch.csv.tmp" 2>/dev/null
+  bench_medians "$results/bench_batch.csv.tmp"
+  mv "$results/bench_batch.csv.tmp" "$results/bench_batch.csv"
+}
+step bench-batch bench_batch
 # One sweep run scalar, in lanes, on 2 threads, 2 MPI ranks and 2 shards: throughput and efficiency.
 scale=()
 [ $mode = quick ] && scale=(--quick)
-scripts/ensemble-scaling.sh "${scale[@]}" --build "${BODYPOINT_BUILD_DIR:-build}" --csv "$results/scaling.csv" \
-  > "$results/scaling.md"
-stage scaling
+scaling() {
+  scripts/ensemble-scaling.sh "${scale[@]}" --build "${BODYPOINT_BUILD_DIR:-build}" --csv "$results/scaling.csv" \
+    > "$results/scaling.md"
+}
+step scaling scaling
 
 # The catalogue: the scripts group methods by the families it gives (paper/catalogue.py).
 "$bin" methods --csv > "$results/methods.csv.tmp"
 mv "$results/methods.csv.tmp" "$results/methods.csv"
 
-# How long the results took (the paper states it beside its grids).
-echo "$(( $(date +%s) - start ))" > "$results/build_seconds.txt"
+# How long the results took (the paper states it beside its grids): the sum of the steps' wall times,
+# and in how many sittings.
+awk -v n="$sittings" '{ s += $2 } END { printf "%.0f %d\n", s, n }' "$stages" > "$results/build_seconds.txt"
 
 out=paper/build
 mkdir -p "$out"
@@ -155,4 +230,4 @@ cp paper/bodypoint.tex paper/bodypoint.bib "$out/"
   echo "paper/build.sh: LaTeX failed; the log is $out/bodypoint.log" >&2
   exit 1
 }
-echo "paper/build.sh: $out/bodypoint.pdf ($mode, $(( $(date +%s) - start )) s; results in $results)"
+echo "paper/build.sh: $out/bodypoint.pdf ($mode, results in $(cut -d' ' -f1 "$results/build_seconds.txt") s over $sittings sitting(s); in $results)"

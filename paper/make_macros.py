@@ -986,8 +986,13 @@ def latex_text(text):
 def build_time(res, M):
     """How long this build took to make its results (paper/build.sh writes build_seconds.txt)."""
     path = os.path.join(res, "build_seconds.txt")
-    seconds = float(open(path).read().split()[0]) if os.path.exists(path) else float("nan")
+    fields = open(path).read().split() if os.path.exists(path) else []
+    seconds = float(fields[0]) if fields else float("nan")
+    sittings = int(fields[1]) if len(fields) > 1 else 1
     M.add("BuildMinutes", f"{seconds / 60:.0f}" if math.isfinite(seconds) else "n/a")
+    M.add("BuildSittings", "in one sitting" if sittings == 1 else
+          f"the sum of its steps' wall times over {sittings} sittings (\\cmd{{paper/build.sh --resume}})",
+          math_mode=False)
 
 
 def platform(res, M):
