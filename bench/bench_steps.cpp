@@ -1,10 +1,12 @@
 // Micro-benchmarks: the floor (one force evaluation, one exact drift), one step of every method on
-// table 3.1 and on a material point, and Boost.Odeint's steppers on the same system.
+// table 3.1 and on a material point, Boost.Odeint's steppers on the same system, and the far pass per
+// radian of spin (BM_FarPass: far-ip at tens of radians per step against the splittings and the peers).
 // Counters: time_per_step (seconds, SI-prefixed) and force evaluations per second.
 //
 //   build/bin/bench_steps --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include "bodypoint/field.hpp"
 #include "bodypoint/methods.hpp"
+#include "bodypoint/reference.hpp"
 #include "bodypoint/sweep.hpp"
 #include "bodypoint/rhs.hpp"
 #include "bodypoint/rk/odeint.hpp"
@@ -13,6 +15,10 @@
 #include "bodypoint/splitting/lie_poisson.hpp"
 
 #include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
 
 namespace bodypoint {
 namespace {
@@ -142,5 +148,61 @@ void BM_OdeintDirectControlledRkf78(benchmark::State& st) {
   set_counters(st, steps, evals);
 }
 BENCHMARK(BM_OdeintDirectControlledRkf78);
+}  // namespace
+}  // namespace bodypoint
+
+namespace bodypoint {
+namespace {
+/// The far pass of bench/far_field.py (table 3.1 with Kz = 0.1 and d = 50, to t = 80: the body stays
+/// 50 or more from the centre the whole time): one whole run per iteration, fixed steps given as the
+/// spin angle per step, or a peer's tolerance per step. Counters: time per radian of spin (the run's
+/// time over the angle the spin turns by), force evaluations per radian, and the final state's
+/// relative error against the long-double reference.
+void BM_FarPass(benchmark::State& st, const std::string& method, double radians_per_step, double tol) {
+  SceneParams params;
+  params.start.Kz = 0.1;
+  params.start.d = 50.0;
+  const Scene s = thesis_scene(params);
+  const Body& b = s.bodies.front();
+  constexpr double kEnd = 80.0;
+  const double turned = std::abs(b.p.B) / b.p.D() * to_momenta(b.p, b.s0).K1.norm() * kEnd;
+  const MethodInfo& m = method_or_throw(method);
+  Advance how = ControlledSteps{0.01, kEnd, tol};
+  if (!is_step_controlled(m)) {
+    const long n = std::max(1L, std::lround(turned / radians_per_step));
+    how = FixedSteps{kEnd / static_cast<double>(n), n};
+  }
+  static const State ref = reference_state(b, s.centres, kEnd, 1e-18L);
+  RunOptions quiet;
+  quiet.track_invariants = false;
+  RunResult r;
+  for (auto _ : st) {
+    r = run(m, b, s.centres, how, quiet);
+    benchmark::DoNotOptimize(r.final.R);
+  }
+  st.counters["time_per_radian"] =
+      benchmark::Counter(turned, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  st.counters["evals_per_radian"] = static_cast<double>(r.force_evals) / turned;
+  st.counters["error"] = std::max((r.final.R - ref.R).norm() / ref.R.norm(), (r.final.v - ref.v).norm() / ref.v.norm());
+}
+
+void register_far_pass() {
+  struct Case {
+    const char* method;
+    double radians, tol;
+    const char* label;
+  };
+  const Case cases[] = {{"far-ip", 20.0, 0.0, "20rad"},       {"far-ip", 40.0, 0.0, "40rad"},
+                        {"lp-kl6", 2.75, 0.0, "2.75rad"},     {"lp-y4", 2.75, 0.0, "2.75rad"},
+                        {"gsl-rk8pd", 0.0, 1e-10, "tol1e-10"}, {"gsl-rk8pd", 0.0, 1e-12, "tol1e-12"},
+                        {"odeint-rkf78", 0.0, 1e-10, "tol1e-10"}, {"odeint-rkf78", 0.0, 1e-12, "tol1e-12"}};
+  for (const Case& c : cases) {
+    if (!find_method(c.method)) continue;  // GSL is optional in the build
+    benchmark::RegisterBenchmark((std::string("BM_FarPass/") + c.method + "/" + c.label).c_str(),
+                                 [c](benchmark::State& st) { BM_FarPass(st, c.method, c.radians, c.tol); });
+  }
+}
+const int far_pass_registered = (register_far_pass(), 0);
+
 }  // namespace
 }  // namespace bodypoint

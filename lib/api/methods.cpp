@@ -48,7 +48,8 @@ std::vector<const MethodInfo*> methods_named(std::string_view list) {
   const bool all = list == "all", fixed = list == "fixed";
   if (all || fixed) {
     for (const MethodInfo& m : methods())
-      if (all || (!has_variable_step(m) && m.family != Family::KeplerSplit)) ms.push_back(&m);
+      if (all || (!has_variable_step(m) && m.family != Family::KeplerSplit && m.family != Family::FarField))
+        ms.push_back(&m);
     return ms;
   }
   for (std::size_t start = 0; start <= list.size();) {

@@ -7,6 +7,7 @@
 
 #include "bodypoint/detail/run_support.hpp"
 
+#include "bodypoint/far_field.hpp"
 #include "bodypoint/field.hpp"
 #include "bodypoint/rhs.hpp"
 #include "bodypoint/rk/run_odeint.hpp"
@@ -114,6 +115,33 @@ MethodInfo kepler_row() {
           &run_kepler_split<T>, &kepler_split_check};
 }
 
+/// The far-field collocation's assumption: Coulomb's law (its force is -A (R - c)/|R - c|^3).
+std::string far_field_check(const MethodInfo& m, const Body& /*body*/, const std::vector<Centre>& centres) {
+  if (non_coulomb(centres)) return m.name + " assumes Coulomb's law";
+  return "";
+}
+
+/// far-ip: fixed steps of the far-field collocation (far_field.hpp).
+RunResult run_far_field(const Body& body, const std::vector<Centre>& centres, const Advance& how,
+                        const RunOptions& options) {
+  const auto& fixed = std::get<FixedSteps>(how);
+  return dispatch(body, centres, [&](const auto& field, auto /*spin*/) {
+    far_field::Stepper stepper(body.p, centres);
+    auto to_physical = [&body](const Momenta& q) { return to_state(body.p, q); };
+    RunResult r = observe(body.p, field, body.s0, options, detail::grid_of(fixed), to_physical, [&](auto& obs) {
+      Momenta x = to_momenta(body.p, body.s0);
+      for (long i = 0; i < fixed.steps; ++i) {
+        stepper.step(x, fixed.h);
+        if constexpr (std::decay_t<decltype(obs)>::active) obs(i + 1, x);
+        sp::poll(obs, i + 1);
+      }
+      return to_state(body.p, x);
+    });
+    r.force_evals = stepper.evals;
+    return r;
+  });
+}
+
 std::vector<MethodInfo> make_rows() {
   std::vector<MethodInfo> all = {
       {"rk4", Family::Odeint, 4, 4, 4, "classical Runge-Kutta (thesis 2.1; odeint runge_kutta4)",
@@ -146,6 +174,10 @@ std::vector<MethodInfo> make_rows() {
   table = 0;
   sp::for_each(sp::LiePoissonTables{}, [&]<class E>() { all.push_back(lie_row<E>(sp::batch_lie_kernel(table++))); });
   sp::for_each(sp::KeplerSplitTables{}, [&all]<class E>() { all.push_back(kepler_row<E>()); });
+  all.push_back({"far-ip", Family::FarField, 0, 0, 0,
+                 "far-field collocation: Chebyshev-Picard iteration in the interaction picture of the exact drift "
+                 "(Bai and Junkins 2011); a step may turn the spin by tens of radians",
+                 &run_far_field, &far_field_check});
   return all;
 }
 
@@ -176,7 +208,7 @@ Checks checks_for(const MethodInfo& m, const std::vector<Centre>& centres, doubl
   // The exact splittings' drift rotates the spin exactly; without a force nothing else acts on it.
   c.spin_exact = free_flight && (m.family == Family::LiePoisson || m.family == Family::KeplerSplit ||
                                  m.family == Family::TimeTransformed);
-  c.macro_steps = m.family == Family::Extrapolated;
+  c.macro_steps = m.family == Family::Extrapolated || m.family == Family::FarField;
   return c;
 }
 

@@ -90,8 +90,10 @@ struct RunResult {
 /// TimeTransformed: fixed fictitious step ds, variable physical step (logh-*, ttl-*);
 /// Regularised: the Kustaanheimo-Stiefel flow, exact in its fictitious time (ks);
 /// Extrapolated: the logH leapfrog with Bulirsch-Stoer extrapolation and a tolerance per step (logh-bs;
-/// a peer, as Mikkola's codes integrate).
-enum class Family { Thesis, LiePoisson, KeplerSplit, Odeint, OdeintAdaptive, Gsl, TimeTransformed, Regularised, Extrapolated };
+/// a peer, as Mikkola's codes integrate);
+/// FarField: Chebyshev-Picard collocation in the interaction picture of the exact drift, a step set by
+/// the field's slow scale rather than by the spin (far-ip, far_field.hpp).
+enum class Family { Thesis, LiePoisson, KeplerSplit, Odeint, OdeintAdaptive, Gsl, TimeTransformed, Regularised, Extrapolated, FarField };
 
 /// The family's name as `bodypoint methods --markdown` prints it.
 constexpr std::string_view family_name(Family f) {
@@ -105,6 +107,7 @@ constexpr std::string_view family_name(Family f) {
     case Family::TimeTransformed: return "time-transformed";
     case Family::Regularised: return "regularised";
     case Family::Extrapolated: return "logH extrapolated";
+    case Family::FarField: return "far-field collocation";
   }
   return "?";
 }
@@ -121,6 +124,7 @@ constexpr std::string_view family_key(Family f) {
     case Family::TimeTransformed: return "time-transformed";
     case Family::Regularised: return "regularised";
     case Family::Extrapolated: return "extrapolated";
+    case Family::FarField: return "far-field";
   }
   return "?";
 }
@@ -296,9 +300,10 @@ struct Checks {
   bool energy_is_integral = true;  ///< false under the thesis code's force law: E is not conserved there
   bool orbit_exact = false;        ///< the method's stages solve the motion about the centre exactly
   bool spin_exact = false;         ///< free flight, solved exactly by the method's drift (any spin angle)
-  /// A step is an extrapolated macro step (logh-bs): its n substeps are compared and extrapolated under
-  /// the tolerance, so what one macro step turns the spin or the direction to a centre by does not say
-  /// that a rotation went unresolved (as for every peer, its error estimate judges its accuracy).
+  /// A step resolves its own inside: an extrapolated macro step (logh-bs: its n substeps are compared and
+  /// extrapolated under the tolerance) or a collocation step (far-ip: its Chebyshev points sample the
+  /// spin and the force, and its iteration converges or the run fails), so what one step turns the spin
+  /// or the direction to a centre by does not say that a rotation went unresolved.
   bool macro_steps = false;
 };
 /// Throws Error unless max_energy_error is a bound assess() can hold a run to: > 0, not NaN

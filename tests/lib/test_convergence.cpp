@@ -97,6 +97,8 @@ bool measured_here(Family f, double B) {
     case Family::OdeintAdaptive:
     case Family::Gsl:
     case Family::Extrapolated: return false;
+    // Spectral in its step (its error is its points' resolution, not C h^p): tests/lib/test_far_field.cpp.
+    case Family::FarField: return false;
   }
   return false;
 }

@@ -33,7 +33,8 @@ std::string closest_method(std::string_view name);
 const MethodInfo& method_or_throw(std::string_view name);
 
 /// The methods a list names: "all", "fixed" (every fixed-step method but the Kepler split, whose stage
-/// is a Kepler solve: the thesis's studies' set) or names separated by commas. Error for an unknown
+/// is a Kepler solve, and the far-field collocation, whose step is tens of radians of spin, not the
+/// thesis's h: the thesis's studies' set) or names separated by commas. Error for an unknown
 /// name or an empty list.
 std::vector<const MethodInfo*> methods_named(std::string_view list);
 
