@@ -6,7 +6,9 @@ Prints two tables:
    centre (the thesis scene with Kz = 0.1, d = 50, t = 80), against the angle Omega_so h that one step
    turns the spin by. The error is smooth in h below pi per step and jumps at pi, 2 pi, 4 pi: a step
    longer than the spin period lands between resonances, and the error stops being the C h^p that
-   Richardson's estimate assumes.
+   Richardson's estimate assumes. Beside them the far-field collocation far-ip, whose step is set by
+   the field's slow scale, at 0.5 to 100 rad of spin per step, and GSL's rk8pd at tolerances per step:
+   error and force evaluations per radian of spin (the whole pass is beyond r = 50).
 2. Where the steps go on the close scene (Kz = 0.1, d = 0.05, t = 80): the share of steps taken farther
    than r from the centre and the spin angle per step beyond r = 50, for the accuracy mode's delivered
    run and for the peers GSL rk8pd and Boost.Odeint rkf78 with their tolerance set to TOL.
@@ -28,6 +30,10 @@ import bodypoint as bp
 T_END = 80.0
 STEPS = [0.1, 0.2, 0.3, 0.4, 0.45, 0.5, 0.6, 0.7, 0.8, 0.9, 0.916, 0.95, 1.0, 1.2, 1.4, 1.6, 1.83, 2.0, 2.5, 3.0]
 METHODS = ["lp-y4", "lp-kl6"]
+# far-ip's steps, as spin angles per step [rad]: across the splittings' resonances and far beyond.
+FAR_METHOD = "far-ip"
+FAR_ANGLES = [0.5, 1.0, 2.0, 3.14, 5.0, 6.28, 10.0, 12.57, 20.0, 30.0, 40.0, 55.0, 70.0, 100.0]
+PEER_TOLS = [1e-6, 1e-8, 1e-10, 1e-12, 1e-14]
 TOLS = ["1e-4", "1e-7", "1e-10"]
 RADII = [5, 10, 20, 50]
 
@@ -67,8 +73,33 @@ def resonances():
             r = bp.integrate(scene, m, h=h, t_end=T_END, invariants=False)["bodies"][0]
             err = distance(r, ref)
             cells += [f"{err:.2e}", str(r["force_evals"])]
-            rows.append([m, repr(h), repr(SPIN_RATE * h), repr(err), r["force_evals"]])
+            rows.append([m, repr(h), repr(SPIN_RATE * h), repr(err), r["force_evals"],
+                         repr(r["force_evals"] / (SPIN_RATE * T_END))])
         print(f"| {h:g} | {SPIN_RATE * h:.2f} | " + " | ".join(cells) + " |")
+    turned = SPIN_RATE * T_END
+    print(f"\nthe same pass: {FAR_METHOD} at steps of tens of radians, and gsl-rk8pd at a tolerance per step")
+    print("| method | step | spin angle per step [rad] | error | force evals | per radian |")
+    print("|---|---|---|---|---|---|")
+    for angle in FAR_ANGLES:
+        n = max(1, round(turned / angle))
+        h = T_END / n
+        r = bp.integrate(scene, FAR_METHOD, h=h, t_end=T_END, invariants=False)["bodies"][0]
+        if r["outcome"] != "ok":  # a step too long for what its points resolve: no numbers
+            print(f"| {FAR_METHOD} | h = {h:.4g} | {SPIN_RATE * h:.3g} | not run: {r['reason']} | | |")
+            continue
+        err = distance(r, ref)
+        print(f"| {FAR_METHOD} | h = {h:.4g} | {SPIN_RATE * h:.3g} | {err:.2e} | {r['force_evals']} | "
+              f"{r['force_evals'] / turned:.2f} |")
+        rows.append([FAR_METHOD, repr(h), repr(SPIN_RATE * h), repr(err), r["force_evals"],
+                     repr(r["force_evals"] / turned)])
+    if "gsl-rk8pd" in {m["name"] for m in bp.methods()}:  # GSL is optional in the build
+        for tol in PEER_TOLS:
+            r = bp.integrate(scene, "gsl-rk8pd", tol=tol, t_end=T_END, h=0.01, invariants=False)["bodies"][0]
+            err = distance(r, ref)
+            print(f"| gsl-rk8pd | tol = {tol:g} | {SPIN_RATE * T_END / r['steps']:.3g} | {err:.2e} | "
+                  f"{r['force_evals']} | {r['force_evals'] / turned:.2f} |")
+            rows.append(["gsl-rk8pd", "", repr(SPIN_RATE * T_END / r["steps"]), repr(err), r["force_evals"],
+                         repr(r["force_evals"] / turned)])
     return rows
 
 
@@ -125,7 +156,7 @@ def main():
     share = far_share(args.binary)
     if args.out_dir:
         write_csv(os.path.join(args.out_dir, "far_field_resonances.csv"),
-                  ["method", "h", "spin_angle", "err", "force_evals"], res)
+                  ["method", "h", "spin_angle", "err", "force_evals", "evals_per_radian"], res)
         write_csv(os.path.join(args.out_dir, "far_field_share.csv"),
                   ["tol", "who", "method", "steps", "force_evals"] + [f"share_beyond_{r}" for r in RADII]
                   + [f"spin_angle_beyond_{RADII[-1]}"], share)

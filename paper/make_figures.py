@@ -351,6 +351,7 @@ def far_field_figure(res, figs, listing):
         ax.annotate(label, (k * math.pi, 1.0), xycoords=("data", "axes fraction"), ha="center", va="bottom",
                     fontsize=7)
     ax.set_yscale("log")
+    ax.set_xscale("log")  # the splittings below a few radians per step, far-ip up to a hundred
     ax.set_xlabel("spin angle per step [rad]")
     ax.set_ylabel("relative error at t = 80")
     ax.legend(loc="lower right")

@@ -779,6 +779,54 @@ def far_field(res, out, M):
     M.add("FarSmoothErr", sci(kl6[smooth]))
     M.add("FarPiErr", sci(nearest(math.pi)))
     M.add("FarTwoPiErr", sci(nearest(2 * math.pi)))
+    far_ip(res_rows, M)
+
+
+# far-ip's errors are quoted at the steps nearest these spin angles per step (radians), and the peer
+# beside it at its cheapest tolerance that errs no more than far-ip at the first of them.
+FAR_IP_ANGLES = [("Twenty", 20.0), ("Forty", 40.0)]
+# Errors within this factor of each other count as one accuracy where both sit at the reference's floor.
+FAR_SPLIT_SLACK = 1.5
+
+
+def far_ip(rows, M):
+    """The far-field collocation on the same pass (bench/far_field.py): error and force evaluations per
+    radian of spin at tens of radians per step, beside GSL's rk8pd at a tolerance per step."""
+    far = [r for r in rows if r["method"] == "far-ip"]
+    for word, angle in FAR_IP_ANGLES:
+        r = min(far, key=lambda x: abs(num(x["spin_angle"]) - angle))
+        M.add(f"FarIpAngle{word}", f"{num(r['spin_angle']):.3g}")
+        M.add(f"FarIpErr{word}", sci(num(r["err"])))
+        M.add(f"FarIpPerRad{word}", f"{num(r['evals_per_radian']):.2g}")
+    first = min(far, key=lambda x: abs(num(x["spin_angle"]) - FAR_IP_ANGLES[0][1]))
+    # The splitting beside it: lp-kl6's cheapest step within FAR_SPLIT_SLACK of far-ip's error (both at the
+    # reference's floor there).
+    split = [r for r in rows if r["method"] == "lp-kl6" and num(r["err"]) <= FAR_SPLIT_SLACK * num(first["err"])]
+    if split:
+        best = min(split, key=lambda x: num(x["evals_per_radian"]))
+        M.add("FarSplitBeside", f"\\cmd{{lp-kl6}} needs {num(best['evals_per_radian']):.2g} per radian for "
+              f"\\ensuremath{{{sci(num(best['err']))}}} ({num(best['spin_angle']):.2g} rad per step)",
+              math_mode=False)
+    else:
+        M.add("FarSplitBeside", "\\cmd{lp-kl6} errs more at every step of the table", math_mode=False)
+    peers = [r for r in rows if r["method"] == "gsl-rk8pd" and num(r["err"]) <= num(first["err"])]
+    if peers:
+        peer = min(peers, key=lambda x: num(x["evals_per_radian"]))
+        M.add("FarPeerErr", sci(num(peer["err"])))
+        M.add("FarPeerPerRad", f"{num(peer['evals_per_radian']):.2g}")
+        M.add("FarPeerAngle", f"{num(peer['spin_angle']):.2g}")
+        text = (f"GSL's \\cmd{{rk8pd}}, at its cheapest tolerance per step that errs no more, "
+                f"errs {M.defs['FarPeerErr']} with {M.defs['FarPeerPerRad']} force evaluations per radian "
+                f"({M.defs['FarPeerAngle']} rad per step)")
+    else:
+        all_peer = [r for r in rows if r["method"] == "gsl-rk8pd"]
+        text = ("GSL's \\cmd{rk8pd} errs more than that at every tolerance per step down to $10^{-14}$" if all_peer
+                else "GSL, optional, is not in this build")
+        if all_peer:
+            best = min(all_peer, key=lambda x: num(x["err"]))
+            text += (f" (its least, \\ensuremath{{{sci(num(best['err']))}}}, with "
+                     f"{num(best['evals_per_radian']):.2g} force evaluations per radian)")
+    M.add("FarPeerBeside", text, math_mode=False)
 
 
 # The statuses of a run that ended with numbers bodypoint does not vouch for (docs/physics.md,
@@ -946,11 +994,18 @@ def scattering(res, M):
     M.add("ScatAutoMethods", ", ".join(tt(m) for m in sorted({r["method"] for r in rows if r["series"] == "B=0"})),
           math_mode=False)
     M.add("ScatThetaMaterial", sci(num(by["B=0"]["theta_min_at_smallest_b"]), 3))
+    middles = [0.5 * (num(by["B=" + B]["theta_min_at_smallest_b"]) + num(by["B=" + B]["theta_max_at_smallest_b"]))
+               for B in ("0.2", "0.5", "0.7", "0.9")]
+    falls = all(a > b for a, b in zip(middles, middles[1:]))
+    M.add("ScatTrend", "falls as its coupling grows" if falls else "depends on its coupling", math_mode=False)
     for B in ("0.2", "0.5", "0.7", "0.9"):
         r = by["B=" + B]
         word = camel("B" + B.replace("0.", ""))
-        M.add(f"ScatThetaLo{word}", sci(num(r["theta_min_at_smallest_b"]), 3))
-        M.add(f"ScatThetaHi{word}", sci(num(r["theta_max_at_smallest_b"]), 3))
+        lo, hi = num(r["theta_min_at_smallest_b"]), num(r["theta_max_at_smallest_b"])
+        # The deflection at the smallest b and how far the arrival phase moves it (the band's width
+        # over its middle, in per cent).
+        M.add(f"ScatTheta{word}", sci(0.5 * (lo + hi), 3))
+        M.add(f"ScatBand{word}", f"{100.0 * (hi - lo) / (0.5 * (lo + hi)):.2g}")
         M.add(f"ScatRainbows{word}", count(int(r["rainbows"])))
         M.add(f"ScatRainbowLo{word}", sci(num(r["rainbow_theta_min"]), 3))
         M.add(f"ScatRainbowHi{word}", sci(num(r["rainbow_theta_max"]), 3))
