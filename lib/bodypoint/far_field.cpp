@@ -1,9 +1,10 @@
 // bodypoint: the far-field collocation step (far_field.hpp).
 #include "bodypoint/far_field.hpp"
 
+#include "bodypoint/detail/run_support.hpp"
+
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <string>
 
@@ -76,36 +77,29 @@ Vec3 Stepper::force(const Vec3& R, Eigen::Matrix3d& jac, double& nearest) const 
   return F;
 }
 
-namespace {
-std::string short_number(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", x);
-  return buf;
-}
-}  // namespace
-
 void Stepper::step(Momenta& x, double h) {
   const double k1 = x.K1.norm();
   if (!(k1 > 0.0)) throw Error("far-ip follows the drift along K1 and needs |K1| > 0 (here the body is at rest)");
   const double angle = std::abs(spin_) * k1 * h;  // spin turned by the step, radians
   // The helix's radius over the closest the step comes to a centre: the guiding centre's straight path
   // over the step (the force bends it little where the step is long), less the radius.
-  const double radius = spin_ != 0.0 ? x.K1.cross(x.K2).norm() / (k1 * k1) : 0.0;
-  const Vec3 gc = spin_ != 0.0 ? Vec3(x.R + x.K1.cross(x.K2) / (k1 * k1)) : x.R;  // B = 0: no helix
+  const Vec3 offset = spin_ != 0.0 ? Vec3(x.K1.cross(x.K2) / (k1 * k1)) : Vec3::Zero();  // B = 0: no helix
+  const double radius = offset.norm();
+  const Vec3 gc = x.R + offset;
   const Vec3 vg = (p_.J * x.K1 - (p_.B * x.K1.dot(x.K2) / (k1 * k1)) * x.K1) * inv_D_;
+  const double vv = vg.squaredNorm();
   const double speed = ((p_.J * x.K1 - p_.B * x.K2) * inv_D_).norm();
   double closest = std::numeric_limits<double>::infinity();
   for (const Centre& k : centres_) {
     if (k.A == 0.0) continue;  // no field, no harmonics
     const Vec3 d = gc - k.c;
-    const double vv = vg.squaredNorm();
     const double t = vv > 0.0 ? std::clamp(-d.dot(vg) / vv, 0.0, h) : 0.0;
     closest = std::min(closest, (d + t * vg).norm() - radius);
   }
   const int n = points_for(angle, closest > 0.0 ? radius / closest : 1.0);
   if (n < 0)
-    throw Error("far-ip: a step of h = " + short_number(h) + " at |R| = " + short_number(x.R.norm()) +
-                " is too long for the spin there: it turns it by " + short_number(angle) + " rad, more than " +
+    throw Error("far-ip: a step of h = " + detail::short_number(h) + " at |R| = " + detail::short_number(x.R.norm()) +
+                " is too long for the spin there: it turns it by " + detail::short_number(angle) + " rad, more than " +
                 std::to_string(kMaxPoints) + " points resolve; take a smaller step");
   const Nodes& nd = nodes_for(n);
   const int N = n + 1;
@@ -200,8 +194,8 @@ void Stepper::step(Momenta& x, double h) {
     const bool stalled = it >= 2 && !(change <= 0.5 * previous);
     if (stalled || it >= kMaxIterations || !std::isfinite(change)) {
       if (change <= kRoundingChange) break;  // converged to rounding
-      throw Error("far-ip: a step of h = " + short_number(h) + " at |R| = " + short_number(x.R.norm()) +
-                  " is too long for the field there (its iteration changes the state by " + short_number(change) +
+      throw Error("far-ip: a step of h = " + detail::short_number(h) + " at |R| = " + detail::short_number(x.R.norm()) +
+                  " is too long for the field there (its iteration changes the state by " + detail::short_number(change) +
                   " after " + std::to_string(it) + " iterations); take a smaller step");
     }
     previous = change;
