@@ -313,11 +313,19 @@ def claims_table(res, out, M):
         worst = max(d[m] for v, d in data[label, "h", K].items() if abs(v - SMALL_H) < 1e-12 * SMALL_H for m in THESIS_SEVEN)
         return f"{'yes' if worst < WELL_CONSERVED else 'no'} (max ${sci(worst)}$)"
 
+    timing_csv = {"model": "timing.csv", "code": "published_timing.csv"}
+
+    def not_timed(label):
+        """The verdict of a cost claim whose methods lack a time: "untimed (...)" naming the flags that
+        left a method without two counted times (a contended machine), or "--" when the study did not run."""
+        why = untimed(res, timing_csv[label], [m for m in THESIS_SEVEN if m not in ns_by[label]])
+        return f"untimed ({why})" if why else "--"
+
     def cost(test, text):
         def claim(label):
             ns = ns_by[label]
             if not all(m in ns for m in THESIS_SEVEN):
-                return "--"
+                return not_timed(label)
             return f"{'yes' if test(ns) else 'no'} ({text(ns)})"
         return claim
 
@@ -328,7 +336,9 @@ def claims_table(res, out, M):
     def euler_cheap_and_better(label):
         ns = ns_by[label]
         k, n, ties, na = tally(data[label, "d", E], below(["thesis-euler"], STANDARD))
-        if not all(m in ns for m in THESIS_SEVEN) or n == 0:
+        if not all(m in ns for m in THESIS_SEVEN):
+            return not_timed(label)
+        if n == 0:
             return "--"
         holds = ns["thesis-euler"] < min(ns["rk4"], ns["ab4"]) and k == n
         return (f"{'yes' if holds else 'no'} ({ns_of(ns, 'thesis-euler')} ns against {ns_of(ns, 'rk4')}, "
@@ -506,6 +516,31 @@ def timing_ns(res, name="timing.csv"):
             den = sum((p[0] - mx) ** 2 for p in pts)
             out[m] = sum((p[0] - mx) * (p[1] - my) for p in pts) / den * 1e9
     return out
+
+
+def flag_word(why):
+    """A timing flag's reason in one word (experiments/stopwatch.cpp: "contended: wall 31 % above
+    CPU", "spread 22 %", "3 repeats (< 5)")."""
+    head = why.split(":")[0].split(" ")
+    return "repeats" if "repeat" in why else head[0]
+
+
+def untimed(res, name, methods):
+    """Why the timing study gave these methods no ns per step although it ran: whose times were
+    flagged and for what, in the flag's first word ("times flagged for rk4, y6: contended"); "" when
+    the study did not run or a method has no flagged time."""
+    path = os.path.join(res, name)
+    if not methods or not os.path.exists(path):
+        return ""
+    rows, _ = read_csv(path)
+    flags = set()
+    for m in methods:
+        mine = {flag_word(w) for r in rows if r["method"] == m and num(r["n"]) >= TIMING_MIN_STEPS and r["flag"]
+                for w in r["flag"].split("; ")}
+        if not mine:
+            return ""
+        flags |= mine
+    return f"times flagged for {', '.join(m.replace('thesis-', '') for m in methods)}: {', '.join(sorted(flags))}"
 
 
 def bench_ns(res):

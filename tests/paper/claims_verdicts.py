@@ -1,0 +1,67 @@
+#!/usr/bin/env python3
+"""The paper's table of claims gives a cost claim a verdict only from counted times: a timing study
+whose times were all flagged (a contended machine, as under a parallel test run) reads "untimed (...)"
+naming the flags, which check_paper accepts; a study that did not run leaves "--", which it refuses.
+
+usage: claims_verdicts.py SOURCE_DIR"""
+import os
+import sys
+import tempfile
+
+sys.path.insert(0, os.path.join(sys.argv[1], "paper"))
+import check_paper  # noqa: E402
+import make_macros  # noqa: E402
+
+HEADER = "n,method,median_s,min_s,max_s,cpu_s,spread,repeats,flag,force_evals\n"
+
+
+def timing_csv(directory, flag_of):
+    """A timing study of the seven thesis methods at three lengths, each time flagged by flag_of(method)."""
+    with open(os.path.join(directory, "timing.csv"), "w") as f:
+        f.write("# bodypoint timing (test)\n" + HEADER)
+        for m in make_macros.THESIS_SEVEN:
+            for n in (20000, 40000, 80000):
+                f.write(f'{n},{m},{n * 1e-7},{n * 1e-7},{n * 1e-7},{n * 1e-7},0.01,5,"{flag_of(m)}",{n}\n')
+
+
+def verdict_accepted(cell):
+    with tempfile.TemporaryDirectory() as build:
+        os.makedirs(os.path.join(build, "generated"))
+        with open(os.path.join(build, "generated", "tab_claims.tex"), "w") as f:
+            f.write(f"14 & a claim & 4.6 & yes (test) & {cell} \\\\\n")
+        return not check_paper.claims_without_verdict(build)
+
+
+def main():
+    failures = []
+    with tempfile.TemporaryDirectory() as res:
+        timing_csv(res, lambda m: "")
+        ns = make_macros.timing_ns(res)
+        if sorted(ns) != sorted(make_macros.THESIS_SEVEN) or abs(ns["rk4"] - 100.0) > 1e-6:
+            failures.append(f"unflagged times: ns per step {ns}, expected 100 for each of the seven")
+        if make_macros.untimed(res, "timing.csv", []):
+            failures.append("a method with a time is reported untimed")
+
+        contended = "contended: wall 31 % above CPU; spread 22 %"
+        timing_csv(res, lambda m: contended if m in ("rk4", "thesis-y6") else "")
+        ns = make_macros.timing_ns(res)
+        if "rk4" in ns or "thesis-y6" in ns:
+            failures.append(f"flagged times were fitted: {sorted(ns)}")
+        why = make_macros.untimed(res, "timing.csv", [m for m in make_macros.THESIS_SEVEN if m not in ns])
+        if why != "times flagged for y6, rk4: contended, spread":
+            failures.append(f"untimed reason: {why!r}")
+        if not verdict_accepted(f"untimed ({why})"):
+            failures.append("check_paper refuses an untimed verdict")
+
+        os.remove(os.path.join(res, "timing.csv"))
+        if make_macros.untimed(res, "timing.csv", ["rk4"]):
+            failures.append("a study that did not run is reported untimed")
+    if verdict_accepted("--"):
+        failures.append("check_paper accepts a claim without a verdict")
+    for f in failures:
+        print(f"claims_verdicts: {f}", file=sys.stderr)
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
