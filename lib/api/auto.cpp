@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace bodypoint {
@@ -20,22 +21,6 @@ constexpr double kTightTolerance = 1e-10;
 /// auto takes a fixed step when the potential at the estimated closest approach is below this
 /// fraction of the time-step constant c: the time transformation would then change the step by < 10%.
 constexpr double kFarFraction = 0.1;
-
-/// Straight-line estimate of the closest approach to c. A spinning body does not travel along v,
-/// which precesses about K1: far from the centres it follows a helix whose axis passes through the
-/// guiding centre R + K1 x K2/|K1|^2 along K1, at the speed (J |K1| - B K2.K1/|K1|)/D (the kinetic
-/// drift, docs/physics.md). For B = 0 that is the line along v.
-double closest_approach(const Body& b, const Centre& c) {
-  const Momenta q = to_momenta(b.p, b.s0);
-  const double k2 = q.K1.squaredNorm();
-  if (!(k2 > 0.0)) return (b.s0.R - c.c).norm();  // no drift
-  const Vec3 axis = q.K1 / std::sqrt(k2);
-  const double speed = (b.p.J * std::sqrt(k2) - b.p.B * q.K2.dot(axis)) / b.p.D();
-  const Vec3 d = b.s0.R + q.K1.cross(q.K2) / k2 - c.c;
-  const Vec3 u = speed >= 0.0 ? axis : Vec3(-axis);
-  if (d.dot(u) >= 0.0 || speed == 0.0) return d.norm();  // moving away, or at rest
-  return d.cross(u).norm();
-}
 
 }  // namespace
 
@@ -53,10 +38,11 @@ const MethodInfo& detail::choose_method_for(const Body& body, const std::vector<
   const char* table = tol >= kLooseTolerance ? "y4" : tol >= kTightTolerance ? "kl6" : "kl8";
   std::ostringstream os;
   bool repulsive = true;
-  double potential_at_closest = 0.0;
+  double potential_at_closest = 0.0;  // at the guiding centre's closest approach to each centre
+  const Helix helix = helix_of(body.p, to_momenta(body.p, body.s0));
   for (const Centre& c : centres) {
     repulsive = repulsive && c.A < 0.0;
-    potential_at_closest += std::abs(c.A) / std::max(closest_approach(body, c), 1e-300);
+    potential_at_closest += std::abs(c.A) / std::max(path_distance(helix, c.c, std::numeric_limits<double>::infinity()), 1e-300);
   }
   const double c = adaptive::automatic_omega_c(body, centres, 0.0);
   std::string name;

@@ -83,20 +83,12 @@ void Stepper::step(Momenta& x, double h) {
   const double angle = std::abs(spin_) * k1 * h;  // spin turned by the step, radians
   // The helix's radius over the closest the step comes to a centre: the guiding centre's straight path
   // over the step (the force bends it little where the step is long), less the radius.
-  const Vec3 offset = spin_ != 0.0 ? Vec3(x.K1.cross(x.K2) / (k1 * k1)) : Vec3::Zero();  // B = 0: no helix
-  const double radius = offset.norm();
-  const Vec3 gc = x.R + offset;
-  const Vec3 vg = (p_.J * x.K1 - (p_.B * x.K1.dot(x.K2) / (k1 * k1)) * x.K1) * inv_D_;
-  const double vv = vg.squaredNorm();
+  const Helix helix = helix_of(p_, x);
   const double speed = ((p_.J * x.K1 - p_.B * x.K2) * inv_D_).norm();
   double closest = std::numeric_limits<double>::infinity();
-  for (const Centre& k : centres_) {
-    if (k.A == 0.0) continue;  // no field, no harmonics
-    const Vec3 d = gc - k.c;
-    const double t = vv > 0.0 ? std::clamp(-d.dot(vg) / vv, 0.0, h) : 0.0;
-    closest = std::min(closest, (d + t * vg).norm() - radius);
-  }
-  const int n = points_for(angle, closest > 0.0 ? radius / closest : 1.0);
+  for (const Centre& k : centres_)
+    if (k.A != 0.0) closest = std::min(closest, path_distance(helix, k.c, h) - helix.radius);  // A = 0: no field
+  const int n = points_for(angle, closest > 0.0 ? helix.radius / closest : 1.0);
   if (n < 0)
     throw Error("far-ip: a step of h = " + detail::short_number(h) + " at |R| = " + detail::short_number(x.R.norm()) +
                 " is too long for the spin there: it turns it by " + detail::short_number(angle) + " rad, more than " +

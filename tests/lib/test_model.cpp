@@ -41,6 +41,30 @@ TEST(InitialConditions, ReproduceThesisEquations) {
   EXPECT_NEAR((b.s0.w - Vec3((B * K1 - m * Kx) / den, 0, m * Kz / den)).norm(), 0.0, kConversionTol);
 }
 
+TEST(InitialConditions, HelixOfTheThesisStartCirclesItsGuidingCentre) {
+  SceneParams sp;  // table 3.1: G = (-L, d, 0), the body at R = (-L, d - Kz/K1, 0)
+  const Scene s = thesis_scene(sp);
+  const Body& b = s.bodies.front();
+  const Helix h = helix_of(b.p, to_momenta(b.p, b.s0));
+  EXPECT_NEAR((h.centre - Vec3(-sp.start.L, sp.start.d, 0)).norm(), 0.0, kConversionTol);
+  EXPECT_NEAR(h.radius, sp.start.Kz / sp.start.K1, kConversionTol);
+  // G moves along K1 at v's mean over a turn: at this start v has no part along K1 that turns.
+  EXPECT_NEAR((h.velocity - Vec3(b.s0.v.x(), 0, 0)).norm(), 0.0, kConversionTol);
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_NEAR(path_distance(h, Vec3::Zero(), inf), sp.start.d, kConversionTol);   // passes the centre at d
+  EXPECT_NEAR(path_distance(h, Vec3::Zero(), 0.0), h.centre.norm(), kConversionTol);  // no time: where it is
+  const Vec3 behind(-2 * sp.start.L, 0, 0);
+  EXPECT_NEAR(path_distance(h, behind, inf), (h.centre - behind).norm(), kConversionTol);  // moving away
+  const double t = 3.0;
+  EXPECT_NEAR(path_distance(h, Vec3::Zero(), t), (h.centre + t * h.velocity).norm(), kConversionTol);
+  // A material point has no helix: G is R and moves at v.
+  const BodyPoint point{1.0, 0.0, 1.0};
+  const Helix m = helix_of(point, to_momenta(point, b.s0));
+  EXPECT_EQ(m.radius, 0.0);
+  EXPECT_NEAR((m.centre - b.s0.R).norm(), 0.0, kConversionTol);
+  EXPECT_NEAR((m.velocity - b.s0.v).norm(), 0.0, kConversionTol);
+}
+
 TEST(InitialConditions, MomentaRoundTrip) {
   const BodyPoint p{1.3, -0.4, 0.8};
   const State s{Vec3(1, 2, 3), Vec3(-0.5, 0.25, 2), Vec3(3, -1, 0.5)};
