@@ -45,6 +45,7 @@ struct TolRow {
   long force_evals = 0, delivered_force_evals = 0;
   int runs = 1;
   bool met = false;
+  std::string refusal;  ///< auto refused TOL (out of reach on the scene, over the budget): why; "" otherwise
   bool is_auto = false;
   bool is_ladder = false;  ///< a peer's run from its tolerance ladder (oracle view), not at TOL
 };
@@ -126,6 +127,7 @@ void measure_at_tolerances(const NamedScene& ns, const State& ref, const std::ve
       refused.is_auto = true;
       refused.method = "refused";
       refused.err = refused.err_estimate = std::numeric_limits<double>::quiet_NaN();
+      refused.refusal = e.what();
       rows.push_back(refused);
       std::cerr << "  " << ns.name << " tol " << sci(tol, 0) << ": auto refused (" << e.what() << ")\n";
       continue;
@@ -171,32 +173,35 @@ void write_tol_rows(std::ostream& csv, const std::vector<TolRow>& rows, const Ti
          "delivered_force_evals,delivered_wall_s\n"
       << "# bodypoint work-precision --by-tol, revision " << git_revision() << "\n"
       << "# err = max(|dR|/|R_ref|, |dv|/|v_ref|) against odeint rkf78 in long double at tol 1e-18; met = err <= tol\n"
-      << "# a call is the whole request (auto: all runs of its search); h = ds for logh/ttl/ks\n"
+      << "# met: refused where auto refused TOL with a reason (the summary gives it); a call is the whole request "
+         "(auto: all runs of its search); h = ds for logh/ttl/ks\n"
       << timing_rules_note(rules)
       << "# delivered_* (auto only): the delivered run alone (delivered_wall_s: median of its step loop in the timed "
          "calls), the cost if the search were free\n";
   for (const TolRow& r : rows)
     csv << CsvLine().text(r.scene).text(r.method).text(r.is_auto ? "auto" : r.is_ladder ? "ladder" : "at-tol")
                .num(r.tol).num_if(r.is_auto, r.h).num_if(r.is_auto, r.err_estimate).num(r.err)
-               .text(r.met ? "yes" : "no").count(r.runs).count(r.force_evals).num(r.time.wall_s)
+               .text(r.met ? "yes" : r.refusal.empty() ? "no" : "refused").count(r.runs).count(r.force_evals).num(r.time.wall_s)
                .num(r.time.cpu_s).num(r.time.spread()).count(r.time.repeats).quoted(r.time.flag())
                .num_if(r.is_auto, static_cast<double>(r.delivered_force_evals)).num_if(r.is_auto, r.delivered_wall_s).str()
         << '\n';
 }
 
-/// The fastest peer run at auto's tolerance that met it, and how many met it.
+/// The fastest peer run at auto's tolerance that met it (faster_pick: among times that count, if any
+/// does), and how many met it.
 std::pair<const TolRow*, int> fastest_meeting(const std::vector<TolRow>& rows, const TolRow& a) {
   const TolRow* best = nullptr;
   int meeting = 0;
   for (const TolRow& r : rows) {
     if (r.is_auto || r.is_ladder || r.scene != a.scene || r.tol != a.tol || !r.met) continue;
     ++meeting;
-    if (!best || r.time.wall_s < best->time.wall_s) best = &r;
+    if (faster_pick(r.time, best ? &best->time : nullptr)) best = &r;
   }
   return {best, meeting};
 }
 
-/// Oracle: the fastest ladder configuration delivering TOL whose next finer one delivers it too.
+/// Oracle: the fastest ladder configuration delivering TOL whose next finer one delivers it too (among
+/// times that count, if any does).
 const TolRow* oracle_for(const std::vector<TolRow>& rows, const TolRow& a) {
   const TolRow* oracle = nullptr;
   for (std::size_t i = 0; i + 1 < rows.size(); ++i) {
@@ -204,7 +209,7 @@ const TolRow* oracle_for(const std::vector<TolRow>& rows, const TolRow& a) {
     const TolRow& next = rows[i + 1];
     if (!r.is_ladder || r.scene != a.scene || !(r.err <= a.tol)) continue;
     if (!(next.is_ladder && next.method == r.method && next.scene == r.scene && next.err <= a.tol)) continue;
-    if (!oracle || r.time.wall_s < oracle->time.wall_s) oracle = &r;
+    if (faster_pick(r.time, oracle ? &oracle->time : nullptr)) oracle = &r;
   }
   return oracle;
 }
@@ -226,15 +231,18 @@ void write_tol_summary(std::ostream& summary, const std::vector<TolRow>& rows, s
              "| delivered run [ms] | speed-up if the search were free |\n"
           << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   int met = 0, total = 0, faster3 = 0, compared = 0, oracle3 = 0, oracle_n = 0;
+  std::ostringstream refusals;
   for (const TolRow& a : rows) {
     if (!a.is_auto) continue;
     const auto [best, meeting] = fastest_meeting(rows, a);
     const TolRow* oracle = oracle_for(rows, a);
     ++total;
     met += a.met ? 1 : 0;
+    if (!a.refusal.empty()) refusals << "- " << a.scene << ", TOL " << sci(a.tol, 0) << ": " << a.refusal << "\n";
     summary << "| " << a.scene << " | " << sci(a.tol, 0) << " | " << a.method << " | " << std::setprecision(3)
-            << a.h << " | " << sci(a.err_estimate) << " | " << sci(a.err) << " | " << (a.met ? "yes" : "**no**")
-            << " | " << time_cell(a.time) << " | ";
+            << a.h << " | " << sci(a.err_estimate) << " | " << sci(a.err) << " | "
+            << (a.met ? "yes" : a.refusal.empty() ? "**no**" : "refused") << " | "
+            << (a.refusal.empty() ? time_cell(a.time) : "-") << " | ";
     if (best) {
       const std::string ratio = ratio_cell(&a.time, &best->time);
       ++compared;
@@ -257,10 +265,15 @@ void write_tol_summary(std::ostream& summary, const std::vector<TolRow>& rows, s
       summary << "none | - | - | " << delivered_cell(a) << " | - |\n";
     }
   }
-  summary << "\nauto met TOL in " << met << " of " << total << " cases; where a peer met it too, auto was >= 3x "
+  const std::string refused = refusals.str();
+  const long n_refused = std::count(refused.begin(), refused.end(), '\n');
+  summary << "\nauto met TOL in " << met << " of " << total << " cases";
+  if (n_refused > 0) summary << " and refused " << n_refused << " with its reason (below)";
+  summary << "; where a peer met it too, auto was >= 3x "
           << "faster in " << faster3 << " of " << compared << "; against the fastest peer configuration that "
           << "delivers TOL (its tolerance chosen afterwards), >= 3x in " << oracle3 << " of " << oracle_n
           << " (a comparison with a flagged time counts as not >= 3x).\n";
+  if (n_refused > 0) summary << "\nauto refused:\n\n" << refused;
 }
 
 }  // namespace

@@ -67,6 +67,10 @@ double median(std::vector<double> v);
 /// configuration once, in order; returns one Timing per configuration.
 std::vector<Timing> time_interleaved(const std::vector<std::function<void()>>& configs, const TimingRules& rules);
 
+/// Whether a is the better pick than b (nullptr: none yet) for "the fastest configuration": a time that
+/// counts beats a flagged one, whatever their medians (a flagged median is not a result); then the shorter.
+bool faster_pick(const Timing& a, const Timing* b);
+
 /// A summary table's time cell: the median in ms (3 digits), or "flagged (t)" when it does not count.
 std::string time_cell(const Timing& t);
 /// A summary table's speed-up cell, theirs / ours: "2.31x", "flagged" when either time does not count,

@@ -269,6 +269,7 @@ std::string config_of(const Row& r) {
 /// The cheapest configuration of ours and of the peers reaching `target` on a scene, counting a row
 /// only when the next finer configuration (the next row of its ladder) reaches it too, so that a
 /// lucky cancellation at one step does not count. The exact regularised flow (ks) has one configuration.
+/// Fastest among the times that count (faster_pick); a flagged time only where none counts.
 std::pair<const Row*, const Row*> best_at(const std::vector<Row>& rows, const std::string& scene, double target) {
   const Row* ours = nullptr;
   const Row* peer = nullptr;
@@ -279,7 +280,7 @@ std::pair<const Row*, const Row*> best_at(const std::vector<Row>& rows, const st
     const Row* next = i + 1 < rows.size() ? &rows[i + 1] : nullptr;
     if (!exact && !(next && next->scene == r.scene && next->method == r.method && next->err_rel <= target)) continue;
     const Row*& slot = is_peer(method_or_throw(r.method)) ? peer : ours;
-    if (!slot || r.time.wall_s < slot->time.wall_s) slot = &r;
+    if (faster_pick(r.time, slot ? &slot->time : nullptr)) slot = &r;
   }
   return {ours, peer};
 }

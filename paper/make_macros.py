@@ -483,7 +483,9 @@ def sweeps(res, M):
                 M.add(f"HAtMin{prefix}{camel(r['method'])}", sci(num(r["max_rel_dE"])))
     rows, _ = read_csv(os.path.join(res, "h_sweep.csv"))
     flagged = [num(r["h"]) for r in rows if r["method"].startswith("thesis-") and r.get("status") != "ok"]
-    M.add("HDivergeThesis", sci(min(flagged)) if flagged else "n/a")
+    hmin = min(num(r["h"]) for r in rows)
+    M.add("HFlaggedThesis", "at no step of the sweep" if not flagged else "at every step of the sweep"
+          if min(flagged) <= hmin else f"from $h = {sci(min(flagged))}$ on", math_mode=False)
     # Energy error against h: fitted slopes where the deviation lies between round-off and 1e-1.
     for prefix, name in [("", "h_sweep.csv"), ("Pub", "published_h_sweep.csv")]:
         rows, _ = read_csv(os.path.join(res, name))
@@ -701,6 +703,18 @@ def by_tol(res, out, M):
     met = [r for r in auto if r["met"] == "yes"]
     M.add("AutoRuns", count(len(auto)))
     M.add("AutoMet", count(len(met)))
+    # A refusal is not a miss: auto says why it will not try (runs that differ only in rounding differ by
+    # more than TOL on the scene, or the search's budget). The clause names where, and whether any peer
+    # configuration delivered that TOL there (then the refusal turned away a reachable answer).
+    refused = [r for r in auto if r["met"] == "refused"]
+    where, reached = {}, []
+    for r in refused:
+        where.setdefault(r["scene"], []).append(f"$10^{{{round(math.log10(num(r['tol'])))}}}$")
+        reached += [p for p in rows if p["kind"] != "auto" and p["scene"] == r["scene"] and num(p["err"]) <= num(r["tol"])]
+    peers_did = (f"although {count(len(reached))} peer runs delivered it" if reached else "no peer run delivered it either")
+    M.add("AutoRefusedClause", f" and refused the other {count(len(refused))}, saying why "
+          f"({'; '.join(f'{tt(k)} at ' + ', '.join(v) for k, v in where.items())}; {peers_did})" if refused else "",
+          math_mode=False)
     ratios = [num(r["err_estimate"]) / num(r["err"]) for r in met if num(r["err"]) > 0]
     M.add("AutoEstLow", sci(min(ratios)) if ratios else "n/a")
     M.add("AutoEstHigh", sci(max(ratios)) if ratios else "n/a")
