@@ -61,6 +61,11 @@ def num(s):
         return float("nan")
 
 
+def power_of_ten(x):
+    """A tolerance that is a power of ten, as LaTeX: 1e-07 -> $10^{-7}$."""
+    return f"$10^{{{round(math.log10(x))}}}$"
+
+
 def sci(x, digits=2):
     """A measured number in LaTeX: 4.5\\times10^{-5}, 0.33, 1,062."""
     if x is None or (isinstance(x, float) and math.isnan(x)):
@@ -707,10 +712,12 @@ def by_tol(res, out, M):
     # more than TOL on the scene, or the search's budget). The clause names where, and whether any peer
     # configuration delivered that TOL there (then the refusal turned away a reachable answer).
     refused = [r for r in auto if r["met"] == "refused"]
-    where, reached = {}, []
+    where = {}
     for r in refused:
-        where.setdefault(r["scene"], []).append(f"$10^{{{round(math.log10(num(r['tol'])))}}}$")
-        reached += [p for p in rows if p["kind"] != "auto" and p["scene"] == r["scene"] and num(p["err"]) <= num(r["tol"])]
+        where.setdefault(r["scene"], []).append(power_of_ten(num(r["tol"])))
+    # Each peer run once, however many of the scene's refused TOLs it delivered.
+    reached = [p for p in rows if p["kind"] != "auto" and any(
+        p["scene"] == r["scene"] and num(p["err"]) <= num(r["tol"]) for r in refused)]
     peers_did = (f"although {count(len(reached))} peer runs delivered it" if reached else "no peer run delivered it either")
     M.add("AutoRefusedClause", f" and refused the other {count(len(refused))}, saying why "
           f"({'; '.join(f'{tt(k)} at ' + ', '.join(v) for k, v in where.items())}; {peers_did})" if refused else "",
@@ -770,7 +777,7 @@ def estimate_grid(res, M):
         M.add(f"Grid{camel(key)}Max", f"{values[-1]:g}")
     M.add("GridKxCount", count(len({r["Kx"] for r in rows})))
     tols = sorted({num(r["tol"]) for r in rows}, reverse=True)
-    M.add("GridTols", ", ".join(f"$10^{{{round(math.log10(t))}}}$" for t in tols), math_mode=False)
+    M.add("GridTols", ", ".join(power_of_ten(t) for t in tols), math_mode=False)
     M.add("GridRefused", count(len(rows) - len(ran)))
     M.add("GridMissed", count(sum(1 for r in ran if num(r["err"]) > num(r["tol"]))))
     # Below 1e-13 the reference's error and the run's round-off are of the error's size (estimate_grid.py).
