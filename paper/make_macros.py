@@ -750,13 +750,14 @@ def by_tol(res, out, M):
         clause = (f"; against the fastest of those that did, \\cmd{{auto}} is ${sci(min(at_tol))}$ to "
                   f"${sci(max(at_tol))}$ times as fast")
     M.add("AutoVsPeerAtTolSpin", clause, math_mode=False)
-    # A ratio whose times do not count (flagged) is left out; none left: "n/a".
-    def low_high(name, values):
-        M.add(f"{name}Low", sci(min(values)) if values else "n/a")
-        M.add(f"{name}High", sci(max(values)) if values else "n/a")
-    low_high("AutoAloneSpin", [r for scene, rs in alone.items() if scene != "material" for r in rs])
-    low_high("AutoVsPeerSpin", [r for scene, rs in ratios.items() if scene != "material" for r in rs])
-    low_high("AutoVsPeerMaterial", ratios.get("material", []))
+    # A ratio whose times do not count (flagged) is left out; none left: the range says so in words
+    # (a contended machine), not "n/a to n/a times as fast".
+    def ratio_range(name, values):
+        M.add(f"{name}Range", f"${sci(min(values))}$ to ${sci(max(values))}$ times as fast" if values else
+              "untimed (every comparison's time flagged)", math_mode=False)
+    ratio_range("AutoAloneSpin", [r for scene, rs in alone.items() if scene != "material" for r in rs])
+    ratio_range("AutoVsPeerSpin", [r for scene, rs in ratios.items() if scene != "material" for r in rs])
+    ratio_range("AutoVsPeerMaterial", ratios.get("material", []))
     with open(os.path.join(out, "tab_by_tol.tex"), "w") as f:
         for row in body:
             f.write(" & ".join(latex_cell(row[i]) for i in keep) + " \\\\\n")
