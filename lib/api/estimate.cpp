@@ -152,7 +152,7 @@ void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& 
   ErrorEstimate& e = r.error;
   if (r.accuracy) {
     e.value = r.accuracy->err_estimate;
-    e.basis = "the accuracy mode's step search (Richardson over its runs)";
+    e.basis = "the accuracy mode's step search (" + r.accuracy->basis + ")";
     e.confirmed = true;
     return;
   }

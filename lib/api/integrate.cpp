@@ -37,7 +37,8 @@ void run_accurately(BodyResult& r, const Body& body, const std::vector<Centre>& 
                     const Options& options) {
   // A method the user named is verified against a companion at half the delivered step; auto's are not.
   adaptive::ToleranceResult t = adaptive::search_step(*r.method, body, centres, a, options, r.chosen.empty());
-  r.accuracy = AccuracyReport{a.tol, t.err_estimate, t.h, t.omega_c, t.runs, t.total_force_evals, t.total_wall_s};
+  r.accuracy = AccuracyReport{a.tol, t.err_estimate, t.h, t.omega_c, t.runs, t.total_force_evals, t.total_wall_s,
+                              std::move(t.basis)};
   r.run = std::move(t.result);
 }
 

@@ -46,13 +46,14 @@ struct ToleranceResult {
   long steps = 0;          ///< fixed-step methods: number of steps (time-transformed: 0)
   double omega_c = 0.0;    ///< time-transformed methods: the time-step constant c of the run
   double err_estimate = 0.0;  ///< estimated relative error of the final state
+  std::string basis;          ///< what the estimate is: Richardson over the ladder's runs, or a pair's difference
   int runs = 0;            ///< integrations made in all (the delivered run included)
   long total_force_evals = 0;  ///< over all those runs
   double total_wall_s = 0.0;   ///< step loops of all those runs (what a user waits for)
 };
 
 /// Checks the scene, the accuracy asked for (check_tolerance; t_end and dt_out: check), the options and
-/// the method (fixed-step or time-transformed with a known order, or ks, accepting the scene), then
+/// the method (fixed-step or time-transformed with a known order, ks or far-ip, accepting the scene), then
 /// searches the step for a run from t = 0 to accuracy.t_end (search_step). The delivered run carries
 /// `delivery`'s observers: its invariants, and its samples (every k-th step, or with dt_out the states
 /// at t = k dt_out), handed to the sink after the search. Throws Error with a one-line reason when tol

@@ -167,6 +167,7 @@ struct AccuracyReport {
   int runs = 0;               ///< integrations made in all, the delivered run (BodyResult::run) included
   long force_evals = 0;       ///< over all of them
   double wall_s = 0.0;        ///< their step loops
+  std::string basis;          ///< what err_estimate is (Richardson over the search's runs, or a pair's difference)
 };
 
 /// One body's run.
