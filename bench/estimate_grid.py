@@ -13,6 +13,7 @@ the delivered error, the estimate, or the reason of a refusal (paper/build.sh ha
 
 Usage (from the repository, after the build; about a minute on 2 cores):
     /usr/bin/python3 bench/estimate_grid.py [build/bin/bodypoint] [--tols 1e-4,1e-7,1e-10] [--out FILE.csv]
+        [--method NAME]   (a named method instead of auto's choice, e.g. far-ip)
 """
 import argparse
 import csv
@@ -36,9 +37,9 @@ COMPARABLE = 1e-13
 FACTOR = 3.0
 
 
-def one(binary, tol, scene):
+def one(binary, tol, scene, method="auto"):
     """The run's JSON record, or the one-line reason it was refused (a str)."""
-    run = subprocess.run([binary, "simulate", "--tol", tol, *scene, "--t-end", T_END, "--reference", "--json",
+    run = subprocess.run([binary, "simulate", "--method", method, "--tol", tol, *scene, "--t-end", T_END, "--reference", "--json",
                           "--quiet"], capture_output=True, text=True)
     if run.returncode != 0:
         return run.stderr.strip().splitlines()[-1] if run.stderr.strip() else f"exit {run.returncode}"
@@ -61,13 +62,13 @@ def write_rows(path, jobs, results):
     os.replace(tmp, path)
 
 
-def main(binary, tols, out=None, quick=False):
+def main(binary, tols, out=None, quick=False, method="auto"):
     axes = (QUICK["D"], QUICK["KZ"], QUICK["B"], QUICK["KX"]) if quick else (D, KZ, B, KX)
     scenes = [["--d", str(d), "--Kz", str(kz), "--B", str(b), "--Kx", str(kx)]
               for d, kz, b, kx in itertools.product(*axes)]
     jobs = [(tol, s) for s in scenes for tol in tols]
     with ThreadPoolExecutor(2) as pool:
-        results = list(pool.map(lambda j: one(binary, *j), jobs))
+        results = list(pool.map(lambda j: one(binary, *j, method), jobs))
     refused = missed = under = over = 0
     worst = 0.0
     search = delivered = 0
@@ -85,7 +86,7 @@ def main(binary, tols, out=None, quick=False):
             under += est < err / FACTOR
             over += est > FACTOR * err
             worst = max(worst, err / est)
-    print(f"{len(jobs)} runs ({len(scenes)} scenes x TOL {', '.join(tols)}, t = {T_END}): refused {refused}, "
+    print(f"{method}: {len(jobs)} runs ({len(scenes)} scenes x TOL {', '.join(tols)}, t = {T_END}): refused {refused}, "
           f"missed TOL {missed}, estimate below error/{FACTOR:g} {under}, above {FACTOR:g} x error {over}, "
           f"worst error/estimate {worst:.2f}; force evaluations: searches {search}, delivered runs {delivered} "
           f"({search / delivered:.2f}x)")
@@ -97,5 +98,6 @@ if __name__ == "__main__":
     parser.add_argument("--tols", default=",".join(TOLS), help="comma-separated requested tolerances")
     parser.add_argument("--out", help="also write every run as a CSV row to this file")
     parser.add_argument("--quick", action="store_true", help="every other value of each axis (32 scenes)")
+    parser.add_argument("--method", default="auto", help="the method the accuracy mode runs (default: auto's choice)")
     args = parser.parse_args()
-    main(args.binary, args.tols.split(","), args.out, args.quick)
+    main(args.binary, args.tols.split(","), args.out, args.quick, args.method)
