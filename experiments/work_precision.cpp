@@ -105,7 +105,7 @@ struct WorkPrecisionArgs {
 
 void add_work_precision_options(po::options_description& desc, WorkPrecisionArgs& a) {
   desc.add_options()
-      ("scenes", po::value(&a.scenes)->default_value(a.scenes), "comma-separated: thesis,close,material,long,two-centres or all")
+      ("scenes", po::value(&a.scenes)->default_value(a.scenes), "comma-separated: thesis,close,material,long,two-centres,three-centres or all")
       ("methods", po::value(&a.methods)->default_value(a.methods), "comma-separated method names or all")
       ("repeats", po::value(&a.o.timing.repeats)->default_value(a.o.timing.repeats), "timed repeats per configuration, "
        "interleaved across the configurations (median and spread reported; fewer than 5 flag every time)")
@@ -133,7 +133,7 @@ void settle(const po::variables_map& vm, WorkPrecisionArgs& a) {
   if (!vm["tols"].defaulted() && !a.by_tol) throw Error("--tols is for --by-tol");
   if (vm.count("summary") && a.summary.empty()) throw Error("--summary needs a file name");
   if (vm.count("out") && a.out.empty()) throw Error("--out needs a file name");
-  if (split_list(a.scenes).empty()) throw Error("--scenes is empty (thesis, close, material, long, two-centres or all)");
+  if (split_list(a.scenes).empty()) throw Error("--scenes is empty (thesis, close, material, long, two-centres, three-centres or all)");
 }
 
 std::vector<const MethodInfo*> chosen_methods(const std::string& arg) {

@@ -6,6 +6,8 @@
 //   material     table 3.1 with B = 0 (a material point), t_end = 50
 //   long         table 3.1 run to t_end = 1e4
 //   two-centres  table 3.1 plus a second repelling centre (A = -1) at (40, 6, 0), t_end = 60
+//   three-centres  two-centres plus an attracting centre (A = 1.5) at (80, -8, 0): centres of both signs,
+//                passed one after the other, t_end = 60
 // and the two scenes on which orders are measured (tests/lib/test_convergence.cpp, `study --name orders`).
 #pragma once
 
@@ -23,7 +25,7 @@ struct NamedScene {
 };
 
 inline std::vector<std::string> named_scene_names() {
-  return {"thesis", "close", "material", "long", "two-centres"};
+  return {"thesis", "close", "material", "long", "two-centres", "three-centres"};
 }
 
 inline NamedScene named_scene(const std::string& name) {
@@ -45,7 +47,14 @@ inline NamedScene named_scene(const std::string& name) {
     validate(s);
     return {name, s, 60.0};
   }
-  throw Error("unknown scene '" + name + "' (thesis, close, material, long, two-centres)");
+  if (name == "three-centres") {
+    Scene s = thesis_scene(sp);
+    s.centres.push_back({Vec3(40.0, 6.0, 0.0), -1.0});
+    s.centres.push_back({Vec3(80.0, -8.0, 0.0), 1.5});
+    validate(s);
+    return {name, s, 60.0};
+  }
+  throw Error("unknown scene '" + name + "' (thesis, close, material, long, two-centres, three-centres)");
 }
 
 /// The encounter used for convergence: table 3.1 moved close (L = 20, d = 1), stopped at t = 3,
