@@ -231,7 +231,7 @@ constexpr double kPairOverstates = 10.0;
 // rounding. Delivered within tol on a far pass (figure 11's), between centres of both
 // signs, on two-centres, swinging round an attracting centre and on a close pass; the estimate at most
 // kPairOverstates above the error and never more than kEstimateFactor below it, where the error is
-// measurable; a refusal only below kProbeBelowTol (tol 1e-12), quoting a floor above tol/kRefusalMargin.
+// measurable; a refusal only below kProbeBelowTol (1e-12, 1e-13), quoting a floor above tol/kRefusalMargin.
 TEST(Tolerance, FarIpDeliversTolWithTheEstimateOfItsPair) {
   std::vector<Case> all;
   for (Case& c : cases())
@@ -248,7 +248,9 @@ TEST(Tolerance, FarIpDeliversTolWithTheEstimateOfItsPair) {
   for (const Case& c : all) {
     const Body& b = c.scene.bodies.front();
     const State ref = reference_state(b, c.scene.centres, c.t_end, 1e-18L);
-    for (double tol : {1e-7, 1e-10, 1e-12}) {
+    // The close pass takes far-ip's finest steps (525,181 force evaluations at its first): one TOL there.
+    const std::vector<double> tols = c.name == "close" ? std::vector<double>{1e-7} : std::vector<double>{1e-7, 1e-10, 1e-12, 1e-13};
+    for (double tol : tols) {
       try {
         const adaptive::ToleranceResult r =
             adaptive::run_to_tolerance(m, b, c.scene.centres, Accuracy{tol, c.t_end}, kUnobserved);
@@ -265,15 +267,17 @@ TEST(Tolerance, FarIpDeliversTolWithTheEstimateOfItsPair) {
       } catch (const Error& e) {
         const std::string reason = e.what();
         EXPECT_LT(tol, adaptive::kProbeBelowTol) << c.name << ": " << reason;
-        const auto at = reason.find("differ by at least ");
+        const std::string floor_said = "was at least ";
+        const auto at = reason.find(floor_said);
         ASSERT_NE(at, std::string::npos) << c.name << ": " << reason;
-        EXPECT_GT(std::stod(reason.substr(at + 19)), tol / kRefusalMargin) << reason;
+        EXPECT_GT(std::stod(reason.substr(at + floor_said.size())), tol / kRefusalMargin) << reason;
         ++refused;
         std::printf("  %-22s tol %.0e  far-ip refused: %s\n", c.name.c_str(), tol, reason.c_str());
       }
     }
   }
   EXPECT_GT(delivered, refused);
+  EXPECT_GT(refused, 0);  // both-signs at 1e-13: its run errs 1.06e-13
   std::printf("  far-ip: %d delivered, %d refused\n", delivered, refused);
 }
 
