@@ -177,7 +177,8 @@ class Search {
     out.err_estimate = estimate_;
     out.basis = p_ > 0 ? std::string("Richardson over its runs") + (floor_ > 0.0 ? ", plus runs that differ only in rounding" : "")
                 : m_.family == Family::FarField
-                    ? "what runs at steps h and h/1.25 and from starts moved by a rounding differ by"
+                    ? std::string("what runs at steps h and h/1.25 and from starts moved by a rounding differ by") +
+                          (floor_ > 0.0 ? ", plus runs that differ only in rounding" : "")
                     : "what runs at fictitious steps ds and ds/1.25 differ by: the KS flow is exact";
     out.result = std::move(best.run);
     out.runs = runs_;
@@ -430,8 +431,9 @@ class Search {
   /// h from the start moved the other way by kStartShift; the estimate is the larger difference (with the
   /// pair alone 47 of 768 estimates of bench/estimate_grid.py were more than 3x below the error, the worst
   /// 30x; with the third run 2 of 256 at TOL 1e-7, the worst 6x, for 3.2x the delivered run's evaluations
-  /// instead of 2.2x). A set that differs by more than tol allows halves the step (near a centre its error falls with the
-  /// step), until kMaxStalls halvings in a row did not halve the difference: the floor it met. A step the
+  /// instead of 2.2x). Below kProbeBelowTol the third run gives way to the ladder's rounding probe, added to
+  /// the pair's difference. An estimate above what tol allows halves the step (a step too coarse for the
+  /// field errs more), until kMaxStalls halvings in a row did not halve it: the floor it met. A step the
   /// method refuses (far-ip: its iteration does not converge there) is halved too.
   Level exact_flow() {
     double h = initial_step(m_, b_, c_, t_end_);
