@@ -175,11 +175,11 @@ class Search {
     out.steps = best.steps;
     out.omega_c = best.omega_c;
     out.err_estimate = estimate_;
-    out.basis = p_ > 0 ? std::string("Richardson over its runs") + (floor_ > 0.0 ? ", plus runs that differ only in rounding" : "")
-                : m_.family == Family::FarField
-                    ? std::string("what runs at steps h and h/1.25 and from starts moved by a rounding differ by") +
-                          (floor_ > 0.0 ? ", plus runs that differ only in rounding" : "")
-                    : "what runs at fictitious steps ds and ds/1.25 differ by: the KS flow is exact";
+    out.basis = (p_ > 0                                ? std::string("Richardson over its runs")
+                 : m_.family == Family::FarField ? "what " + pair_text() + " differ by"
+                                                 : "what runs at fictitious steps ds and ds/" + fmt_number(kMinRefinement) +
+                                                       " differ by: the KS flow is exact") +
+                (floor_ > 0.0 ? ", plus runs that differ only in rounding" : "");
     out.result = std::move(best.run);
     out.runs = runs_;
     out.total_force_evals = total_evals_;
@@ -393,10 +393,16 @@ class Search {
                                                : t_end_ / static_cast<double>(l.steps + k);
       floor = std::max(floor, state_distance(l.run.final, run_at(h, h_c, false).run.final));
     }
-    Body moved = b_;
-    moved.s0.R *= 1.0 + kStartShift;
-    moved.s0.v *= 1.0 - kStartShift;
+    const Body moved = start_moved(kStartShift);
     return std::max(floor, state_distance(l.run.final, run_at(l.h, h_c, false, &moved).run.final));
+  }
+
+  /// The body with its start moved by a relative `shift`: R scaled by 1 + shift, v by 1 - shift.
+  [[nodiscard]] Body start_moved(double shift) const {
+    Body moved = b_;
+    moved.s0.R *= 1.0 + shift;
+    moved.s0.v *= 1.0 - shift;
+    return moved;
   }
 
   /// The order q with which x(h) = x* + C h^q fits three runs at steps h1 > h2 > h3: the root of
@@ -438,13 +444,7 @@ class Search {
   Level exact_flow() {
     double h = initial_step(m_, b_, c_, t_end_);
     const bool far = m_.family == Family::FarField;
-    Body moved = b_, rounded = b_;
-    if (far) {
-      moved.s0.R *= 1.0 + kFarStartShift;
-      moved.s0.v *= 1.0 - kFarStartShift;
-      rounded.s0.R *= 1.0 - kStartShift;
-      rounded.s0.v *= 1.0 + kStartShift;
-    }
+    const Body moved = start_moved(kFarStartShift), rounded = start_moved(-kStartShift);
     double best = std::numeric_limits<double>::infinity();
     int stalled = 0;
     for (int k = 0;; ++k) {
@@ -472,7 +472,7 @@ class Search {
         }
         if (!far || k >= kMaxLevels || stalled >= kMaxStalls)
           throw SearchLimit("tol " + fmt_tol() + " is below what " + std::string(m_.name) + " delivers on this scene: " +
-                            (far ? "the estimate from runs at steps h and h/1.25 and from starts moved by a rounding was at least " : "runs differ by ") +
+                            (far ? "the estimate from " + pair_text() + " was at least " : "runs differ by ") +
                             fmt_number(best) + (far ? " at every step it tried" : ""));
       } catch (const SearchLimit&) {
         throw;
@@ -491,6 +491,10 @@ class Search {
     return 0.0;  // unknown in advance; the budget is checked against what was spent
   }
   [[nodiscard]] std::string fmt_tol() const { return fmt_number(tol_); }
+  /// far-ip's runs (exact_flow), as its estimate's basis and its refusal name them.
+  static std::string pair_text() {
+    return "runs at steps h and h/" + fmt_number(kMinRefinement) + " and from starts moved by a rounding";
+  }
   static std::string fmt_number(double x) {
     std::ostringstream os;
     os.precision(3);
