@@ -27,7 +27,9 @@ std::string scene_header(const po::variables_map& vm, const SceneOptions& o) {
   if (vm.count("scene")) return "scene=" + o.scene_file;
   std::string data;  // the asymptotic data the scene was given by (describe shows what they solved)
   if (vm.count("b")) data += " b=" + fmt(o.b);
-  if (vm.count("v-inf")) data += " v_inf=" + fmt(o.v_inf);
+  if (vm.count("v-inf"))  // which of K1's two roots: the one with an encounter
+    data += " v_inf=" + fmt(o.v_inf) + ", K1 above " + fmt(least_approaching_k1(o.params)) +
+            " where the guiding centre approaches";
   if (vm.count("arrival-phase")) data += " arrival_phase=" + fmt(o.arrival_phase);
   return describe(o.params) + (data.empty() ? "" : " (solved for" + data + ")");
 }

@@ -101,14 +101,22 @@ Encounter measure_encounter(const Body& body, const std::vector<Centre>& centres
     e.t_min = nearest->t;
   }
   e.reason = unfinished(body, centres, run);
+  const bool finished = e.reason.empty();
+  // A scattering result exists only for an encounter that happened: a body (guiding centre) that
+  // drifts away from the start passes no closest approach, and its "incoming" asymptote is a leg it
+  // never travelled (v_inf = 1 on table 3.1 had solved such a start, deflection 0.445 reported).
+  if (finished && !nearest_approach(hits, events))
+    e.reason = "no encounter happened: the distance to the centres has no minimum within the run (the " +
+               std::string(body.p.B == 0.0 ? "body" : "guiding centre") + " recedes from the start)";
   if (!e.reason.empty()) {
     e.outcome = Outcome::incomplete;
     Scattering& sc = e.scattering;
-    if (sc.in) sc.asymptotes = "none: the encounter did not finish";
+    const std::string none = finished ? "no encounter happened" : "the encounter did not finish";
+    if (sc.in) sc.asymptotes = "none: " + none;
     sc.in.reset();
     sc.out.reset();
     sc.deflection = sc.out_of_plane = sc.b = sc.v_inf = sc.time_delay = Scattering::kNaN;
-    e.asymptote_basis = "not known: the encounter did not finish";
+    e.asymptote_basis = "not known: " + none;
     return e;
   }
   estimate_asymptote_error(e, body, centres, hits, events);

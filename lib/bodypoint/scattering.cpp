@@ -166,6 +166,10 @@ std::pair<Asymptote, double> incoming(const SceneParams& p) {
   const Body& body = s.bodies.front();
   const auto k = kepler_particle(body.p, body.s0, s.centres.front().c);
   if (!k) throw Error("the scene's body does not drift along K1: it has no incoming asymptote");
+  // An encounter needs the guiding centre to approach the centre: drifting away from the start (K1 below
+  // the drift's zero, B Kx/J, where it drifts against K1), it has no periapsis ahead and no incoming leg.
+  if (!(k->X.dot(k->P) < 0.0))
+    throw Error("the scene's guiding centre drifts away from the centre at the start: no encounter happens");
   const auto a = kepler_asymptote(k->mu, k->kappa(s.centres.front().A), k->X, k->P, false);
   if (!a) throw Error("the scene's orbit is bound (energy at infinity <= 0): it has no incoming asymptote");
   return {*a, k->mu};
@@ -293,19 +297,36 @@ double d_for_impact_parameter(SceneParams params, double b) {
   if (!(std::isfinite(b) && b > 0.0)) throw Error("the impact parameter b must be a finite number > 0");
   const double d0 = params.B == 0.0 ? params.start.Kz / params.start.K1 + b : b;
   params.start.d = d0;
-  const double d = solve_parameter(params, d_of, b_of, b, d0, d0 - (b_of(params) - b));  // db/dd ~ 1
+  double d = 0.0;
+  try {
+    d = solve_parameter(params, d_of, b_of, b, d0, d0 - (b_of(params) - b));  // db/dd ~ 1
+  } catch (const Error& e) {  // the scene at the first guess has no incoming asymptote, or cannot be built
+    throw Error("no start distance d gives the impact parameter b = " + fmt(b) + ": " + e.what());
+  }
   if (!std::isfinite(d))
     throw Error("no start distance d gives the impact parameter b = " + fmt(b) +
                 " (the scene's numbers overflow on the way; give a smaller b)");
   return d;
 }
 
+double least_approaching_k1(const SceneParams& p) { return std::max(0.0, p.B * p.start.Kx / p.J); }
+
+/// The first K1 the search for v_inf starts from: the scene's own where it approaches the centre,
+/// otherwise twice the drift's zero (v is 0 at the zero and grows with K1: one root on the branch).
+constexpr double kApproachingStart = 2.0;
+
 double k1_for_speed_at_infinity(SceneParams params, double v_inf) {
   if (!(std::isfinite(v_inf) && v_inf > 0.0)) throw Error("the speed at infinity v_inf must be a finite number > 0");
+  // Only the branch on which the guiding centre drifts towards the centre has an encounter: below the
+  // drift's zero it drifts away, its "incoming" asymptote a leg it never travels (v_inf = 1 on table 3.1
+  // solved K1 = 0.884 there). incoming() refuses that branch, so a secant trial on it is pulled back.
+  const double k_min = least_approaching_k1(params);
+  if (!(params.start.K1 > k_min)) params.start.K1 = k_min > 0.0 ? kApproachingStart * k_min : 1.0;
   const double k0 = params.start.K1;
   const double k1 = k0 * v_inf / v_of(params);  // v_inf ~ K1 / mass
   const double k = solve_parameter(params, k1_of, v_of, v_inf, k0, k1);
-  if (!(std::isfinite(k) && k > 0.0)) throw Error("no momentum K1 > 0 gives the speed at infinity v_inf = " + std::to_string(v_inf));
+  if (!(std::isfinite(k) && k > k_min))
+    throw Error("no momentum K1 above " + fmt(k_min) + " (where the guiding centre approaches the centre) gives the speed at infinity v_inf = " + fmt(v_inf));
   return k;
 }
 

@@ -111,9 +111,14 @@ Scattering scattering(const BodyPoint& p, const std::vector<Centre>& centres, co
 double d_for_impact_parameter(SceneParams params, double b);
 
 /// The thesis's scene whose body moves at speed v_inf at infinity (B != 0: its guiding centre): the
-/// momentum K1 solved for it (secant iterations, relative 1e-14), d and the rest kept. Error when
-/// v_inf is not a finite number > 0 or no K1 reaches it (a bound orbit on the way).
+/// momentum K1 solved for it (secant iterations, relative 1e-14), d and the rest kept. The root is the one
+/// with an encounter: K1 above least_approaching_k1, where the guiding centre drifts towards the centre
+/// (below it, it drifts away: a second root with no encounter). Error when v_inf is not a finite number
+/// > 0 or no K1 on that branch reaches it (a bound orbit on the way).
 double k1_for_speed_at_infinity(SceneParams params, double v_inf);
+/// The least K1 > 0 at which the thesis's guiding centre drifts along K1, towards the centre: its drift
+/// K1 (J K1 - B Kx)/D vanishes at K1 = B Kx/J; 0 where it drifts along K1 at every K1 > 0.
+double least_approaching_k1(const SceneParams& p);
 
 /// The scene given by its asymptotic data: impact parameter b and/or speed at infinity v_inf (NaN:
 /// not given, the scene's own d or K1 kept). Both are solved together (each depends a little on the

@@ -214,7 +214,9 @@ TEST(Reliability, ThirdPassCasesAreRefusedWithTheirQuantityOrSolved) {
                                                         {"/proc/self/mem", "the scene file cannot be read"}});
   // The speed at infinity is solved for where the first guess of K1 does not drift (0.2..1.5 were refused).
   for (const char* v : {"0.2", "0.5", "1.5"}) {
-    const auto r = run_cli(std::string("simulate --json --max-error inf --scattering --h 0.01 --t-end 400 --v-inf ") + v);
+    // To its departure: at v_inf = 0.2 the encounter takes more than t = 2,000 (the root that ended by
+    // t = 400 drifted away from the centre and had no encounter, issue #56).
+    const auto r = run_cli(std::string("simulate --json --scattering --tol 1e-8 --v-inf ") + v);
     ASSERT_EQ(r.code, 0) << v << ": " << r.err;
     const std::smatch m = [&r] {
       std::smatch x;
