@@ -145,6 +145,21 @@ bool ended_alike(const BodyResult& run, const Options& run_options, const BodyRe
          x.run.final.v.allFinite() && stopped_by_event(run, run_options) == stopped_by_event(x, o);
 }
 
+/// A companion that broke down (diverged, failed, a non-finite state) at a finer step than the run's is
+/// not "no estimate": the run's step does not resolve what the finer one could not get through either
+/// (ttl-s4 at ds = 3 on the two-centre material pass ended at R = -1.8e9 where the answer is 149, its
+/// companion at ds/2 failed, and the run read ok). The run is flagged unresolved, the companion's reason
+/// quoted. A companion stopped on request, or ended at another stop event, did not break down.
+void flag_broken_companion(BodyResult& r, const BodyResult& x, const std::string& basis) {
+  const bool finite = x.run.final.R.allFinite() && x.run.final.v.allFinite();
+  const bool broke = !finite || x.outcome == Outcome::diverged || x.outcome == Outcome::collision ||
+                     (x.outcome == Outcome::failed && x.reason != kStoppedOnRequest);
+  if (!broke || (r.outcome != Outcome::ok && r.outcome != Outcome::inaccurate)) return;
+  r.outcome = Outcome::unresolved;
+  r.reason = "the " + basis + " broke down (" + (x.reason.empty() ? std::string(outcome_name(x.outcome)) : x.reason) +
+             "): a finer step did not get through the scene, so this run's step does not resolve it and its error is unknown";
+}
+
 }  // namespace
 
 void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Advance& how,
@@ -184,6 +199,7 @@ void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& 
     e.wall_s += x.run.wall_s;
     if (!ended_alike(r, options, x, o)) {
       e.basis = "the " + c->basis + " did not end as the run did" + (x.reason.empty() ? "" : " (" + x.reason + ")");
+      flag_broken_companion(r, x, c->basis);
       return;
     }
     if (refines(how, r.run.steps, x.run.steps)) break;
