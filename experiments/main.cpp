@@ -6,6 +6,7 @@
 #include "mpi_sweep.hpp"
 #include "rows_file.hpp"
 
+#include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -47,29 +48,29 @@ void exec_mpi_program(char** argv) {
 }
 #endif
 
-/// The error as one line: an echoed value's newline, tab or other control character is shown escaped
-/// ("\\n"), so that a reason is always exactly one line of standard error.
-std::string one_line(std::string_view s) {
-  std::string out;
-  for (const unsigned char c : s) {
-    if (c == '\n') {
-      out += "\\n";
-    } else if (c == '\t') {
-      out += "\\t";
-    } else if (c < 0x20 || c == 0x7f) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02x", c);
-      out += buf;
-    } else {
-      out += static_cast<char>(c);
-    }
-  }
-  return out;
+/// Standard output is checked like a file: what the command printed is flushed now, and a write that
+/// failed (a full disk, a closed pipe, /dev/full) turns the exit code into 2 with one line saying so,
+/// so that a cut table is never taken for a whole one.
+int checked_stdout(int code) {
+  errno = 0;
+  std::cout.flush();
+  const bool failed = !std::cout || std::fflush(stdout) != 0 || std::ferror(stdout) != 0;
+  if (!failed) return code;
+  const int err = errno;
+  std::cerr << "bodypoint: error: standard output could not be written" << (err ? std::string(" (") + std::strerror(err) + ")" : "")
+            << ": what was printed is incomplete\n";
+  return 2;
 }
+
+int run_command(int argc, char** argv);
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int main(int argc, char** argv) { return checked_stdout(run_command(argc, argv)); }
+
+namespace {
+
+int run_command(int argc, char** argv) {
 #ifdef BODYPOINT_MPI_PROGRAM
   if (bodypoint::cli::launched_by_mpi()) exec_mpi_program(argv);
 #endif
@@ -86,7 +87,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   const std::string cmd = argv[1];
-  bodypoint::cli::install_signal_cleanup();
+  bodypoint::cli::install_signal_cleanup(bodypoint::cli::launcher_rank() == 0);
   try {
     // Every process of an MPI launch runs the same command line: only sweep shares its runs among them,
     // any other command would run N times over, its outputs colliding.
@@ -108,7 +109,9 @@ int main(int argc, char** argv) {
       std::cerr << "bodypoint: error: out of memory: the request needs more memory than this process may have "
                    "(fewer points, frames, rows or threads)\n";
   } catch (const std::exception& e) {  // bodypoint::Error, boost::program_options::error and the rest
-    if (bodypoint::cli::launcher_rank() == 0) std::cerr << "bodypoint: error: " << one_line(e.what()) << "\n";
+    if (bodypoint::cli::launcher_rank() == 0) std::cerr << "bodypoint: error: " << bodypoint::one_line(e.what()) << "\n";
   }
   return 2;
 }
+
+}  // namespace

@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -15,6 +18,15 @@ std::string fmt(double x) {
   char buf[32];
   const auto res = std::to_chars(buf, buf + sizeof buf, x);
   return std::string(buf, res.ptr);
+}
+
+std::optional<double> read_double(const std::string& s) {
+  errno = 0;
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  if (s.empty() || end != s.c_str() + s.size() || std::isspace(static_cast<unsigned char>(s.front()))) return std::nullopt;
+  if (errno == ERANGE && std::abs(v) > 1.0) return std::nullopt;  // overflow; underflow gives the subnormal
+  return v;
 }
 
 CsvLine& CsvLine::quoted(std::string s) {
@@ -69,10 +81,29 @@ std::string join(const std::vector<std::string>& items, std::string_view sep) {
   return out;
 }
 
+std::string one_line(std::string_view s) {
+  std::string out;
+  for (const unsigned char c : s) {
+    if (c == '\n') {
+      out += "\\n";
+    } else if (c == '\t') {
+      out += "\\t";
+    } else if (c < 0x20 || c == 0x7f) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      out += buf;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out;
+}
+
+
 std::string unknown_name(std::string_view what, std::string_view word, const std::vector<std::string>& valid) {
   constexpr std::size_t kSuggestEdits = 2;  // a typo: a letter missing, extra, wrong or two of them
   const std::string near = closest_word(word, valid, kSuggestEdits);
-  std::string out = "unknown " + std::string(what) + " '" + std::string(word) + "'";
+  std::string out = "unknown " + std::string(what) + " '" + one_line(word) + "'";
   if (!near.empty()) out += " (did you mean '" + near + "'?)";
   return out + "; valid: " + join(valid, ", ");
 }

@@ -8,6 +8,7 @@
 #include "bodypoint/model.hpp"
 
 #include <fstream>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -16,6 +17,10 @@ namespace bodypoint {
 
 /// x in the shortest form that reads back exactly ("nan"/"inf" spelled as such).
 std::string fmt(double x);
+/// The whole text s as a double, or nullopt where it is not a number or beyond the range of a double. A
+/// value below the smallest normal double (1e-320) is a number: its subnormal (std::stod refuses it).
+/// Leading white space is not a number. "nan" and "inf" read as such: the caller says if they may be.
+std::optional<double> read_double(const std::string& s);
 /// One CSV line, the one row format of every CSV the tool writes: cells separated by commas, numbers
 /// by fmt, counts and names as they are, free text quoted (its own quotes turned into apostrophes).
 class CsvLine {
@@ -53,6 +58,10 @@ std::string closest_word(std::string_view word, const std::vector<std::string>& 
 
 /// The items with `sep` between them.
 std::string join(const std::vector<std::string>& items, std::string_view sep);
+
+/// s as one line: a newline, tab or other control character in it shown escaped, so that a message that
+/// echoes a value is always one line.
+std::string one_line(std::string_view s);
 
 /// "unknown <what> 'word' (did you mean 'x'?); valid: a, b, c": the one wording of an unknown name.
 std::string unknown_name(std::string_view what, std::string_view word, const std::vector<std::string>& valid);
