@@ -24,8 +24,6 @@ constexpr long kCalibrationSteps = 100'000;
 /// Time-transformed runs to an end time first take this many fictitious steps to see how much
 /// physical time they cover: a run that is shorter than that is not calibrated further.
 constexpr long kProbeSteps = 1'000;
-/// Estimates above this are announced on stderr before the run starts.
-constexpr double kAnnounceSeconds = 10.0;
 /// A bar is drawn only for runs expected to take longer than this.
 constexpr double kBarSeconds = 2.0;
 

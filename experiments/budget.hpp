@@ -27,6 +27,9 @@ struct WorkEstimate {
 std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
                                           const Advance& how, const Options& options);
 
+/// Estimates above this are announced on stderr before the run (or study) starts.
+inline constexpr double kAnnounceSeconds = 10.0;
+
 /// Every command's budget of wall-clock time unless --max-seconds says otherwise (0: none): a day, so
 /// that no command runs on without end by default (simulate's own default is an hour).
 inline constexpr double kDefaultMaxSeconds = 86400.0;

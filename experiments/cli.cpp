@@ -130,15 +130,12 @@ std::vector<std::string> split_list(const std::string& s) {
 }
 
 double parse_number(const std::string& s, const std::string& option) {
-  // strtod, not stod: a value below the smallest normal double (1e-320) is a valid subnormal, which
-  // std::stod rejects as out of range.
-  errno = 0;
+  const std::optional<double> v = read_double(s);
+  if (v) return *v;
   char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  if (s.empty() || end != s.c_str() + s.size() || std::isspace(static_cast<unsigned char>(s.front())))
-    throw Error(option + ": '" + s + "' is not a number");
-  if (errno == ERANGE && std::abs(v) > 1.0) throw Error(option + ": '" + s + "' is beyond the range of a double");
-  return v;
+  std::strtod(s.c_str(), &end);  // read whole but refused: beyond the range of a double
+  const bool whole = !s.empty() && end == s.c_str() + s.size() && !std::isspace(static_cast<unsigned char>(s.front()));
+  throw Error(option + ": '" + s + (whole ? "' is beyond the range of a double" : "' is not a number"));
 }
 
 long whole_number(double x, const std::string& what, double max) {

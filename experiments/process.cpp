@@ -39,6 +39,7 @@ struct Slot {
 };
 Slot g_slots[kSlots];
 std::atomic<int> g_signal{0};
+std::atomic<bool> g_say_signal{true};  ///< install_signal_cleanup(say)
 std::atomic<int> g_cooperative{0};
 std::atomic<long> g_counter{0};
 // The budget (set_deadline): its end on CLOCK_MONOTONIC (a SIGALRM from outside before it is a signal
@@ -103,6 +104,24 @@ void arm_interrupt_grace(int sig) {
   ::alarm(kInterruptGraceSeconds);
 }
 
+/// From a signal handler that ends the process by the signal: one line saying so (a SIGINT while a
+/// large grid was checked ended it with exit 130 and no word). Async-signal-safe: composed by hand.
+void say_interrupted(int sig) {
+  if (!g_say_signal.load()) return;
+  static constexpr char kHead[] = "bodypoint: error: interrupted by signal ";
+  static constexpr char kTail[] = "; its unfinished outputs removed\n";
+  char line[sizeof kHead + sizeof kTail + 12];
+  std::size_t n = 0;
+  for (const char* c = kHead; *c; ++c) line[n++] = *c;
+  char digits[12];
+  int k = 0;
+  for (int x = sig; x > 0 && k < 11; x /= 10) digits[k++] = static_cast<char>('0' + x % 10);
+  while (k > 0) line[n++] = digits[--k];
+  for (const char* c = kTail; *c; ++c) line[n++] = *c;
+  const ssize_t written = ::write(2, line, n);
+  (void)written;
+}
+
 extern "C" void on_signal(int sig) {
   if (sig == SIGALRM && g_deadline.load() && monotonic_ns() >= g_deadline_ns.load()) {  // the budget: stop now, wherever the process is
     remove_open_outputs();
@@ -119,6 +138,7 @@ extern "C" void on_signal(int sig) {
     return;
   }
   remove_open_outputs();
+  say_interrupted(sig);
   ::signal(sig, SIG_DFL);
   ::raise(sig);
 }
@@ -354,7 +374,8 @@ void register_input(const std::string& path) {
   g_inputs.insert(key_of(path));
 }
 
-void install_signal_cleanup() {
+void install_signal_cleanup(bool say) {
+  g_say_signal.store(say);
   struct sigaction sa {};
   sa.sa_handler = on_signal;
   sigemptyset(&sa.sa_mask);

@@ -56,7 +56,9 @@ void register_input(const std::string& path);
 /// `CooperativeInterrupt` is alive the handler records the first signal, so that a loop can stop at a
 /// boundary of its own (a sweep's row) and unwind normally; a loop that has not stopped a second later
 /// is ended there, with its one-line reason and exit status 2 (the journal keeps the finished rows).
-void install_signal_cleanup();
+/// `say`: a signal that ends the process is said on stderr in one line (false on an MPI launch's ranks
+/// other than 0, which the launcher ends when one of them fails).
+void install_signal_cleanup(bool say = true);
 
 /// The signal received since install_signal_cleanup(), or 0.
 int interrupted();

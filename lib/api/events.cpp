@@ -44,16 +44,9 @@ constexpr const char* kEventForms = "closest, closest:K, local-min, local-min:K,
                                     "plane=nx,ny,nz,offset, departure, departure=R, arrival=R (K: a centre's index)";
 
 double event_number(std::string_view text, const std::string& value) {
-  std::size_t used = 0;
-  double x = 0.0;
-  try {
-    x = std::stod(value, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != value.size() || !std::isfinite(x))
-    throw Error("event '" + std::string(text) + "': '" + value + "' is not a finite number");
-  return x;
+  const std::optional<double> x = read_double(value);
+  if (!x || !std::isfinite(*x)) throw Error("event '" + std::string(text) + "': '" + value + "' is not a finite number");
+  return *x;
 }
 
 std::size_t event_centre(std::string_view text, const std::string& index) {
@@ -72,7 +65,15 @@ Event parse_plane(std::string_view text, const std::string& value) {
     from = comma + 1;
   }
   Event e{Event::Kind::plane, 0, n[3], Vec3(n[0], n[1], n[2])};
-  if (!(e.normal.norm() > 0.0)) throw Error("event '" + std::string(text) + "': the plane's normal must not be zero");
+  if (e.normal == Vec3::Zero()) throw Error("event '" + std::string(text) + "': the plane's normal must not be zero");
+  // A normal whose length underflows (plane=1e-320,0,0,0) is a plane all the same: n.R = offset scaled
+  // by its largest component.
+  if (const double s = e.normal.cwiseAbs().maxCoeff(); !(e.normal.norm() > 0.0)) {
+    e.normal /= s;
+    e.value /= s;
+    if (!std::isfinite(e.value))
+      throw Error("event '" + std::string(text) + "': the plane's offset over its normal's length overflows; scale them alike");
+  }
   if (!std::isfinite(e.normal.norm()))
     throw Error("event '" + std::string(text) + "': the plane's normal is too long (its length overflows); scale it down");
   return e;

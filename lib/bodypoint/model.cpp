@@ -81,6 +81,11 @@ void validate(const Scene& scene) {
       const std::string centre = "centre " + std::to_string(k + 1);
       if (d == Vec3::Zero()) throw Error(who + " starts on " + centre + " (R = c); move it off the centre");
       const double r = d.stableNorm();
+      // The force and the potential take |R - c|^2 (a centre at 1e308 read "an invariant became
+      // non-finite; reduce --h").
+      if (!std::isfinite(d.squaredNorm()))
+        throw Error(who + " starts " + num(r) + " from " + centre + ": the square of that distance overflows a double; "
+                    "rescale the units");
       if (!(r > 0.0) || !std::isfinite(scene.centres[k].A / r) || !std::isfinite(scene.centres[k].A / (r * r)))
         throw Error(who + " starts " + num(r) + " from " + centre + ": its potential or force there (A/r, A/r^2 with A = " +
                     num(scene.centres[k].A) + ") overflows a double; start it farther or rescale the units");
@@ -96,18 +101,28 @@ void validate(const Scene& scene) {
           std::isfinite(potential) && std::isfinite(kinetic + potential)))
       throw Error(who + ": the energy or angular momentum at the start overflows a double (|R| = " + num(b.s0.R.norm()) +
                   ", |v| = " + num(b.s0.v.norm()) + "); rescale the units");
+    // The angular momentum about each centre is an integral the runs track (a centre at 1e308 read
+    // "an invariant became non-finite; reduce --h").
+    for (std::size_t c = 0; c < scene.centres.size(); ++c)
+      if (!((k.R - scene.centres[c].c).cross(k.K1) + k.K2).allFinite())
+        throw Error(who + ": the angular momentum about centre " + std::to_string(c + 1) + " overflows a double (|R - c| = " +
+                    num((b.s0.R - scene.centres[c].c).norm()) + "); rescale the units");
   }
+}
+
+void validate(const ThesisStart& t, const std::string& who) {
+  require_finite(t.d, who + "d");
+  require_finite(t.L, who + "L");
+  require_finite(t.K1, who + "K1");
+  require_finite(t.Kx, who + "Kx");
+  require_finite(t.Kz, who + "Kz");
+  require_finite(t.phase, who + "phase");
+  if (t.K1 == 0.0) throw Error(who + "K1 must be non-zero (R(0) contains Kz/K1)");
 }
 
 Scene thesis_scene(const SceneParams& sp) {
   require_finite(sp.A, "A");
-  require_finite(sp.start.d, "d");
-  require_finite(sp.start.L, "L");
-  require_finite(sp.start.K1, "K1");
-  require_finite(sp.start.Kx, "Kx");
-  require_finite(sp.start.Kz, "Kz");
-  require_finite(sp.start.phase, "phase");
-  if (sp.start.K1 == 0.0) throw Error("K1 must be non-zero (R(0) contains Kz/K1)");
+  validate(sp.start, "");
   BodyPoint p{sp.m, sp.B, sp.J};
   validate(p, "body");
   Body body{p, to_state(p, thesis_momenta(sp.start)), "body"};

@@ -194,5 +194,8 @@ Scene thesis_scene(const SceneParams& sp);
 /// J > 0, D = mJ - B^2 > 0, at least one centre and one body, no body starting on a centre.
 void validate(const Scene& scene);
 void validate(const BodyPoint& p, const std::string& who);
+/// The thesis's start parameters (d, L, K1, Kx, Kz, phase) finite and K1 non-zero; `who` prefixes the
+/// message ("" for the thesis's scene, "body 2: " in a scene file).
+void validate(const ThesisStart& t, const std::string& who);
 
 }  // namespace bodypoint

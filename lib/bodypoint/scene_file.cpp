@@ -128,7 +128,11 @@ Body parse_body(const toml::table& t, std::size_t i, const std::string& origin) 
     b.s0 = State{vector3(t, "R", where, origin), vector3(t, "v", where, origin), vector3(t, "w", where, origin)};
   } else {
     read_parameters(t, Of::start, p, where, origin);
-    if (p.start.K1 == 0.0) fail(origin, where + ": K1 must be non-zero");
+    try {
+      validate(p.start, where + ": ");
+    } catch (const Error& e) {
+      fail(origin, e.what());
+    }
     b.s0 = to_state(b.p, thesis_momenta(p.start));
   }
   if (b.name.empty()) b.name = "body" + std::to_string(i + 1);

@@ -71,6 +71,27 @@ def _count(name, value, *, optional=False):
     return int(value)
 
 
+def _index(name, value):
+    """value as an index (a whole number >= 0), or bodypoint.Error naming it."""
+    i = _count(name, value)
+    if i < 0:
+        raise Error(f"{name} must be a whole number >= 0, got {i}")
+    return i
+
+
+def _numbers_of(name, values):
+    """A sequence of numbers; a single number is a sequence of one."""
+    if isinstance(values, _numbers.Real) and not isinstance(values, bool):
+        return [_number(name, values)]
+    if isinstance(values, (str, bytes)):
+        raise Error(f"{name} must be a number or a sequence of numbers, got {type(values).__name__}")
+    try:
+        items = list(values)
+    except TypeError:
+        raise Error(f"{name} must be a number or a sequence of numbers, got {type(values).__name__}") from None
+    return [_number(name, v) for v in items]
+
+
 def _flag(name, value):
     """A yes/no keyword: True or False (a text such as "no" would read as True)."""
     if not isinstance(value, (bool, _np_bool)):
@@ -263,7 +284,7 @@ def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, accuracy=None
         axes = list(dict(axes).items())
     except (TypeError, ValueError):
         raise Error(f"axes must be a dict {{parameter: values}}, got {type(axes).__name__}") from None
-    columns = [(_text("an axis' parameter", k), [_number(f"a value of {k}", v) for v in vals]) for k, vals in axes]
+    columns = [(_text("an axis' parameter", k), _numbers_of(f"the values of {k}", vals)) for k, vals in axes]
     return _core._sweep(columns, _texts("methods", methods), base, _number("h", h), _count("steps", steps),
                         _number("t_end", t_end), _number("tol", tol),
                         0 if threads is None else _count("threads", threads), _number("max_energy_error", max_energy_error),
@@ -306,7 +327,7 @@ class Stepper:
     """
 
     def __init__(self, scene, method, step, *, body=0, events=(), stop_at=(), omega_c=None):
-        self._s = _core._Stepper(_scene(scene), _count("body", body), _text("method", method), _number("step", step),
+        self._s = _core._Stepper(_scene(scene), _index("body", body), _text("method", method), _number("step", step),
                                  _texts("events", events), _texts("stop_at", stop_at),
                                  _number("omega_c", omega_c, optional=True))
 
