@@ -430,3 +430,29 @@ def test_sweep_in_the_accuracy_mode_equals_integrate_per_row():
         bp.sweep({"h": [0.1]}, "lp-y4", t_end=50, accuracy=tol)
     with pytest.raises(bp.Error, match="give t_end"):
         bp.sweep({"d": [5]}, "lp-y4", steps=100, accuracy=tol)
+
+
+def test_fourth_pass_messages_are_one_line_errors_naming_the_quantity():
+    # Each raised a pybind11 TypeError (several lines) or a TypeError of Python's own, or echoed a key raw.
+    with pytest.raises(bp.Error, match=r"^body must be a whole number >= 0, got -1$"):
+        bp.Stepper(bp.thesis_scene(), "lp-y4", 0.1, body=-1)
+    with pytest.raises(bp.Error) as key:
+        bp.Scene(centres=[{"position": [0, 0, 0], "A": -2}],
+                 bodies=[{"R": [1, 0, 0], "v": [1, 0, 0], "w": [0, 0, 0], "a\nb\nc": 1}])
+    assert "\n" not in str(key.value) and "unknown key 'a\\nb\\nc'" in str(key.value)
+    with pytest.raises(bp.Error, match="the values of d must be a number or a sequence of numbers"):
+        bp.sweep({"d": "abc"}, ["lp-y4"], steps=10)
+    # A single value is an axis of one value (a right answer is not refused).
+    one = bp.sweep({"d": 5}, ["lp-y4"], steps=10)
+    assert list(one["d"]) == [5.0] and one["status"] == ["ok"]
+
+
+def test_speed_at_infinity_takes_the_root_with_an_encounter():
+    # v_inf = 1 solved K1 = 0.884, whose guiding centre drifts away: a deflection of 0.445 was reported
+    # with no closest approach.
+    r = bp.encounter(bp.thesis_scene(v_inf=1.0), tol=1e-8)
+    assert r["outcome"] == "ok"
+    assert abs(r["v_inf"] - 1.0) < 1e-12
+    assert math.isfinite(r["r_min"])  # a closest approach happened
+    with pytest.raises(bp.Error, match="drifts away from the centre"):
+        bp.thesis_scene(K1=0.8, b=5.0)
