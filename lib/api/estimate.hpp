@@ -10,9 +10,9 @@
 
 namespace bodypoint::detail {
 
-/// Runs the same body with the same method under another way of advancing time and other options (a
-/// request valid by construction: it is not checked again).
-using Rerun = std::function<BodyResult(const Advance& how, const Options& options)>;
+/// Runs the body (the run's own, or its start moved by a rounding) with the same method under another way
+/// of advancing time and other options (a request valid by construction: it is not checked again).
+using Rerun = std::function<BodyResult(const Body& body, const Advance& how, const Options& options)>;
 
 /// Sets r.error for the finished run r, asked for as `how` with `options`: the accuracy mode's own
 /// estimate, a companion run's (bodypoint.hpp, ErrorEstimate), or why the run has none.
@@ -25,6 +25,15 @@ void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& 
 FixedSteps fixed_companion(const FixedSteps& run, int level = 1);
 ErrorEstimate fixed_step_estimate(const MethodInfo& m, const Body& body, const State& run, const State& companion);
 bool confirms(const MethodInfo& m, const Body& body, const State& run, const State& first, const State& second);
+
+/// Whether the estimate e is at the scene's rounding level (below kRoundingLevel, estimate.cpp), where the
+/// companion pair can agree by chance: the run is repeated from start_moved_by_rounding and what the two
+/// differ by is added (add_rounding_spread).
+bool at_rounding_level(const ErrorEstimate& e);
+/// The state s with R scaled by 1 + 4 eps and v by 1 - 4 eps: a start moved by a rounding.
+State start_moved_by_rounding(State s);
+/// Adds to e what the run's final state and its repeat's from the moved start differ by, and its cost.
+void add_rounding_spread(ErrorEstimate& e, const State& run, const State& repeat, long force_evals, double wall_s);
 
 /// The relative energy error of the state `end` of a run of `body` (NaN where E is not an integral).
 double final_energy_error(const Body& body, const std::vector<Centre>& centres, const State& end);

@@ -89,9 +89,20 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
     } else {
       row.error.basis = "the run ended " + std::string(outcome_name(row.outcome));
     }
-    detail::settle(row.outcome, row.reason, row.warnings, row.error, spec.max_error, spec.max_energy_error,
-                   detail::final_energy_error(scenes[k].bodies.front(), scenes[k].centres, row.result.final));
   }
+  // As integrate(): lanes whose estimate is at the rounding level add a repeat from their start moved by
+  // a rounding (estimate.hpp), run as one more batch.
+  if (spec.estimate_error && std::any_of(rows.begin(), rows.end(), [](const SweepRow& r) { return detail::at_rounding_level(r.error); })) {
+    std::vector<batch::Member> moved = members;
+    for (batch::Member& m : moved) m.s0 = detail::start_moved_by_rounding(m.s0);
+    const auto repeats = batch::run(method, moved, how);
+    for (std::size_t k = 0; k < rows.size(); ++k)
+      if (detail::at_rounding_level(rows[k].error))
+        detail::add_rounding_spread(rows[k].error, rows[k].result.final, repeats[k].final, repeats[k].force_evals, repeats[k].wall_s);
+  }
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    detail::settle(rows[k].outcome, rows[k].reason, rows[k].warnings, rows[k].error, spec.max_error, spec.max_energy_error,
+                   detail::final_energy_error(scenes[k].bodies.front(), scenes[k].centres, rows[k].result.final));
 }
 
 /// The row of a run with its encounter (SweepSpec::scattering): integrate_body with the encounter's
