@@ -121,6 +121,27 @@ ProgressBar::ProgressBar(const std::optional<WorkEstimate>& e, bool enabled) {
   });
 }
 
+ProgressBar::ProgressBar(const std::string& label, bool enabled) {
+  if (!enabled) return;
+  thread_ = std::thread([this, label] {
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
+    bool drawn = false;
+    while (!stop_.load()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(250));
+      const double el = std::chrono::duration<double>(Clock::now() - t0).count();
+      if (el < kBarSeconds) continue;
+      std::fprintf(stderr, "\r%s: %s so far ", label.c_str(), duration(el).c_str());
+      std::fflush(stderr);
+      drawn = true;
+    }
+    if (drawn) {
+      std::fprintf(stderr, "\r%*s\r", static_cast<int>(label.size()) + 24, "");
+      std::fflush(stderr);
+    }
+  });
+}
+
 ProgressBar::~ProgressBar() {
   stop_.store(true);
   if (thread_.joinable()) thread_.join();

@@ -11,6 +11,7 @@
 
 #include <atomic>
 #include <optional>
+#include <string>
 #include <thread>
 
 namespace bodypoint::cli {
@@ -55,6 +56,9 @@ bool progress_wanted(bool quiet);
 class ProgressBar {
  public:
   ProgressBar(const std::optional<WorkEstimate>& e, bool enabled);
+  /// A search whose length is not known beforehand (the accuracy mode): past kBarSeconds, "<label>: N s"
+  /// (the time so far) instead of a bar (a kep-y4 search at 1e-12 ran 600 s without a sign).
+  ProgressBar(const std::string& label, bool enabled);
   ~ProgressBar();
   ProgressBar(const ProgressBar&) = delete;
   ProgressBar& operator=(const ProgressBar&) = delete;

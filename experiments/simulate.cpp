@@ -243,7 +243,9 @@ SimulatedBody simulate_body(const SimulateOptions& o, const RunPlan& plan, const
   }
   SimulatedBody sb;
   {
-    const ProgressBar bar(estimate, progress_wanted(o.quiet));
+    const auto* accuracy = std::get_if<Accuracy>(&plan.how);
+    const ProgressBar bar = accuracy ? ProgressBar("searching the step for tol " + fmt(accuracy->tol), progress_wanted(o.quiet))
+                                     : ProgressBar(estimate, progress_wanted(o.quiet));
     sb.run = run_body(plan, body, scene.centres, plan.how, sink, events);
   }
   const BodyResult& br = sb.run;
