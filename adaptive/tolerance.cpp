@@ -80,9 +80,6 @@ constexpr double kMaxEvals = 2e9;
 /// on each run about to be delivered, and the estimate their sum (both errors are in the delivered run),
 /// none did, for 24 refusals instead of 18 and 28 % more force evaluations.
 constexpr double kProbeShift = 1e-9;
-/// The starting state's relative move of the rounding probe: a few units in the last place of a double
-/// (the rounding of a decimal input such as Kz = 0.1 is half of one).
-constexpr double kStartShift = 4.0 * std::numeric_limits<double>::epsilon();
 /// far-ip's pair (exact_flow) starts its finer run from the start moved by this relative amount: one unit
 /// in the last place, the rounding the start's conversion to momenta makes; its third run's start moves by
 /// kStartShift the other way.

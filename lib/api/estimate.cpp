@@ -162,13 +162,10 @@ void flag_broken_companion(BodyResult& r, const BodyResult& x, const std::string
 
 /// A companion difference below kRoundingLevel is at the scene's rounding level, where the pair can agree
 /// by chance (one draw of the rounding each; rk4 at h = 5e-4 on a bound orbit: estimated 3.3e-12 for an
-/// error of 2.9e-11): the run is repeated from its start moved by kStartShift, and what the two differ
+/// error of 2.9e-11): the run is repeated from its start moved by adaptive::kStartShift, and what the two differ
 /// by (the scene's amplification of a rounding of its start) is added to the estimate, as the accuracy
 /// mode adds its rounding probe below the same level (tolerance.hpp, kProbeBelowTol).
 constexpr double kRoundingLevel = adaptive::kProbeBelowTol;
-/// The start's relative move: a few units in the last place (the rounding of a decimal input such as
-/// Kz = 0.1 is half of one), as the accuracy mode's rounding probe moves it.
-constexpr double kStartShift = 4.0 * std::numeric_limits<double>::epsilon();
 
 void add_rounding_floor(ErrorEstimate& e, const BodyResult& r, const Body& body, const Advance& how, const Options& o,
                         const Rerun& rerun) {
@@ -252,8 +249,8 @@ void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& 
 bool at_rounding_level(const ErrorEstimate& e) { return e.value < kRoundingLevel; }
 
 State start_moved_by_rounding(State s) {
-  s.R *= 1.0 + kStartShift;
-  s.v *= 1.0 - kStartShift;
+  s.R *= 1.0 + adaptive::kStartShift;
+  s.v *= 1.0 - adaptive::kStartShift;
   return s;
 }
 

@@ -16,6 +16,7 @@
 
 #include "bodypoint/run.hpp"
 
+#include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -34,6 +35,10 @@ inline constexpr double kMinTolerance = 1e-13;
 /// delivered 2.6e-11 on a close pass with an estimate of 8.9e-13: bench/accuracy_grid.py.)
 inline constexpr double kProbeBelowTol = 1e-10;
 inline constexpr int kProbeRuns = 3;
+/// The rounding probe's relative move of the starting state (R scaled by 1 + kStartShift, v by 1 -
+/// kStartShift): a few units in the last place of a double (the rounding of a decimal input such as
+/// Kz = 0.1 is half of one). The run-by-step estimate at the rounding level moves it alike (estimate.cpp).
+inline constexpr double kStartShift = 4.0 * std::numeric_limits<double>::epsilon();
 
 /// Why the accuracy mode refuses a scene with a centre that does not follow Coulomb's law.
 inline constexpr std::string_view kNeedsCoulomb =
