@@ -70,6 +70,9 @@ struct Point {
   double b_target = 0.0, psi = 0.0, d = 0.0;
   Scattering sc;
   double r_min = kNaN, t_min = kNaN, t_end = 0.0, tol = kStudyTolerance, asymptote_error = kNaN;
+  /// The finite start distance's part of the deflection's error and the deflection's total error
+  /// (bodypoint.hpp, add_start_distance_error): the same (b, arrival phase) again from 2L.
+  double start_distance_error = kNaN, deflection_error = kNaN;
   long force_evals = 0;
   std::string method, failure;
   [[nodiscard]] bool ok() const { return failure.empty() && std::isfinite(sc.deflection); }
@@ -107,8 +110,18 @@ Point run_point(const Series& s, double b, double psi) {
       p.failure = r.encounter.reason;
       return p;
     }
+    if (s.B == 0.0) {
+      add_start_distance_error(r.encounter, nullptr, true, r.run.error.value);
+    } else {
+      const Scene far = thesis_scene(thesis_params_twice_as_far(params, b, kNaN, phased(s) ? psi : kNaN));
+      const EncounterResult f = encounter_twice_as_far(far, twice_as_far_tol(p.tol), o);
+      p.force_evals += f.run.total_force_evals();
+      add_start_distance_error(r.encounter, &f, false, r.run.error.value);
+    }
     p.sc = r.encounter.scattering;
     p.asymptote_error = r.encounter.asymptote_error;
+    p.start_distance_error = r.encounter.start_distance_error;
+    p.deflection_error = r.encounter.deflection_error;
     p.r_min = r.encounter.r_min;
     p.t_min = r.encounter.t_min;
   } catch (const Error& e) {
@@ -330,7 +343,7 @@ void write_points(std::ostream& os, const Grid& g) {
         line.num(p.sc.v_inf).num(p.sc.deflection).num(p.asymptote_error).num_if(s.B == 0.0 && ok, th_r);
         line.num_if(s.B == 0.0 && ok, std::abs(p.sc.deflection / th_r - 1.0)).num(p.sc.out_of_plane).num(p.r_min).num(p.t_min);
         line.num(p.t_end).num(p.sc.spin_turn).num(p.sc.K1_turn).num(p.sc.time_delay).quoted(p.sc.asymptotes).text(p.method);
-        line.num(p.tol).count(p.force_evals).quoted(p.failure);
+        line.num(p.tol).count(p.force_evals).quoted(p.failure).num(p.start_distance_error).num(p.deflection_error);
         os << line.str() << "\n";
       }
   }
@@ -350,7 +363,7 @@ void write_summary(std::ostream& ss, const Grid& g, const std::vector<Rainbow>& 
   for (std::size_t k = 0; k < g.all.size(); ++k) {
     const Series& s = g.all[k];
     long points = 0, failed = 0, evals = 0;
-    double max_rel = 0.0, max_oop = 0.0, min_r = kNaN, max_asym = 0.0, th_lo = kNaN, th_hi = kNaN;
+    double max_rel = 0.0, max_oop = 0.0, min_r = kNaN, max_asym = 0.0, max_start = 0.0, th_lo = kNaN, th_hi = kNaN;
     for (std::size_t j = 0; j < g.phases_of(s); ++j)
       for (std::size_t i = 0; i < g.bs.size(); ++i) {
         const Point& p = g.row(k, j)[i];
@@ -364,6 +377,7 @@ void write_summary(std::ostream& ss, const Grid& g, const std::vector<Rainbow>& 
         max_oop = std::max(max_oop, std::abs(p.sc.out_of_plane));
         if (!(p.r_min >= min_r)) min_r = p.r_min;
         if (std::isfinite(p.asymptote_error)) max_asym = std::max(max_asym, p.asymptote_error);
+        if (std::isfinite(p.start_distance_error)) max_start = std::max(max_start, p.start_distance_error);
         if (i == 0) {
           th_lo = std::isnan(th_lo) ? p.sc.deflection : std::min(th_lo, p.sc.deflection);
           th_hi = std::isnan(th_hi) ? p.sc.deflection : std::max(th_hi, p.sc.deflection);
@@ -382,7 +396,7 @@ void write_summary(std::ostream& ss, const Grid& g, const std::vector<Rainbow>& 
     CsvLine line;
     line.quoted(s.name).num(s.B).num(s.Kx).num(s.Kz).count(static_cast<long>(g.phases_of(s))).count(points).count(failed);
     line.num_if(s.B == 0.0, max_rel).num(th_lo).num(th_hi).num(rutherford(A, m, p_inf / m, first.sc.b)).num(max_oop);
-    line.count(n_rainbows).num(rb_lo).num(rb_hi).num(min_r).num(max_asym).count(evals);
+    line.count(n_rainbows).num(rb_lo).num(rb_hi).num(min_r).num(max_asym).count(evals).num(max_start);
     ss << line.str() << "\n";
   }
 }
@@ -404,7 +418,8 @@ void write_scattering_study(const std::filesystem::path& dir, bool quick, unsign
       rb((dir / "scattering_rainbows.csv").string()), xs((dir / "scattering_cross_section.csv").string());
   const std::string header = header_line(quick, g);
   csv.stream() << "series,B,Kx,Kz,b,arrival_phase,d,v_inf,theta,asymptote_error,theta_rutherford,rel_diff_rutherford,"
-                  "out_of_plane,r_min,t_min,t_end,spin_turn,K1_turn,time_delay,asymptotes,method,tol,force_evals,failure\n"
+                  "out_of_plane,r_min,t_min,t_end,spin_turn,K1_turn,time_delay,asymptotes,method,tol,force_evals,failure,"
+                  "start_distance_error,deflection_error\n"
                << header;
   write_points(csv.stream(), g);
   rb.stream() << "series,B,arrival_phase,b,theta,kind,runs\n" << header
@@ -418,7 +433,7 @@ void write_scattering_study(const std::filesystem::path& dir, bool quick, unsign
   write_cross_sections(xs.stream(), g, quick);
   summary.stream() << "series,B,Kx,Kz,phases,points,failed,max_rel_diff_rutherford,theta_min_at_smallest_b,"
                       "theta_max_at_smallest_b,theta_material_point_at_smallest_b,max_abs_out_of_plane,rainbows,"
-                      "rainbow_theta_min,rainbow_theta_max,min_r_min,max_asymptote_error,force_evals\n"
+                      "rainbow_theta_min,rainbow_theta_max,min_r_min,max_asymptote_error,force_evals,max_start_distance_error\n"
                    << header << "# one row per series; rainbows: maxima of theta(b) over every phase\n";
   write_summary(summary.stream(), g, rainbows);
   csv.commit();

@@ -68,7 +68,12 @@ void print_encounter(const std::vector<Event>& events, const BodyResult& run, co
               << ", time delay = " << fmt(sc.time_delay) << "\n"
               << "    the asymptotes' model error in the deflection: "
               << (std::isfinite(e->asymptote_error) ? fmt(e->asymptote_error) + " (" : "") << e->asymptote_basis
-              << (std::isfinite(e->asymptote_error) ? ")" : "") << "\n";
+              << (std::isfinite(e->asymptote_error) ? ")" : "") << "\n"
+              << "    the start distance's error (deflection, time delay): "
+              << (std::isfinite(e->start_distance_error) ? fmt(e->start_distance_error) + ", " + fmt(e->time_delay_error) + " (" : "")
+              << e->start_distance_basis << (std::isfinite(e->start_distance_error) ? ")" : "") << "\n"
+              << "    the deflection's total error (the run's, the asymptotes' and the start distance's): "
+              << (std::isfinite(e->deflection_error) ? fmt(e->deflection_error) : "not known") << "\n";
   if (std::isfinite(e->r_min)) std::cout << "    closest approach r_min = " << fmt(e->r_min) << " at t_min = " << fmt(e->t_min) << "\n";
   else std::cout << "    no closest approach within the run (the distance has no minimum between its ends)\n";
   std::cout << "    K1 turned " << fmt(sc.K1_turn) << " rad, the spin K2 " << fmt(sc.spin_turn) << " rad; K1: "
@@ -223,6 +228,25 @@ class TrajectoryFile {
   double max_rows_;
   long rows_ = 0;
 };
+
+/// The start distance's part of an encounter's error: the thesis's scene at 2L with the same asymptotic
+/// data, run to its departure by auto (twice_as_far_tol); not known for a scene file's states.
+void add_start_distance(Encounter& e, const po::variables_map& vm, const SceneOptions& so, const RunPlan& plan,
+                        const Body& body, double numerical) {
+  const bool material = body.p.B == 0.0;
+  if (vm.count("scene")) {
+    no_start_distance_error(e, material, numerical, "the scene file gives states, not the thesis's start distance L");
+    return;
+  }
+  if (material) {
+    add_start_distance_error(e, nullptr, true, numerical);
+    return;
+  }
+  const Scene far = thesis_scene(thesis_params_twice_as_far(so.params, so.b, so.v_inf, so.arrival_phase));
+  const EncounterResult r =
+      encounter_twice_as_far(far, twice_as_far_tol(plan.search ? std::optional<double>(plan.tol) : std::nullopt));
+  add_start_distance_error(e, &r, material, numerical);
+}
 
 /// One body's run and, with --reference, the reference state at its end.
 struct SimulatedBody {
@@ -395,6 +419,7 @@ int cmd_simulate(int argc, char** argv) {
       enc[b] = measure_encounter(scene.bodies[b], scene.centres, runs[b].run.run, runs[b].run.events, o.body_events[b]);
       if (enc[b]->outcome != Outcome::ok)
         throw Error("body '" + scene.bodies[b].name + "': " + enc[b]->reason + "; no output written");
+      add_start_distance(*enc[b], vm, o.so, plan, scene.bodies[b], runs[b].run.error.value);
     }
   if (file) file->commit();
   if (o.json) {

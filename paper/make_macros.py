@@ -1069,6 +1069,7 @@ def scattering(res, M):
         M.add(f"ScatOutOfPlane{word}", sci(num(r["max_abs_out_of_plane"]), 2))
         M.add(f"ScatRMin{word}", sci(num(r["min_r_min"]), 2))
         M.add(f"ScatAsymptote{word}", sci(num(r["max_asymptote_error"]), 1))
+        M.add(f"ScatStartDistance{word}", sci(num(r["max_start_distance_error"]), 1))
     along, across = by["B=0.7 spin along K1"], by["B=0.7 spin across K1"]
     M.add("ScatAlongFailed", count(int(along["failed"])))
     M.add("ScatThetaAlong", sci(num(along["theta_min_at_smallest_b"]), 4))

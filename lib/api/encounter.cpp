@@ -1,6 +1,7 @@
 // bodypoint: an encounter measured on a run (bodypoint.hpp, Encounter; scattering.hpp).
 #include "bodypoint/bodypoint.hpp"
 #include "bodypoint/io.hpp"
+#include "bodypoint/scattering.hpp"
 #include "events.hpp"
 
 #include <algorithm>
@@ -15,6 +16,12 @@ namespace {
 /// that distance to round-off in time (~1e-15 relative), and this much slack covers the located
 /// state's own error without calling a body that is still inside "finished".
 constexpr double kLeftSlack = 1e-9;
+/// A spinning body's observables at a fixed b, v_inf and arrival phase converge as 1/L in the start
+/// distance L (B = 0.7, b = 1, psi = 1: 0.0900936, 0.0901056, 0.0901116, 0.0901147 from L = 200, 400,
+/// 800, 1600; docs/physics.md): x(L) - x(infinity) = 2 (x(L) - x(2L)) for the 1/L term alone, times a
+/// margin of 1.5 for the next one (the differences fall by 2.0x and 1.94x there: 2 |x(200) - x(400)| is
+/// 0.3 % below the limit's 2.42e-5).
+constexpr double kStartDistanceFactor = 2.0 * 1.5;
 
 double start_distance(const Body& body, const Centre& c) { return (detail::guiding_centre(body.p, body.s0) - c.c).norm(); }
 
@@ -129,6 +136,48 @@ double encounter_span(const Body& body, const std::vector<Centre>& centres) {
   const auto a = k ? kepler_asymptote(k->mu, k->kappa(centres.front().A), k->X, k->P, false) : std::nullopt;
   if (!a) throw Error("the body has no speed at infinity (a bound orbit, or a guiding centre at rest): give t_end");
   return kEncounterSpans * 2.0 * k->X.norm() / (a->p_inf / k->mu);
+}
+
+void add_start_distance_error(Encounter& at_L, const EncounterResult* at_2L, bool material, double numerical) {
+  if (material) {
+    at_L.start_distance_error = at_L.time_delay_error = 0.0;
+    at_L.start_distance_basis = "exact: a material point's Kepler hyperbola does not depend on where it starts";
+  } else if (!at_2L || at_2L->run.outcome != Outcome::ok || at_2L->encounter.outcome != Outcome::ok ||
+             !std::isfinite(at_2L->encounter.scattering.deflection)) {
+    const std::string why = !at_2L ? "" : at_2L->run.outcome != Outcome::ok ? at_2L->run.reason : at_2L->encounter.reason;
+    at_L.start_distance_basis = "not known: the encounter from twice the start distance did not finish" +
+                                (why.empty() ? std::string() : " (" + why + ")");
+  } else {
+    // x(L) = x_inf + c/L: x(L) - x_inf = 2 (x(L) - x(2L)), with a margin; the far run's own error counts.
+    const Scattering& far = at_2L->encounter.scattering;
+    const double far_error = std::isfinite(at_2L->run.error.value) ? at_2L->run.error.value : 0.0;
+    at_L.start_distance_error = kStartDistanceFactor * (std::abs(at_L.scattering.deflection - far.deflection) + far_error);
+    at_L.time_delay_error = kStartDistanceFactor * std::abs(at_L.scattering.time_delay - far.time_delay);
+    at_L.start_distance_basis = "3 |x(L) - x(2L)| from the encounter started at twice the distance (" + fmt(far.deflection) +
+                                " rad there, estimated error " + fmt(far_error) +
+                                "): the observables converge as 1/L, a margin of 1.5 for the next order";
+  }
+  at_L.deflection_error = numerical + at_L.asymptote_error + at_L.start_distance_error;  // NaN if any is
+}
+
+EncounterResult encounter_twice_as_far(const Scene& far, double tol, const Options& options) {
+  constexpr double kLooser = 100.0, kLoosest = 1e-6;
+  for (;; tol *= kLooser) {
+    EncounterResult r = encounter(far.bodies.front(), far.centres, nullptr, tol, Scattering::kNaN, options);
+    if (r.run.outcome != Outcome::failed || r.run.reason.find("out of reach") == std::string::npos ||
+        tol * kLooser > kLoosest)
+      return r;
+  }
+}
+
+void no_start_distance_error(Encounter& e, bool material, double numerical, const std::string& why) {
+  add_start_distance_error(e, nullptr, material, numerical);
+  if (!material) e.start_distance_basis = "not known: " + why;
+}
+
+SceneParams thesis_params_twice_as_far(SceneParams solved, double b, double v_inf, double arrival_phase) {
+  solved.start.L *= 2.0;
+  return with_asymptotic_data(solved, b, v_inf, arrival_phase);
 }
 
 EncounterResult encounter(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method, double tol,

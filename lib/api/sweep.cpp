@@ -105,6 +105,28 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
                    detail::final_energy_error(scenes[k].bodies.front(), scenes[k].centres, rows[k].result.final));
 }
 
+/// The start distance's part of a row's encounter error: the same grid point with the start distance L
+/// doubled (an axis of L doubled too), its asymptotic data solved again, run to its departure by auto
+/// (twice_as_far_tol).
+void add_start_distance(Encounter& e, const SweepSpec& spec, const std::vector<double>& point, const Body& body,
+                        double numerical) {
+  if (body.p.B == 0.0) {
+    add_start_distance_error(e, nullptr, true, numerical);
+    return;
+  }
+  SweepSpec far = spec;
+  far.base.start.L *= 2.0;
+  std::vector<double> at = point;
+  for (std::size_t a = 0; a < spec.axes.size(); ++a)
+    if (spec.axes[a].param == "L") at[a] *= 2.0;
+  const Scene scene = thesis_scene(point_params(far, at));
+  Options o;
+  o.track_invariants = false;
+  o.cancel = spec.cancel;
+  const EncounterResult r = encounter_twice_as_far(scene, twice_as_far_tol(spec.accuracy), o);
+  add_start_distance_error(e, &r, false, numerical);
+}
+
 /// The row of a run with its encounter (SweepSpec::scattering): integrate_body with the encounter's
 /// events (encounter_options: it stops at the departure, the sweep's end the latest), measured by
 /// measure_encounter; an encounter that did not finish by the end is the row's outcome (incomplete).
@@ -114,10 +136,14 @@ SweepRow encounter_row(SweepRow row, const MethodInfo& method, const Scene& scen
   const Options options = encounter_options(body, scene.centres, sweep_options(spec), true);
   BodyResult r = integrate_body(body, scene.centres, &method, how, options);
   if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return result_row(std::move(row), std::move(r));
-  const Encounter e = measure_encounter(body, scene.centres, r.run, r.events, options.events);
+  Encounter e = measure_encounter(body, scene.centres, r.run, r.events, options.events);
+  if (e.outcome == Outcome::ok && r.outcome == Outcome::ok) add_start_distance(e, spec, row.point, body, r.error.value);
   row.r_min = e.r_min;
   row.t_min = e.t_min;
   row.asymptote_error = e.asymptote_error;
+  row.start_distance_error = e.start_distance_error;
+  row.time_delay_error = e.time_delay_error;
+  row.deflection_error = e.deflection_error;
   row = result_row(std::move(row), std::move(r));
   if (row.outcome != Outcome::ok) return row;
   row.scattering = e.scattering;

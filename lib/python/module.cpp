@@ -461,7 +461,17 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
 }
 
 /// The encounter's record with its run's (`run`: method, steps, t_end, err_estimate, force_evals, ...).
-py::dict encounter_py(const Scene& scene, const std::string& method, double tol, double t_end, double max_seconds) {
+/// The thesis keywords `kw` (thesis_scene's) with the start distance L doubled, the asymptotic data kept.
+py::dict twice_as_far(const py::dict& kw) {
+  py::dict far;
+  for (const auto& [k, v] : kw) far[k] = v;
+  const double L = kw.contains("L") ? number_of(kw["L"], "L") : SceneParams{}.start.L;
+  far["L"] = 2.0 * L;
+  return far;
+}
+
+py::dict encounter_py(const Scene& scene, const std::string& method, double tol, double t_end, double max_seconds,
+                      const std::optional<py::dict>& thesis) {
   const MethodInfo* m = method == "auto" ? nullptr : &method_or_throw(method);
   Options o;
   o.track_invariants = false;
@@ -474,6 +484,22 @@ py::dict encounter_py(const Scene& scene, const std::string& method, double tol,
   }
   stop.raise();
   if (r.run.outcome != Outcome::ok) throw Error(r.run.reason);
+  // The start distance's part of the error (bodypoint.hpp, add_start_distance_error): the thesis's scene
+  // again from 2L; a scene given by its states has no L to double.
+  const Body& body = scene.bodies.front();
+  if (r.encounter.outcome == Outcome::ok && (body.p.B == 0.0 || !thesis)) {
+    no_start_distance_error(r.encounter, body.p.B == 0.0, r.run.error.value,
+                            "the scene gives states, not the thesis's start distance L (thesis_scene() does)");
+  } else if (r.encounter.outcome == Outcome::ok) {
+    const Scene far = thesis_from(twice_as_far(*thesis));
+    EncounterResult f;
+    {
+      py::gil_scoped_release free;
+      f = encounter_twice_as_far(far, twice_as_far_tol(tol), o);
+    }
+    stop.raise();
+    add_start_distance_error(r.encounter, &f, false, r.run.error.value);
+  }
   const Advance how = Accuracy{tol, r.run.run.t_end};
   return to_py(encounter_record(r.encounter).record("run", body_record(r.run, how, r.events)));
 }
@@ -526,7 +552,7 @@ struct PyStepper {
 
 /// The Scene class and the functions that make scenes or list the catalogue.
 void bind_scenes(py::module_& mod) {
-  py::class_<Scene>(mod, "Scene", "Fixed Coulomb centres and independent body-points (docs/physics.md).")
+  py::class_<Scene>(mod, "Scene", "Fixed Coulomb centres and independent body-points (docs/physics.md).", py::dynamic_attr())
       .def(py::init(&scene_from), py::arg("centres"), py::arg("bodies"))
       .def_property_readonly("centres", [](const Scene& s) {
         py::list l;
@@ -610,5 +636,5 @@ PYBIND11_MODULE(_bodypoint, mod) {
           py::arg("t_end"), py::arg("tol"), py::arg("threads"), py::arg("max_energy_error"), py::arg("estimate_error"), py::arg("max_error"),
           py::arg("scattering"), py::arg("force_law"), py::arg("accuracy"), py::arg("max_seconds"));
   mod.def("_encounter", &encounter_py, py::arg("scene"), py::arg("method"), py::arg("tol"), py::arg("t_end"),
-          py::arg("max_seconds"));
+          py::arg("max_seconds"), py::arg("thesis"));
 }

@@ -101,6 +101,34 @@ TEST(FourthPass, Rk4UnderTolDelivers) {
   }
 }
 
+TEST(FourthPass, ScatteringStatesItsStartDistanceError) {
+  // At B = 0.7, b = 1, arrival phase 1 the deflection converges as 1/L (0.0900936, 0.0901056, 0.0901116,
+  // 0.0901147 from L = 200 .. 1600): the run at L = 200 stated a model error of 2e-8 for a distance of
+  // 2.4e-5 from the limit. The limit lies within the stated error of the run at L = 1600; the run at 200
+  // must state at least its distance to that run plus that run's own error.
+  const std::string args = "simulate --json --tol 1e-10 --scattering --B 0.7 --b 1 --arrival-phase 1 --L ";
+  const auto near = run_cli(args + "200"), far = run_cli(args + "1600");
+  ASSERT_EQ(near.code, 0) << near.err;
+  ASSERT_EQ(far.code, 0) << far.err;
+  const double theta = json_number(near.out, "deflection"), theta_far = json_number(far.out, "deflection");
+  const double error = json_number(near.out, "deflection_error"), error_far = json_number(far.out, "deflection_error");
+  EXPECT_GE(json_number(near.out, "start_distance_error"), 0.0);
+  EXPECT_LE(std::abs(theta - theta_far) + error_far, error) << near.out;
+  EXPECT_GT(json_number(near.out, "time_delay_error"), 0.0);
+  // A material point's hyperbola does not depend on where it starts; a scene file's states have no L.
+  const auto material = run_cli("simulate --json --tol 1e-10 --scattering --B 0 --b 1");
+  ASSERT_EQ(material.code, 0) << material.err;
+  EXPECT_EQ(json_number(material.out, "start_distance_error"), 0.0);
+  EXPECT_TRUE(std::isfinite(json_number(material.out, "deflection_error")));
+  const fs::path scene = test::temp_path("spinning.toml");
+  std::ofstream(scene) << "[[centre]]\nposition = [0.0, 0.0, 0.0]\nA = -2.0\n[[body]]\nm = 1.0\nB = 0.7\nJ = 1.0\nd = 10.0\n"
+                          "L = 200.0\nK1 = 5.0\nKx = 2.0\nKz = 5.0\n";
+  const auto file = run_cli("simulate --json --tol 1e-8 --scattering --scene " + scene.string());
+  ASSERT_EQ(file.code, 0) << file.err;
+  EXPECT_TRUE(std::isnan(json_number(file.out, "start_distance_error"))) << file.out;
+  EXPECT_NE(file.out.find("the scene file gives states"), std::string::npos);
+}
+
 TEST(FourthPass, MessagesNameTheQuantity) {
   const fs::path phase = test::temp_path("phase.toml"), far = test::temp_path("far.toml");
   const std::string body = "[[body]]\nm = 1.0\nB = 0.7\nJ = 1.0\nd = 10.0\nL = 200.0\nK1 = 5.0\nKx = 2.0\nKz = 5.0\n";

@@ -456,3 +456,13 @@ def test_speed_at_infinity_takes_the_root_with_an_encounter():
     assert math.isfinite(r["r_min"])  # a closest approach happened
     with pytest.raises(bp.Error, match="drifts away from the centre"):
         bp.thesis_scene(K1=0.8, b=5.0)
+
+
+def test_encounter_states_its_start_distance_error():
+    # A spinning body's deflection converges as 1/L: a scene of thesis_scene() is run again from 2L.
+    near = bp.encounter(bp.thesis_scene(B=0.7, b=1.0, arrival_phase=1.0), tol=1e-10)
+    far = bp.encounter(bp.thesis_scene(B=0.7, b=1.0, arrival_phase=1.0, L=1600.0), tol=1e-10)
+    assert abs(near["deflection"] - far["deflection"]) + far["deflection_error"] <= near["deflection_error"]
+    assert near["start_distance_error"] > near["asymptote_error"]
+    material = bp.encounter(bp.thesis_scene(B=0.0, b=1.0), tol=1e-10)
+    assert material["start_distance_error"] == 0.0 and material["deflection_error"] is not None

@@ -259,6 +259,16 @@ struct Encounter {
   /// asymptotes, or the body never came within half its start distance).
   double asymptote_error = Scattering::kNaN;
   std::string asymptote_basis;  ///< how asymptote_error was obtained, or why it is not known
+  /// The error of the deflection and of the time delay that the start's finite distance L leaves against
+  /// the limit L -> infinity at the same asymptotic data (a spinning body's observables converge as 1/L:
+  /// 2 |x(L) - x(2L)| from the same encounter started at 2L, add_start_distance_error). 0 for B = 0 (a
+  /// Kepler hyperbola's observables do not depend on where it starts); NaN when not known.
+  double start_distance_error = Scattering::kNaN, time_delay_error = Scattering::kNaN;
+  std::string start_distance_basis = "not known: not measured";
+  /// The deflection's total error: the run's estimated error (a relative error of the final state, which
+  /// bounds the angle of its velocity), the asymptotes' model error and the start distance's; NaN when
+  /// any part is not known.
+  double deflection_error = Scattering::kNaN;
 };
 
 /// The slowest fall of the asymptotes' model error with the distance L measured (L^-2.7; study
@@ -291,6 +301,27 @@ struct EncounterResult {
 };
 EncounterResult encounter(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method, double tol,
                           double t_end = Scattering::kNaN, Options options = {});
+
+/// The accuracy of the encounter from twice the start distance, run by auto (the run's own method may not
+/// reach its tol that far out: lp-kl8 at 1e-10 from L = 400): the run's tol where it had one, otherwise
+/// kTwiceAsFarTol (its error must stay well below the 1/L term it measures, 1e-5..1e-3 relative at L = 200).
+inline constexpr double kTwiceAsFarTol = 1e-10;
+inline double twice_as_far_tol(std::optional<double> run_tol) { return run_tol ? *run_tol : kTwiceAsFarTol; }
+/// Sets the start distance's part of `at_L`'s error from the same encounter started twice as far
+/// (`at_2L`: encounter_twice_as_far of the thesis's scene at thesis_params_twice_as_far; its own estimated
+/// error counts in), and the deflection's total error with `numerical` (the run's err_estimate). For
+/// B = 0 (`material`) no second encounter is needed: pass nullptr.
+void add_start_distance_error(Encounter& at_L, const EncounterResult* at_2L, bool material, double numerical);
+/// The encounter of `far` (the thesis's scene from 2L) by auto at `tol` (twice_as_far_tol), looser by
+/// 100x while auto refuses it as out of reach, to 1e-6 at most (the 1/L term it measures is 1e-6..1e-3
+/// at L = 200..1600; auto at 1e-10 is out of reach from L = 3200).
+EncounterResult encounter_twice_as_far(const Scene& far, double tol, const Options& options = {});
+/// The same when the start distance cannot be doubled (a scene given by its states): the part is not
+/// known (`why`), nor is the total, for B != 0.
+void no_start_distance_error(Encounter& e, bool material, double numerical, const std::string& why);
+/// The thesis's parameters `solved` (d, K1, phase solved for the asymptotic data) with the start distance L
+/// doubled and the data b, v_inf, arrival_phase (NaN: not given, d, K1, phase kept) solved for again.
+SceneParams thesis_params_twice_as_far(SceneParams solved, double b, double v_inf, double arrival_phase);
 
 /// One body advanced in segments: advance_to(t) integrates from the current time to t and may be
 /// called again to continue. Each segment starts from the state the previous one ended in, as a run

@@ -185,7 +185,9 @@ def thesis_scene(**params):
     reaches its periapsis; phase is solved for it). docs/physics.md says what each means: d is *not*
     the geometric impact parameter.
     """
-    return _core._thesis_scene(params)
+    scene = _core._thesis_scene(params)
+    scene._thesis = dict(params)  # encounter() doubles its start distance L for the 1/L part of the error
+    return scene
 
 
 def read_scene(path):
@@ -301,7 +303,11 @@ def encounter(scene, *, t_end=None, method="auto", tol=1e-10, max_seconds=DEFAUL
     at the latest after two free passes; with t_end it runs to t_end. Returns outcome ("ok", or
     "incomplete" when the run ended before the body left: then deflection, out_of_plane, b, v_inf and
     time_delay are None), reason, deflection, out_of_plane, b, v_inf, time_delay, asymptote_error (the
-    asymptotes' model error in the deflection; 0 for B = 0) and asymptote_basis, K1_turn, spin_turn,
+    asymptotes' model error in the deflection; 0 for B = 0) and asymptote_basis, start_distance_error and
+    time_delay_error (what the finite start distance L leaves against L -> infinity: a scene of
+    thesis_scene() is run again from 2L; 0 for B = 0; None for a scene given by its states) and
+    start_distance_basis, deflection_error (the deflection's total: the run's estimate, the asymptotes' and
+    the start distance's; None where a part is not known), K1_turn, spin_turn,
     r_min, t_min (the closest approach to any centre), asymptotes, direction_in and direction_out, K1,
     K2 (and K2Q) and E at both ends: the keys of ``simulate --scattering --json``'s "scattering" object.
     ``run`` holds the run's own fields, as integrate() gives a body's (method, steps, t_end,
@@ -309,7 +315,7 @@ def encounter(scene, *, t_end=None, method="auto", tol=1e-10, max_seconds=DEFAUL
     A run that is not ok (refused, diverged, ...) raises bodypoint.Error."""
     return _core._encounter(_scene(scene), _text("method", method), _number("tol", tol),
                             float("nan") if t_end is None else _number("t_end", t_end),
-                            _number("max_seconds", max_seconds))
+                            _number("max_seconds", max_seconds), getattr(scene, "_thesis", None))
 
 
 class Stepper:
