@@ -18,6 +18,7 @@ import statistics
 import subprocess
 import sys
 import tempfile
+import time
 from concurrent.futures import ThreadPoolExecutor
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -32,11 +33,18 @@ TOLS = "1e-3,1e-4,1e-5,1e-6,1e-7,1e-8,1e-9,1e-10,1e-11,1e-12,1e-13"
 REFERENCE_ERROR = 1e-12
 
 
+# A search is bounded (issue #56) when it takes at most this many times its delivered run, plus SLACK_S.
+BOUND_RUNS = 2.0
+SLACK_S = 10.0
+
+
 def one(binary, max_seconds, job):
     scene, args, t_end, method, tol = job
+    start = time.monotonic()
     code, out, err = simulate(binary, [*args, "--t-end", t_end, "--method", method, "--tol", tol,
                                        "--max-seconds", str(max_seconds)])
-    return {"scene": scene, "method": method, "tol": float(tol), "exit": code, "out": out, "reason": err}
+    return {"scene": scene, "method": method, "tol": float(tol), "exit": code, "out": out, "reason": err,
+            "seconds": time.monotonic() - start}
 
 
 def main():
@@ -76,6 +84,16 @@ def main():
     for r in sorted(missed, key=lambda r: -r["error"] / r["tol"])[:15]:
         print(f"   {r['scene']} {r['method']} tol {r['tol']:g}: error {r['error']:.3g} ({r['error'] / r['tol']:.3g} x TOL), "
               f"estimate {r['out']['err_estimate']:.3g}")
+    # The search's cost against its delivered run's: force evaluations (load-independent) and wall seconds.
+    over = [r for r in rows if r["exit"] == 0 and r["out"]["search_wall_s"] > BOUND_RUNS * r["out"]["wall_s"] + SLACK_S]
+    evals = [r["out"]["search_force_evals"] / max(r["out"]["force_evals"], 1) for r in rows if r["exit"] == 0]
+    slow_refusals = [r for r in rows if r["exit"] != 0 and r["seconds"] > SLACK_S]
+    if evals:
+        print(f"search / delivered run, force evaluations: median {statistics.median(evals):.3g}, max {max(evals):.3g}; "
+              f"searches beyond {BOUND_RUNS:g}x the delivered run + {SLACK_S:g} s: {len(over)}; refusals after more "
+              f"than {SLACK_S:g} s: {len(slow_refusals)}")
+    for r in sorted(slow_refusals, key=lambda r: -r["seconds"])[:8]:
+        print(f"   {r['scene']} {r['method']} tol {r['tol']:g}: refused after {r['seconds']:.1f} s: {r['reason'][-90:]}")
     print("refusals by reason:")
     for why, n in refusals.most_common(12):
         print(f"   {n:5d}  {why}")

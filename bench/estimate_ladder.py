@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Do a run's flags and its error estimate tell right answers from wrong ones? (issue #40)
 
-A step ladder of every method over nine scenes: each run is made as a user makes it (`bodypoint
+A step ladder of every method over thirteen scenes (two attracting and two several-centre scenes
+added for issue #56): each run is made as a user makes it (`bodypoint
 simulate --json`, the default bounds: energy error and estimated error 1e-2) and its final state is
 compared with a reference (Boost.Odeint rkf78 in long double at tolerance 1e-16, `--reference`, one per
 scene). A run refused by a flag is made again with the bounds lifted, to know its error. Prints:
@@ -55,6 +56,32 @@ w = [0.0, 0.0, 0.0]
 """
 
 
+# Several centres with the thesis's spinning body: two repelling, then one attracting beyond them (the
+# named scenes two-centres and three-centres of lib/bodypoint/scenes.hpp).
+SPINNING_BODY = """[[body]]
+name = "spinning"
+m = 1.0
+B = 0.7
+J = 1.0
+d = 10.0
+L = 200.0
+K1 = 5.0
+Kx = 2.0
+Kz = 5.0
+"""
+TWO_CENTRES_SPIN = """[[centre]]
+position = [0.0, 0.0, 0.0]
+A = -2.0
+[[centre]]
+position = [40.0, 6.0, 0.0]
+A = -1.0
+""" + SPINNING_BODY
+THREE_CENTRES = TWO_CENTRES_SPIN.replace(SPINNING_BODY, "") + """[[centre]]
+position = [80.0, -8.0, 0.0]
+A = 1.5
+""" + SPINNING_BODY
+
+
 def bound_orbit(B):
     return f"""[[centre]]
 position = [0.0, 0.0, 0.0]
@@ -72,7 +99,8 @@ w = [0.0, 0.0, 1.0]
 
 def scenes(folder):
     files = {}
-    for name, text in [("two-centres", TWO_CENTRES), ("bound", bound_orbit(0.0)), ("bound-spin", bound_orbit(0.7))]:
+    for name, text in [("two-centres", TWO_CENTRES), ("bound", bound_orbit(0.0)), ("bound-spin", bound_orbit(0.7)),
+                       ("two-centres-spin", TWO_CENTRES_SPIN), ("three-centres", THREE_CENTRES)]:
         path = os.path.join(folder, name + ".toml")
         with open(path, "w") as f:
             f.write(text)
@@ -87,6 +115,11 @@ def scenes(folder):
         ("two-centres", ["--scene", files["two-centres"]], "60"),
         ("bound-orbit", ["--scene", files["bound"]], "300"),
         ("bound-spin", ["--scene", files["bound-spin"]], "300"),
+        # Two more attracting and two several-centre scenes (issue #56).
+        ("attracting-material", ["--A", "2", "--B", "0", "--d", "3"], "80"),
+        ("attracting-close", ["--A", "1", "--d", "1.5"], "80"),
+        ("two-centres-spin", ["--scene", files["two-centres-spin"]], "60"),
+        ("three-centres", ["--scene", files["three-centres"]], "60"),
     ]
 
 

@@ -142,6 +142,8 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
                                 " for B != 0);"
                                 " time_delay = against free motion, Coulomb logarithm removed; asymptote_error = the"
                                 " asymptotes' model error in the deflection (estimated from half the start distance);"
+                                " start_distance_error, time_delay_error = what the start distance L leaves against L ->"
+                                " infinity (the point again from 2L; 0 for B = 0); deflection_error = the deflection's total;"
                                 " a run that ended before the body left is status incomplete, without them;"
                                 " K1_turn, spin_turn ="
                                 " angles K1 and K2 turned over the run (rad); K1x,K1y,K1z = final K1;"

@@ -71,6 +71,16 @@ TEST(FourthPass, ACompanionThatBreaksDownFlagsTheRun) {
   EXPECT_TRUE(std::isfinite(json_number(fine.out, "err_estimate"))) << fine.out;
 }
 
+TEST(FourthPass, ARunOfAFewStepsIsBoundedByASecondCompanion) {
+  // ttl-verlet and logh-verlet at ds = 1 and 0.5 on the material pass take 1 step: 2.1e-5 off, estimated
+  // 4.0e-6 and 5.0e-6 from a companion of 2 steps (the estimate ladder's low estimates).
+  for (const char* args : {"--method ttl-verlet --h 1", "--method ttl-verlet --h 0.5", "--method logh-verlet --h 0.5"}) {
+    const auto r = run_cli(std::string("simulate --json --B 0 --t-end 20 --reference ") + args);
+    ASSERT_EQ(r.code, 0) << args << ": " << r.err;
+    EXPECT_GE(json_number(r.out, "err_estimate"), json_number(r.out, "err_rel")) << args;
+  }
+}
+
 TEST(FourthPass, StandardOutputIsCheckedLikeAFile) {
   const fs::path err = test::temp_path("full.err");
   for (const char* args : {"simulate --json", "simulate", "methods", "--version",
