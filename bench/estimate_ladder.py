@@ -39,13 +39,15 @@ FACTOR = 3.0
 STEPS = ["1", "0.5", "0.2", "0.1", "0.05", "0.02", "0.01"]
 TOLS = ["1e-3", "1e-5", "1e-7", "1e-9"]
 
-TWO_CENTRES = """[[centre]]
+# The two repelling centres of scenes/two-centres.toml.
+CENTRES = """[[centre]]
 position = [0.0, 0.0, 0.0]
 A = -2.0
 [[centre]]
 position = [40.0, 6.0, 0.0]
 A = -1.0
-[[body]]
+"""
+TWO_CENTRES = CENTRES + """[[body]]
 name = "material"
 m = 1.0
 B = 0.0
@@ -69,14 +71,8 @@ K1 = 5.0
 Kx = 2.0
 Kz = 5.0
 """
-TWO_CENTRES_SPIN = """[[centre]]
-position = [0.0, 0.0, 0.0]
-A = -2.0
-[[centre]]
-position = [40.0, 6.0, 0.0]
-A = -1.0
-""" + SPINNING_BODY
-THREE_CENTRES = TWO_CENTRES_SPIN.replace(SPINNING_BODY, "") + """[[centre]]
+TWO_CENTRES_SPIN = CENTRES + SPINNING_BODY
+THREE_CENTRES = CENTRES + """[[centre]]
 position = [80.0, -8.0, 0.0]
 A = 1.5
 """ + SPINNING_BODY
