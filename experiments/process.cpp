@@ -107,7 +107,8 @@ void arm_interrupt_grace(int sig) {
 /// From a signal handler that ends the process by the signal: one line saying so (a SIGINT while a
 /// large grid was checked ended it with exit 130 and no word). Async-signal-safe: composed by hand.
 void say_interrupted(int sig) {
-  if (!g_say_signal.load()) return;
+  // A closed pipe (`bodypoint methods | head -1`) ends the process as it ends every filter: silently.
+  if (!g_say_signal.load() || sig == SIGPIPE) return;
   static constexpr char kHead[] = "bodypoint: error: interrupted by signal ";
   static constexpr char kTail[] = "; its unfinished outputs removed\n";
   char line[sizeof kHead + sizeof kTail + 12];

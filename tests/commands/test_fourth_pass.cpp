@@ -92,6 +92,10 @@ TEST(FourthPass, StandardOutputIsCheckedLikeAFile) {
     EXPECT_NE(said.find("standard output could not be written"), std::string::npos) << args << ": " << said;
     EXPECT_EQ(std::count(said.begin(), said.end(), '\n'), 1) << said;
   }
+  // A pipe its reader closed ends the command as it ends every filter: by SIGPIPE, without a word.
+  const std::string piped = std::string(BODYPOINT_BIN) + " methods 2>" + err.string() + " | head -c 1 >/dev/null";
+  ASSERT_EQ(std::system(piped.c_str()), 0);
+  EXPECT_EQ(test::read(err), "");
 }
 
 /// The search's force evaluations over its delivered run's: the pilot pair, its halvings while the pair
