@@ -24,7 +24,12 @@ void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& 
 /// it (the difference falls as h^p): for a batch's lanes, which run them outside integrate().
 FixedSteps fixed_companion(const FixedSteps& run, int level = 1);
 ErrorEstimate fixed_step_estimate(const MethodInfo& m, const Body& body, const State& run, const State& companion);
-bool confirms(const MethodInfo& m, const Body& body, const State& run, const State& first, const State& second);
+/// Whether the second companion confirms e (ErrorEstimate::confirmed), its basis saying so: the differences
+/// fall as the order says (min_fall), or at least geometrically, the estimate then raised to the bound
+/// that gives (estimate.cpp, kGeometricFall).
+void confirm(ErrorEstimate& e, double min_fall, const State& run, const State& first, const State& second);
+void confirm(ErrorEstimate& e, const MethodInfo& m, const Body& body, const State& run, const State& first,
+             const State& second);
 
 /// Whether the estimate e is at the scene's rounding level (below kRoundingLevel, estimate.cpp), where the
 /// companion pair can agree by chance: the run is repeated from start_moved_by_rounding and what the two

@@ -84,8 +84,7 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
       row.error.force_evals = companions[k].force_evals;
       row.error.wall_s = companions[k].wall_s;
       if (row.outcome == Outcome::unresolved)
-        row.error.confirmed = detail::confirms(method, scenes[k].bodies.front(), row.result.final, companions[k].final,
-                                               second[k].final);
+        detail::confirm(row.error, method, scenes[k].bodies.front(), row.result.final, companions[k].final, second[k].final);
     } else {
       row.error.basis = "the run ended " + std::string(outcome_name(row.outcome));
     }
