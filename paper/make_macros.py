@@ -291,9 +291,7 @@ def claims_table(res, out, M):
     E, K = "max_rel_dE", "max_rel_dK2sq"
     # Costs under each column's own law: the timing study on table 3.1 (corrected) and on the harness's
     # scene under the code's force law (published_timing.csv).
-    ns_by = {"model": timing_ns(res), "code": timing_ns(res, "published_timing.csv")}
-    if "ab4-thesis" in ns_by["code"]:  # as published, AB4 is the thesis's code's (four evaluations per step)
-        ns_by["code"]["ab4"] = ns_by["code"].pop("ab4-thesis")
+    ns_by = {label: seven_ns(res, label) for label in TIMING_CSV}
     evals, _ = read_csv(os.path.join(res, "force_evals.csv"))
     printed = {r["method"]: r for r in evals if r.get("thesis_table_4_1")}
 
@@ -318,12 +316,10 @@ def claims_table(res, out, M):
         worst = max(d[m] for v, d in data[label, "h", K].items() if abs(v - SMALL_H) < 1e-12 * SMALL_H for m in THESIS_SEVEN)
         return f"{'yes' if worst < WELL_CONSERVED else 'no'} (max ${sci(worst)}$)"
 
-    timing_csv = {"model": "timing.csv", "code": "published_timing.csv"}
-
     def not_timed(label):
         """The verdict of a cost claim whose methods lack a time: "untimed (...)" naming the flags that
         left a method without two counted times (a contended machine), or "--" when the study did not run."""
-        why = untimed(res, timing_csv[label], [m for m in THESIS_SEVEN if m not in ns_by[label]])
+        why = seven_untimed(res, label, ns_by[label])
         return f"untimed ({why})" if why else "--"
 
     def cost(test, text):
@@ -353,7 +349,7 @@ def claims_table(res, out, M):
     def table41(label):
         # As published: the thesis's code's AB4 (ab4-thesis) re-evaluates the four past right-hand sides
         # every step; corrected: bodypoint's (odeint's) keeps them. Both counted over a run.
-        m = "ab4-thesis" if label == "code" else "ab4"
+        m = csv_method(label, "ab4")
         if m not in measured:
             return "--"
         return f"{'yes' if round(measured[m]) == 4 else 'no'} ({measured[m]:.2f} measured, \\texttt{{{m}}})"
@@ -548,6 +544,28 @@ def untimed(res, name, methods):
             return ""
         flags |= mine
     return f"times flagged for {', '.join(m.replace('thesis-', '') for m in methods)}: {', '.join(sorted(flags))}"
+
+
+# The cost claims' timing studies: on table 3.1 (corrected law) and, as published, on the harness's scene
+# under the code's force law, where AB4 is the thesis's code's (four evaluations per step, "ab4-thesis").
+TIMING_CSV = {"model": "timing.csv", "code": "published_timing.csv"}
+PUBLISHED_NAME = {"ab4": "ab4-thesis"}
+
+
+def csv_method(label, m):
+    return PUBLISHED_NAME.get(m, m) if label == "code" else m
+
+
+def seven_ns(res, label):
+    """ns per step of each thesis method in a column's timing study, under the seven's own names."""
+    ns = timing_ns(res, TIMING_CSV[label])
+    return {m: ns[csv_method(label, m)] for m in THESIS_SEVEN if csv_method(label, m) in ns}
+
+
+def seven_untimed(res, label, ns):
+    """Why the seven methods missing from ns have no time in a column's study (untimed), read under the
+    names that study's CSV gives them."""
+    return untimed(res, TIMING_CSV[label], [csv_method(label, m) for m in THESIS_SEVEN if m not in ns])
 
 
 def bench_ns(res):
