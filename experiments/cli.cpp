@@ -20,7 +20,7 @@ void add_scene_options(po::options_description& desc, SceneOptions& o) {
   SceneParams& p = o.params;
   for (const SceneParameter& q : scene_parameters()) {
     double& field = q.field(p);
-    desc.add_options()(std::string(q.name).c_str(), po::value(&field)->default_value(field), std::string(q.help).c_str());
+    desc.add_options()(std::string(q.name).c_str(), defaulted(&field), std::string(q.help).c_str());
   }
   desc.add_options()
       ("force-law", po::value<std::string>()->default_value("coulomb")->notifier([&p](const std::string& v) {
@@ -66,13 +66,13 @@ Scene make_scene(const po::variables_map& vm, SceneOptions& o) {
 
 void add_step_options(po::options_description& desc, StepOptions& o) {
   desc.add_options()
-      ("h", po::value(&o.h)->default_value(o.h), "step size")
-      ("steps", po::value(&o.steps)->default_value(o.steps), "number of steps n")
+      ("h", defaulted(&o.h), "step size")
+      ("steps", defaulted(&o.steps), "number of steps n")
       ("t-end", po::value(&o.t_end), "end time T (steps = ceil(T/h), h adjusted to T/steps)")
-      ("max-energy-error", po::value(&o.max_energy_error)->default_value(o.max_energy_error),
+      ("max-energy-error", defaulted(&o.max_energy_error),
        "flag a run whose relative energy error exceeds this bound as inaccurate (inf: no bound; not applied "
        "under --force-law thesis-code, whose flow does not conserve E)")
-      ("max-error", po::value(&o.max_error)->default_value(o.max_error),
+      ("max-error", defaulted(&o.max_error),
        "flag a run whose estimated relative error of the final state exceeds this bound as inaccurate (inf: no "
        "bound)")
       ("no-error-estimate", po::bool_switch(&o.no_error_estimate),
@@ -164,7 +164,7 @@ bool parse(int argc, char** argv, const po::options_description& desc, po::varia
   all.add_options()("help", "show this help");
   // One budget for every command (simulate has its own default): past it, every loop stops alike.
   if (!desc.find_nothrow("max-seconds", false))
-    all.add_options()("max-seconds", po::value<double>()->default_value(kDefaultMaxSeconds),
+    all.add_options()("max-seconds", po::value<double>()->default_value(kDefaultMaxSeconds, fmt(kDefaultMaxSeconds)),
                       "stop with an error after this many seconds of wall-clock time (0: no limit); runs "
                       "whose calibrated estimate exceeds it are refused before they start");
   // Whole option names only: with boost's default prefix guessing, "--ou x" would mean "--out x".

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "bodypoint/bodypoint.hpp"
+#include "bodypoint/io.hpp"
 #include "bodypoint/model.hpp"
 #include "bodypoint/run.hpp"
 
@@ -10,11 +11,20 @@
 #include <optional>
 #include <limits>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace bodypoint::cli {
 
 namespace po = boost::program_options;
+
+/// An option stored in *field and defaulting to its present value; a number's default is shown as the
+/// shortest text that reads back (--B arg (=0.7), not 0.69999999999999996).
+template <class T>
+po::typed_value<T>* defaulted(T* field) {
+  if constexpr (std::is_floating_point_v<T>) return po::value(field)->default_value(*field, fmt(*field));
+  else return po::value(field)->default_value(*field);
+}
 
 /// Scene options named as in the thesis, defaulting to table 3.1.
 struct SceneOptions {

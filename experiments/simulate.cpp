@@ -104,18 +104,18 @@ void add_simulate_options(po::options_description& desc, SimulateOptions& o) {
   add_scene_options(desc, o.so);
   add_step_options(desc, o.st);
   desc.add_options()
-      ("method", po::value(&o.method_name)->default_value(o.method_name),
+      ("method", defaulted(&o.method_name),
        "integration method (see 'bodypoint methods'), or auto (the default with --tol)")
       ("out", po::value(&o.out), "write the trajectory to this CSV file (atomically)")
       ("observe", po::value(&o.observe)->multitoken(),
        "with --out: also write these observables (e.g. spin_angle; the list is in observables.cpp)")
-      ("tol", po::value(&o.tol)->default_value(o.tol),
+      ("tol", defaulted(&o.tol),
        "odeint-*/gsl-*: error tolerance per step; any other method: the final state's relative error "
        "(R and v) to deliver, the step is chosen for it")
       ("dt-out", po::value(&o.dt_out), "with --out: write the states at t = k dt-out (and at the end), every method")
       ("omega-c", po::value(&o.omega_c), "time-transformed methods: constant c added to the time-step function "
        "(physical step <= ds/c); default: from the scene's spin-orbit rate")
-      ("every", po::value(&o.every)->default_value(o.every), "with --out: write every k-th step (and the last)")
+      ("every", defaulted(&o.every), "with --out: write every k-th step (and the last)")
       ("event", po::value(&o.event_text)->multitoken()->composing(),
        "locate events on the method's own steps and report them: closest (a closest approach; closest:K to "
        "centre K), r=RADIUS (r:K=RADIUS), x=X, y=Y, z=Z or plane=nx,ny,nz,offset")
@@ -128,9 +128,9 @@ void add_simulate_options(po::options_description& desc, SimulateOptions& o) {
       ("json", po::bool_switch(&o.json), "print one JSON object instead of the summary")
       ("no-invariants", po::bool_switch(&o.no_invariants), "do not track the invariants (fastest; final state only)")
       ("dry-run", po::bool_switch(&o.dry_run), "check every option and the scene, print what would run, run nothing")
-      ("max-seconds", po::value(&o.max_seconds)->default_value(o.max_seconds),
+      ("max-seconds", defaulted(&o.max_seconds),
        "refuse a run whose calibrated estimate exceeds this many seconds")
-      ("max-rows", po::value(&o.max_rows)->default_value(o.max_rows), "with --out: refuse to write more rows than this")
+      ("max-rows", defaulted(&o.max_rows), "with --out: refuse to write more rows than this")
       ("quiet", po::bool_switch(&o.quiet), "no estimate and no progress bar on stderr")
       ("reference", po::bool_switch(&o.with_reference),
        "also report err_R = |R - R_ref| against Boost.Odeint rkf78 in long double at tolerance 1e-16");

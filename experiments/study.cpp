@@ -380,10 +380,10 @@ int cmd_study(int argc, char** argv) {
   long threads = 0;
   po::options_description desc("bodypoint study");
   desc.add_options()
-      ("name", po::value(&which)->default_value(which), "recipe: d, L, h, Kx, timing, evals, appendix, errata, orders, published (chapter 4 with the thesis code's force "
+      ("name", defaulted(&which), "recipe: d, L, h, Kx, timing, evals, appendix, errata, orders, published (chapter 4 with the thesis code's force "
        "law), all (these), stress (hostile scenes), dL-map (the (d, L) stability map) or scattering "
        "(the deflection function theta(b) against Rutherford's, spinning bodies, cross-sections)")
-      ("results", po::value(&results)->default_value(results), "folder for the CSVs (created if missing)")
+      ("results", defaulted(&results), "folder for the CSVs (created if missing)")
       ("quick", po::bool_switch(&quick), "coarser grids, same recipes (under two minutes on 2 cores)")
       ("threads", po::value(&threads)->default_value(0), "worker threads for the sweeps (0: all cores)")
       ("resume", po::bool_switch(&c.resume), "finish the sweeps of an interrupted run from their journals (<csv>.journal)")

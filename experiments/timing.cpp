@@ -98,14 +98,14 @@ int cmd_timing(int argc, char** argv) {
   po::options_description desc("bodypoint timing");
   add_scene_options(desc, so);
   desc.add_options()
-      ("h", po::value(&spec.h)->default_value(spec.h), "step size")
-      ("from", po::value(&from)->default_value(from), "smallest n")
-      ("to", po::value(&to)->default_value(to), "largest n")
-      ("step", po::value(&step)->default_value(step), "increment of n")
+      ("h", defaulted(&spec.h), "step size")
+      ("from", defaulted(&from), "smallest n")
+      ("to", defaulted(&to), "largest n")
+      ("step", defaulted(&step), "increment of n")
       ("values", po::value(&values), "explicit comma-separated values of n instead")
-      ("methods", po::value(&methods_arg)->default_value(methods_arg), "comma-separated names, 'fixed' (every fixed-step method but the Kepler split kep-*) or 'all'")
-      ("repeats", po::value(&spec.repeats)->default_value(spec.repeats), "timed repeats per point, interleaved across the methods (median, min, max, spread)")
-      ("warmup", po::value(&spec.warmup)->default_value(spec.warmup), "untimed runs before the repeats")
+      ("methods", defaulted(&methods_arg), "comma-separated names, 'fixed' (every fixed-step method but the Kepler split kep-*) or 'all'")
+      ("repeats", defaulted(&spec.repeats), "timed repeats per point, interleaved across the methods (median, min, max, spread)")
+      ("warmup", defaulted(&spec.warmup), "untimed runs before the repeats")
       ("out", po::value(&out), "CSV file (default: standard output)");
   po::variables_map vm;
   if (!parse(argc, argv, desc, vm,

@@ -169,13 +169,16 @@ std::string encounter_json(const Body& body, const std::vector<Centre>& centres,
 }
 
 TrackJson body_json(const Body& body, const std::vector<Centre>& centres, RunPlan plan, const Advance& how,
-                    std::size_t frames, const std::string& method_label) {
+                    std::size_t frames, const std::string& method_label, const std::vector<Event>& events) {
   plan.options.track_invariants = true;  // the energy panel and the header show the deviations
   plan.options.every = 1;
   Decimator d(centres, std::max<std::size_t>(8 * frames, 1 << 16));
   const SampleSink sink = [&d](const Sample& s) { d.add(s); };
-  const std::vector<Event> closest = closest_approaches(centres.size());  // located for the marks
-  const BodyResult br = run_body(plan, body, centres, how, &sink, closest);
+  std::vector<Event> located = closest_approaches(centres.size());  // located for the marks
+  const std::size_t first_asked = located.size();
+  located.insert(located.end(), events.begin(), events.end());
+  const BodyResult br = run_body(plan, body, centres, how, &sink, located);
+  const std::vector<Event> closest(located.begin(), located.begin() + static_cast<std::ptrdiff_t>(first_asked));
   const std::string who = "body '" + body.name + "' with " + method_label;
   if (d.non_finite_at())
     throw Error(who + ": the state became non-finite at t = " + fmt(*d.non_finite_at()) + "; no page written");
@@ -212,7 +215,15 @@ TrackJson body_json(const Body& body, const std::vector<Centre>& centres, RunPla
   });
   out += ", ";
   put_array(out, "dt", f, kOtherDigits, [](std::string& o, const Frame& x, int g) { put(o, x.dt, g); });
-  out += "}" + encounter_json(body, centres, br, closest) + "}";
+  out += "}" + encounter_json(body, centres, br, closest) + ", \"events\": [";
+  bool first = true;
+  for (const EventHit& h : br.events) {  // the asked events' hits, located to round-off (the marks)
+    if (h.event < first_asked) continue;
+    out += (first ? "" : ", ") + std::string("{\"label\": ") + json_string(located[h.event].label(), true) +
+           ", \"t\": " + json_number(h.t) + ", \"R\": " + json_vec(h.s.R) + ", \"r\": " + json_number(h.distance) + "}";
+    first = false;
+  }
+  out += "]}";
   return {out, br.run.t_end};
 }
 
@@ -241,22 +252,28 @@ struct ViewOptions {
   std::string method_name = "lp-y4", compare, out = "bodypoint-view.html";
   double tol = kDefaultStepTolerance, compare_h = 0.0, max_mb = 32.0;
   long frames = 3000;
-  bool dry_run = false;
+  bool dry_run = false, quiet = false;
+  std::vector<std::string> event_text;  ///< --event: located on the method's steps and marked on the page
+  std::vector<Event> events;
 };
 
 void add_view_options(po::options_description& desc, ViewOptions& o) {
   add_scene_options(desc, o.so);
   add_step_options(desc, o.st);
   desc.add_options()
-      ("method", po::value(&o.method_name)->default_value(o.method_name), "integration method, or auto with --tol")
-      ("tol", po::value(&o.tol)->default_value(o.tol), "as for simulate: per-step tolerance of odeint-*/gsl-*, "
+      ("method", defaulted(&o.method_name), "integration method, or auto with --tol")
+      ("tol", defaulted(&o.tol), "as for simulate: per-step tolerance of odeint-*/gsl-*, "
        "otherwise the final state's relative error to deliver")
       ("compare", po::value(&o.compare), "a second method on the same scene, drawn in a second colour")
       ("compare-h", po::value(&o.compare_h), "step (or ds) of the --compare method (default: --h)")
-      ("frames", po::value(&o.frames)->default_value(o.frames), "states kept per body (equal arc length, closest approach kept)")
-      ("max-mb", po::value(&o.max_mb)->default_value(o.max_mb), "refuse to write a page larger than this many MB")
-      ("out", po::value(&o.out)->default_value(o.out), "the HTML file to write (atomically)")
-      ("dry-run", po::bool_switch(&o.dry_run), "check every option and the scene, run nothing, write nothing");
+      ("frames", defaulted(&o.frames), "states kept per body (equal arc length, closest approach kept)")
+      ("max-mb", defaulted(&o.max_mb), "refuse to write a page larger than this many MB")
+      ("out", defaulted(&o.out), "the HTML file to write (atomically)")
+      ("event", po::value(&o.event_text)->multitoken()->composing(),
+       "as for simulate: locate these events on the method's steps and mark every hit on the page (closest, "
+       "local-min, r=RADIUS, x=X, y=Y, z=Z, plane=nx,ny,nz,offset, departure, arrival=R)")
+      ("dry-run", po::bool_switch(&o.dry_run), "check every option and the scene, run nothing, write nothing")
+      ("quiet", po::bool_switch(&o.quiet), "no line announcing a long run, none for the page written (warnings and errors still print)");
 }
 
 void check_view_options(const po::variables_map& vm, const ViewOptions& o) {
@@ -287,7 +304,8 @@ std::vector<RunPlan> view_plans(const po::variables_map& vm, const ViewOptions& 
 
 /// The page's data: the scene, and every run of every body (the second run ends where the first did).
 std::string page_json(const std::string& title, const std::string& scene_line, const Scene& scene,
-                      const std::vector<RunPlan>& plans, const std::vector<std::string>& labels, long frames) {
+                      const std::vector<RunPlan>& plans, const std::vector<std::string>& labels, long frames,
+                      const std::vector<Event>& events) {
   std::string json = "{\"title\": " + json_string(title, true) + ", \"scene\": " + json_string(scene_line, true) +
                      ", \"revision\": " + json_string(git_revision(), true) + ", \"centres\": [";
   for (std::size_t i = 0; i < scene.centres.size(); ++i)
@@ -301,7 +319,7 @@ std::string page_json(const std::string& title, const std::string& scene_line, c
     for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
       const Advance how = k == 0 ? plans[k].how : ending_at(plans[k], t_end[b]);
       const TrackJson tr = body_json(scene.bodies[b], scene.centres, plans[k], how,
-                                     static_cast<std::size_t>(frames), labels[k]);
+                                     static_cast<std::size_t>(frames), labels[k], events);
       if (k == 0) t_end[b] = tr.t_end;
       json += (b ? ", " : "") + tr.json;
     }
@@ -324,6 +342,7 @@ int cmd_view(int argc, char** argv) {
              "the energy error against t. Options as for simulate."))
     return 0;
   check_view_options(vm, o);
+  for (const std::string& text : o.event_text) o.events.push_back(parse_event(text));
   const std::vector<RunPlan> plans = view_plans(vm, o);
   std::vector<std::string> labels;
   for (const RunPlan& p : plans) labels.push_back(p.automatic ? "auto" : std::string(p.method->name));
@@ -340,7 +359,7 @@ int cmd_view(int argc, char** argv) {
     if (!p.search)
       for (const Body& body : scene.bodies)
         if (const auto e = estimate_work(*p.method, body, scene.centres, p.how, p.options))
-          check_budget(*e, vm["max-seconds"].as<double>() > 0.0 ? vm["max-seconds"].as<double>() : HUGE_VAL, true);
+          check_budget(*e, vm["max-seconds"].as<double>() > 0.0 ? vm["max-seconds"].as<double>() : HUGE_VAL, o.quiet);
   if (o.dry_run) {
     std::cout << "would write " << o.out << ": " << plans.size() << " run(s) of " << scene.bodies.size()
               << " body-point(s), about " << std::round(estimate / 1e3) << " kB\n";
@@ -349,7 +368,7 @@ int cmd_view(int argc, char** argv) {
   AtomicFile file(o.out);  // an unwritable path fails before the runs
   const std::string title = "bodypoint view: " + labels[0] + (plans.size() > 1 ? " vs " + labels[1] : "");
   const std::string json = page_json(title, vm.count("scene") ? "scene=" + o.so.scene_file : describe(o.so.params),
-                                     scene, plans, labels, o.frames);
+                                     scene, plans, labels, o.frames, o.events);
   std::ostream& os = file.stream();
   os << "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
      << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
@@ -362,7 +381,8 @@ int cmd_view(int argc, char** argv) {
     throw Error("the page holds " + fmt(std::round(size / 1e5) / 10) + " MB, above --max-mb " + fmt(o.max_mb) +
                 ": lower --frames or raise --max-mb; nothing written");
   file.commit();
-  std::cout << "wrote " << o.out << " (" << std::round(size / 1e3) << " kB, " << scene.bodies.size()
+  if (!o.quiet)
+    std::cout << "wrote " << o.out << " (" << std::round(size / 1e3) << " kB, " << scene.bodies.size()
             << " body-point(s), " << plans.size() << " run(s)); open it in a browser\n";
   return 0;
 }

@@ -105,14 +105,14 @@ struct WorkPrecisionArgs {
 
 void add_work_precision_options(po::options_description& desc, WorkPrecisionArgs& a) {
   desc.add_options()
-      ("scenes", po::value(&a.scenes)->default_value(a.scenes), "comma-separated: thesis,close,material,long,two-centres,three-centres or all")
-      ("methods", po::value(&a.methods)->default_value(a.methods), "comma-separated method names or all")
-      ("repeats", po::value(&a.o.timing.repeats)->default_value(a.o.timing.repeats), "timed repeats per configuration, "
+      ("scenes", defaulted(&a.scenes), "comma-separated: thesis,close,material,long,two-centres,three-centres or all")
+      ("methods", defaulted(&a.methods), "comma-separated method names or all")
+      ("repeats", defaulted(&a.o.timing.repeats), "timed repeats per configuration, "
        "interleaved across the configurations (median and spread reported; fewer than 5 flag every time)")
-      ("max-evals", po::value(&a.o.max_evals)->default_value(a.o.max_evals), "largest run of a ladder, in force evaluations")
+      ("max-evals", defaulted(&a.o.max_evals), "largest run of a ladder, in force evaluations")
       ("by-tol", po::bool_switch(&a.by_tol), "second view: auto and every step-size-controlled peer with the same "
        "requested tolerance; delivered error, whether it met TOL, and time")
-      ("tols", po::value(&a.tols)->default_value(a.tols), "with --by-tol: the tolerances")
+      ("tols", defaulted(&a.tols), "with --by-tol: the tolerances")
       ("list-scenes", po::bool_switch(&a.list_scenes), "print the named scenes that 'all' means, one per line, and exit")
       ("quick", po::bool_switch(&a.quick), "coarse: scenes thesis and material, every ladder (the peers' too) up to 1e6 force evaluations")
       ("out", po::value(&a.out), "CSV: scene, method, h, tol, err_R, err_rel, max_rel_dE, force_evals, wall_s, cpu_s, "

@@ -135,5 +135,39 @@ TEST(View, BadInputIsRefusedWithoutAPage) {
   fs::remove_all(dir);
 }
 
+// --event marks each located hit on the page; --quiet writes the page without a word; the header states
+// the located closest approach. A bad event is refused in one line.
+TEST(View, EventsAreLocatedAndQuietWritesNothingToStdout) {
+  if (!have_viewer()) GTEST_SKIP() << "built without the viewer's script";
+  const fs::path out = test::temp_path("bp_view_events.html");
+  fs::remove(out);
+  const auto r = run_cli("view --quiet --event x=0 --event r=50 --t-end 60 --out " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out, "");
+  const std::string page = read(out);
+  // The thesis body crosses x = 0 once near its closest approach and r = 50 on the way in and out.
+  std::size_t x0 = 0, r50 = 0;
+  for (std::size_t at = page.find("\"label\": \"x=0\""); at != std::string::npos; at = page.find("\"label\": \"x=0\"", at + 1)) ++x0;
+  for (std::size_t at = page.find("\"label\": \"r=50\""); at != std::string::npos; at = page.find("\"label\": \"r=50\"", at + 1)) ++r50;
+  EXPECT_EQ(x0, 1u);
+  EXPECT_EQ(r50, 2u);
+  const auto bad = run_cli("view --event r=-1 --steps 10 --out " + out.string());
+  EXPECT_NE(bad.code, 0);
+  EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
+  fs::remove(out);
+}
+
+// Defaults are shown as the shortest text that reads back (0.7, not 0.69999999999999996).
+TEST(View, HelpShowsDefaultsAsTheyWereWritten) {
+  for (const std::string cmd : {"simulate", "sweep", "view", "timing", "work-precision", "study"}) {
+    const auto r = run_cli(cmd + " --help");
+    EXPECT_EQ(r.code, 0) << cmd;
+    if (cmd != "work-precision" && cmd != "study") {
+      EXPECT_NE(r.out.find("--B arg (=0.7)"), std::string::npos) << cmd;
+    }
+    EXPECT_EQ(r.out.find("99999999"), std::string::npos) << cmd << ": " << r.out;
+  }
+}
+
 }  // namespace
 }  // namespace bodypoint

@@ -6,9 +6,11 @@
 //   { title, scene, revision, centres: [{c: [x,y,z], A}],
 //     runs: [{ method, step, bodies: [{ name, steps, force_evals, invariants: {...}, closest: {t, r},
 //              frames: { t: [...], R: [x,y,z,...], v: [...], w: [...], dE: [...], dt: [...] },
-//              encounter: { R_min, r_min, t_min, asymptotes: [{point, direction, incoming}], deflection } }] }] }
-// encounter.R_min is the closest approach located on the method's steps; the asymptotes (one Coulomb
-// centre) are lines the body travels at infinity (docs/physics.md, Scattering).
+//              encounter: { R_min, r_min, t_min, asymptotes: [{point, direction, incoming}], deflection },
+//              events: [{ label, t, R, r }] }] }] }
+// encounter.R_min is the closest approach located on the method's steps (closest.r is only the nearest
+// stored state); the asymptotes (one Coulomb centre) are lines the body travels at infinity
+// (docs/physics.md, Scattering); events are the hits of `view --event`, located to round-off.
 // Frames are decimated by arc length (closest approach kept); the page interpolates linearly in t.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
@@ -51,7 +53,12 @@ data.runs.forEach((run, k) => {
     const i = b.invariants || {};
     let s = `${esc(b.name)}: max|dE/E| ${fmt(i.max_rel_dE)}, max|dK2²|/K2² ${fmt(i.max_rel_dK2sq)}`;
     if (i.max_abs_dK2Q !== undefined) s += `, max|dK2Q| ${fmt(i.max_abs_dK2Q)}`;
-    s += `, r_min ${fmt(b.closest.r)} at t=${fmt(b.closest.t)}`;
+    const located = b.encounter && b.encounter.R_min;  // the header states the located minimum, not a sample's
+    s += located ? `, r_min ${fmt(b.encounter.r_min)} at t=${fmt(b.encounter.t_min)}`
+      : `, nearest state r ${fmt(b.closest.r)} at t=${fmt(b.closest.t)}`;
+    const hits = b.events || [];
+    if (hits.length) s += `; ${hits.length} event hit(s): ` + hits.slice(0, 4).map((h) => `${esc(h.label)} at t=${fmt(h.t)}`).join(', ') +
+      (hits.length > 4 ? ', ...' : '');
     if (b.status && b.status !== 'ok') s += ` <b class="flag">${esc(b.status)}</b>: ${esc(b.reason)}`;
     return s;
   });
@@ -195,8 +202,15 @@ for (const tr of tracks) {
 // Encounter marks: the located closest approach (a white wire octahedron) and the incoming and outgoing
 // asymptotes as dashed half-lines in the track's colour, from infinity to their closest point to the
 // centre and from there on.
-const marks = { closest: 0, asymptotes: 0 };
+const marks = { closest: 0, asymptotes: 0, events: 0 };
 for (const tr of tracks) {
+  for (const h of data.runs[tr.run].bodies[tr.body].events || []) {  // asked events: a small sphere in the track's colour
+    const m = new THREE.Mesh(new THREE.SphereGeometry(1.2 * bodyRadius, 12, 8),
+      new THREE.MeshBasicMaterial({ color: tr.colour, wireframe: true }));
+    m.position.set(...h.R);
+    scene.add(m);
+    ++marks.events;
+  }
   const e = data.runs[tr.run].bodies[tr.body].encounter;
   if (!e) continue;
   if (e.R_min) {

@@ -48,7 +48,8 @@ if (!existsSync(chromiumPath)) {
 mkdirSync(artifacts, { recursive: true });
 
 const pages = [
-  { name: 'thesis', args: [] },
+  // The thesis page asks for an event (the body crossing x = 0 near its closest approach): one mark per hit.
+  { name: 'thesis', args: ['--event', 'x=0'], events: true },
   { name: 'two-centres', args: ['--scene', path.join(repo, 'scenes/two-centres.toml'), '--method', 'logh-y4', '--h', '0.01', '--t-end', '60'] },
   { name: 'compare', args: ['--Kz', '0.1', '--d', '0.05', '--t-end', '80', '--method', 'thesis-verlet', '--h', '1e-3',
     '--compare', 'logh-kl6', '--compare-h', '0.05'] },
@@ -80,6 +81,13 @@ try {
     if (marks.closest !== tracks) failures.push(`${p.name}: ${marks.closest} closest-approach marks for ${tracks} tracks`);
     if (p.name !== 'two-centres' && marks.asymptotes !== 2 * tracks)
       failures.push(`${p.name}: ${marks.asymptotes} asymptote lines for ${tracks} tracks`);
+    // The asked events: one mark per located hit, and the header names the located closest approach.
+    const hits = await page.evaluate(() => JSON.parse(document.getElementById('bodypoint-data').textContent)
+      .runs.flatMap((r) => r.bodies.flatMap((b) => b.events)).length);
+    if (marks.events !== hits || (p.events && hits === 0))
+      failures.push(`${p.name}: ${marks.events} event marks for ${hits} located hits`);
+    const header = await page.evaluate(() => document.getElementById('bp-header').textContent);
+    if (!/r_min \S+ at t=/.test(header)) failures.push(`${p.name}: the header does not state the located r_min`);
 
     // Frame rate while playing, then pause for the still checks.
     const fps = await page.evaluate(async () => {
