@@ -47,6 +47,16 @@ std::vector<double> linear_range(double from, double to, double step) {
   return v;
 }
 
+std::vector<double> linear_points(double from, double to, long points) {
+  if (!std::isfinite(from) || !std::isfinite(to)) throw Error("--from and --to must be finite numbers");
+  if (points < 2) throw Error("--points must be >= 2");
+  if (points > 1'000'000) throw Error("--points must be at most 1e6");
+  std::vector<double> v;
+  for (long k = 0; k < points; ++k) v.push_back(from + (to - from) * static_cast<double>(k) / static_cast<double>(points - 1));
+  v.back() = to;
+  return v;
+}
+
 std::vector<double> log_range(double from, double to, long points) {
   if (!(from > 0.0) || !(to > 0.0) || !std::isfinite(from) || !std::isfinite(to))
     throw Error("--log needs --from and --to finite and > 0");
@@ -98,6 +108,14 @@ std::vector<std::string> run_sweep(const SweepSpec& spec, const SweepControl& co
   return rows;
 }
 
+/// "1 spinning, 2 material": the bodies of a scene file's sweep by their axis value.
+std::string body_names(const SweepSpec& spec) {
+  const Scene scene = parse_scene(spec.scene_text, spec.scene_origin);
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i) names.push_back(std::to_string(i + 1) + " " + scene.bodies[i].name);
+  return join(names, ", ");
+}
+
 std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& command) {
   std::string varied;
   bool sweeps_h = false;
@@ -107,7 +125,8 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
     sweeps_h = sweeps_h || spec.axes[a].param == "h";
   }
   const bool grid = spec.axes.size() > 1;
-  std::string fixed = "# fixed: " + describe(spec.base) + (grid ? " (the varied ones excepted)" : " (the varied one excepted)");
+  std::string fixed = "# fixed: " + (spec.scene_text.empty() ? describe(spec.base) : "scene=" + spec.scene_origin) +
+                      (grid ? " (the varied ones excepted)" : " (the varied one excepted)");
   if (!sweeps_h) fixed += " h=" + fmt(spec.h);
   fixed += spec.t_end > 0 ? " t_end=" + fmt(spec.t_end) : " steps=" + std::to_string(spec.steps);
   if (spec.accuracy) fixed += " accuracy=" + fmt(*spec.accuracy) + " (the accuracy mode: each row's step searched for it)";
@@ -119,7 +138,11 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
   return {std::move(columns),
           "# bodypoint sweep, revision " + std::string(git_revision()),
           "# command: " + command,
-          "# varied: " + varied + (grid ? " (a grid: every combination, the last one varying fastest)" : ""),
+          "# varied: " + varied + (grid ? " (a grid: every combination, the last one varying fastest)" : "") +
+              (std::find_if(spec.axes.begin(), spec.axes.end(), [](const Axis& a) { return a.param == kBodyAxis; }) !=
+                       spec.axes.end()
+                   ? "; body = which of the scene's bodies (from 1: " + body_names(spec) + ")"
+                   : ""),
           fixed,
           "# columns: " + varied + (grid ? " = values of the varied parameters" : " = value of the varied parameter") +
               "; method; max_rel_dE = max_i |E_i-E_0|/|E_0|;"
@@ -153,7 +176,7 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
 }
 
 std::string sweep_key(const SweepSpec& spec) {
-  std::string s = std::string(git_revision()) + "|" + describe(spec.base) + "|" + fmt(spec.h) + "|" +
+  std::string s = std::string(git_revision()) + "|" + describe(spec.base) + "|" + hex64(fnv1a(spec.scene_text)) + "|" + fmt(spec.h) + "|" +
                   std::to_string(spec.steps) + "|" + fmt(spec.t_end) + "|" + fmt(spec.tol);
   for (const Axis& a : spec.axes) {
     s.append("|").append(a.param);
@@ -172,14 +195,20 @@ void write_sweep_csv(std::ostream& os, const SweepSpec& spec, const std::vector<
   for (const std::string& row : rows) os << row << "\n";
 }
 
+/// A sweep parameter (sweep_parameters()) or a scene file's key (centre2.A; validate_sweep checks it
+/// against the scene); Error naming the valid ones otherwise.
+static void check_axis_name(const std::string& name) {
+  const auto& ps = sweep_parameters();
+  if (std::find(ps.begin(), ps.end(), name) == ps.end() && !is_scene_key(name))
+    throw Error(unknown_name("parameter", name, ps) + "; over --scene, a key such as centre2.A or body.B");
+}
+
 Axis parse_axis(const std::string& item) {
   const std::size_t eq = item.find('=');
   if (eq == std::string::npos || eq == 0)
     throw Error("--grid '" + item + "': give NAME=FROM:TO:STEP, NAME=log:FROM:TO:POINTS or NAME=a,b,c");
   Axis axis{item.substr(0, eq), {}};
-  const auto& ps = sweep_parameters();
-  if (std::find(ps.begin(), ps.end(), axis.param) == ps.end())
-    throw Error("unknown parameter '" + axis.param + "' (" + join(ps, ", ") + ")");
+  check_axis_name(axis.param);
   std::string spec = item.substr(eq + 1);
   const bool log = spec.rfind("log:", 0) == 0;
   if (log) spec = spec.substr(4);
@@ -262,9 +291,7 @@ std::vector<Axis> parse_axes(const po::variables_map& vm, const std::vector<std:
   }
   if (!vm.count("param")) throw Error("--param is required (or --grid; parameters: " + join(sweep_parameters(), ", ") + ")");
   const std::string param = vm["param"].as<std::string>();
-  const auto& ps = sweep_parameters();
-  if (std::find(ps.begin(), ps.end(), param) == ps.end())
-    throw Error("unknown parameter '" + param + "' (" + join(ps, ", ") + ")");
+  check_axis_name(param);
   const bool log = vm["log"].as<bool>();
   if (vm.count("values")) {
     if (vm.count("from") || vm.count("to") || vm.count("step") || log) throw Error("give --values or a range, not both");
@@ -273,7 +300,9 @@ std::vector<Axis> parse_axes(const po::variables_map& vm, const std::vector<std:
   if (!vm.count("from") || !vm.count("to")) throw Error("give --from and --to (or --values)");
   const double from = vm["from"].as<double>(), to = vm["to"].as<double>();
   if (log) return {{param, log_range(from, to, vm.count("points") ? vm["points"].as<long>() : 0)}};
-  if (!vm.count("step")) throw Error("give --step (or --log --points N)");
+  if (vm.count("points") && vm.count("step")) throw Error("give --step or --points, not both");
+  if (vm.count("points")) return {{param, linear_points(from, to, vm["points"].as<long>())}};
+  if (!vm.count("step")) throw Error("give --step or --points (or --log --points N)");
   return {{param, linear_range(from, to, vm["step"].as<double>())}};
 }
 
@@ -322,17 +351,19 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
   add_step_options(desc, st);
   desc.add_options()
       ("param", po::value<std::string>(), "parameter to vary: d, L, h, Kx, Kz, K1, A, B, J, m, or the asymptotic data b "
-       "(impact parameter; d is solved for it) and v_inf (speed at infinity; K1 is solved for it)")
+       "(impact parameter; d is solved for it), v_inf (speed at infinity; K1 is solved for it) and arrival_phase; "
+       "with --scene, a key of the file: centreK.A, centreK.position.x, bodyK.B, NAME.d, body.B (every body), "
+       "bodyK.R.x (one row per body of the scene)")
       ("from", po::value<double>(), "first value")
       ("to", po::value<double>(), "last value")
       ("step", po::value<double>(), "linear increment")
       ("log", po::bool_switch(), "log-spaced values from --from to --to, --points of them")
-      ("points", po::value<long>(), "with --log: number of values")
+      ("points", po::value<long>(), "number of values from --from to --to (both included; log-spaced with --log)")
       ("values", po::value<std::string>(), "explicit comma-separated values instead of a range")
       ("grid", po::value(&grid)->composing(), "instead of --param: one varied parameter of a grid, NAME=FROM:TO:STEP, "
        "NAME=log:FROM:TO:POINTS or NAME=a,b,c; repeat for each (every combination is run)")
-      ("methods", po::value(&methods_arg)->default_value(methods_arg), "comma-separated names, 'fixed' (every fixed-step method but the Kepler split kep-*) or 'all'")
-      ("tol", po::value(&job.spec.tol)->default_value(job.spec.tol), "adaptive methods: error tolerance")
+      ("methods", defaulted(&methods_arg), "comma-separated names, 'fixed' (every fixed-step method but the Kepler split kep-*) or 'all'")
+      ("tol", defaulted(&job.spec.tol), "adaptive methods: error tolerance")
       ("accuracy", po::value<double>(), "the accuracy mode: every method but the step-size-controlled peers delivers this "
        "relative error of the final state at --t-end, its step searched per row (columns h_chosen, search_force_evals)")
       ("threads", po::value(&job.threads)->default_value(0), "worker threads (0: all cores)")
@@ -349,7 +380,6 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
                 "One CSV row per (grid point, method): the deviations of the invariants, the final position and the cost.");
   if (help) return job;
   job.spec.axes = parse_axes(vm, grid);
-  if (vm.count("scene")) throw Error("sweep varies the thesis's scene parameters; --scene is not supported");
   if (vm.count("shard")) parse_shard(shard, job);
   if (job.resume && job.out.empty()) throw Error("--resume needs --out (the journal is <out>.journal)");
   if (job.sharded && job.out.empty()) throw Error("--shard needs --out (the shard's rows file)");
@@ -366,6 +396,12 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
   apply_fixed_data(vm, so, job.spec);
   apply_steps(vm, st, job.spec);
   if (vm.count("accuracy")) job.spec.accuracy = vm["accuracy"].as<double>();
+  if (vm.count("scene")) {
+    for (const SceneParameter& q : scene_parameters())
+      if (!vm[std::string(q.name)].defaulted())
+        throw Error("--" + std::string(q.name) + " is a thesis parameter: with --scene, set it in the file or sweep its key");
+    job.spec = with_scene_file(std::move(job.spec), read_scene_text(so.scene_file), so.scene_file);
+  }
   job.command = science_command(argc, argv);
   job.max_seconds = vm["max-seconds"].as<double>();
   return job;
@@ -449,7 +485,7 @@ void check_sweep_budget(const SweepJob& job) {
   Scene scene;
   try {
     steps = mean_row_steps(job.spec);
-    scene = thesis_scene(point_params(job.spec, grid_point(job.spec, 0)));
+    scene = point_scene(job.spec, grid_point(job.spec, 0));
   } catch (const Error&) {
     return;  // validate_sweep names the step or the point
   }

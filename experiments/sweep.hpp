@@ -16,6 +16,8 @@ namespace bodypoint::cli {
 /// Values from --from/--to/--step (linear, computed as from + k step), --log with --points, or a list.
 std::vector<double> linear_range(double from, double to, double step);
 std::vector<double> log_range(double from, double to, long points);
+/// `points` equally spaced values from `from` to `to`, both included.
+std::vector<double> linear_points(double from, double to, long points);
 
 /// Parses one --grid item: NAME=FROM:TO:STEP (linear), NAME=log:FROM:TO:POINTS or NAME=a,b,c.
 Axis parse_axis(const std::string& item);

@@ -37,6 +37,18 @@ inline std::filesystem::path temp_path(const std::string& name) {
   return root.path / name;
 }
 
+/// A fresh folder under temp_path(name), removed with everything in it when the test ends.
+struct TempDir {
+  std::filesystem::path path;
+  explicit TempDir(const std::string& name) : path(temp_path(name)) {
+    std::filesystem::remove_all(path);
+    std::filesystem::create_directories(path);
+  }
+  ~TempDir() { std::filesystem::remove_all(path); }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+};
+
 struct CliResult {
   int code;
   std::string out, err;

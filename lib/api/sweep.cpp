@@ -5,6 +5,7 @@
 #include "bodypoint/batch.hpp"
 #include "bodypoint/threads.hpp"
 #include "bodypoint/io.hpp"
+#include "bodypoint/scene_file.hpp"
 #include "estimate.hpp"
 
 #include <algorithm>
@@ -113,6 +114,10 @@ void add_start_distance(Encounter& e, const SweepSpec& spec, const std::vector<d
     add_start_distance_error(e, nullptr, true, numerical);
     return;
   }
+  if (!spec.scene_text.empty()) {
+    no_start_distance_error(e, false, numerical, "a scene file's body has no thesis start distance to double");
+    return;
+  }
   SweepSpec far = spec;
   far.base.start.L *= 2.0;
   std::vector<double> at = point;
@@ -186,6 +191,34 @@ SceneParams point_params(const SweepSpec& spec, const std::vector<double>& point
   return std::isnan(b) && std::isnan(v_inf) && std::isnan(arrival) ? p : with_asymptotic_data(p, b, v_inf, arrival);
 }
 
+SweepSpec with_scene_file(SweepSpec spec, std::string text, std::string origin) {
+  const Scene scene = parse_scene(text, origin);
+  for (const Axis& a : spec.axes)
+    if (a.param == kBodyAxis) throw Error("the axis 'body' is the sweep's own (one row per body of the scene)");
+  spec.scene_text = std::move(text);
+  spec.scene_origin = std::move(origin);
+  if (scene.bodies.size() > 1) {
+    Axis bodies{kBodyAxis, {}};
+    for (std::size_t i = 1; i <= scene.bodies.size(); ++i) bodies.values.push_back(static_cast<double>(i));
+    spec.axes.push_back(std::move(bodies));
+  }
+  return spec;
+}
+
+Scene point_scene(const SweepSpec& spec, const std::vector<double>& point) {
+  if (spec.scene_text.empty()) return thesis_scene(point_params(spec, point));
+  std::vector<SceneValue> set;
+  std::size_t body = 0;
+  for (std::size_t a = 0; a < spec.axes.size(); ++a) {
+    const std::string& name = spec.axes[a].param;
+    if (name == kBodyAxis) body = static_cast<std::size_t>(point[a]);
+    else if (name != "h") set.push_back({name, point[a]});
+  }
+  Scene scene = parse_scene(spec.scene_text, spec.scene_origin, set);
+  if (body > 0) scene.bodies = {scene.bodies.at(body - 1)};
+  return scene;
+}
+
 FixedSteps sweep_steps(double h, long steps, double t_end, ForceLaw law) {
   require_positive(h, "the step h");
   if (law == ForceLaw::thesis_code) return thesis_code_steps(h, steps, t_end);
@@ -201,7 +234,12 @@ Advance to_common_end(const MethodInfo& method, const FixedSteps& f, double tol)
 }
 
 Advance point_advance(const SweepSpec& spec, const MethodInfo& method, const std::vector<double>& point) {
-  if (spec.accuracy && !is_step_controlled(method)) return Accuracy{*spec.accuracy, spec.t_end};
+  if (spec.accuracy && !is_step_controlled(method)) {
+    if (spec.t_end > 0.0 || !spec.scattering) return Accuracy{*spec.accuracy, spec.t_end};
+    // An encounter without an end: its span (the departure event stops the run), as simulate takes it.
+    const Scene scene = point_scene(spec, point);
+    return Accuracy{*spec.accuracy, encounter_span(scene.bodies.front(), scene.centres)};
+  }
   return to_common_end(method, sweep_steps(point_h(spec, point), spec.steps, spec.t_end, spec.base.law), spec.tol);
 }
 
@@ -219,9 +257,20 @@ void validate_sweep(const SweepSpec& spec) {
   check_energy_bound(spec.max_energy_error);
   check_error_bound(spec.max_error);
   if (spec.axes.empty()) throw Error("the sweep has no varied parameter");
+  const bool file = !spec.scene_text.empty();
+  for (const Axis& a : spec.axes) {
+    if (a.param == "h" || (file && a.param == kBodyAxis)) continue;
+    if (file && !is_scene_key(a.param))
+      throw Error("a sweep over a scene file varies its keys (centre2.A, centre1.position.x, body.B, bodyK.d, NAME.KEY), "
+                  "not '" + a.param + "'");
+    if (!file && is_scene_key(a.param)) throw Error("the axis '" + a.param + "' is a scene file's key: give the scene");
+    if (!file && std::find(sweep_parameters().begin(), sweep_parameters().end(), a.param) == sweep_parameters().end())
+      throw Error(unknown_name("parameter", a.param, sweep_parameters()));
+  }
   if (spec.accuracy) {
     adaptive::check_tolerance(*spec.accuracy);
-    if (!(spec.t_end > 0.0)) throw Error("the accuracy mode delivers its tolerance at an end time: give t_end");
+    if (!(spec.t_end > 0.0) && !spec.scattering)
+      throw Error("the accuracy mode delivers its tolerance at an end time: give t_end");
     for (const Axis& a : spec.axes)
       if (a.param == "h") throw Error("the accuracy mode chooses the step: h cannot be a varied parameter");
   }
@@ -242,7 +291,7 @@ void validate_sweep(const SweepSpec& spec) {
   for (std::size_t p = 0; p < points; ++p) {
     const std::vector<double> point = grid_point(spec, p);
     try {
-      thesis_scene(point_params(spec, point));
+      point_scene(spec, point);
       for (const MethodInfo* m : spec.methods) check(point_advance(spec, *m, point));
     } catch (const Error& e) {
       throw Error(point_label(spec, point) + ": " + e.what());
@@ -262,7 +311,7 @@ std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vect
     row.point = grid_point(spec, i / M);
     row.method = &method;
     rows.push_back(std::move(row));
-    scenes.push_back(thesis_scene(point_params(spec, rows.back().point)));
+    scenes.push_back(point_scene(spec, rows.back().point));
     members.push_back({scenes.back().bodies.front().p, scenes.back().bodies.front().s0, scenes.back().centres.front().A});
   }
   if (unit.size() > 1) {  // a batch: one method, one step (plan_units), lanes that accept it
@@ -289,7 +338,7 @@ std::vector<std::vector<std::size_t>> plan_units(const SweepSpec& spec, const st
   for (std::size_t i : todo) {
     const MethodInfo& method = *spec.methods[i % M];
     const std::vector<double> point = grid_point(spec, i / M);
-    const Scene scene = thesis_scene(point_params(spec, point));
+    const Scene scene = point_scene(spec, point);
     if (lanes < 2 || !batch::accepts(method, scene.bodies.front(), scene.centres) ||
         (spec.cancel && static_cast<double>(std::get<FixedSteps>(point_advance(spec, method, point)).steps) >
                             kMaxUnpolledBatchSteps)) {

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <toml++/toml.h>
 
@@ -139,9 +140,85 @@ Body parse_body(const toml::table& t, std::size_t i, const std::string& origin) 
   return b;
 }
 
+std::vector<std::string> split_key(const std::string& key) {
+  std::vector<std::string> parts;
+  std::size_t from = 0;
+  for (std::size_t at; (at = key.find('.', from)) != std::string::npos; from = at + 1) parts.push_back(key.substr(from, at - from));
+  parts.push_back(key.substr(from));
+  return parts;
+}
+
+/// "3" from "centre3" (prefix "centre"); 0 for the bare prefix (every one); nullopt otherwise.
+std::optional<std::size_t> numbered(const std::string& part, const std::string& prefix) {
+  if (part.rfind(prefix, 0) != 0) return std::nullopt;
+  const std::string digits = part.substr(prefix.size());
+  if (digits.empty()) return 0;
+  if (digits.size() > 6 || !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+    return std::nullopt;
+  const std::size_t k = std::stoul(digits);
+  if (k == 0) return std::nullopt;
+  return k;
+}
+
+/// The [[centre]] or [[body]] tables a key path's first part names, with that part's meaning.
+std::vector<toml::table*> tables_of(toml::table& root, const std::string& head, const std::string& key,
+                                    const std::string& origin) {
+  const bool centre = numbered(head, "centre").has_value();
+  toml::array* a = root.get(centre ? "centre" : "body") ? root.get(centre ? "centre" : "body")->as_array() : nullptr;
+  std::vector<toml::table*> all;
+  if (a && a->is_array_of_tables())
+    for (auto& t : *a) all.push_back(t.as_table());
+  const auto k = numbered(head, centre ? "centre" : "body");
+  if (k) {
+    if (*k == 0) return all;
+    if (*k <= all.size()) return {all[*k - 1]};
+    fail(origin, "scene key '" + key + "': the scene has " + std::to_string(all.size()) + (centre ? " centre(s)" : " body(ies)"));
+  }
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const toml::node* n = all[i]->get("name");
+    const std::string name = n && n->value<std::string>() ? *n->value<std::string>() : "body" + std::to_string(i + 1);
+    if (name == head) return {all[i]};
+    names.push_back(name);
+  }
+  fail(origin, "scene key '" + key + "': its first part is centreK, bodyK, centre, body or a body's name (" +
+                   (names.empty() ? std::string("the scene has no body") : "bodies: " + join(names, ", ")) + ")");
+}
+
+void apply(toml::table& root, const SceneValue& kv, const std::string& origin) {
+  const std::vector<std::string> parts = split_key(kv.key);
+  const std::string& key = kv.key;
+  if (parts.size() < 2 || parts.size() > 3)
+    fail(origin, "scene key '" + key + "': give PART.KEY or PART.VECTOR.x|y|z (centre2.A, body.B, centre1.position.x)");
+  const bool vector = parts.size() == 3;
+  static const std::vector<std::string> axes{"x", "y", "z"};
+  const auto axis = vector ? std::find(axes.begin(), axes.end(), parts[2]) : axes.end();
+  if (vector && axis == axes.end()) fail(origin, "scene key '" + key + "': a vector's component is x, y or z");
+  for (toml::table* t : tables_of(root, parts[0], key, origin)) {
+    if (!vector) {
+      if (t->get(parts[1]) && t->get(parts[1])->is_array())
+        fail(origin, "scene key '" + key + "': '" + parts[1] + "' is a vector: give " + key + ".x, .y or .z");
+      t->insert_or_assign(parts[1], kv.value);
+      continue;
+    }
+    toml::node* n = t->get(parts[1]);
+    if (!n && parts[1] == "position") {  // a centre's default position
+      t->insert_or_assign("position", toml::array{0.0, 0.0, 0.0});
+      n = t->get("position");
+    }
+    toml::array* a = n ? n->as_array() : nullptr;
+    if (!a || a->size() != 3)
+      fail(origin, "scene key '" + key + "': the scene has no vector '" + parts[1] + "' there" +
+                       (parts[1] == "R" || parts[1] == "v" || parts[1] == "w" ? " (that body is given by the thesis's d, L, K1, Kx, Kz)" : ""));
+    a->replace(a->begin() + (axis - axes.begin()), kv.value);
+  }
+}
+
 }  // namespace
 
-Scene parse_scene(const std::string& text, const std::string& origin) {
+bool is_scene_key(const std::string& key) { return key.find('.') != std::string::npos; }
+
+Scene parse_scene(const std::string& text, const std::string& origin, const std::vector<SceneValue>& set) {
   toml::table root;
   try {
     root = toml::parse(text, origin);
@@ -150,6 +227,7 @@ Scene parse_scene(const std::string& text, const std::string& origin) {
     fail(origin, "line " + std::to_string(src.begin.line) + ": " + std::string(e.description()));
   }
   only_keys(root, {"centre", "body"}, "top level", origin);
+  for (const SceneValue& kv : set) apply(root, kv, origin);
   Scene scene;
   if (const toml::array* cs = array_of_tables(root, "centre", origin))
     for (std::size_t k = 0; k < cs->size(); ++k)
@@ -164,7 +242,9 @@ Scene parse_scene(const std::string& text, const std::string& origin) {
   return scene;
 }
 
-Scene read_scene_file(const std::string& path) {
+Scene read_scene_file(const std::string& path) { return parse_scene(read_scene_text(path), path); }
+
+std::string read_scene_text(const std::string& path) {
   // A scene file is a few lines; a device (/dev/zero) or a huge file would be read forever.
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
@@ -183,7 +263,7 @@ Scene read_scene_file(const std::string& path) {
     if (text.size() > kMaxSceneFileBytes) throw Error(path + ": the scene file is larger than 16 MB");
   }
   if (std::ferror(in.get())) throw Error(path + ": the scene file cannot be read (" + std::strerror(errno) + ")");
-  return parse_scene(text, path);
+  return text;
 }
 
 }  // namespace bodypoint

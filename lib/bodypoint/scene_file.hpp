@@ -18,13 +18,29 @@
 #include "bodypoint/model.hpp"
 
 #include <string>
+#include <vector>
 
 namespace bodypoint {
 
 /// Reads and validates a scene; throws Error with "<file>: <what>" on any problem.
 Scene read_scene_file(const std::string& path);
+/// A scene file's text, read as read_scene_file reads it (a regular file of at most 16 MB).
+std::string read_scene_text(const std::string& path);
 
-/// Parses scene text (`origin` names it in messages).
-Scene parse_scene(const std::string& text, const std::string& origin);
+/// One number of a scene file set by its key path (a sweep's axis over a scene):
+///   centreK.A, centreK.position.x|y|z        the K-th [[centre]] (from 1); `centre.` every centre
+///   bodyK.KEY, NAME.KEY, body.KEY            the K-th [[body]], the body called NAME, every body:
+///     KEY = m, B, J, one of the thesis's d, L, K1, Kx, Kz, phase (a body given so), or R|v|w.x|y|z
+/// The file's own checks then apply to the changed scene (a body keeps one form).
+struct SceneValue {
+  std::string key;
+  double value = 0.0;
+};
+
+/// Parses scene text (`origin` names it in messages), with `set` applied to the file's keys first;
+/// Error naming the key for a key the scene does not have.
+Scene parse_scene(const std::string& text, const std::string& origin, const std::vector<SceneValue>& set = {});
+/// Whether `key` is a key path of SceneValue's form (a scene file's key, not a thesis parameter).
+bool is_scene_key(const std::string& key);
 
 }  // namespace bodypoint

@@ -425,7 +425,8 @@ py::dict sweep_columns(const SweepSpec& spec, const std::vector<SweepRow>& rows)
 py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>& axes,
                   const std::vector<std::string>& methods, const py::dict& base, double h, long steps, double t_end,
                   double tol, long threads, double max_energy_error, bool estimate_error, double max_error,
-                  bool scattering, const std::string& force_law, std::optional<double> accuracy, double max_seconds) {
+                  bool scattering, const std::string& force_law, std::optional<double> accuracy, double max_seconds,
+                  const std::optional<std::pair<std::string, std::string>>& scene) {
   SweepSpec s;
   s.max_energy_error = max_energy_error;
   s.estimate_error = estimate_error;
@@ -446,6 +447,10 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
   s.steps = t_end > 0.0 ? 0 : steps;
   s.t_end = t_end;
   s.tol = tol;
+  if (scene) {  // a scene file's text and name: its keys are the axes (with_scene_file)
+    if (!base.empty()) throw Error("with a scene, set the scene's numbers in it or sweep its keys (centre2.A, body.B)");
+    s = with_scene_file(std::move(s), scene->first, scene->second);
+  }
   const unsigned workers = thread_count(threads);
   Interruptible stop(max_seconds);
   s.cancel = stop.flag();
@@ -570,7 +575,9 @@ void bind_scenes(py::module_& mod) {
       });
   mod.def("_thesis_scene", &thesis_from, py::arg("params"));
   mod.def("_read_scene", &read_scene_file, py::arg("path"));
-  mod.def("_parse_scene", [](const std::string& text) { return parse_scene(text, "<string>"); }, py::arg("text"));
+  mod.def("_parse_scene", [](const std::string& text, const std::string& origin) { return parse_scene(text, origin); },
+          py::arg("text"), py::arg("origin") = "<string>");
+  mod.def("_read_scene_text", &read_scene_text, py::arg("path"));
   mod.def("_arrival_phase", [](const py::dict& kw) {
     SceneParams sp;
     for (const auto& [k, v] : kw) scene_field(sp, k.cast<std::string>()) = number_of(v, k.cast<std::string>());
@@ -634,7 +641,7 @@ PYBIND11_MODULE(_bodypoint, mod) {
           py::arg("omega_c"), py::arg("tol"), py::arg("max_seconds"));
   mod.def("_sweep", &sweep_py, py::arg("axes"), py::arg("methods"), py::arg("base"), py::arg("h"), py::arg("steps"),
           py::arg("t_end"), py::arg("tol"), py::arg("threads"), py::arg("max_energy_error"), py::arg("estimate_error"), py::arg("max_error"),
-          py::arg("scattering"), py::arg("force_law"), py::arg("accuracy"), py::arg("max_seconds"));
+          py::arg("scattering"), py::arg("force_law"), py::arg("accuracy"), py::arg("max_seconds"), py::arg("scene"));
   mod.def("_encounter", &encounter_py, py::arg("scene"), py::arg("method"), py::arg("tol"), py::arg("t_end"),
           py::arg("max_seconds"), py::arg("thesis"));
 }

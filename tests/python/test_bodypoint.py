@@ -466,3 +466,32 @@ def test_encounter_states_its_start_distance_error():
     assert near["start_distance_error"] > near["asymptote_error"]
     material = bp.encounter(bp.thesis_scene(B=0.0, b=1.0), tol=1e-10)
     assert material["start_distance_error"] == 0.0 and material["deflection_error"] is not None
+
+
+def test_sweep_takes_any_scene_and_its_rows_equal_integrate_of_the_scene_with_the_key_set():
+    # Issue #57: "scene must be a number, got Scene". A scene file's second charge over 50 values in the
+    # accuracy mode, both bodies (one row each): 100 rows, each what integrate() gives the edited scene.
+    path = os.path.join(SOURCE, "scenes", "two-centres.toml")
+    charges = np.linspace(-2.0, -0.04, 50)
+    tol = 1e-8
+    cols = bp.sweep({"centre2.A": charges}, ["logh-kl6"], accuracy=tol, t_end=60, scene=path)
+    assert len(cols["status"]) == 100 and set(cols["status"]) == {"ok"}
+    assert list(cols["body"][:4]) == [1, 2, 1, 2]
+    text = open(path).read()
+    edited = bp.parse_scene(text.replace("A = -1.0", f"A = {charges[3]!r}"))
+    one = bp.integrate(edited, "logh-kl6", tol=tol, t_end=60)["bodies"]
+    for b in range(2):
+        i = 2 * 3 + b
+        assert [cols["Rx"][i], cols["Ry"][i], cols["Rz"][i]] == one[b]["R"].tolist(), b
+        assert cols["err_estimate"][i] <= tol
+    # A Scene built from dicts is swept by its states' keys; a thesis_scene() by the thesis's parameters.
+    s = bp.Scene([{"A": -2}, {"A": -1, "position": [40, 6, 0]}], [{"R": [-150, 3, 0], "v": [5, 0, 0]}])
+    by_dict = bp.sweep({"body.v.x": [4.0, 5.0]}, ["lp-y4"], h=0.01, steps=100, scene=s)
+    assert by_dict["body.v.x"].tolist() == [4.0, 5.0] and "body" not in by_dict
+    assert by_dict["Rx"][1] == bp.integrate(s, "lp-y4", h=0.01, steps=100)["bodies"][0]["R"][0]
+    thesis = bp.sweep({"d": [5.0]}, ["lp-y4"], steps=10, scene=bp.thesis_scene(B=0.3))
+    assert thesis["Rx"][0] == bp.integrate(bp.thesis_scene(B=0.3, d=5.0), "lp-y4", steps=10, h=1e-4)["bodies"][0]["R"][0]
+    with pytest.raises(bp.Error, match="varies its keys"):
+        bp.sweep({"d": [5]}, ["lp-y4"], steps=10, scene=s)
+    with pytest.raises(bp.Error, match="give the scene"):
+        bp.sweep({"centre2.A": [-1]}, ["lp-y4"], steps=10)

@@ -1,8 +1,9 @@
-// bodypoint: sweeps and grids of the thesis's scene, part of the public API.
+// bodypoint: sweeps and grids of a scene, part of the public API.
 //
 // A sweep varies the step h and scene parameters (scene_parameters(): A, m, B, J, d, L, K1, Kx, Kz)
 // over given values, one axis or a grid of several (every combination, the last axis fastest), for a
-// list of methods. Task i is grid point i / M with method i % M (M methods). Every task is one run of
+// list of methods. Over a scene file (with_scene_file) it varies the file's keys instead (centre2.A,
+// centre1.position.x, body.B, spinning.d: scene_file.hpp), one body per row (the axis "body"). Task i is grid point i / M with method i % M (M methods). Every task is one run of
 // the thesis's scene (thesis_scene) at that point, with fixed steps h (or fictitious steps ds = h, or
 // a first trial step h for step-size-controlled methods, with tol) to the end time, invariants
 // tracked, its error estimated by a companion run (SweepSpec::estimate_error); its result is a typed
@@ -68,6 +69,9 @@ struct SweepSpec {
   double max_energy_error = kDefaultMaxEnergyError;  ///< Options::max_energy_error of every run
   bool estimate_error = true;                        ///< Options::estimate_error of every run
   double max_error = kDefaultMaxError;               ///< Options::max_error of every run
+  /// A scene file's text and name (with_scene_file): each point is this scene with the axes' keys set;
+  /// empty: the thesis's scene from `base`.
+  std::string scene_text, scene_origin;
   /// RunOptions::cancel of every run, also polled between units (a batch of vector lanes runs to its end,
   /// so rows of more than 1e6 steps then run alone): once set, run_sweep_rows throws Error(kStoppedOnRequest).
   const std::atomic<bool>* cancel = nullptr;
@@ -79,6 +83,15 @@ std::size_t task_count(const SweepSpec& spec);
 std::vector<double> grid_point(const SweepSpec& spec, std::size_t p);
 /// The scene parameters at a grid point.
 SceneParams point_params(const SweepSpec& spec, const std::vector<double>& point);
+/// The axis of a scene file's sweep that picks its body (values 1..n), one row per body.
+inline constexpr const char* kBodyAxis = "body";
+/// `spec` over a scene file's text (`origin` names it in messages): checked, and with several bodies
+/// the axis kBodyAxis appended (every body of every point its own row). Error for a scene that does not
+/// parse or a sweep of the thesis's parameters (d, b, ...) that a scene file does not have.
+SweepSpec with_scene_file(SweepSpec spec, std::string text, std::string origin);
+/// The scene at a grid point: the thesis's (point_params), or the scene file's with the axes' keys set
+/// and, with the axis kBodyAxis, only that body.
+Scene point_scene(const SweepSpec& spec, const std::vector<double>& point);
 /// A sweep task's fixed steps: `steps` steps of h, or with t_end > 0 the steps of at most h that land
 /// on t_end (fixed_steps_to); under ForceLaw::thesis_code the code's count instead (thesis_code_steps:
 /// n - 1 steps of exactly h). Error for an h that is not a finite number > 0 or fewer than one step.

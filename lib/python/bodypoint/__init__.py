@@ -16,6 +16,7 @@ anything that happens to a valid run is reported in its ``outcome`` and ``reason
 import enum as _enum
 import json as _json
 import numbers as _numbers
+import os as _os
 
 from numpy import bool_ as _np_bool
 
@@ -192,12 +193,36 @@ def thesis_scene(**params):
 
 def read_scene(path):
     """A scene from a TOML scene file (the project's scenes/ folder has examples)."""
-    return _core._read_scene(str(path))
+    path = _os.fspath(path)
+    text = _core._read_scene_text(path)
+    scene = _core._parse_scene(text, path)
+    scene._toml = (text, path)  # sweep(scene=) varies the file's own keys (body.d of a thesis-form body too)
+    return scene
 
 
 def parse_scene(text):
     """A scene from the text of a TOML scene file."""
-    return _core._parse_scene(text)
+    scene = _core._parse_scene(_text("text", text))
+    scene._toml = (text, "<string>")
+    return scene
+
+
+def _sweep_scene(scene, axes, base, force_law):
+    """sweep()'s scene: (scene-file text and name, axes, base, force law). A thesis_scene() is swept as the
+    thesis's parameters (its keywords fixed, its asymptotic data as one-value axes); any other Scene
+    by its file's keys (read_scene(), parse_scene()) or, built from dicts, by the keys of its states."""
+    if isinstance(scene, (str, _os.PathLike)):
+        scene = read_scene(scene)
+    _scene(scene)
+    thesis = getattr(scene, "_thesis", None)
+    if thesis is not None:
+        data = ("b", "v_inf", "arrival_phase")
+        named = [k for k, _ in axes]
+        axes = axes + [(k, [_number(k, v)]) for k, v in thesis.items() if k in data and k not in named]
+        fixed = {k: v for k, v in thesis.items() if k not in data and k != "force_law"}
+        return None, axes, {**fixed, **base}, thesis.get("force_law", force_law)
+    toml = getattr(scene, "_toml", None) or (_scene_toml(scene.centres, scene.bodies), "bodypoint.Scene")
+    return toml, axes, base, force_law
 
 
 def integrate(scene, method="auto", *, h=None, steps=None, t_end=None, tol=None, invariants=True,
@@ -261,11 +286,16 @@ def trajectory(scene, method, step=None, times=(), *, tol=None, omega_c=None, ma
 
 def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, accuracy=None, threads=None, scattering=False,
           force_law="coulomb", max_energy_error=_core.DEFAULT_MAX_ENERGY_ERROR, estimate_error=True,
-          max_error=_core.DEFAULT_MAX_ERROR, max_seconds=DEFAULT_MAX_SECONDS, **base):
-    """Runs the thesis's scene over a grid of parameters and methods; returns columns.
+          max_error=_core.DEFAULT_MAX_ERROR, max_seconds=DEFAULT_MAX_SECONDS, scene=None, **base):
+    """Runs a scene (the thesis's unless ``scene`` is given) over a grid of parameters and methods;
+    returns columns.
 
     ``axes``: {parameter: values} in order (one axis, or a grid of every combination, the last axis
-    fastest); a parameter is h, one of scene_parameters(), b or v_inf. ``methods``: names, a list of
+    fastest); a parameter is h, one of scene_parameters(), b, v_inf or arrival_phase. ``scene``: a
+    Scene or a scene file's path; its axes are then the file's keys, "centre2.A", "centre1.position.x",
+    "body.B" (every body), "body2.d" or "NAME.B" (a body by name), "body1.R.x" (docs/guide.md, Sweeps),
+    and a scene of several bodies gives a row per body (the column "body", from 1). A thesis_scene()
+    is swept as the thesis's parameters. ``methods``: names, a list of
     names separated by commas, "fixed" (every fixed-step method but the Kepler split) or "all", as
     ``bodypoint sweep --methods`` takes them (named methods: "auto" is not one; ``accuracy`` below is the
     accuracy mode for each). ``base``: fixed scene parameters; ``force_law`` as
@@ -280,20 +310,23 @@ def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, accuracy=None
     out_of_plane, b_in, v_inf_in, time_delay, asymptote_error, K1_turn, spin_turn, K1x..K1z,
     asymptotes); then steps, t_end, vx..vz, wx..wz. One row per (grid point, method), grid point major.
     """
-    if steps == 0 and t_end == 0.0:
-        raise Error("give steps or t_end")
+    if steps == 0 and t_end == 0.0 and not (scattering and accuracy is not None):
+        raise Error("give steps or t_end (an encounter in the accuracy mode runs to its departure without them)")
     try:
         axes = list(dict(axes).items())
     except (TypeError, ValueError):
         raise Error(f"axes must be a dict {{parameter: values}}, got {type(axes).__name__}") from None
     columns = [(_text("an axis' parameter", k), _numbers_of(f"the values of {k}", vals)) for k, vals in axes]
+    toml = None
+    if scene is not None:
+        toml, columns, base, force_law = _sweep_scene(scene, columns, base, force_law)
     return _core._sweep(columns, _texts("methods", methods), base, _number("h", h), _count("steps", steps),
                         _number("t_end", t_end), _number("tol", tol),
                         0 if threads is None else _count("threads", threads), _number("max_energy_error", max_energy_error),
                         _flag("estimate_error", estimate_error), _number("max_error", max_error),
                         _flag("scattering", scattering),
                         _text("force_law", force_law), _number("accuracy", accuracy, optional=True),
-                        _number("max_seconds", max_seconds))
+                        _number("max_seconds", max_seconds), toml)
 
 
 def encounter(scene, *, t_end=None, method="auto", tol=1e-10, max_seconds=DEFAULT_MAX_SECONDS):
