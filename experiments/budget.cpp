@@ -39,7 +39,8 @@ std::string duration(double s) {
 }  // namespace
 
 std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
-                                          const Advance& how, const Options& options) {
+                                          const Advance& requested, const Options& options) {
+  const Advance how = forwards(requested);  // a run backwards costs what its forward run does
   const auto* fixed = std::get_if<FixedSteps>(&how);
   const auto* fictitious = std::get_if<FictitiousSteps>(&how);
   if (!fixed && !fictitious) return std::nullopt;

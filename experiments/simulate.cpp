@@ -1,5 +1,6 @@
 // `bodypoint simulate`: one method on one scene; readable summary, --json, or a trajectory CSV.
 #include "process.hpp"
+#include "bodypoint/adaptive/methods.hpp"
 #include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
@@ -92,6 +93,8 @@ struct SimulateOptions {
   long every = 1;
   double tol = kDefaultStepTolerance, dt_out = 0.0, omega_c = -1.0;
   bool json = false, no_invariants = false, with_reference = false, dry_run = false, quiet = false, scattering = false;
+  bool backward = false;       ///< --backward: from t = 0 back to -t_end
+  bool reversibility = false;  ///< --reversibility: the run, then back to its start by the same steps
   std::vector<std::string> event_text, stop_text;
   std::vector<Event> events;  ///< parsed from event_text and stop_text
   /// Each body's events: `events`, and with --scattering those of its encounter (encounter_options).
@@ -132,6 +135,12 @@ void add_simulate_options(po::options_description& desc, SimulateOptions& o) {
        "refuse a run whose calibrated estimate exceeds this many seconds")
       ("max-rows", defaulted(&o.max_rows), "with --out: refuse to write more rows than this")
       ("quiet", po::bool_switch(&o.quiet), "no estimate and no progress bar on stderr")
+      ("backward", po::bool_switch(&o.backward),
+       "integrate backwards in time, from t = 0 to -T (the --t-end or --steps given; --t-end=-T says the same): "
+       "every method, through time reversal (v, w -> -v, -w; docs/physics.md)")
+      ("reversibility", po::bool_switch(&o.reversibility),
+       "after the run, integrate back to its start with the same method and steps and report how far from the "
+       "start it lands (a symmetric splitting: round-off), beside the run's estimated error")
       ("reference", po::bool_switch(&o.with_reference),
        "also report err_R = |R - R_ref| against Boost.Odeint rkf78 in long double at tolerance 1e-16");
 }
@@ -249,13 +258,47 @@ void add_start_distance(Encounter& e, const po::variables_map& vm, const SceneOp
 }
 
 /// One body's run and, with --reference, the reference state at its end.
+/// --reversibility: the run taken back to its start by the same method and steps.
+struct Reversal {
+  double return_error = 0.0;  ///< max(|dR|/|R0|, |dv|/|v0|) of the state back at the start
+  double back_estimate = 0.0;  ///< the way back's own estimated error (NaN: none)
+  long force_evals = 0;        ///< of the way back, its estimate included
+};
+
 struct SimulatedBody {
   BodyResult run;
   std::optional<State> reference;
+  std::optional<Reversal> reversal;
   /// With the reference: |R - R_ref| and the relative error as --tol measures it, max(|dR|/|R_ref|, |dv|/|v_ref|).
   [[nodiscard]] double err_R() const { return (run.run.final.R - reference->R).norm(); }
   [[nodiscard]] double err_rel() const { return adaptive::state_distance(run.run.final, *reference); }
 };
+
+/// The run `fwd` of `body` taken back from its final state to its start time by the same method, step and
+/// time-step constant (the accuracy mode's delivered ones), time reversed (is_backward).
+Reversal run_back(const RunPlan& plan, const BodyResult& fwd, const Body& body, const std::vector<Centre>& centres) {
+  Body there = body;
+  there.s0 = fwd.run.final;
+  Options options = plan.options;
+  const MethodInfo& m = *fwd.method;
+  const bool constant = is_time_transformed(m) && m.family != Family::Regularised;  // takes omega_c
+  Advance how;
+  if (fwd.accuracy) {
+    StepRequest q;
+    q.h = fwd.accuracy->step;
+    q.t_end = -fwd.run.t_end;
+    how = advance_for(&m, q);
+    if (constant) options.omega_c = fwd.accuracy->omega_c;
+  } else {
+    if (fwd.run.stopped) throw Error("--reversibility takes a run to its end time, not one a --stop-at event ended");
+    how = is_backward(plan.how) ? forwards(plan.how) : backwards(plan.how);
+    if (constant && options.omega_c < 0.0) options.omega_c = adaptive::automatic_omega_c(body, centres, planned_step(plan));
+  }
+  const BodyResult back = integrate_body(there, centres, &m, how, options);
+  if (back.outcome == Outcome::refused || back.outcome == Outcome::failed)
+    throw Error("body '" + body.name + "': the way back failed: " + back.reason);
+  return {adaptive::state_distance(back.run.final, body.s0), back.error.value, back.total_force_evals()};
+}
 
 /// One body: budget, run (with the progress bar), health, and the reference state when asked for.
 SimulatedBody simulate_body(const SimulateOptions& o, const RunPlan& plan, const Body& body, const Scene& scene,
@@ -287,6 +330,7 @@ SimulatedBody simulate_body(const SimulateOptions& o, const RunPlan& plan, const
   for (const std::string& w : br.warnings)
     std::cerr << "bodypoint: warning: body '" << body.name << "' (" << br.method->name << "): " << w << "\n";
   if (o.with_reference) sb.reference = reference_state(body, scene.centres, br.run.t_end);
+  if (o.reversibility) sb.reversal = run_back(plan, br, body, scene.centres);
   return sb;
 }
 
@@ -302,6 +346,11 @@ Record simulated_record(const SimulatedBody& b, const Advance& how, const std::v
     r.insert_before(r.find("accepted_steps") ? "accepted_steps" : "force_evals", ref);
   }
   if (e) r.record("scattering", encounter_record(*e));
+  if (b.reversal)
+    r.record("reversibility", Record()
+                                  .number("return_error", b.reversal->return_error)
+                                  .number("back_err_estimate", b.reversal->back_estimate)
+                                  .count("back_force_evals", b.reversal->force_evals));
   return r;
 }
 
@@ -350,6 +399,12 @@ void report_body(const SimulatedBody& body, const std::string& name) {
               << body.err_R() << ", relative error (as estimated) = " << body.err_rel() << "\n" << std::defaultfloat;
   std::cout << "  force evaluations = " << r.force_evals << ", wall time = " << std::setprecision(3) << r.wall_s
             << " s\n";
+  if (body.reversal)
+    std::cout << std::setprecision(3) << std::scientific << "  reversibility: back at t = 0 within "
+              << body.reversal->return_error << " (relative) of the start; the run's estimated error "
+              << run.error.value << ", the way back's " << body.reversal->back_estimate << " ("
+              << body.reversal->force_evals << " force evaluations)\n"
+              << std::defaultfloat;
 }
 
 void report_text(const std::vector<SimulatedBody>& runs, const Scene& scene, const RunPlan& plan, const SimulateOptions& o,
@@ -388,6 +443,11 @@ int cmd_simulate(int argc, char** argv) {
   if (to_departure)
     for (const Body& body : scene.bodies) span = std::max(span.value_or(0.0), encounter_span(body, scene.centres));
   RunPlan plan = plan_run(vm, o.st, o.method_name, vm["method"].defaulted(), o.tol, span);
+  if (o.backward) {
+    if (is_backward(plan.how)) throw Error("--backward with a negative --t-end says it twice: give one");
+    if (o.scattering) throw Error("--scattering measures an encounter forwards in time: drop --backward");
+    plan.how = backwards(plan.how);
+  }
   if (plan.automatic) o.method_name = "auto";
   apply_output_options(vm, o, scene, plan);
   for (const std::string& text : o.event_text) o.events.push_back(parse_event(text));

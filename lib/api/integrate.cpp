@@ -3,6 +3,7 @@
 
 #include "bodypoint/adaptive/methods.hpp"
 #include "bodypoint/adaptive/tolerance.hpp"
+#include "bodypoint/io.hpp"
 #include "bodypoint/field.hpp"
 #include "bodypoint/invariants.hpp"
 #include "choice.hpp"
@@ -310,7 +311,9 @@ BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& cen
 /// way of advancing time and whether the method takes it, the options and the events.
 void check_request(const Scene& scene, const MethodInfo* method, const Advance& how, const Options& options) {
   validate(scene);
-  check(how);
+  if (const auto* f = std::get_if<FictitiousSteps>(&how); f && f->end.index() == 0 && f->ds < 0.0)
+    throw Error("the fictitious step ds must be > 0 (a run backwards has a negative end time), got " + fmt(f->ds));
+  check(forwards(how));  // a run backwards is checked as the forward run it makes (integrate_estimated)
   if (const auto* accuracy = std::get_if<Accuracy>(&how)) {
     adaptive::check_tolerance(accuracy->tol);
     if (method) adaptive::check_searchable(*method);
@@ -325,9 +328,39 @@ void check_request(const Scene& scene, const MethodInfo* method, const Advance& 
   detail::validate_events(options.events, scene.centres);
 }
 
+BodyResult integrate_forwards(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
+                              const Advance& how, const Options& options);
+
 /// A checked request's run, with its error estimate (estimate.hpp) and its outcome in the light of it.
+/// A run backwards in time (is_backward) is the forward run of the time-reversed state (v, w negated),
+/// its states, times and events reversed back: every method runs backwards, a symmetric splitting's
+/// steps being exactly its steps of -h.
 BodyResult integrate_estimated(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
                                const Advance& how, const Options& options) {
+  if (!is_backward(how)) return integrate_forwards(body, centres, method, how, options);
+  Body reversed = body;
+  reversed.s0 = time_reversed(body.s0);
+  Options o = options;
+  SampleSink back;
+  if (options.sink) {
+    back = [&options](const Sample& x) {
+      const State s = time_reversed(x.s);
+      return (*options.sink)(Sample{x.step, -x.t, s, x.rel_dE, x.rel_dK2sq, x.abs_dK2Q});
+    };
+    o.sink = &back;
+  }
+  BodyResult r = integrate_forwards(reversed, centres, method, forwards(how), o);
+  r.run.final = time_reversed(r.run.final);
+  r.run.t_end = -r.run.t_end;
+  for (EventHit& h : r.events) {
+    h.t = -h.t;
+    h.s = time_reversed(h.s);
+  }
+  return r;
+}
+
+BodyResult integrate_forwards(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
+                              const Advance& how, const Options& options) {
   BodyResult r = integrate_valid_body(body, centres, method, how, options);
   detail::estimate_error(r, body, centres, how, options, [&](const Body& from, const Advance& a, const Options& o) {
     return integrate_valid_body(from, centres, r.method, a, o);
@@ -386,23 +419,28 @@ Advance advance_for(const MethodInfo* m, const StepRequest& r) {
     if (!r.tol) throw Error("method auto needs the accuracy to deliver, tol");
     if (r.h || r.steps) throw Error("the accuracy mode (tol) chooses the step: give the end time t_end, not h or steps");
     if (!r.t_end) throw Error("the accuracy mode (tol) needs the end time t_end");
-    return Accuracy{*r.tol, *r.t_end, r.dt_out};
+    return Accuracy{*r.tol, r.backward ? -std::abs(*r.t_end) : *r.t_end, r.dt_out};
   }
   if (!r.t_end && !r.steps) throw Error("give an end time t_end or a number of steps");
   const double h = require_positive(r.h.value_or(kDefaultStep), is_time_transformed(*m) ? "the fictitious step ds (h)" : "the step h");
+  // Backwards in time: a negative end time, or `backward` with a count of steps; planned forwards.
+  const bool back = r.backward || (r.t_end && *r.t_end < 0.0);
+  if (back && r.code_loop) throw Error("the thesis code's loop runs forwards only: give a positive end time");
+  const std::optional<double> end = r.t_end ? std::optional<double>(std::abs(*r.t_end)) : std::nullopt;
+  Advance how;
   if (is_step_controlled(*m)) {
-    const double end = r.t_end ? *r.t_end : h * static_cast<double>(require_count(*r.steps, "the number of steps"));
-    return ControlledSteps{std::min(h, end), end, r.tol.value_or(kDefaultStepTolerance), r.dt_out};
+    const double t = end ? *end : h * static_cast<double>(require_count(*r.steps, "the number of steps"));
+    how = ControlledSteps{std::min(h, t), t, r.tol.value_or(kDefaultStepTolerance), r.dt_out};
+  } else if (is_time_transformed(*m)) {
+    how = end ? FictitiousSteps{h, EndTime{*end}, r.dt_out} : FictitiousSteps{h, StepCount{*r.steps}, r.dt_out};
+  } else {
+    FixedSteps f = r.code_loop ? thesis_code_steps(h, r.steps.value_or(0), end.value_or(0.0))
+                   : end       ? fixed_steps_to(*end, h)
+                               : FixedSteps{h, *r.steps};
+    f.dt_out = r.dt_out;
+    how = f;
   }
-  if (is_time_transformed(*m)) {
-    if (r.t_end) return FictitiousSteps{h, EndTime{*r.t_end}, r.dt_out};
-    return FictitiousSteps{h, StepCount{*r.steps}, r.dt_out};
-  }
-  FixedSteps f = r.code_loop ? thesis_code_steps(h, r.steps.value_or(0), r.t_end.value_or(0.0))
-                 : r.t_end   ? fixed_steps_to(*r.t_end, h)
-                             : FixedSteps{h, *r.steps};
-  f.dt_out = r.dt_out;
-  return f;
+  return back ? backwards(how) : how;
 }
 
 // --- Stepper ---
@@ -428,14 +466,60 @@ Stepper::Stepper(const MethodInfo& method, Body body, std::vector<Centre> centre
 Stepper::Stepper(std::string_view method, Body body, std::vector<Centre> centres, double step, Options options)
     : Stepper(method_or_throw(method), std::move(body), std::move(centres), step, options) {}
 
+namespace {
+
+/// The accuracy mode's delivered run for a Stepper built with a tolerance: method, step and time-step
+/// constant searched over the whole span (no sink, no events: the segments hand those on).
+BodyResult searched(std::string_view method, const Body& body, const std::vector<Centre>& centres, const Accuracy& a,
+                    Options options) {
+  options.sink = nullptr;
+  options.events.clear();
+  const MethodInfo* m = method == "auto" ? nullptr : &method_or_throw(method);
+  BodyResult r = integrate_body(body, centres, m, Accuracy{a.tol, a.t_end}, options);
+  if (r.outcome != Outcome::ok || !r.accuracy)
+    throw Error("the accuracy mode found no step for tol " + fmt(a.tol) + " to t_end = " + fmt(a.t_end) + ": " + r.reason);
+  return r;
+}
+
+Options with_constant(Options o, const BodyResult& r) {
+  if (is_time_transformed(*r.method) && r.method->family != Family::Regularised) o.omega_c = r.accuracy->omega_c;
+  return o;
+}
+
+}  // namespace
+
+Stepper::Stepper(std::string_view method, Body body, std::vector<Centre> centres, const Accuracy& a, Options options)
+    : Stepper(body, centres, searched(method, body, centres, a, options), options, a.t_end) {}
+
+Stepper::Stepper(const Body& body, const std::vector<Centre>& centres, const BodyResult& r, const Options& options,
+                 double t_end)
+    : Stepper(*r.method, body, centres, r.accuracy->step, with_constant(options, r)) {
+  accuracy_ = r.accuracy;
+  accuracy_t_end_ = t_end;
+}
+
+void Stepper::set_state(const State& s) { set_state(s, t_); }
+
+void Stepper::set_state(const State& s, double t) {
+  if (!std::isfinite(t)) throw Error("the stepper's time must be a finite number, got " + fmt(t));
+  Body b = body_;
+  b.s0 = s;
+  validate(Scene{centres_, {b}});
+  body_ = std::move(b);
+  t_ = t;
+  stopped_ = false;
+  accuracy_.reset();  // the search's estimate was for the states it ran from
+}
+
 Outcome Stepper::advance_to(double t) {
-  if (!(std::isfinite(t) && t > t_))
-    throw Error("advance_to needs a finite time after the current one (" + std::to_string(t_) + ")");
-  const double span = t - t_;
+  if (!(std::isfinite(t) && t != t_))
+    throw Error("advance_to needs a finite time other than the current one (" + fmt(t_) + "), got " + fmt(t));
+  const double span = std::abs(t - t_);  // before t_: backwards in time (integrate_body, is_backward)
   Advance how;
   if (is_time_transformed(*method_)) how = FictitiousSteps{step_, EndTime{span}};
   else if (is_step_controlled(*method_)) how = ControlledSteps{std::min(1e-3, span), span, step_};
   else how = fixed_steps_to(span, step_);
+  if (t < t_) how = backwards(how);
   // Samples carry absolute times (the segment's run starts at 0); a later segment's first sample is
   // the state the previous one ended with, already handed on.
   const double t0 = t_;

@@ -80,6 +80,15 @@ struct State {
   Vec3 w = Vec3::Zero();
 };
 
+/// Time reversal (docs/physics.md, "Time reversal"): the equations keep their form under t -> -t,
+/// v -> -v, w -> -w (the kinetic energy is quadratic in the velocities, the potential depends on R
+/// alone), so a run backwards in time is the forward run of the reversed state, reversed again.
+inline State time_reversed(State s) {
+  s.v = -s.v;
+  s.w = -s.w;
+  return s;
+}
+
 /// Canonical variables (R, K1, K2) used by the splitting methods.
 struct Momenta {
   Vec3 R = Vec3::Zero();

@@ -29,6 +29,11 @@ namespace bodypoint {
 /// tolerance `tol`.
 inline State reference_state(const Body& body, const std::vector<Centre>& centres, double t_end,
                              long double tol = 1e-16L) {
+  if (t_end < 0.0) {  // backwards: the time-reversed state forwards, reversed back (time_reversed)
+    Body reversed = body;
+    reversed.s0 = time_reversed(body.s0);
+    return time_reversed(reference_state(reversed, centres, -t_end, tol));
+  }
   namespace odeint = boost::numeric::odeint;
   using S = OdeState<long double>;
   PreciseEquations<long double> sys(body.p, centres);

@@ -276,6 +276,54 @@ void check(const Advance& how) {
       how);
 }
 
+bool is_backward(const Advance& how) {
+  return std::visit(
+      [](const auto& a) {
+        using A = std::decay_t<decltype(a)>;
+        if constexpr (std::is_same_v<A, FixedSteps>) return a.h < 0.0;
+        else if constexpr (std::is_same_v<A, FictitiousSteps>) return a.end.index() == 0 ? a.t_end() < 0.0 : a.ds < 0.0;
+        else return a.t_end < 0.0;
+      },
+      how);
+}
+
+Advance forwards(Advance how) {
+  std::visit(
+      [](auto& a) {
+        using A = std::decay_t<decltype(a)>;
+        if constexpr (std::is_same_v<A, FixedSteps>) {
+          a.h = std::abs(a.h);
+        } else if constexpr (std::is_same_v<A, FictitiousSteps>) {
+          a.ds = std::abs(a.ds);
+          if (a.end.index() == 0) a.end = EndTime{std::abs(a.t_end())};
+        } else if constexpr (std::is_same_v<A, ControlledSteps>) {
+          a.h0 = std::abs(a.h0);
+          a.t_end = std::abs(a.t_end);
+        } else {
+          a.t_end = std::abs(a.t_end);
+        }
+      },
+      how);
+  return how;
+}
+
+Advance backwards(Advance how) {
+  how = forwards(std::move(how));
+  std::visit(
+      [](auto& a) {
+        using A = std::decay_t<decltype(a)>;
+        if constexpr (std::is_same_v<A, FixedSteps>) a.h = -a.h;
+        else if constexpr (std::is_same_v<A, FictitiousSteps>) {
+          if (a.end.index() == 0) a.end = EndTime{-a.t_end()};
+          else a.ds = -a.ds;
+        } else {
+          a.t_end = -a.t_end;
+        }
+      },
+      how);
+  return how;
+}
+
 double output_interval(const Advance& how) {
   return std::visit([](const auto& a) -> double { return a.dt_out; }, how);
 }

@@ -172,6 +172,14 @@ struct Accuracy {
 };
 using Advance = std::variant<FixedSteps, FictitiousSteps, ControlledSteps, Accuracy>;
 
+/// A request backwards in time, from t = 0 to a negative end: FixedSteps with h < 0, FictitiousSteps
+/// with a negative end time (or ds < 0 for a count of steps), ControlledSteps and Accuracy with t_end < 0.
+bool is_backward(const Advance& how);
+/// The same request forwards: every time and step by its magnitude.
+Advance forwards(Advance how);
+/// The same request backwards (forwards(how) with its times and steps negated as is_backward reads them).
+Advance backwards(Advance how);
+
 /// Every number of `how` checked, each with one message naming the quantity: steps and times finite
 /// and > 0, counts >= 1, dt_out >= 0, a tolerance per step in [1e-15, inf). The accuracy mode's
 /// tolerance is checked by adaptive::check_tolerance, one layer up.

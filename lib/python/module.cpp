@@ -52,6 +52,14 @@ double number_of(const py::handle& v, const std::string& name) {
   }
 }
 
+/// Three numbers (a list, tuple or array) as a vector; Error naming it otherwise.
+Vec3 vec3_of(const py::handle& v, const std::string& name) {
+  if (PyUnicode_Check(v.ptr()) || PyBytes_Check(v.ptr()) || !PySequence_Check(v.ptr()) || py::len(v) != 3)
+    throw Error(name + " must be a sequence of 3 numbers");
+  const py::sequence seq = py::reinterpret_borrow<py::sequence>(v);
+  return Vec3(number_of(seq[0], name), number_of(seq[1], name), number_of(seq[2], name));
+}
+
 /// A keyword's text (Error naming it otherwise).
 std::string text_of(const py::handle& v, const std::string& name) {
   if (!PyUnicode_Check(v.ptr())) throw Error(name + " must be a text, got " + std::string(py::str(py::type::of(v).attr("__name__"))));
@@ -511,20 +519,58 @@ py::dict encounter_py(const Scene& scene, const std::string& method, double tol,
 
 /// A Stepper of one body of a scene, with its events' labels kept for the hits' records.
 struct PyStepper {
-  PyStepper(const Scene& scene, std::size_t body, const std::string& method, double step, const std::vector<std::string>& events,
-            const std::vector<std::string>& stop_at, std::optional<double> omega_c)
-      : labels(events_of(events, stop_at)), stepper(make(scene, body, method, step, labels, omega_c)) {}
-  static Stepper make(const Scene& scene, std::size_t body, const std::string& method, double step, std::vector<Event> events,
-                      std::optional<double> omega_c) {
+  PyStepper(const Scene& scene, std::size_t body, const std::string& method, std::optional<double> step,
+            const std::vector<std::string>& events, const std::vector<std::string>& stop_at, std::optional<double> omega_c,
+            std::optional<double> tol, std::optional<double> t_end, bool invariants)
+      : labels(events_of(events, stop_at)),
+        stepper(make(scene, body, method, step, labels, omega_c, tol, t_end, invariants)) {}
+  /// With a step: the method's steps; with tol (and t_end): the accuracy mode's method and step for
+  /// that span. Invariants tracked as integrate() tracks them, so one segment is integrate()'s run.
+  static Stepper make(const Scene& scene, std::size_t body, const std::string& method, std::optional<double> step,
+                      std::vector<Event> events, std::optional<double> omega_c, std::optional<double> tol,
+                      std::optional<double> t_end, bool invariants) {
     if (body >= scene.bodies.size())
       throw Error("body must be an index 0.." + std::to_string(scene.bodies.size() - 1) + ", got " + std::to_string(body));
     Options o;
-    o.track_invariants = false;
+    o.track_invariants = invariants;
+    o.events = std::move(events);
+    if (tol) {
+      if (step) throw Error("give a step or a tolerance tol, not both (the accuracy mode chooses the step)");
+      if (!t_end) throw Error("a Stepper with a tolerance needs the end time t_end the accuracy is searched for");
+      if (omega_c) throw Error("the accuracy mode chooses the time-step constant omega_c itself: do not give it");
+      return Stepper(method, scene.bodies[body], scene.centres, Accuracy{*tol, *t_end}, o);
+    }
+    if (t_end) throw Error("t_end is the span a tolerance is searched for: give tol too, or leave t_end out");
+    if (!step) throw Error("give a step (h, ds or a tolerance per step) or a tolerance tol with t_end");
+    if (method == "auto") throw Error("method auto needs a tolerance: give tol and t_end");
     const MethodInfo& m = method_or_throw(method);
     if (omega_c) check_time_step_constant(*omega_c, &m, false);
     o.omega_c = omega_c.value_or(-1.0);
-    o.events = std::move(events);
-    return Stepper(m, scene.bodies[body], scene.centres, step, o);
+    return Stepper(m, scene.bodies[body], scene.centres, *step, o);
+  }
+  void set_state(const py::dict& d) {
+    State s = stepper.state();
+    for (const auto& [k, v] : d) {
+      const std::string key = k.cast<std::string>();
+      if (key == "R") s.R = vec3_of(v, "state R");
+      else if (key == "v") s.v = vec3_of(v, "state v");
+      else if (key == "w") s.w = vec3_of(v, "state w");
+      else if (key != "t") throw Error(unknown_name("state key", key, {"t", "R", "v", "w"}));
+    }
+    if (d.contains("t")) stepper.set_state(s, number_of(d["t"], "state t"));
+    else stepper.set_state(s);
+  }
+  py::object accuracy() const {
+    if (!stepper.accuracy()) return py::none();
+    const AccuracyReport& a = *stepper.accuracy();
+    py::dict d;
+    d["tol"] = a.tol;
+    d["t_end"] = stepper.accuracy_t_end();
+    d["err_estimate"] = a.err_estimate;
+    d["step"] = a.step;
+    d["basis"] = a.basis;
+    d["force_evals"] = a.force_evals;
+    return d;
   }
   std::string advance_to(double t, double max_seconds) {
     Interruptible stop(max_seconds);
@@ -607,13 +653,16 @@ void bind_scenes(py::module_& mod) {
 /// The Stepper class (bodypoint/__init__.py wraps it).
 void bind_stepper(py::module_& mod) {
   py::class_<PyStepper>(mod, "_Stepper")
-      .def(py::init<const Scene&, std::size_t, const std::string&, double, const std::vector<std::string>&,
-                    const std::vector<std::string>&, std::optional<double>>(),
+      .def(py::init<const Scene&, std::size_t, const std::string&, std::optional<double>, const std::vector<std::string>&,
+                    const std::vector<std::string>&, std::optional<double>, std::optional<double>, std::optional<double>,
+                    bool>(),
            py::arg("scene"), py::arg("body"), py::arg("method"), py::arg("step"), py::arg("events"), py::arg("stop_at"),
-           py::arg("omega_c"))
+           py::arg("omega_c"), py::arg("tol"), py::arg("t_end"), py::arg("invariants"))
       .def("advance_to", &PyStepper::advance_to, py::arg("t"), py::arg("max_seconds"))
       .def_property_readonly("time", [](const PyStepper& s) { return s.stepper.time(); })
-      .def_property_readonly("state", &PyStepper::state)
+      .def_property("state", &PyStepper::state, &PyStepper::set_state)
+      .def_property_readonly("accuracy", &PyStepper::accuracy)
+      .def_property_readonly("step", [](const PyStepper& s) { return s.stepper.step(); })
       .def_property_readonly("events", &PyStepper::hits)
       .def_property_readonly("stopped", [](const PyStepper& s) { return s.stepper.stopped(); })
       .def_property_readonly("force_evals", [](const PyStepper& s) { return s.stepper.force_evals(); })

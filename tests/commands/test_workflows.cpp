@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -134,6 +136,53 @@ TEST(SceneSweep, AKeyTheSceneDoesNotHaveIsRefusedInOneLine) {
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << " -> " << r.err;
     EXPECT_TRUE(r.out.empty()) << args;
   }
+}
+
+/// The number after `"key": ` in simulate --json's output (NaN when absent).
+double json_number(const std::string& json, const std::string& key) {
+  const std::size_t at = json.find("\"" + key + "\": ");
+  if (at == std::string::npos) return std::nan("");
+  return std::strtod(json.c_str() + at + key.size() + 4, nullptr);
+}
+
+// The estimate is honest to a factor 3 (bench/estimate_ladder.py's bound on exit-0 runs).
+constexpr double kEstimateFactor = 3.0;
+
+TEST(Backward, ARunBackwardsMatchesTheLongDoubleReferenceWithinItsEstimate) {
+  for (const char* method : {"lp-y4", "rk4", "logh-kl6"}) {
+    const auto neg = run_cli(std::string("simulate --method ") + method + " --h 0.01 --t-end=-30 --reference --json");
+    ASSERT_EQ(neg.code, 0) << method << ": " << neg.err;
+    EXPECT_EQ(json_number(neg.out, "t_end"), -30.0) << method;
+    const double err = json_number(neg.out, "err_rel"), est = json_number(neg.out, "err_estimate");
+    EXPECT_LE(err, kEstimateFactor * est) << method;
+    // --backward says the same as a negative end time.
+    const auto flag = run_cli(std::string("simulate --method ") + method + " --h 0.01 --t-end 30 --backward --json");
+    ASSERT_EQ(flag.code, 0) << flag.err;
+    EXPECT_EQ(json_number(flag.out, "err_estimate"), est) << method;
+    const std::size_t r1 = flag.out.find("\"R\": "), r2 = neg.out.find("\"R\": ");
+    EXPECT_EQ(flag.out.substr(r1, flag.out.find(']', r1) - r1), neg.out.substr(r2, neg.out.find(']', r2) - r2)) << method;
+  }
+  for (const char* args : {"--backward --t-end=-5", "--backward --scattering"}) {
+    const auto r = run_cli(std::string("simulate ") + args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+}
+
+TEST(Backward, ForwardsAndBackIsOneCommandAndASymmetricSplittingReturnsWithinItsEstimate) {
+  // Issue #57: "a forward-backward run of lp-kl8 returns to its start within its error estimate".
+  const auto kl8 = run_cli("simulate --method lp-kl8 --h 0.01 --t-end 50 --reversibility --json");
+  ASSERT_EQ(kl8.code, 0) << kl8.err;
+  const double back = json_number(kl8.out, "return_error"), est = json_number(kl8.out, "err_estimate");
+  EXPECT_LE(back, est);
+  // rk4 is not symmetric: its way back adds its error again (a check that can fail).
+  const auto rk4 = run_cli("simulate --method rk4 --h 0.01 --t-end 20 --reversibility --json");
+  ASSERT_EQ(rk4.code, 0) << rk4.err;
+  EXPECT_GT(json_number(rk4.out, "return_error"), 1e3 * back);
+  // The accuracy mode's delivered method and step go back; the text names the return.
+  const auto text = run_cli("simulate --tol 1e-9 --t-end 50 --reversibility");
+  ASSERT_EQ(text.code, 0) << text.err;
+  EXPECT_NE(text.out.find("reversibility: back at t = 0 within"), std::string::npos) << text.out;
 }
 
 }  // namespace

@@ -217,6 +217,8 @@ struct StepRequest {
   std::optional<double> tol = std::nullopt;
   double dt_out = 0.0;          ///< output interval (0: none)
   bool code_loop = false;       ///< count fixed steps as the thesis's code did (thesis_code_steps)
+  /// Backwards in time from t = 0 (to -t_end, or `steps` steps back); a negative t_end says it too.
+  bool backward = false;
 };
 /// True when `request` asks the accuracy mode to choose the step of `method` (nullptr: auto).
 bool searches(const MethodInfo* method, const StepRequest& request);
@@ -330,13 +332,24 @@ SceneParams thesis_params_twice_as_far(SceneParams solved, double b, double v_in
 ///   step: fixed-step methods: the largest step <= step that lands on t; time-transformed methods: the
 ///         fictitious step ds; step-size-controlled methods: the tolerance per step, and the first
 ///         trial step is min(1e-3, t - time()).
-/// A segment has no error estimate (Options::estimate_error is off for it).
+/// A segment has no error estimate (Options::estimate_error is off for it). A time before time()
+/// integrates backwards (the time-reversed run, is_backward): forwards and back by the same steps, a
+/// symmetric splitting returns to its start to round-off. Events: each segment locates its hits at
+/// absolute times; the closest approach (Event::closest_approach) is the nearest *so far*, replaced
+/// when a later segment comes nearer (after advance_to(28) on table 3.1 it is a helix wiggle at
+/// t = 27.571, after advance_to(28.5) the encounter's minimum at t = 28.399).
 class Stepper {
  public:
   Stepper(const MethodInfo& method, Body body, std::vector<Centre> centres, double step, Options options = {});
   Stepper(std::string_view method, Body body, std::vector<Centre> centres, double step, Options options = {});
+  /// A stepper that asks for an accuracy: the accuracy mode searches `method` ("auto": the method
+  /// too) for a.tol over [0, a.t_end] (a negative t_end: backwards), and the segments then advance with
+  /// the method, step and time-step constant it delivered; accuracy() reports that search, whose
+  /// estimate holds at a.t_end (landing steps on the segments' times only shorten steps). Error when the
+  /// search refuses (out of reach, the budget).
+  Stepper(std::string_view method, Body body, std::vector<Centre> centres, const Accuracy& a, Options options = {});
 
-  /// Integrates to time t > time(); returns the outcome of the segment (refused or failed leave the
+  /// Integrates to time t != time() (before it: backwards); returns the outcome of the segment (refused or failed leave the
   /// stepper where it was). Samples handed to options.sink carry absolute times.
   Outcome advance_to(double t);
 
@@ -355,8 +368,21 @@ class Stepper {
   [[nodiscard]] bool stopped() const { return stopped_; }
   /// The flag the next segments poll (RunOptions::cancel; nullptr: none), to stop one from outside.
   void cancel_with(const std::atomic<bool>* flag) { options_.cancel = flag; }
+  /// The step of the segments: h, a time-transformed method's ds, a controlled method's tolerance per step.
+  [[nodiscard]] double step() const { return step_; }
+  /// With a tolerance: the search that chose the method and step, its estimate (at its t_end) included;
+  /// none for a stepper given a step, or once its state was set.
+  [[nodiscard]] const std::optional<AccuracyReport>& accuracy() const { return accuracy_; }
+  [[nodiscard]] double accuracy_t_end() const { return accuracy_t_end_; }
+  /// Replaces the current state (a kick, a corrected state), checked as a scene's; the time stays
+  /// unless given. The accuracy search's estimate no longer applies (accuracy() becomes empty).
+  void set_state(const State& s);
+  void set_state(const State& s, double t);
 
  private:
+  Stepper(const Body& body, const std::vector<Centre>& centres, const BodyResult& searched, const Options& options,
+          double t_end);
+
   const MethodInfo* method_;
   Body body_;  // body_.s0 is the current state
   std::vector<Centre> centres_;
@@ -367,6 +393,8 @@ class Stepper {
   std::string reason_;
   std::vector<EventHit> events_;
   bool stopped_ = false;
+  std::optional<AccuracyReport> accuracy_;
+  double accuracy_t_end_ = 0.0;
 };
 
 }  // namespace bodypoint

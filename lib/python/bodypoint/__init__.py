@@ -358,26 +358,52 @@ class Stepper:
         s.advance_to(50)          # an Outcome; stops early at the first hit of a stop event
         s.stopped, s.time, s.state["R"], s.events
         s.advance_to(50)          # continues from the stop
+        s.advance_to(0)           # backwards in time, to the start
+        s = bp.Stepper(scene, "auto", tol=1e-10, t_end=50)   # the accuracy mode chooses method and step
+        s.accuracy                # its search: tol, t_end, err_estimate (at t_end), step, basis
 
     ``step``: a fixed-step method's largest step (each segment lands on its end), the fictitious step
-    ds of a time-transformed one, or a step-size-controlled peer's tolerance per step. A one-step
-    method continues exactly as one run of the same steps; ab4 restarts its history at each segment.
-    ``events`` / ``stop_at``: as integrate()'s. A segment has no error estimate.
+    ds of a time-transformed one, or a step-size-controlled peer's tolerance per step. Or ``tol`` with
+    ``t_end``: the accuracy mode searches the method ("auto") or the named method's step for that span
+    (a negative t_end: backwards) and the segments advance with what it delivered; ``accuracy`` gives
+    the search and its estimate, which holds at t_end (landing on the segments' times only shortens
+    steps). A time before ``time`` integrates backwards (time reversal; a symmetric splitting run
+    forwards and back by the same steps returns to round-off). ``state`` can be set (a dict of R, v, w
+    and optionally t); the search's estimate then no longer applies (``accuracy`` is None).
+    One segment is integrate()'s run of the same steps bit for bit (``invariants`` tracked as there);
+    segments land on their times with a shortened last step, so several segments differ from one run
+    by round-off and that step's error. ab4 restarts its history at each segment.
+    ``events`` / ``stop_at``: as integrate()'s, at absolute times. ``closest`` is the closest approach
+    *so far*: a later segment that comes nearer replaces it (on table 3.1, after advance_to(28) a helix
+    wiggle at t = 27.571, r = 10.76; after advance_to(28.5) the encounter's minimum, t = 28.399, r = 9.0546).
+    A segment has no error estimate of its own.
     """
 
-    def __init__(self, scene, method, step, *, body=0, events=(), stop_at=(), omega_c=None):
-        self._s = _core._Stepper(_scene(scene), _index("body", body), _text("method", method), _number("step", step),
-                                 _texts("events", events), _texts("stop_at", stop_at),
-                                 _number("omega_c", omega_c, optional=True))
+    def __init__(self, scene, method="auto", step=None, *, tol=None, t_end=None, body=0, events=(), stop_at=(),
+                 omega_c=None, invariants=True):
+        self._s = _core._Stepper(_scene(scene), _index("body", body), _text("method", method),
+                                 _number("step", step, optional=True), _texts("events", events),
+                                 _texts("stop_at", stop_at), _number("omega_c", omega_c, optional=True),
+                                 _number("tol", tol, optional=True), _number("t_end", t_end, optional=True),
+                                 _flag("invariants", invariants))
 
     def advance_to(self, t, *, max_seconds=DEFAULT_MAX_SECONDS):
-        """Integrates from time to t (> time); returns the segment's Outcome (refused or failed leave
-        the stepper where it was: ``reason`` says why). Ctrl-C or max_seconds stop the segment (the
-        stepper stays where it was) and raise KeyboardInterrupt or bodypoint.Error."""
+        """Integrates from time to t (before time: backwards); returns the segment's Outcome (refused or
+        failed leave the stepper where it was: ``reason`` says why). Ctrl-C or max_seconds stop the
+        segment (the stepper stays where it was) and raise KeyboardInterrupt or bodypoint.Error."""
         return Outcome(self._s.advance_to(_number("t", t), _number("max_seconds", max_seconds)))
 
+    def _set_state(self, state):
+        if not isinstance(state, dict):
+            raise Error(f"state must be a dict of R, v, w (and t), got {type(state).__name__}")
+        self._s.state = state
+
     time = property(lambda self: self._s.time, doc="the current time")
-    state = property(lambda self: self._s.state, doc="the current state: t, R, v, w")
+    state = property(lambda self: self._s.state, _set_state,
+                     doc="the current state: t, R, v, w; set it with a dict of some of them (checked as a scene's)")
+    accuracy = property(lambda self: self._s.accuracy,
+                        doc="with tol: the search (tol, t_end, err_estimate at t_end, step, basis, force_evals); else None")
+    step = property(lambda self: self._s.step, doc="the segments' step (h, ds, or a tolerance per step)")
     events = property(lambda self: self._s.events, doc="events located so far: event, t, r, R, v, w")
     stopped = property(lambda self: self._s.stopped, doc="a stop event ended the last segment")
     force_evals = property(lambda self: self._s.force_evals, doc="force evaluations so far")
