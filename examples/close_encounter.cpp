@@ -31,7 +31,7 @@ int main() {
   const bodypoint::State& s = b.run.final;
   std::printf("method %s\nchosen %s\n", b.method->name.c_str(), b.chosen.c_str());
   std::printf("R %.17g %.17g %.17g\n", s.R.x(), s.R.y(), s.R.z());
-  std::printf("err_estimate %.3g\nstep %.6g\nsearch_runs %d\n", b.accuracy->err_estimate, b.accuracy->step,
+  std::printf("err_estimate %.3g\nstep %.6g\nsearch_runs %d\n", b.accuracy->err_estimate, b.accuracy->h_chosen,
               b.accuracy->runs);
   std::printf("closest_sample %.6g at t = %.6g\nforce_evals %ld\n", r_min, t_min, r.force_evals);
   return 0;

@@ -102,11 +102,7 @@ StepRequest step_request(const po::variables_map& vm, const StepOptions& o, cons
   // --force-law thesis-code counts steps as the thesis's code did (n - 1 of n asked; run.hpp).
   r.code_loop = vm.count("force-law") && parse_force_law(vm["force-law"].as<std::string>()) == ForceLaw::thesis_code;
   if (!r.t_end && !r.steps && end_if_none) r.t_end = end_if_none;
-  if (!r.t_end && !r.steps) {
-    if (searches(method, r)) r.t_end = kDefaultStep * static_cast<double>(kDefaultSteps);
-    else r.steps = kDefaultSteps;
-  }
-  return r;
+  return with_default_end(r, method);
 }
 
 std::string describe(const SceneParams& p) {

@@ -39,7 +39,7 @@ std::string search_line(const BodyResult& b) {
   std::ostringstream os;
   os << "method=" << b.method->name;
   if (b.accuracy)
-    os << (is_time_transformed(*b.method) ? " ds=" : " h=") << fmt(b.accuracy->step) << " search: " << b.accuracy->runs
+    os << (is_time_transformed(*b.method) ? " ds=" : " h=") << fmt(b.accuracy->h_chosen) << " search: " << b.accuracy->runs
        << " runs (the delivered one included), " << b.accuracy->force_evals << " force evaluations";
   return os.str();
 }
@@ -57,7 +57,7 @@ std::string error_line(const ErrorEstimate& e) {
 
 void print_encounter(const std::vector<Event>& events, const BodyResult& run, const std::optional<Encounter>& e) {
   for (const EventHit& h : run.events)
-    std::cout << "  event " << events[h.event].label() << ": t = " << fmt(h.t) << ", r = " << fmt(h.distance)
+    std::cout << "  event " << events[h.event].label() << ": t = " << fmt(h.t) << ", r = " << fmt(h.r)
               << ", R = " << json_vec(h.s.R) << "\n";
   if (run.run.stopped) std::cout << "  the run stopped at event " << events[run.events.back().event].label() << "\n";
   if (!e) return;
@@ -285,7 +285,7 @@ Reversal run_back(const RunPlan& plan, const BodyResult& fwd, const Body& body, 
   Advance how;
   if (fwd.accuracy) {
     StepRequest q;
-    q.h = fwd.accuracy->step;
+    q.h = fwd.accuracy->h_chosen;
     q.t_end = -fwd.run.t_end;
     how = advance_for(&m, q);
     if (constant) options.omega_c = fwd.accuracy->omega_c;

@@ -157,7 +157,7 @@ std::string encounter_json(const Body& body, const std::vector<Centre>& centres,
   const EventHit* nearest = nearest_approach(br.events, closest);
   const Scattering sc = scattering(body.p, centres, body.s0, br.run.final, br.run.t_end);
   std::string out = ", \"encounter\": {\"R_min\": " + (nearest ? json_vec(nearest->s.R) : std::string("null"));
-  if (nearest) out += ", \"r_min\": " + json_number(nearest->distance) + ", \"t_min\": " + json_number(nearest->t);
+  if (nearest) out += ", \"r_min\": " + json_number(nearest->r) + ", \"t_min\": " + json_number(nearest->t);
   out += ", \"asymptotes\": [";
   if (sc.in && sc.out) {
     const Vec3& c = centres.front().c;
@@ -220,7 +220,7 @@ TrackJson body_json(const Body& body, const std::vector<Centre>& centres, RunPla
   for (const EventHit& h : br.events) {  // the asked events' hits, located to round-off (the marks)
     if (h.event < first_asked) continue;
     out += (first ? "" : ", ") + std::string("{\"label\": ") + json_string(located[h.event].label(), true) +
-           ", \"t\": " + json_number(h.t) + ", \"R\": " + json_vec(h.s.R) + ", \"r\": " + json_number(h.distance) + "}";
+           ", \"t\": " + json_number(h.t) + ", \"R\": " + json_vec(h.s.R) + ", \"r\": " + json_number(h.r) + "}";
     first = false;
   }
   out += "]}";

@@ -104,7 +104,7 @@ Encounter measure_encounter(const Body& body, const std::vector<Centre>& centres
   Encounter e;
   e.scattering = scattering(body.p, centres, body.s0, run.final, run.t_end);
   if (const EventHit* nearest = nearest_approach(hits, events)) {
-    e.r_min = nearest->distance;
+    e.r_min = nearest->r;
     e.t_min = nearest->t;
   }
   e.reason = unfinished(body, centres, run);

@@ -115,7 +115,7 @@ const EventHit* nearest_approach(const std::vector<EventHit>& hits, const std::v
   const EventHit* nearest = nullptr;
   for (const EventHit& h : hits)
     if ((events[h.event].kind == Event::Kind::closest_approach || events[h.event].kind == Event::Kind::local_minimum) &&
-        (!nearest || h.distance < nearest->distance || (std::isnan(nearest->distance) && !std::isnan(h.distance))))
+        (!nearest || h.r < nearest->r || (std::isnan(nearest->r) && !std::isnan(h.r))))
       nearest = &h;
   return nearest;
 }
@@ -167,7 +167,7 @@ void keep_closest(std::vector<EventHit>& hits, const std::vector<Event>& events)
   std::vector<const EventHit*> nearest(events.size(), nullptr);
   for (const EventHit& h : hits)
     if (events[h.event].kind == Event::Kind::closest_approach &&
-        (!nearest[h.event] || h.distance < nearest[h.event]->distance))
+        (!nearest[h.event] || h.r < nearest[h.event]->r))
       nearest[h.event] = &h;
   std::vector<EventHit> kept;
   for (const EventHit& h : hits)
@@ -278,7 +278,7 @@ std::vector<EventHit> locate(const EventWatch& watch, const std::vector<Event>& 
     h.event = b.event;
     h.t = b.t_a + best_tau;
     h.s = best;
-    h.distance = distance_for(e, centres, best);
+    h.r = distance_for(e, centres, best);
     hits.push_back(h);
   }
   std::stable_sort(hits.begin(), hits.end(), [](const EventHit& x, const EventHit& y) { return x.t < y.t; });

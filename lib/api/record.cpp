@@ -22,7 +22,7 @@ double step_of(const BodyResult& r, const Advance& how) {
   if (const auto* f = std::get_if<FixedSteps>(&how)) return f->h;
   if (const auto* f = std::get_if<FictitiousSteps>(&how)) return f->ds;
   if (const auto* c = std::get_if<ControlledSteps>(&how)) return c->h0;
-  return r.accuracy ? r.accuracy->step : Scattering::kNaN;
+  return r.accuracy ? r.accuracy->h_chosen : Scattering::kNaN;
 }
 
 Record event_hits(const BodyResult& r, const std::vector<Event>& events) {
@@ -133,7 +133,7 @@ const Value* Record::find(std::string_view key) const {
 
 Record event_record(const EventHit& h, const std::vector<Event>& events) {
   Record e;
-  e.text("event", events[h.event].label()).number("t", h.t).number("r", h.distance);
+  e.text("event", events[h.event].label()).number("t", h.t).number("r", h.r);
   return e.vector("R", h.s.R).vector("v", h.s.v).vector("w", h.s.w);
 }
 
@@ -144,7 +144,7 @@ Record body_record(const BodyResult& r, const Advance& how, const std::vector<Ev
   out.text("outcome", std::string(outcome_name(r.outcome))).note("reason", r.reason).number("h", step_of(r, how));
   if (const auto* c = std::get_if<ControlledSteps>(&how)) out.number("tol", c->tol);
   if (const auto* a = r.accuracy ? &*r.accuracy : nullptr) {
-    out.number("tol", a->tol).number("h_chosen", a->step).count("search_runs", a->runs);
+    out.number("tol", a->tol).number("h_chosen", a->h_chosen).count("search_runs", a->runs);
     out.count("search_force_evals", a->force_evals).number("search_wall_s", a->wall_s);
   }
   if (!r.chosen.empty()) out.text("chosen", r.chosen);
@@ -205,7 +205,7 @@ Record sweep_record(const SweepSpec& spec, const SweepRow& r) {
   }
   out.count("steps", r.result.steps).number("t_end", r.result.t_end);
   if (spec.accuracy) {  // the accuracy mode's choice and cost (the row's own run is its delivered one)
-    out.number("h_chosen", r.accuracy ? r.accuracy->step : nan);
+    out.number("h_chosen", r.accuracy ? r.accuracy->h_chosen : nan);
     out.count("search_force_evals", r.accuracy ? r.accuracy->force_evals : 0);
   }
   out.number("vx", f.v.x()).number("vy", f.v.y()).number("vz", f.v.z()).number("wx", f.w.x()).number("wy", f.w.y()).number("wz", f.w.z());

@@ -385,13 +385,18 @@ void run_sweep_tasks(const SweepSpec& spec, const std::vector<std::size_t>& todo
   if (error) std::rethrow_exception(error);
 }
 
-std::vector<SweepRow> run_sweep_rows(const SweepSpec& spec, unsigned threads) {
+std::vector<SweepRow> run_sweep_rows(const SweepSpec& spec, unsigned threads,
+                                     const std::function<void(std::size_t, std::size_t)>& progress) {
   std::vector<std::size_t> all(task_count(spec));
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
   std::vector<SweepRow> rows(all.size());
   SweepRunner runner;
   runner.threads = std::max(1u, threads);
-  runner.on_row = [&rows](SweepRow&& r) { rows[r.task] = std::move(r); };
+  std::size_t done = 0;
+  runner.on_row = [&rows, &done, &progress, total = all.size()](SweepRow&& r) {  // under the runner's lock
+    rows[r.task] = std::move(r);
+    if (progress) progress(++done, total);
+  };
   const auto cancelled = [&spec] { return spec.cancel && spec.cancel->load(std::memory_order_relaxed); };
   runner.stop = cancelled;
   run_sweep_tasks(spec, all, runner);

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <functional>
 #include <condition_variable>
 #include <csignal>
 #include <mutex>
@@ -235,7 +236,7 @@ py::dict body_result(const Body& body, const BodyResult& r, const Advance& how, 
 Advance advance_of_keywords(const MethodInfo* m, std::optional<double> h, std::optional<long> steps,
                             std::optional<double> t_end, std::optional<double> tol, bool code_loop) {
   StepRequest request{h, steps, t_end, tol, 0.0, code_loop};
-  return advance_for(m, request);
+  return advance_for(m, with_default_end(request, m));  // the command line's defaults
 }
 
 /// Events by the library's one parser (parse_event): `events` located, `stop_at` ending a run.
@@ -296,8 +297,33 @@ struct Followed {
   double max_rel_dE = 0.0;
   long force_evals = 0, steps = 0;
 };
+/// A Python callable told (done, in all) of a long call from its C++ threads (bodypoint's _Progress):
+/// at most every kProgressSeconds and at the end, under the GIL; its errors are dropped, so a display
+/// never stops the work. None: nothing is told.
+class ProgressHook {
+ public:
+  static constexpr double kProgressSeconds = 0.25;
+  explicit ProgressHook(py::object f) : f_(std::move(f)) {}
+  void operator()(std::size_t done, std::size_t total) {
+    if (f_.is_none()) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (done < total && std::chrono::duration<double>(now - last_).count() < kProgressSeconds) return;
+    last_ = now;
+    py::gil_scoped_acquire gil;
+    try {
+      f_(done, total);
+    } catch (const py::error_already_set&) {  // dropped with its Python error (a display only)
+    }
+  }
+
+ private:
+  py::object f_;
+  std::chrono::steady_clock::time_point last_{};
+};
+
 Followed follow(const Body& body, const std::vector<Centre>& centres, const MethodInfo& m, double h, double c,
-                const std::vector<double>& times, const std::atomic<bool>* cancel) {
+                const std::vector<double>& times, const std::atomic<bool>* cancel,
+                const std::function<void(std::size_t)>& at_time = {}) {
   Options o;
   o.omega_c = c;
   o.cancel = cancel;
@@ -314,6 +340,7 @@ Followed follow(const Body& body, const std::vector<Centre>& centres, const Meth
     f.states[k] = s.state();
     f.E[k] = energy(body.p, field, s.state());
     f.max_rel_dE = std::max(f.max_rel_dE, std::abs(f.E[k] - E0) / scale);
+    if (at_time) at_time(k + 1);
     if (f.outcome != Outcome::ok) break;
   }
   if (f.outcome != Outcome::ok) f.reason = s.reason();
@@ -343,8 +370,11 @@ void check_times(const std::vector<double>& times) {
 /// time-step constant are the accuracy mode's for a run to the last time, whose estimate is reported.
 py::list trajectory_py(const Scene& scene, const std::string& method, std::optional<double> step,
                        const std::vector<double>& times, std::optional<double> omega_c, std::optional<double> tol,
-                       double max_seconds) {
+                       double max_seconds, const py::object& progress) {
   check_times(times);
+  ProgressHook told(progress);
+  const std::size_t total = times.size() * scene.bodies.size();
+  std::size_t before = 0;  // the times of the bodies followed already
   if (tol && step) throw Error("give a step or a tolerance tol, not both (tol chooses the step)");
   if (!tol && !step) throw Error("give a step (h, ds or a peer's tolerance per step) or a tolerance tol");
   const MethodInfo* named = method == "auto" ? nullptr : &method_or_throw(method);
@@ -369,7 +399,7 @@ py::list trajectory_py(const Scene& scene, const std::string& method, std::optio
       stop.raise();
       if (!r.accuracy) throw Error((body.name.empty() ? std::string("body") : body.name) + ": " + r.reason);
       m = r.method;
-      h = r.accuracy->step;
+      h = r.accuracy->h_chosen;
       c = r.accuracy->omega_c;
       d["tol"] = *tol;
       d["h_chosen"] = h;
@@ -379,8 +409,9 @@ py::list trajectory_py(const Scene& scene, const std::string& method, std::optio
     Followed f;
     {
       py::gil_scoped_release free;
-      f = follow(body, scene.centres, *m, h, c, times, stop.flag());
+      f = follow(body, scene.centres, *m, h, c, times, stop.flag(), [&](std::size_t k) { told(before + k, total); });
     }
+    before += times.size();
     stop.raise();
     d["method"] = m->name;
     d["outcome"] = std::string(outcome_name(f.outcome));
@@ -434,7 +465,7 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
                   const std::vector<std::string>& methods, const py::dict& base, double h, long steps, double t_end,
                   double tol, long threads, double max_energy_error, bool estimate_error, double max_error,
                   bool scattering, const std::string& force_law, std::optional<double> accuracy, double max_seconds,
-                  const std::optional<std::pair<std::string, std::string>>& scene) {
+                  const std::optional<std::pair<std::string, std::string>>& scene, const py::object& progress) {
   SweepSpec s;
   s.max_energy_error = max_energy_error;
   s.estimate_error = estimate_error;
@@ -463,9 +494,10 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
   Interruptible stop(max_seconds);
   s.cancel = stop.flag();
   std::vector<SweepRow> rows;
+  ProgressHook told(progress);  // made and destroyed holding the GIL; it takes the GIL to call
   try {
     py::gil_scoped_release free;
-    rows = run_sweep_rows(s, workers);
+    rows = run_sweep_rows(s, workers, [&told](std::size_t done, std::size_t total) { told(done, total); });
   } catch (const Error&) {
     stop.raise();  // stopped: KeyboardInterrupt or the budget's error
     throw;
@@ -567,7 +599,7 @@ struct PyStepper {
     d["tol"] = a.tol;
     d["t_end"] = stepper.accuracy_t_end();
     d["err_estimate"] = a.err_estimate;
-    d["step"] = a.step;
+    d["h_chosen"] = a.h_chosen;
     d["basis"] = a.basis;
     d["force_evals"] = a.force_evals;
     return d;
@@ -687,10 +719,10 @@ PYBIND11_MODULE(_bodypoint, mod) {
           py::arg("stop_at"), py::arg("max_energy_error"), py::arg("estimate_error"), py::arg("max_error"),
           py::arg("max_seconds"));
   mod.def("_trajectory", &trajectory_py, py::arg("scene"), py::arg("method"), py::arg("step"), py::arg("times"),
-          py::arg("omega_c"), py::arg("tol"), py::arg("max_seconds"));
+          py::arg("omega_c"), py::arg("tol"), py::arg("max_seconds"), py::arg("progress"));
   mod.def("_sweep", &sweep_py, py::arg("axes"), py::arg("methods"), py::arg("base"), py::arg("h"), py::arg("steps"),
           py::arg("t_end"), py::arg("tol"), py::arg("threads"), py::arg("max_energy_error"), py::arg("estimate_error"), py::arg("max_error"),
-          py::arg("scattering"), py::arg("force_law"), py::arg("accuracy"), py::arg("max_seconds"), py::arg("scene"));
+          py::arg("scattering"), py::arg("force_law"), py::arg("accuracy"), py::arg("max_seconds"), py::arg("scene"), py::arg("progress"));
   mod.def("_encounter", &encounter_py, py::arg("scene"), py::arg("method"), py::arg("tol"), py::arg("t_end"),
           py::arg("max_seconds"), py::arg("thesis"));
 }

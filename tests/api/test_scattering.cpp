@@ -78,10 +78,10 @@ TEST(Events, ClosestApproachRadiusAndPlaneOnEveryFamilyAgainstKepler) {
     EXPECT_EQ(hits[1].event, 0u) << c.method;
     EXPECT_EQ(hits[2].event, 2u) << c.method;
     EXPECT_EQ(hits[3].event, 1u);
-    EXPECT_NEAR(hits[1].distance / peri->r, 1.0, kKeplerRel) << c.method;
+    EXPECT_NEAR(hits[1].r / peri->r, 1.0, kKeplerRel) << c.method;
     EXPECT_NEAR(hits[1].t / peri->dt, 1.0, kKeplerRel) << c.method;
-    EXPECT_NEAR(hits[0].distance, 5.0, kEventRoundOff) << c.method;
-    EXPECT_NEAR(hits[3].distance, 5.0, kEventRoundOff) << c.method;
+    EXPECT_NEAR(hits[0].r, 5.0, kEventRoundOff) << c.method;
+    EXPECT_NEAR(hits[3].r, 5.0, kEventRoundOff) << c.method;
     EXPECT_NEAR(hits[2].s.R.x(), 0.0, kEventRoundOff) << c.method;
     EXPECT_LT(hits[0].t, hits[1].t);
     EXPECT_GT(r.bodies.front().total_force_evals(), r.bodies.front().run.force_evals - 1) << c.method;
@@ -99,7 +99,7 @@ TEST(Events, ClosestApproachToAnAttractingCentre) {
     const Result r = integrate(s, c.method, c.how, o);
     ASSERT_EQ(r.outcome, Outcome::ok) << c.method << ": " << r.reason;
     ASSERT_EQ(r.bodies.front().events.size(), 1u) << c.method;
-    EXPECT_NEAR(r.bodies.front().events[0].distance / peri->r, 1.0, kKeplerRel) << c.method;
+    EXPECT_NEAR(r.bodies.front().events[0].r / peri->r, 1.0, kKeplerRel) << c.method;
     EXPECT_NEAR(r.bodies.front().events[0].t / peri->dt, 1.0, kKeplerRel) << c.method;
   }
 }
@@ -327,13 +327,13 @@ TEST(Encounter, TheClosestApproachIsTheGlobalMinimumNotAHelixWiggle) {
   double first_local = -1.0, smallest_local = 1e300;
   for (const EventHit& h : r.bodies.front().events) {
     if (h.event == 0) closest = &h;
-    if (h.event == 1 && first_local < 0.0) first_local = h.distance;
-    if (h.event == 1) smallest_local = std::min(smallest_local, h.distance);
+    if (h.event == 1 && first_local < 0.0) first_local = h.r;
+    if (h.event == 1) smallest_local = std::min(smallest_local, h.r);
   }
   ASSERT_NE(closest, nullptr);
-  EXPECT_EQ(closest->distance, smallest_local);
-  EXPECT_NEAR(closest->distance, 9.055, 1e-3);
-  EXPECT_GT(first_local, closest->distance + 1.0);
+  EXPECT_EQ(closest->r, smallest_local);
+  EXPECT_NEAR(closest->r, 9.055, 1e-3);
+  EXPECT_GT(first_local, closest->r + 1.0);
   Options stop;
   stop.events = {Event{Event::Kind::closest_approach, 0, 0.0, Vec3::UnitX(), true}};
   EXPECT_THROW((void)integrate(s, "lp-kl8", FixedSteps{1e-3, 10}, stop), Error);

@@ -324,7 +324,7 @@ TEST(Cli, ScatteringAndEventsAreTheLibrarysToTheLastBit) {
   const Scattering sc = scattering(b.p, s.centres, b.s0, lib.bodies.front().run.final);
   EXPECT_EQ(json_num(r.out, "deflection"), sc.deflection);
   EXPECT_EQ(json_num(r.out, "b"), sc.b);
-  EXPECT_EQ(json_num(r.out, "r_min"), lib.bodies.front().events[1].distance);
+  EXPECT_EQ(json_num(r.out, "r_min"), lib.bodies.front().events[1].r);
   EXPECT_EQ(json_num(r.out, "t_min"), lib.bodies.front().events[1].t);
   EXPECT_NE(r.out.find("\"asymptotes\": \"kepler\""), std::string::npos);
   EXPECT_NE(r.out.find("\"event\": \"r=5\""), std::string::npos);

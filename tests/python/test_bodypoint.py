@@ -511,7 +511,7 @@ def test_a_stepper_with_a_tolerance_delivers_it_in_segments_against_the_long_dou
                   np.linalg.norm(s.state["v"] - v_ref) / np.linalg.norm(v_ref))
         assert err <= tol, (tol, s.method, err)
     named = bp.Stepper(bp.thesis_scene(), "lp-y4", tol=1e-8, t_end=50)
-    assert named.method == "lp-y4" and named.step == named.accuracy["step"]
+    assert named.method == "lp-y4" and named.step == named.accuracy["h_chosen"]
     with pytest.raises(bp.Error, match="give a step or a tolerance tol, not both"):
         bp.Stepper(bp.thesis_scene(), "lp-y4", 0.01, tol=1e-8, t_end=50)
     with pytest.raises(bp.Error, match="needs the end time t_end"):
@@ -553,3 +553,45 @@ def test_a_stepper_runs_backwards_is_integrate_in_one_segment_and_takes_a_state(
         t.state = {"R": [1, 2]}
     with pytest.raises(bp.Error, match="centre"):
         t.state = {"R": [0.0, 0.0, 0.0]}
+
+
+def test_long_calls_show_progress_where_asked_and_stay_silent_in_scripts(capsys, monkeypatch):
+    monkeypatch.setattr(bp._Progress, "SILENT_SECONDS", 0.0)  # every call counts as long here
+    bp.sweep({"d": [5, 10, 20]}, ["lp-y4"], steps=100, progress=True)
+    err = capsys.readouterr().err
+    assert "sweep: 3/3 rows (100 %)" in err and err.endswith("\n")
+    bp.trajectory(bp.thesis_scene(), "lp-y4", 0.01, [1, 2, 3], progress=True)
+    assert "trajectory: 3/3 times (100 %)" in capsys.readouterr().err
+    # The default: pytest's stderr is not a terminal and this is no notebook, so nothing is shown.
+    bp.sweep({"d": [5, 10]}, ["lp-y4"], steps=100)
+    bp.sweep({"d": [5, 10]}, ["lp-y4"], steps=100, progress=False)
+    assert capsys.readouterr().err == ""
+    with pytest.raises(bp.Error, match="progress must be"):
+        bp.sweep({"d": [5]}, ["lp-y4"], steps=10, progress="yes")
+
+
+def test_one_name_and_one_default_per_quantity():
+    # Outcomes are Outcome values everywhere (a str enum), as advance_to returns them.
+    r = bp.integrate(bp.thesis_scene(), "lp-y4", h=0.01, t_end=1)
+    assert isinstance(r["outcome"], bp.Outcome) and isinstance(r["bodies"][0]["outcome"], bp.Outcome)
+    assert r["outcome"] == "ok" and r["bodies"][0]["outcome"] == bp.Outcome.ok
+    # The accuracy mode ends where the command line's does (t = 50) when no end is given.
+    mine = bp.integrate(bp.thesis_scene(), tol=1e-8)["bodies"][0]
+    cli_run = json.loads(cli("simulate", "--tol", "1e-8", "--json"))
+    assert mine["t_end"] == cli_run["t_end"] == 50 and mine["R"].tolist() == cli_run["R"]
+    # trajectory() defaults to auto as integrate() does.
+    rows = bp.trajectory(bp.thesis_scene(), times=[10, 20], tol=1e-8)[0]
+    assert rows["outcome"] == "ok" and rows["method"] == mine["method"]
+    # An event's distance is r in Python, JSON and C++ (EventHit::r).
+    hit = bp.integrate(bp.thesis_scene(), "lp-y4", h=0.01, t_end=40, events=["closest"])["bodies"][0]["events"][0]
+    assert "r" in hit and "distance" not in hit
+
+
+def test_a_named_method_is_not_refused_where_auto_delivers_it():
+    # Issue #57: auto delivered this encounter with logh-kl6 at 1e-9; logh-kl6 named was refused,
+    # quoting runs that "still differ by 9.39e-10", below the tolerance asked.
+    scene = bp.thesis_scene(B=0.7, b=1.0, arrival_phase=0)
+    auto = bp.encounter(scene, tol=1e-9)
+    named = bp.encounter(scene, method=auto["run"]["method"], tol=1e-9)
+    assert named["outcome"] == "ok" and named["run"]["err_estimate"] <= 1e-9
+    assert named["deflection"] == auto["deflection"]  # one search rule: the same run

@@ -98,7 +98,7 @@ struct EventHit {
   std::size_t event = 0;  ///< index into Options::events
   double t = 0.0;
   State s;
-  double distance = 0.0;  ///< |R - c| to the event's centre (plane: to the scene's first centre)
+  double r = 0.0;  ///< |R - c| to the event's centre (plane: to the scene's first centre); "r" in JSON and Python too
 };
 
 /// Every centre's closest approach (Kind::closest_approach for centres 0 .. n-1), as events.
@@ -162,7 +162,7 @@ struct ErrorEstimate {
 struct AccuracyReport {
   double tol = 0.0;
   double err_estimate = 0.0;  ///< estimated relative error of the final state
-  double step = 0.0;          ///< the step chosen: h, or the fictitious step ds of time-transformed methods
+  double h_chosen = 0.0;      ///< the step chosen: h, or the fictitious step ds of time-transformed methods (JSON, CSV, Python: h_chosen)
   double omega_c = 0.0;       ///< time-transformed methods: the time-step constant c used
   int runs = 0;               ///< integrations made in all, the delivered run (BodyResult::run) included
   long force_evals = 0;       ///< over all of them
@@ -222,6 +222,10 @@ struct StepRequest {
 };
 /// True when `request` asks the accuracy mode to choose the step of `method` (nullptr: auto).
 bool searches(const MethodInfo* method, const StepRequest& request);
+/// Every front end's default end (the command line's, Python's): a request with neither an end time
+/// nor a count of steps runs the accuracy mode to t_end = kDefaultStep kDefaultSteps (50, the thesis's
+/// h n) and any other way kDefaultSteps steps; a request with one is returned as it is.
+StepRequest with_default_end(StepRequest request, const MethodInfo* method);
 /// The one mapping from a step request to a way of advancing time, by the method's kind:
 ///   accuracy (searches): Accuracy{tol, t_end}; h and steps are refused, t_end is needed;
 ///   fixed-step: t_end given, the steps of at most h that land on it (fixed_steps_to); otherwise

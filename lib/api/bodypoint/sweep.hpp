@@ -161,6 +161,8 @@ struct SweepRunner {
 void run_sweep_tasks(const SweepSpec& spec, const std::vector<std::size_t>& todo, const SweepRunner& runner);
 
 /// Every task of the sweep, by task index, on `threads` threads.
-std::vector<SweepRow> run_sweep_rows(const SweepSpec& spec, unsigned threads = 1);
+/// `progress`, when given, is told (rows done, rows in all) after every row, one call at a time.
+std::vector<SweepRow> run_sweep_rows(const SweepSpec& spec, unsigned threads = 1,
+                                     const std::function<void(std::size_t, std::size_t)>& progress = {});
 
 }  // namespace bodypoint

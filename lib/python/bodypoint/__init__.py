@@ -17,6 +17,8 @@ import enum as _enum
 import json as _json
 import numbers as _numbers
 import os as _os
+import sys as _sys
+import time as _time
 
 from numpy import bool_ as _np_bool
 
@@ -259,15 +261,64 @@ def integrate(scene, method="auto", *, h=None, steps=None, t_end=None, tol=None,
     ``max_energy_error``, or an estimated error above ``max_error``; float("inf") lifts a bound),
     "collision"; or "refused"/"failed" without a run (docs/physics.md, "Resolution and accuracy flags").
     """
-    return _core._integrate(_scene(scene), _text("method", method), _number("h", h, optional=True),
+    return _with_outcomes(_core._integrate(_scene(scene), _text("method", method), _number("h", h, optional=True),
                             _count("steps", steps, optional=True), _number("t_end", t_end, optional=True),
                             _number("tol", tol, optional=True), _flag("invariants", invariants), _number("omega_c", omega_c, optional=True),
                             _texts("events", events), _texts("stop_at", stop_at),
                             _number("max_energy_error", max_energy_error), _flag("estimate_error", estimate_error),
-                            _number("max_error", max_error), _number("max_seconds", max_seconds))
+                            _number("max_error", max_error), _number("max_seconds", max_seconds)))
 
 
-def trajectory(scene, method, step=None, times=(), *, tol=None, omega_c=None, max_seconds=DEFAULT_MAX_SECONDS):
+def _with_outcomes(result):
+    """A result whose outcomes are Outcome values (a str enum: "ok" == Outcome.ok), as advance_to's."""
+    result["outcome"] = Outcome(result["outcome"])
+    for body in result.get("bodies", ()):
+        body["outcome"] = Outcome(body["outcome"])
+    return result
+
+
+def _in_notebook():
+    """Whether this runs in a Jupyter kernel (its stderr is shown in the notebook)."""
+    shell = _sys.modules.get("IPython")
+    ip = shell.get_ipython() if shell and hasattr(shell, "get_ipython") else None
+    return ip is not None and type(ip).__name__ == "ZMQInteractiveShell"
+
+
+class _Progress:
+    """A one-line display of a long call on stderr, rewritten in place ("sweep: 120/800 rows (15 %),
+    3 s, ~20 s left"); silent for calls that end within a second."""
+
+    SILENT_SECONDS = 1.0
+
+    def __init__(self, label, unit):
+        self.label, self.unit, self.start, self.shown = label, unit, _time.monotonic(), False
+
+    def __call__(self, done, total):
+        elapsed = _time.monotonic() - self.start
+        if not self.shown and (done == total or elapsed < self.SILENT_SECONDS):
+            return
+        left = f", ~{elapsed * (total - done) / done:.0f} s left" if 0 < done < total else ""
+        _sys.stderr.write(f"\r{self.label}: {done}/{total} {self.unit} ({100 * done // max(total, 1)} %), "
+                          f"{elapsed:.0f} s{left}   " + ("\n" if done == total else ""))
+        _sys.stderr.flush()
+        self.shown = True
+
+
+def _progress(progress, label, unit):
+    """The progress display of a long call: ``progress`` None (the default) shows it where stderr is a
+    terminal or in a notebook, not in a script whose stderr is a file or a pipe, nor under CI; True or
+    False decide."""
+    if progress is None:
+        try:
+            terminal = _sys.stderr.isatty()
+        except (AttributeError, ValueError):
+            terminal = False
+        progress = (terminal or _in_notebook()) and not _os.environ.get("CI")
+    return _Progress(label, unit) if _flag("progress", progress) else None
+
+
+def trajectory(scene, method="auto", step=None, times=(), *, tol=None, omega_c=None, max_seconds=DEFAULT_MAX_SECONDS,
+               progress=None):
     """Each body's state at the given times (increasing, >= 0), by a Stepper landing on every one.
 
     ``step``: the step h of a fixed-step method (the largest step <= h that lands on every requested
@@ -278,15 +329,17 @@ def trajectory(scene, method, step=None, times=(), *, tol=None, omega_c=None, ma
     A list of dicts per body: name, method, outcome and reason (a segment that was not ok ends the rows
     there: NaN after it; "unresolved" and "inaccurate" keep the state that was computed), t (n,), R, v,
     w (n, 3), E (n,) the energy at each time, max_rel_dE its largest deviation from the start's,
-    force_evals, steps."""
+    force_evals, steps. ``progress``: a line on stderr while it runs (None: where stderr is a terminal
+    or a notebook; see sweep())."""
     return _core._trajectory(_scene(scene), _text("method", method), _number("step", step, optional=True),
                              [_number("a time", t) for t in times], _number("omega_c", omega_c, optional=True),
-                             _number("tol", tol, optional=True), _number("max_seconds", max_seconds))
+                             _number("tol", tol, optional=True), _number("max_seconds", max_seconds),
+                             _progress(progress, "trajectory", "times"))
 
 
 def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, accuracy=None, threads=None, scattering=False,
           force_law="coulomb", max_energy_error=_core.DEFAULT_MAX_ENERGY_ERROR, estimate_error=True,
-          max_error=_core.DEFAULT_MAX_ERROR, max_seconds=DEFAULT_MAX_SECONDS, scene=None, **base):
+          max_error=_core.DEFAULT_MAX_ERROR, max_seconds=DEFAULT_MAX_SECONDS, scene=None, progress=None, **base):
     """Runs a scene (the thesis's unless ``scene`` is given) over a grid of parameters and methods;
     returns columns.
 
@@ -309,6 +362,9 @@ def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, accuracy=None
     err_basis, warning; with ``scattering=True`` the encounter's (r_min, t_min, deflection,
     out_of_plane, b_in, v_inf_in, time_delay, asymptote_error, K1_turn, spin_turn, K1x..K1z,
     asymptotes); then steps, t_end, vx..vz, wx..wz. One row per (grid point, method), grid point major.
+    ``progress``: a line on stderr, rewritten as rows finish (rows done, elapsed, time left), for calls
+    longer than a second; None (the default) shows it where stderr is a terminal or in a Jupyter
+    notebook, not in a script whose stderr is a file or pipe, nor under CI; True or False decide.
     """
     if steps == 0 and t_end == 0.0 and not (scattering and accuracy is not None):
         raise Error("give steps or t_end (an encounter in the accuracy mode runs to its departure without them)")
@@ -326,7 +382,7 @@ def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, accuracy=None
                         _flag("estimate_error", estimate_error), _number("max_error", max_error),
                         _flag("scattering", scattering),
                         _text("force_law", force_law), _number("accuracy", accuracy, optional=True),
-                        _number("max_seconds", max_seconds), toml)
+                        _number("max_seconds", max_seconds), toml, _progress(progress, "sweep", "rows"))
 
 
 def encounter(scene, *, t_end=None, method="auto", tol=1e-10, max_seconds=DEFAULT_MAX_SECONDS):
@@ -360,7 +416,7 @@ class Stepper:
         s.advance_to(50)          # continues from the stop
         s.advance_to(0)           # backwards in time, to the start
         s = bp.Stepper(scene, "auto", tol=1e-10, t_end=50)   # the accuracy mode chooses method and step
-        s.accuracy                # its search: tol, t_end, err_estimate (at t_end), step, basis
+        s.accuracy                # its search: tol, t_end, err_estimate (at t_end), h_chosen, basis
 
     ``step``: a fixed-step method's largest step (each segment lands on its end), the fictitious step
     ds of a time-transformed one, or a step-size-controlled peer's tolerance per step. Or ``tol`` with
@@ -402,7 +458,7 @@ class Stepper:
     state = property(lambda self: self._s.state, _set_state,
                      doc="the current state: t, R, v, w; set it with a dict of some of them (checked as a scene's)")
     accuracy = property(lambda self: self._s.accuracy,
-                        doc="with tol: the search (tol, t_end, err_estimate at t_end, step, basis, force_evals); else None")
+                        doc="with tol: the search (tol, t_end, err_estimate at t_end, h_chosen, basis, force_evals); else None")
     step = property(lambda self: self._s.step, doc="the segments' step (h, ds, or a tolerance per step)")
     events = property(lambda self: self._s.events, doc="events located so far: event, t, r, R, v, w")
     stopped = property(lambda self: self._s.stopped, doc="a stop event ended the last segment")
