@@ -35,11 +35,15 @@ def _tag():
 def _build_module():
     """Configures (once) and builds the _bodypoint target; returns the build's python folder."""
     build = pathlib.Path(os.environ.get("BODYPOINT_BUILD_DIR") or SOURCE / "build" / "pip")
+    # pip's isolated build hides the system's site-packages through PYTHONPATH; a configure that CMake
+    # re-runs inside it (an edited CMakeLists or __init__.py) would find no numpy, pytest or matplotlib
+    # and leave the build tree's Python tests out.
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONNOUSERSITE", "PYTHONHOME")}
     if not (build / "CMakeCache.txt").exists():
         subprocess.run(["cmake", "-S", str(SOURCE), "-B", str(build), "-G", "Ninja", "-DCMAKE_BUILD_TYPE=Release",
                         f"-DBODYPOINT_PYTHON_EXECUTABLE={sys.executable}", f"-DPython3_EXECUTABLE={sys.executable}"],
-                       check=True, stdout=sys.stderr)
-    subprocess.run(["cmake", "--build", str(build), "--target", "_bodypoint"], check=True, stdout=sys.stderr)
+                       check=True, stdout=sys.stderr, env=env)
+    subprocess.run(["cmake", "--build", str(build), "--target", "_bodypoint"], check=True, stdout=sys.stderr, env=env)
     return build / "python" / NAME
 
 
