@@ -153,8 +153,8 @@ struct TrackJson {
 /// single Coulomb centre, the incoming and outgoing asymptotes (scattering.hpp) as a point on each line
 /// and its direction.
 std::string encounter_json(const Body& body, const std::vector<Centre>& centres, const BodyResult& br,
-                           const std::vector<Event>& closest) {
-  const EventHit* nearest = nearest_approach(br.events, closest);
+                           const std::vector<Event>& events) {  // the events br's hits index
+  const EventHit* nearest = nearest_approach(br.events, events);
   const Scattering sc = scattering(body.p, centres, body.s0, br.run.final, br.run.t_end);
   std::string out = ", \"encounter\": {\"R_min\": " + (nearest ? json_vec(nearest->s.R) : std::string("null"));
   if (nearest) out += ", \"r_min\": " + json_number(nearest->r) + ", \"t_min\": " + json_number(nearest->t);
@@ -178,7 +178,6 @@ TrackJson body_json(const Body& body, const std::vector<Centre>& centres, RunPla
   const std::size_t first_asked = located.size();
   located.insert(located.end(), events.begin(), events.end());
   const BodyResult br = run_body(plan, body, centres, how, &sink, located);
-  const std::vector<Event> closest(located.begin(), located.begin() + static_cast<std::ptrdiff_t>(first_asked));
   const std::string who = "body '" + body.name + "' with " + method_label;
   if (d.non_finite_at())
     throw Error(who + ": the state became non-finite at t = " + fmt(*d.non_finite_at()) + "; no page written");
@@ -215,7 +214,7 @@ TrackJson body_json(const Body& body, const std::vector<Centre>& centres, RunPla
   });
   out += ", ";
   put_array(out, "dt", f, kOtherDigits, [](std::string& o, const Frame& x, int g) { put(o, x.dt, g); });
-  out += "}" + encounter_json(body, centres, br, closest) + ", \"events\": [";
+  out += "}" + encounter_json(body, centres, br, located) + ", \"events\": [";  // located: what the hits index
   bool first = true;
   for (const EventHit& h : br.events) {  // the asked events' hits, located to round-off (the marks)
     if (h.event < first_asked) continue;

@@ -176,13 +176,14 @@ void flag_broken_companion(BodyResult& r, const BodyResult& x, const std::string
 /// mode adds its rounding probe below the same level (tolerance.hpp, kProbeBelowTol).
 constexpr double kRoundingLevel = adaptive::kProbeBelowTol;
 
-void add_rounding_floor(ErrorEstimate& e, const BodyResult& r, const Body& body, const Advance& how, const Options& o,
-                        const Rerun& rerun) {
+/// `options`: the run's (its events index them), `o`: the companions' (companion_options).
+void add_rounding_floor(ErrorEstimate& e, const BodyResult& r, const Body& body, const Advance& how,
+                        const Options& options, const Options& o, const Rerun& rerun) {
   if (!at_rounding_level(e)) return;
   Body moved = body;
   moved.s0 = start_moved_by_rounding(body.s0);
   const BodyResult p = rerun(moved, how, o);
-  if (!ended_alike(r, o, p, o)) {
+  if (!ended_alike(r, options, p, o)) {
     e.force_evals += p.total_force_evals();
     e.wall_s += p.run.wall_s;
     return;
@@ -241,7 +242,7 @@ void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& 
   const double d = adaptive::state_distance(r.run.final, x.run.final);
   e.value = c->factor * d;
   e.basis = c->basis;
-  add_rounding_floor(e, r, body, how, o, rerun);
+  add_rounding_floor(e, r, body, how, options, o, rerun);
   if (r.outcome != Outcome::unresolved && r.run.steps >= kFewSteps) return;
   // A flagged run: a second companion one level finer tells whether the pair is in the asymptotic regime.
   std::string none;

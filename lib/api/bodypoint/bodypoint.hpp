@@ -21,11 +21,13 @@
 //   - what a run observes (Options): invariants, samples to a sink (which may end the run by
 //     returning Flow::stop), events, the bound of the accuracy flag.
 //   - integrate(): every body of a scene with one method and one Advance; a Result per body with a
-//     typed Outcome (ok, diverged, collision, refused, failed) and its one-line reason.
+//     typed Outcome (ok, diverged, unresolved, inaccurate, collision, incomplete, refused, failed) and its
+//     one-line reason; a negative end time runs backwards (time reversal).
 //   - events (Event): closest approaches, radii and planes crossed, located to round-off on the
 //     method's own steps; scattering.hpp turns a run into an encounter's observables (deflection,
 //     asymptotes, impact parameter, spin turn).
-//   - Stepper: one body advanced segment by segment (advance_to), queried and continued.
+//   - Stepper: one body advanced segment by segment (advance_to, either way in time), queried and
+//     continued; built with a step or with a tolerance (the accuracy mode's method and step).
 //   - <bodypoint/record.hpp>: a run's results as named fields (JSON, CSV rows), as the command line
 //     and the Python module write them; RunOptions::cancel stops a run from another thread.
 //
