@@ -281,7 +281,7 @@ Reversal run_back(const RunPlan& plan, const BodyResult& fwd, const Body& body, 
   there.s0 = fwd.run.final;
   Options options = plan.options;
   const MethodInfo& m = *fwd.method;
-  const bool constant = is_time_transformed(m) && m.family != Family::Regularised;  // takes omega_c
+  const bool constant = takes_time_step_constant(m);
   Advance how;
   if (fwd.accuracy) {
     StepRequest q;

@@ -376,10 +376,14 @@ BodyResult integrate_forwards(const Body& body, const std::vector<Centre>& centr
 
 }  // namespace
 
+bool takes_time_step_constant(const MethodInfo& method) {
+  return is_time_transformed(method) && method.family != Family::Regularised;
+}
+
 void check_time_step_constant(double omega_c, const MethodInfo* method, bool accuracy) {
   require_non_negative(omega_c, "the time-step constant omega_c");
   if (accuracy) throw Error("the accuracy mode chooses the time-step constant omega_c itself: do not give it");
-  if (method && (!is_time_transformed(*method) || method->family == Family::Regularised))
+  if (method && !takes_time_step_constant(*method))
     throw Error("the time-step constant omega_c is for the time-transformed methods (logh-*, ttl-*); " + method->name +
                 " does not take it");
 }
@@ -493,7 +497,7 @@ BodyResult searched(std::string_view method, const Body& body, const std::vector
 }
 
 Options with_constant(Options o, const BodyResult& r) {
-  if (is_time_transformed(*r.method) && r.method->family != Family::Regularised) o.omega_c = r.accuracy->omega_c;
+  if (takes_time_step_constant(*r.method)) o.omega_c = r.accuracy->omega_c;
   return o;
 }
 
