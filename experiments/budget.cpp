@@ -70,7 +70,7 @@ std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body,
   const auto r = calibrate(kCalibrationSteps);
   if (!r) return std::nullopt;
   if (t_end > 0.0) steps = r->t_end > 0.0 ? kCalibrationSteps * t_end / r->t_end : HUGE_VAL;
-  const double companion = options.estimate_error ? ErrorEstimate::kStepRatio : 0.0;  // its steps, at the same pace
+  const double companion = options.estimate_error ? ErrorEstimate::kTypicalCost : 0.0;  // its steps, at the same pace
   return WorkEstimate{steps, (1.0 + companion) * r->wall_s * steps / kCalibrationSteps};
 }
 

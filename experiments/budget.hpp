@@ -24,7 +24,7 @@ struct WorkEstimate {
 /// The estimate for a run that may be long, or nothing when the run is short (or adaptive: those are
 /// bounded by their own step cap).
 /// `options` are the run's (the calibration observes as it will; an error estimate's companion costs
-/// ErrorEstimate::kStepRatio runs more).
+/// ErrorEstimate::kTypicalCost runs more).
 std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
                                           const Advance& how, const Options& options);
 

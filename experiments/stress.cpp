@@ -160,7 +160,7 @@ void write_stress(std::ostream& csv, std::ostream& md, const std::vector<StressR
       << "# bodypoint study stress, revision " << git_revision() << "\n"
       << "# status: ok | refused (not run, reason) | failed (started and stopped, reason) | diverged | unresolved | inaccurate | collision (flagged, reason; "
          "docs/physics.md, Resolution and accuracy flags); max_rel_dE only for runs; err_estimate = the run's estimated "
-         "relative error (a companion at half the step; docs/physics.md, Error estimate of a run by step; NaN: none)\n";
+         "relative error (a companion run at up to twice or half the step; docs/physics.md, Error estimate of a run by step; NaN: none)\n";
   for (const StressRow& r : rows) {
     csv << CsvLine().quoted(r.case_name).text(r.method).text(std::string(outcome_name(r.outcome))).num(r.max_rel_dE).count(r.steps)
                .num(r.wall_s).quoted(r.reason).num(r.err_estimate).str()

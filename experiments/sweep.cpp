@@ -489,7 +489,7 @@ void check_sweep_budget(const SweepJob& job) {
   } catch (const Error&) {
     return;  // validate_sweep names the step or the point
   }
-  const double runs_per_task = job.spec.estimate_error ? 1.0 + ErrorEstimate::kStepRatio : 1.0;  // and the companion
+  const double runs_per_task = job.spec.estimate_error ? 1.0 + ErrorEstimate::kTypicalCost : 1.0;  // and the companion
   if (static_cast<double>(tasks) * static_cast<double>(steps.steps) * runs_per_task * kMaxSecondsPerStep <= job.max_seconds)
     return;
   double seconds = 0.0;

@@ -115,12 +115,45 @@ std::optional<Companion> companion_of(const MethodInfo& m, const Body& body, con
   return std::nullopt;
 }
 
+/// The coarse companion (CoarseCompanion, estimate.hpp) needs this many steps of the run: below, the
+/// coarse run has no asymptotic regime of its own (kFewSteps), and the fine companion decides.
+constexpr long kCoarseMinSteps = 16;
+/// The coarse companion's estimate is trusted up to this value: a run estimated above it is near the end
+/// of its own asymptotic regime, where the coarse run at twice the step may be beyond it (aliasing the
+/// spin, unstable), which Richardson on the coarse side would take for the run's error; such runs are
+/// estimated by the fine companion at h/2 as before (bench/estimate_ladder.py, docs/developers.md).
+constexpr double kCoarseTrusted = 1e-5;
+/// On the coarse side the order is taken as at most this: at twice the step a method of order 6 to 10
+/// is rarely in its asymptotic regime where it matters (lp-ss10 at h = 0.2 on the attracting scene:
+/// 7.4e-5 off, its coarse companion 3.5e-4 away, a fall of 5 where order 10 says 1023), so the
+/// difference over 2^p - 1 was more than 3x low in 49 of the ladder's runs of order >= 6 and over
+/// 2^4 - 1 in 3; at order <= 4 Richardson's factor is kept.
+constexpr int kCoarseMaxOrder = 4;
+constexpr int kCoarseMaxOrderBelow2 = 2;
+/// The coarse companion's steps are kept this far inside the flags' limits (a step turning the spin by
+/// pi, the direction to a centre by pi/2) that the run's own steps, scaled by the ratio, predict: a
+/// time-transformed run whose constant c lets a far step turn the spin by 2 rad (adaptive/run.cpp) takes
+/// its companion at 1.41 ds, where 2 ds would alias the spin and be refused after it was paid for.
+constexpr double kCoarseAngleMargin = 0.9;
+/// Below this ratio the pair differs too little to measure the error (ratio^p - 1 small against their
+/// rounding): the fine companion decides.
+constexpr double kMinCoarseRatio = 1.25;
+
 /// Whether a companion that took `companion_steps` refines a run of `how` that took `run_steps`.
 bool refines(const Advance& how, long run_steps, long companion_steps) {
   if (std::holds_alternative<FictitiousSteps>(how))
     return static_cast<double>(companion_steps) >= kRefined * static_cast<double>(run_steps);
   if (std::holds_alternative<ControlledSteps>(how)) return companion_steps > run_steps;
   return true;
+}
+
+/// Whether a coarse companion that took `coarse_steps` is coarser than the run of `run_steps`: a
+/// time-transformed pair whose steps were not cut by the ratio (the landing step, steps bound by
+/// something else) is no Richardson pair; it must take at most 1 / (1 + (ratio - 1) / 2) of the steps,
+/// as the fine companion must take kRefined = 1.5 times the run's at ratio 2.
+bool coarser(const CoarseCompanion& c, long coarse_steps, long run_steps) {
+  if (!std::holds_alternative<FictitiousSteps>(c.how)) return true;
+  return static_cast<double>(run_steps) >= (1.0 + (c.ratio - 1.0) / 2.0) * static_cast<double>(coarse_steps);
 }
 
 bool stopped_by_event(const BodyResult& r, const Options& options) {
@@ -191,7 +224,87 @@ void add_rounding_floor(ErrorEstimate& e, const BodyResult& r, const Body& body,
   add_rounding_spread(e, r.run.final, p.run.final, p.total_force_evals(), p.run.wall_s);
 }
 
+/// The estimate of the coarse companion where the run has one and it is trusted (true); otherwise its
+/// cost is counted and the fine companion decides (false). A coarse run that breaks down or that the
+/// run does not refine says nothing of the run; a flagged run is left to the fine pair, which can
+/// confirm it.
+bool estimated_by_coarse(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Advance& how,
+                         const Options& options, const Options& o, const Rerun& rerun) {
+  if (r.outcome == Outcome::unresolved) return false;
+  const std::optional<CoarseCompanion> c =
+      coarse_companion(*r.method, how, r.run.steps, coarse_ratio_limit(*r.method, centres, r.run));
+  if (!c) return false;
+  Body moved = body;
+  moved.s0 = start_moved_by_rounding(body.s0);
+  // The coarse run is held to the default flags whether or not the run tracks its invariants: a coarse
+  // step that aliases the spin, skips past a centre or loses the energy can agree with the run by
+  // chance (rk4 at h = 0.2 on two-centres-spin, 70 % off: its coarse companion 1.5e-5 away, 0.63 in energy).
+  Options oc = o;
+  oc.track_invariants = true;
+  oc.max_energy_error = kCoarseEnergyBound;
+  const BodyResult x = rerun(moved, c->how, oc);
+  ErrorEstimate& e = r.error;
+  e.force_evals += x.total_force_evals();
+  e.wall_s += x.run.wall_s;
+  if (x.outcome != Outcome::ok || !ended_alike(r, options, x, oc) || !coarser(*c, x.run.steps, r.run.steps)) return false;
+  std::optional<ErrorEstimate> coarse = coarse_estimate(*r.method, body, *c, r.run.final, x.run.final);
+  if (!coarse) return false;
+  coarse->force_evals = e.force_evals;
+  coarse->wall_s = e.wall_s;
+  e = std::move(*coarse);
+  return true;
+}
+
 }  // namespace
+
+double coarse_ratio_limit(const MethodInfo& m, const std::vector<Centre>& centres, const RunResult& run) {
+  if (!run.invariants) return kStepRatio;
+  const Checks checks = checks_for(m, centres);
+  double limit = kStepRatio;
+  if (!checks.spin_exact && !checks.macro_steps && run.invariants->max_spin_angle > 0.0)
+    limit = std::min(limit, kCoarseAngleMargin * kMaxSpinAngle / run.invariants->max_spin_angle);
+  const double turn = std::acos(std::clamp(run.invariants->min_turn_cos, -1.0, 1.0));
+  if (!checks.orbit_exact && !checks.macro_steps && turn > 0.0) limit = std::min(limit, kCoarseAngleMargin * kMaxTurnAngle / turn);
+  return limit;
+}
+
+std::optional<CoarseCompanion> coarse_companion(const MethodInfo& m, const Advance& how, long run_steps, double max_ratio) {
+  const double r = std::min(kStepRatio, max_ratio);
+  if (run_steps < kCoarseMinSteps || !(r >= kMinCoarseRatio)) return std::nullopt;
+  if (const auto* f = std::get_if<FixedSteps>(&how)) {
+    // Whole steps to the same end: ceil(n / r) of them, at the step that lands there.
+    const long n = f->steps, coarse = static_cast<long>(std::ceil(static_cast<double>(n) / r));
+    const double ratio = static_cast<double>(n) / static_cast<double>(coarse);
+    if (!(ratio >= kMinCoarseRatio)) return std::nullopt;
+    return CoarseCompanion{FixedSteps{f->h * ratio, coarse}, ratio};
+  }
+  const auto* f = std::get_if<FictitiousSteps>(&how);
+  if (f == nullptr || f->end.index() != 0 || m.family == Family::Regularised) return std::nullopt;
+  return CoarseCompanion{FictitiousSteps{f->ds * r, EndTime{f->t_end()}}, r};
+}
+
+std::optional<ErrorEstimate> coarse_estimate(const MethodInfo& m, const Body& body, const CoarseCompanion& c,
+                                             const State& run, const State& coarse) {
+  if (!(coarse.R.allFinite() && coarse.v.allFinite())) return std::nullopt;
+  const int p = std::min(c.ratio < kStepRatio ? kCoarseMaxOrderBelow2 : kCoarseMaxOrder, fixed_order(m, body));
+  const double d = adaptive::state_distance(run, coarse);
+  ErrorEstimate e;
+  e.value = d / (std::pow(c.ratio, p) - 1.0);
+  const bool h = std::holds_alternative<FixedSteps>(c.how);
+  const std::string step = h ? "h" : "ds";
+  e.basis = "companion run at " + (c.ratio == kStepRatio ? "2" + step : step + " x " + short_number(c.ratio)) +
+            " from a start moved by a rounding, " + order_text(p) +
+            (p < fixed_order(m, body) ? " (at most " + std::to_string(p) + " on the coarse side)" : "");
+  // Where the pair differs by the scene's rounding, that difference is not divided: the run's own
+  // rounding is of its size (the two runs' roundings are independent draws, the moved start's growth one more).
+  if (const double floor = std::min(d, kRoundingLevel); floor > e.value) {
+    e.value = floor;
+    e.basis += floor == d ? "; at the scene's rounding level: their whole difference"
+                          : "; raised to the rounding level " + short_number(kRoundingLevel) + ", below which they may differ by rounding alone";
+  }
+  if (!(e.value <= kCoarseTrusted)) return std::nullopt;
+  return e;
+}
 
 void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Advance& how,
                     const Options& options, const Rerun& rerun) {
@@ -215,6 +328,7 @@ void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& 
     return;
   }
   const Options o = companion_options(body, centres, how, options);
+  if (estimated_by_coarse(r, body, centres, how, options, o, rerun)) return;
   // A companion that takes no more steps than the run does not refine it: a time-transformed run whose
   // steps are cut to land on t_end (one physical step ds/c beyond the whole span), a controlled run whose
   // tolerance does not bind (its steps grow at the controller's largest rate from the first trial

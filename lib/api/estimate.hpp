@@ -5,6 +5,7 @@
 #include "bodypoint/bodypoint.hpp"
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,29 @@ using Rerun = std::function<BodyResult(const Body& body, const Advance& how, con
 /// estimate, a companion run's (bodypoint.hpp, ErrorEstimate), or why the run has none.
 void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Advance& how,
                     const Options& options, const Rerun& rerun);
+
+/// The coarse companion of a run by step: up to twice its step (h, or ds with the same time-step
+/// constant; a fixed-step run of an odd number of steps: half as many rounded up, at the step that lands
+/// on the same end), from its start moved by a rounding. It costs half a run; in the asymptotic regime it
+/// differs from the run by the run's error times ratio^p - 1 (Richardson on the coarse side, the fine run
+/// delivered), plus what the moved start grows to. nullopt where a run has none: step-size control, KS,
+/// a counted number of fictitious steps, fewer than kCoarseMinSteps steps (estimate.cpp).
+struct CoarseCompanion {
+  Advance how;
+  double ratio = 2.0;  ///< the companion's step over the run's
+};
+/// The coarse companion is trusted only where the default flags pass it: no aliased spin, no skipped
+/// centre, its energy within this bound.
+constexpr double kCoarseEnergyBound = kDefaultMaxEnergyError;
+/// ratio at most max_ratio (coarse_ratio_limit), nullopt below kMinCoarseRatio.
+std::optional<CoarseCompanion> coarse_companion(const MethodInfo& m, const Advance& how, long run_steps, double max_ratio);
+/// The largest ratio at which the run's steps, scaled by it, stay inside the flags' angles (what its
+/// invariants saw; kStepRatio where it tracked none).
+double coarse_ratio_limit(const MethodInfo& m, const std::vector<Centre>& centres, const RunResult& run);
+/// The estimate from the run's and the coarse companion's final states; nullopt where it is not trusted
+/// (a coarse state not finite, an estimate above kCoarseTrusted, estimate.cpp): the fine companion decides.
+std::optional<ErrorEstimate> coarse_estimate(const MethodInfo& m, const Body& body, const CoarseCompanion& c,
+                                             const State& run, const State& coarse);
 
 /// A fixed-step run's companion `level` levels finer (h/2^level, 2^level times the steps), the estimate
 /// from the final states of the run and its first companion, and whether the second companion confirms

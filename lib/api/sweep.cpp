@@ -12,7 +12,6 @@
 #include <atomic>
 #include <cmath>
 #include <exception>
-#include <limits>
 #include <map>
 #include <mutex>
 #include <thread>
@@ -59,8 +58,41 @@ SweepRow result_row(SweepRow row, BodyResult r) {
   return row;
 }
 
+/// Whether a lane's run ended so that it has an estimate (estimate_error of integrate(): ok, or a flag).
+bool estimable(Outcome o) { return o == Outcome::ok || o == Outcome::unresolved || o == Outcome::inaccurate; }
+
+/// The lanes' estimates from the coarse companion batch (estimate.hpp, CoarseCompanion), as integrate()
+/// makes them: nullopt for a lane the fine companions decide (flagged, or its coarse estimate not trusted),
+/// whose estimate then counts the coarse lane's cost in `cost` as integrate() does.
+std::vector<std::optional<ErrorEstimate>> coarse_estimates(const MethodInfo& method, const FixedSteps& how,
+                                                           const std::vector<batch::Member>& members,
+                                                           const std::vector<Scene>& scenes,
+                                                           const std::vector<RunResult>& results,
+                                                           const std::vector<Health>& health,
+                                                           std::vector<ErrorEstimate>& cost) {
+  std::vector<std::optional<ErrorEstimate>> out(members.size());
+  double max_ratio = ErrorEstimate::kStepRatio;  // one coarse batch: the ratio every lane's steps allow
+  for (std::size_t k = 0; k < members.size(); ++k)
+    max_ratio = std::min(max_ratio, detail::coarse_ratio_limit(method, scenes[k].centres, results[k]));
+  const auto c = detail::coarse_companion(method, how, how.steps, max_ratio);
+  if (!c) return out;
+  std::vector<batch::Member> moved = members;
+  for (batch::Member& m : moved) m.s0 = detail::start_moved_by_rounding(m.s0);
+  const auto coarse = batch::run(method, moved, std::get<FixedSteps>(c->how));
+  for (std::size_t k = 0; k < members.size(); ++k) {
+    cost[k].force_evals = coarse[k].force_evals;
+    cost[k].wall_s = coarse[k].wall_s;
+    if (health[k].outcome != Outcome::ok && health[k].outcome != Outcome::inaccurate) continue;
+    if (assess(coarse[k], checks_for(method, scenes[k].centres, detail::kCoarseEnergyBound)).outcome != Outcome::ok) continue;
+    out[k] = detail::coarse_estimate(method, scenes[k].bodies.front(), *c, results[k].final, coarse[k].final);
+    if (out[k]) out[k]->force_evals = coarse[k].force_evals, out[k]->wall_s = coarse[k].wall_s;
+  }
+  return out;
+}
+
 /// The rows of a batch: its lanes, judged by assess() and, with SweepSpec::estimate_error, by the
-/// estimate from a companion batch at h/2 (the same kernel, as integrate() would run them alone).
+/// estimate from a coarse companion batch or, where that is not trusted, from companion batches at h/2
+/// (and h/4 for flagged lanes): the same kernel and the same rule as integrate() alone (estimate.cpp).
 void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const MethodInfo& method,
                 const std::vector<batch::Member>& members, const std::vector<Scene>& scenes) {
   const FixedSteps how = std::get<FixedSteps>(point_advance(spec, method, rows.front().point));
@@ -68,8 +100,13 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
   std::vector<Health> health;
   for (std::size_t k = 0; k < rows.size(); ++k)
     health.push_back(assess(results[k], checks_for(method, scenes[k].centres, spec.max_energy_error)));
+  std::vector<std::optional<ErrorEstimate>> by_coarse(rows.size());
+  std::vector<ErrorEstimate> coarse_cost(rows.size());
+  if (spec.estimate_error) by_coarse = coarse_estimates(method, how, members, scenes, results, health, coarse_cost);
+  bool fine = false;
+  for (std::size_t k = 0; k < rows.size(); ++k) fine = fine || (estimable(health[k].outcome) && !by_coarse[k]);
   std::vector<RunResult> companions, second;
-  if (spec.estimate_error) companions = batch::run(method, members, detail::fixed_companion(how));
+  if (spec.estimate_error && fine) companions = batch::run(method, members, detail::fixed_companion(how));
   if (spec.estimate_error && std::any_of(health.begin(), health.end(), [](const Health& h) { return h.outcome == Outcome::unresolved; }))
     second = batch::run(method, members, detail::fixed_companion(how, 2));  // to confirm the flagged lanes' estimates
   for (std::size_t k = 0; k < rows.size(); ++k) {
@@ -80,24 +117,29 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
     row.reason = std::move(h.why);
     if (!spec.estimate_error) {
       row.error.basis = "not asked for (estimate_error off)";
-    } else if (row.outcome == Outcome::ok || row.outcome == Outcome::unresolved || row.outcome == Outcome::inaccurate) {
+    } else if (by_coarse[k]) {
+      row.error = std::move(*by_coarse[k]);
+    } else if (estimable(row.outcome)) {
       row.error = detail::fixed_step_estimate(method, scenes[k].bodies.front(), row.result.final, companions[k].final);
-      row.error.force_evals = companions[k].force_evals;
-      row.error.wall_s = companions[k].wall_s;
+      row.error.force_evals = coarse_cost[k].force_evals + companions[k].force_evals;
+      row.error.wall_s = coarse_cost[k].wall_s + companions[k].wall_s;
       if (row.outcome == Outcome::unresolved)
         detail::confirm(row.error, method, scenes[k].bodies.front(), row.result.final, companions[k].final, second[k].final);
     } else {
       row.error.basis = "the run ended " + std::string(outcome_name(row.outcome));
     }
   }
-  // As integrate(): lanes whose estimate is at the rounding level add a repeat from their start moved by
-  // a rounding (estimate.hpp), run as one more batch.
-  if (spec.estimate_error && std::any_of(rows.begin(), rows.end(), [](const SweepRow& r) { return detail::at_rounding_level(r.error); })) {
+  // As integrate(): lanes whose fine estimate is at the rounding level add a repeat from their start moved
+  // by a rounding (estimate.hpp), run as one more batch.
+  const auto repeat = [&](std::size_t k) { return spec.estimate_error && !by_coarse[k] && detail::at_rounding_level(rows[k].error); };
+  bool any_repeat = false;
+  for (std::size_t k = 0; k < rows.size(); ++k) any_repeat = any_repeat || repeat(k);
+  if (any_repeat) {
     std::vector<batch::Member> moved = members;
     for (batch::Member& m : moved) m.s0 = detail::start_moved_by_rounding(m.s0);
     const auto repeats = batch::run(method, moved, how);
     for (std::size_t k = 0; k < rows.size(); ++k)
-      if (detail::at_rounding_level(rows[k].error))
+      if (repeat(k))
         detail::add_rounding_spread(rows[k].error, rows[k].result.final, repeats[k].final, repeats[k].force_evals, repeats[k].wall_s);
   }
   for (std::size_t k = 0; k < rows.size(); ++k)

@@ -134,7 +134,7 @@ struct Options : RunOptions {
   /// bound). Not applied where E is not conserved (the thesis code's force law).
   double max_energy_error = kDefaultMaxEnergyError;
   /// Estimate the error of a run asked for by step with a companion run (ErrorEstimate; it costs about
-  /// twice the run). Off: BodyResult::error says the run has none. The accuracy mode always has one.
+  /// half the run). Off: BodyResult::error says the run has none. The accuracy mode always has one.
   bool estimate_error = true;
   /// A run whose estimated relative error (BodyResult::error) exceeds this bound ends Outcome::inaccurate
   /// (> 0; infinity: no bound).
@@ -144,17 +144,25 @@ struct Options : RunOptions {
 /// How good a run's final state is: an a-posteriori estimate of its relative error,
 ///   err = max(|R - R_exact|/|R_exact|, |v - v_exact|/|v_exact|)   (the accuracy mode's measure, tol),
 /// or, when the run has none, why. A run by step is compared with a companion run of the same method
-/// to the same end (the same stop event, the same time-step constant c) at half the step (fixed and
-/// fictitious steps) or a tenth of the tolerance per step (step-size-controlled methods): the
-/// companion's error is 2^-p of the run's in the asymptotic regime, so the run's error is their
-/// difference over 1 - 2^-p (Richardson's principle, Hairer, Norsett, Wanner, Solving ODEs I, sec. II.4);
-/// where round-off or a step outside the asymptotic regime dominates, the difference is still of the
-/// run's error's size. The accuracy mode's estimate is its search's (adaptive/tolerance.hpp).
+/// to the same end (the same stop event, the same time-step constant c), by Richardson's principle
+/// (Hairer, Norsett, Wanner, Solving ODEs I, sec. II.4): first a coarse companion at up to twice the
+/// step (fixed and fictitious steps) from the start moved by a rounding; in the asymptotic regime it
+/// differs from the run by the run's error times r^p - 1 (the order taken as at most 4, at most 2 for
+/// a ratio r below 2), and it costs half a run. Where that pair cannot be trusted (the run flagged, the
+/// coarse steps beyond the flags or its energy, an estimate above 1e-5, too few steps) a fine companion
+/// at half the step decides, or at a tenth of the tolerance per step (step-size-controlled methods):
+/// its error is 2^-p of the run's, so the run's error is their difference over 1 - 2^-p. Where
+/// round-off dominates, the estimate is at least the pair's difference up to the rounding level 1e-10.
+/// The accuracy mode's estimate is its search's (adaptive/tolerance.hpp).
 struct ErrorEstimate {
-  /// The companion of a run by step runs at the step over this ratio: it costs that many runs.
+  /// The fine companion of a run by step runs at the step over this ratio (it costs that many runs),
+  /// the coarse one at up to this ratio times the step.
   static constexpr double kStepRatio = 2.0;
+  /// What an estimate costs in runs where its coarse companion is trusted (the fine one costs
+  /// kStepRatio runs more): budgets count this.
+  static constexpr double kTypicalCost = 1.0 / kStepRatio;
   double value = std::numeric_limits<double>::quiet_NaN();  ///< the estimate; NaN when the run has none
-  std::string basis;       ///< how it was obtained ("companion at h/2, order 4"), or why there is none
+  std::string basis;       ///< how it was obtained ("companion run at 2h ..., order 4"), or why there is none
   long force_evals = 0;    ///< what the companion cost (the accuracy mode: counted in its search)
   double wall_s = 0.0;
   /// Where the run was flagged unresolved: a second companion one level finer showed the error falling

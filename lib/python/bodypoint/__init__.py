@@ -252,8 +252,8 @@ def integrate(scene, method="auto", *, h=None, steps=None, t_end=None, tol=None,
     steps: events (event, t, r, R, v, w), event_force_evals; ``stop_at``: events that end the run at
     their first hit (stopped_by).
     Each body's ``err_estimate`` is the estimated relative error of its final state, max(|dR|/|R|,
-    |dv|/|v|): from a companion run at half the step (a tenth of a peer's tolerance; it costs about twice
-    the run), or the accuracy mode's; None when there is none, ``err_basis`` saying how it was obtained
+    |dv|/|v|): from a companion run at up to twice the step (about half a run), or, where that pair cannot
+    be trusted, at half the step (a tenth of a peer's tolerance), or the accuracy mode's; None when there is none, ``err_basis`` saying how it was obtained
     or why there is none (``estimate_error=False``: not asked for). ``warnings``: flags the estimate
     overruled.
     The outcome is "ok", or the flag of a run whose numbers bodypoint does not vouch for: "diverged",
