@@ -351,6 +351,7 @@ std::vector<MethodInfo> methods() {
   all.push_back({"logh-bs", Family::Extrapolated, 0, 0, 0,
                  "logH leapfrog with Bulirsch-Stoer extrapolation (Mikkola's codes; repulsive scenes); a tolerance per step",
                  &run_logh_bs, &logh_bs_check});
+  for (MethodInfo& m : all) m.traits = catalogue_traits(m.family);
   return all;
 }
 

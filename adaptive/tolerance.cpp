@@ -140,13 +140,13 @@ Advance step_advance(const MethodInfo& m, double h, double t_end, double dt_out)
 
 /// The first, coarse step of the ladder.
 double initial_step(const MethodInfo& m, const Body& b, const std::vector<Centre>& centres, double t_end) {
-  if (m.family == Family::Regularised) {
+  if (m.traits.search == SearchStrategy::exact_pair) {
     // KS fictitious time: one sub-step of the exact flow (sqrt(2 |h|) ds = 1, ks.hpp).
     const double mu = centres.front().A / b.p.m;
     const double h = 0.5 * b.s0.v.squaredNorm() - mu / (b.s0.R - centres.front().c).norm();
     return h != 0.0 ? 1.0 / std::sqrt(2.0 * std::abs(h)) : 1.0;
   }
-  if (m.family == Family::FarField) {
+  if (m.traits.search == SearchStrategy::field_pair) {
     // far-ip's step is set by the field's slow scale (far_field.hpp): the time the guiding centre takes to
     // cover its least distance to the nearest centre; a step too long for the field is refused and halved.
     const Helix helix = helix_of(b.p, to_momenta(b.p, b.s0));
@@ -178,7 +178,7 @@ class Search {
     out.omega_c = best.omega_c;
     out.err_estimate = estimate_;
     out.basis = (p_ > 0                                ? std::string("Richardson over its runs")
-                 : m_.family == Family::FarField ? "what " + pair_text() + " differ by"
+                 : m_.traits.search == SearchStrategy::field_pair ? "what " + pair_text() + " differ by"
                                                  : "what runs at fictitious steps ds and ds/" + fmt_number(kMinRefinement) +
                                                        " differ by: the KS flow is exact") +
                 (floor_ > 0.0 ? ", plus runs that differ only in rounding" : "");
@@ -454,7 +454,7 @@ class Search {
   /// method refuses (far-ip: its iteration does not converge there) is halved too.
   Level exact_flow() {
     double h = initial_step(m_, b_, c_, t_end_);
-    const bool far = m_.family == Family::FarField;
+    const bool far = m_.traits.search == SearchStrategy::field_pair;
     const Body moved = start_moved(kFarStartShift), rounded = start_moved(-kStartShift);
     double best = std::numeric_limits<double>::infinity();
     int stalled = 0;
@@ -531,7 +531,7 @@ class Search {
 
 int effective_order(const MethodInfo& m, const Body& b) {
   // The thesis's schemes freeze the gyroscopic term: first order for B != 0 (README, findings).
-  if (m.family == Family::Thesis && b.p.B != 0.0) return 1;
+  if (m.traits.frozen_gyroscopic_term && b.p.B != 0.0) return 1;
   return m.order;
 }
 
@@ -555,7 +555,7 @@ void check_searchable(const MethodInfo& method) {
   if (is_step_controlled(method))
     throw Error(std::string(method.name) + " controls its own step: give it a tolerance per step, not the accuracy mode's "
                 "search (which is for fixed-step and time-transformed methods)");
-  if (method.order == 0 && method.family != Family::Regularised && method.family != Family::FarField)
+  if (method.traits.search == SearchStrategy::none || (method.traits.search == SearchStrategy::ladder && method.order == 0))
     throw Error(std::string(method.name) + " has no fixed order for the error estimate");
 }
 

@@ -18,9 +18,9 @@ void print_markdown_table() {
   std::cout << "| method | family | order | stages | evals/step | description |\n|---|---|---|---|---|---|\n";
   for (const MethodInfo& m : methods())
     std::cout << "| `" << m.name << "` | " << family_name(m.family) << " | " << (m.order ? std::to_string(m.order) : "var")
-              << " | " << (is_step_controlled(m) || m.family == Family::FarField ? "-" : std::to_string(m.stages)) << " | "
+              << " | " << (is_step_controlled(m) || m.traits.cost_set_by_field ? "-" : std::to_string(m.stages)) << " | "
               << (is_step_controlled(m) ? "adaptive"
-                  : m.family == Family::FarField ? "points x sweeps"  // far_field.hpp: set by the step and the field
+                  : m.traits.cost_set_by_field ? "points x sweeps"  // far_field.hpp: set by the step and the field
                                                  : std::to_string(m.evals_per_step))
               << " | " << m.description << " |\n";
 }

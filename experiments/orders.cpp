@@ -96,7 +96,7 @@ void write_orders(std::ostream& csv) {
     const bool ks = !refusal(m, enc_spin.scene.bodies.front(), enc_spin.scene.centres).empty();
     std::size_t ue = 0, uo = 0;
     const double enc = measured_order(m, ks ? enc_material : enc_spin, &ue);
-    const double orb = m.family == Family::Thesis ? std::numeric_limits<double>::quiet_NaN()
+    const double orb = m.traits.frozen_gyroscopic_term ? std::numeric_limits<double>::quiet_NaN()
                                                    : measured_order(m, ks ? orb_material : orb_spin, &uo);
     csv << CsvLine().text(m.name).count(m.order).num_if(std::isfinite(enc), enc).count(static_cast<long>(ue))
                .num_if(std::isfinite(orb), orb).count(static_cast<long>(uo)).str()

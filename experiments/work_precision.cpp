@@ -195,7 +195,7 @@ void run_ladder(const NamedScene& ns, const MethodInfo& m, const State& ref, con
     return below < 2 && (!capped || static_cast<double>(r.force_evals) <= o.max_evals);
   };
   Row r;
-  if (m.family == Family::Regularised) {
+  if (m.traits.exact_in_fictitious_time) {
     // Exact in its fictitious time: one configuration, the run of one fictitious step to t_end (the
     // first ds, doubled from 0.2, whose run takes a single step); a ladder would time one answer many times.
     for (double ds = 0.2; ds <= 1e6; ds *= 2) {
@@ -226,7 +226,7 @@ void run_ladder(const NamedScene& ns, const MethodInfo& m, const State& ref, con
   } else {
     // far-ip's step is tens of radians of spin (far_field.hpp): its ladder starts at kFarFieldFirstStep,
     // and a step too long for the scene's closest approach (its iteration diverges) is left out.
-    const bool far = m.family == Family::FarField;
+    const bool far = m.traits.search == SearchStrategy::field_pair;
     for (double h = far ? kFarFieldFirstStep : 0.5; ns.t_end / h * std::max(1, m.evals_per_step) <= o.max_evals; h /= 2) {
       if (far) {
         if (!try_measure(h, 0, r)) continue;
@@ -277,7 +277,7 @@ std::pair<const Row*, const Row*> best_at(const std::vector<Row>& rows, const st
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const Row& r = rows[i];
     if (r.scene != scene || !(r.err_rel <= target)) continue;
-    const bool exact = method_or_throw(r.method).family == Family::Regularised;
+    const bool exact = method_or_throw(r.method).traits.exact_in_fictitious_time;
     const Row* next = i + 1 < rows.size() ? &rows[i + 1] : nullptr;
     if (!exact && !(next && next->scene == r.scene && next->method == r.method && next->err_rel <= target)) continue;
     const Row*& slot = is_peer(method_or_throw(r.method)) ? peer : ours;

@@ -98,7 +98,7 @@ std::optional<Companion> companion_of(const MethodInfo& m, const Body& body, con
     }
     const FictitiousSteps finer{f->ds / ratio, EndTime{f->t_end()}};
     const std::string at = "companion run at ds/" + short_number(ratio);
-    if (m.family == Family::Regularised)  // exact in its fictitious time: the runs differ by rounding
+    if (m.traits.exact_in_fictitious_time)  // the runs differ by rounding
       return Companion{finer, 1.0, at + " (the KS flow is exact: they differ by rounding and the time equation)", 1.0};
     return Companion{finer, richardson, at + " and the same time-step constant, " + order_text(p), fall};
   }
@@ -279,7 +279,7 @@ std::optional<CoarseCompanion> coarse_companion(const MethodInfo& m, const Advan
     return CoarseCompanion{FixedSteps{f->h * ratio, coarse}, ratio};
   }
   const auto* f = std::get_if<FictitiousSteps>(&how);
-  if (f == nullptr || f->end.index() != 0 || m.family == Family::Regularised) return std::nullopt;
+  if (f == nullptr || f->end.index() != 0 || m.traits.exact_in_fictitious_time) return std::nullopt;
   return CoarseCompanion{FictitiousSteps{f->ds * r, EndTime{f->t_end()}}, r};
 }
 

@@ -377,7 +377,7 @@ BodyResult integrate_forwards(const Body& body, const std::vector<Centre>& centr
 }  // namespace
 
 bool takes_time_step_constant(const MethodInfo& method) {
-  return is_time_transformed(method) && method.family != Family::Regularised;
+  return method.traits.takes_omega_c;
 }
 
 void check_time_step_constant(double omega_c, const MethodInfo* method, bool accuracy) {

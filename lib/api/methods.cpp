@@ -48,7 +48,7 @@ std::vector<const MethodInfo*> methods_named(std::string_view list) {
   const bool all = list == "all", fixed = list == "fixed";
   if (all || fixed) {
     for (const MethodInfo& m : methods())
-      if (all || (!has_variable_step(m) && m.family != Family::KeplerSplit && m.family != Family::FarField))
+      if (all || m.traits.in_fixed_set)
         ms.push_back(&m);
     return ms;
   }

@@ -178,6 +178,7 @@ std::vector<MethodInfo> make_rows() {
                  "far-field collocation: Chebyshev-Picard iteration in the interaction picture of the exact drift "
                  "(Bai and Junkins 2011); a step may turn the spin by tens of radians",
                  &run_far_field, &far_field_check});
+  for (MethodInfo& m : all) m.traits = catalogue_traits(m.family);
   return all;
 }
 
@@ -199,16 +200,65 @@ void check_energy_bound(double max_energy_error) {
                 detail::short_number(max_energy_error));
 }
 
+MethodTraits catalogue_traits(Family f) {
+  MethodTraits t;
+  switch (f) {
+    case Family::Thesis:
+      t.frozen_gyroscopic_term = true;
+      t.in_fixed_set = true;
+      break;
+    case Family::LiePoisson:
+      t.free_flight_spin_exact = true;  // the exact drift rotates the spin; without a force nothing else acts on it
+      t.in_fixed_set = true;
+      break;
+    case Family::KeplerSplit:
+      t.orbit_exact = true;
+      t.free_flight_spin_exact = true;
+      break;
+    case Family::Odeint:
+      t.peer = true;
+      t.in_fixed_set = true;
+      break;
+    case Family::OdeintAdaptive:
+    case Family::Gsl:
+      t.stepping = Stepping::controlled;
+      t.search = SearchStrategy::none;
+      t.peer = true;
+      break;
+    case Family::TimeTransformed:
+      t.stepping = Stepping::fictitious;
+      t.free_flight_spin_exact = true;
+      t.takes_omega_c = true;
+      break;
+    case Family::Regularised:
+      t.stepping = Stepping::fictitious;
+      t.search = SearchStrategy::exact_pair;
+      t.orbit_exact = true;
+      t.exact_in_fictitious_time = true;
+      break;
+    case Family::Extrapolated:
+      t.stepping = Stepping::controlled;
+      t.search = SearchStrategy::none;
+      t.peer = true;
+      t.macro_steps = true;
+      break;
+    case Family::FarField:
+      t.search = SearchStrategy::field_pair;
+      t.macro_steps = true;
+      t.cost_set_by_field = true;
+      break;
+  }
+  return t;
+}
+
 Checks checks_for(const MethodInfo& m, const std::vector<Centre>& centres, double max_energy_error) {
   Checks c;
   c.max_energy_error = max_energy_error;
   c.energy_is_integral = !non_coulomb(centres);
-  c.orbit_exact = m.family == Family::KeplerSplit || m.family == Family::Regularised;
+  c.orbit_exact = m.traits.orbit_exact;
   const bool free_flight = std::all_of(centres.begin(), centres.end(), [](const Centre& k) { return k.A == 0.0; });
-  // The exact splittings' drift rotates the spin exactly; without a force nothing else acts on it.
-  c.spin_exact = free_flight && (m.family == Family::LiePoisson || m.family == Family::KeplerSplit ||
-                                 m.family == Family::TimeTransformed);
-  c.macro_steps = m.family == Family::Extrapolated || m.family == Family::FarField;
+  c.spin_exact = free_flight && m.traits.free_flight_spin_exact;
+  c.macro_steps = m.traits.macro_steps;
   return c;
 }
 

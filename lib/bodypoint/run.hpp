@@ -219,6 +219,48 @@ void check(const RunOptions& options);
 struct MethodInfo;
 using SceneCheck = std::string (*)(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres);
 
+/// How a method advances time: the Advance alternative its driver takes.
+enum class Stepping {
+  fixed,       ///< FixedSteps: a fixed physical step h
+  fictitious,  ///< FictitiousSteps: a fixed fictitious step ds, a variable physical one
+  controlled,  ///< ControlledSteps: a tolerance per step, its own step-size control
+};
+/// How the accuracy mode (tolerance.hpp) searches a method's step.
+enum class SearchStrategy {
+  none,        ///< not searched: it controls its own step (a tolerance per step), or has no fixed order
+  ladder,      ///< Richardson over a ladder of runs (a fixed order p)
+  exact_pair,  ///< an exact flow in fictitious time (ks): what runs at ds and a finer ds differ by
+  field_pair,  ///< far-ip: what runs from moved starts differ by, its step set by the field's slow scale
+};
+
+/// What the code asks of a method besides its name, order and cost: one row of the catalogue
+/// (catalogue_traits, run.cpp, sets it from the family), so no code outside it tests a family's name.
+struct MethodTraits {
+  Stepping stepping = Stepping::fixed;
+  SearchStrategy search = SearchStrategy::ladder;
+  /// A general-purpose peer bodypoint's methods compete with (Boost.Odeint, GSL, Mikkola's logh-bs).
+  bool peer = false;
+  /// Its stages follow the motion about a centre exactly (the orbital resolution check is skipped).
+  bool orbit_exact = false;
+  /// In free flight its drift turns the spin exactly (the spin resolution check is skipped there).
+  bool free_flight_spin_exact = false;
+  /// A step resolves its own inside (an extrapolated macro step, a collocation step): what one step turns
+  /// the spin or the direction to a centre by says nothing.
+  bool macro_steps = false;
+  /// Exact in its fictitious time (ks): a run and its companion differ by rounding and the time equation.
+  bool exact_in_fictitious_time = false;
+  /// Its fictitious time is transformed with the time-step constant c (Options::omega_c).
+  bool takes_omega_c = false;
+  /// Freezes the gyroscopic term (the thesis's schemes): first order for B != 0, whatever its table.
+  bool frozen_gyroscopic_term = false;
+  /// In the thesis's "fixed" set (`--methods fixed`): a fixed physical step of its own.
+  bool in_fixed_set = false;
+  /// Its cost per step is set by the step and the field, not by a number of stages (far-ip: points x sweeps).
+  bool cost_set_by_field = false;
+};
+/// The catalogue's traits of a family (run.cpp): the one place that knows what each family is.
+MethodTraits catalogue_traits(Family f);
+
 struct MethodInfo {
   std::string name;
   Family family;
@@ -232,6 +274,8 @@ struct MethodInfo {
   /// The number of its kernel that runs vector lanes of trajectories in lockstep (batch.hpp;
   /// splitting/catalogue.hpp numbers them); -1: none.
   int batch_kernel = -1;
+  /// What differs between methods beyond the above (set by the catalogue from the family).
+  MethodTraits traits = {};
 };
 
 /// Why `m` refuses the scene (empty: it accepts it). `run` throws this reason; sweeps, studies,
@@ -244,19 +288,12 @@ const std::vector<MethodInfo>& core_methods();
 
 /// True for methods that choose their own steps from a tolerance per step (ControlledSteps):
 /// Boost.Odeint's and GSL's controlled steppers, and logh-bs.
-inline bool is_step_controlled(const MethodInfo& m) {
-  return m.family == Family::OdeintAdaptive || m.family == Family::Gsl || m.family == Family::Extrapolated;
-}
+inline bool is_step_controlled(const MethodInfo& m) { return m.traits.stepping == Stepping::controlled; }
 /// True for the peers that bodypoint's own methods compete with: the general-purpose ones (Boost.Odeint,
 /// GSL) and the time-transformed one of Mikkola's codes (logh-bs).
-inline bool is_peer(const MethodInfo& m) {
-  return m.family == Family::Odeint || m.family == Family::OdeintAdaptive || m.family == Family::Gsl ||
-         m.family == Family::Extrapolated;
-}
+inline bool is_peer(const MethodInfo& m) { return m.traits.peer; }
 /// True for methods with a fixed fictitious step (FictitiousSteps): time-transformed and regularised.
-inline bool is_time_transformed(const MethodInfo& m) {
-  return m.family == Family::TimeTransformed || m.family == Family::Regularised;
-}
+inline bool is_time_transformed(const MethodInfo& m) { return m.traits.stepping == Stepping::fictitious; }
 /// True for every method whose physical step varies (step-size-controlled or time-transformed).
 inline bool has_variable_step(const MethodInfo& m) { return is_step_controlled(m) || is_time_transformed(m); }
 
