@@ -48,6 +48,7 @@ struct TolRow {
   std::string refusal;  ///< auto refused TOL (out of reach on the scene, over the budget): why; "" otherwise
   bool is_auto = false;
   bool is_ladder = false;  ///< a peer's run from its tolerance ladder (oracle view), not at TOL
+  bool is_own = false;     ///< a configuration of bodypoint's own methods (own_ladders): a method and a step
 };
 
 /// A peer's ladder stops once its delivered error is below this (the smallest TOL of the grid is 1e-12).
@@ -168,6 +169,87 @@ void measure_peer_ladders(const NamedScene& ns, const State& ref, const std::vec
   }
 }
 
+/// bodypoint's own ladders start at this step (h, or ds) and go down by half octaves (a factor sqrt 2), so
+/// that its fastest configuration at a TOL is within that factor of the best any step would give.
+constexpr double kOwnFirstStep = 0.5;
+constexpr double kOwnRungRatio = 1.4142135623730951;
+/// An own ladder ends after this many rungs that failed (a step too coarse for the scene) or that are
+/// at or below the smallest TOL asked for (the rungs that matter are above it, and one more below).
+constexpr int kOwnFailures = 3;
+constexpr int kOwnBelowSmallest = 2;
+/// ... or after this many rungs in a row below kOwnStallBelow that did not halve its best error (a
+/// first-order scheme, or its round-off floor: the thesis's schemes with B != 0 went on to 2e7 evaluations
+/// a run; above it a coarse step's error need not fall yet: logh-mcl8's ladder on two-centres ended before
+/// its fastest rung at 1e-10 with 3 rungs and no level),
+constexpr int kOwnStalls = 6;
+constexpr double kOwnStallBelow = 1e-2;
+/// ... or once a run costs this many times auto's costliest call on the scene: a configuration that
+/// dear is not the fastest where auto delivered (where none is cheaper, the cell says none).
+constexpr double kOwnOverAuto = 4.0;
+
+/// One rung of an own ladder: `m` at step h (fixed steps landing on t_end, or the fictitious step ds with
+/// its automatic constant c), as a user would run `--method m --h h --no-error-estimate`.
+Advance own_advance(const MethodInfo& m, double h, double t_end) {
+  if (is_time_transformed(m)) return FictitiousSteps{h, EndTime{t_end}};
+  return fixed_steps_to(t_end, h);
+}
+
+/// bodypoint's own configurations, untimed: every own method that takes the scene at a fixed or
+/// fictitious step (not the peers; not far-ip, whose step is set by the field), from kOwnFirstStep down
+/// until two rungs are below the smallest TOL, kOwnStalls rungs did not halve the error, a run would
+/// exceed max_evals, or kOwnFailures steps failed. The fastest per TOL (own_best_for) is then timed with the rest.
+void measure_own_ladders(const NamedScene& ns, const State& ref, double smallest_tol, double max_evals,
+                         std::vector<TolRow>& rows) {
+  const Body& body = ns.scene.bodies.front();
+  for (const MethodInfo& m : methods()) {
+    if (is_peer(m) || is_step_controlled(m) || m.traits.search == SearchStrategy::field_pair) continue;
+    if (!refusal(m, body, ns.scene.centres).empty()) continue;
+    int failures = 0, below = 0, stalled = 0;
+    double best = std::numeric_limits<double>::infinity();
+    for (double h = kOwnFirstStep; failures < kOwnFailures && below < kOwnBelowSmallest && stalled < kOwnStalls;
+         h /= kOwnRungRatio) {
+      const Advance how = own_advance(m, h, ns.t_end);
+      if (const auto* f = std::get_if<FixedSteps>(&how);
+          f && static_cast<double>(f->steps) * std::max(1, m.evals_per_step) > max_evals)
+        break;
+      TolRow r;
+      r.scene = ns.name;
+      r.method = m.name;
+      r.h = h;
+      r.is_own = true;
+      try {
+        const RunResult x = run_or_throw(m, body, ns.scene.centres, how, unobserved());
+        r.err = adaptive::state_distance(x.final, ref);
+        r.force_evals = std::max(x.force_evals, x.steps);  // ks counts its exact steps
+      } catch (const Error&) {
+        ++failures;
+        continue;
+      }
+      if (!std::isfinite(r.err)) r.err = std::numeric_limits<double>::infinity();
+      r.run = [&m, body, centres = ns.scene.centres, how] { run_or_throw(m, body, centres, how, unobserved()); };
+      rows.push_back(std::move(r));
+      below = rows.back().err <= smallest_tol ? below + 1 : 0;
+      stalled = rows.back().err < 0.5 * best || rows.back().err > kOwnStallBelow ? 0 : stalled + 1;
+      best = std::min(best, rows.back().err);
+      if (static_cast<double>(rows.back().force_evals) > max_evals) break;
+    }
+  }
+}
+
+/// bodypoint's fastest own configuration delivering a's TOL on a's scene whose next finer rung delivers it
+/// too (the fewest force evaluations, cheaper_pick's rule without the time: it is not timed yet).
+TolRow* own_best_for(std::vector<TolRow>& rows, const TolRow& a) {
+  TolRow* best = nullptr;
+  for (std::size_t i = 0; i + 1 < rows.size(); ++i) {
+    TolRow& r = rows[i];
+    const TolRow& next = rows[i + 1];
+    if (!r.is_own || r.scene != a.scene || !(r.err <= a.tol)) continue;
+    if (!(next.is_own && next.method == r.method && next.scene == r.scene && next.err <= a.tol)) continue;
+    if (!best || r.force_evals < best->force_evals) best = &r;
+  }
+  return best;
+}
+
 void write_tol_rows(std::ostream& csv, const std::vector<TolRow>& rows, const TimingRules& rules) {
   csv << "scene,method,kind,tol,h,err_estimate,err,met,runs,force_evals,wall_s,cpu_s,spread,repeats,flag,"
          "delivered_force_evals,delivered_wall_s\n"
@@ -175,12 +257,14 @@ void write_tol_rows(std::ostream& csv, const std::vector<TolRow>& rows, const Ti
       << "# err = max(|dR|/|R_ref|, |dv|/|v_ref|) against odeint rkf78 in long double at tol 1e-18; met = err <= tol\n"
       << "# met: refused where auto refused TOL with a reason (the summary gives it); a call is the whole request "
          "(auto: all runs of its search); h = ds for logh/ttl/ks\n"
+      << "# kind own: bodypoint's fastest own configuration delivering TOL (a method at a step h, no error estimate; the "
+         "fewest force evaluations on ladders from h = 0.5 down by factors sqrt 2 whose next finer rung delivers TOL too)\n"
       << timing_rules_note(rules)
       << "# delivered_* (auto only): the delivered run alone (delivered_wall_s: median of its step loop in the timed "
          "calls), the cost if the search were free\n";
   for (const TolRow& r : rows)
-    csv << CsvLine().text(r.scene).text(r.method).text(r.is_auto ? "auto" : r.is_ladder ? "ladder" : "at-tol")
-               .num(r.tol).num_if(r.is_auto, r.h).num_if(r.is_auto, r.err_estimate).num(r.err)
+    csv << CsvLine().text(r.scene).text(r.method).text(r.is_auto ? "auto" : r.is_ladder ? "ladder" : r.is_own ? "own" : "at-tol")
+               .num(r.tol).num_if(r.is_auto || r.is_own, r.h).num_if(r.is_auto, r.err_estimate).num(r.err)
                .text(r.met ? "yes" : r.refusal.empty() ? "no" : "refused").count(r.runs).count(r.force_evals).num(r.time.wall_s)
                .num(r.time.cpu_s).num(r.time.spread()).count(r.time.repeats).quoted(r.time.flag())
                .num_if(r.is_auto, static_cast<double>(r.delivered_force_evals)).num_if(r.is_auto, r.delivered_wall_s).str()
@@ -231,12 +315,38 @@ std::string delivered_cell(const TolRow& a) {
   return time_cell(t);
 }
 
+/// The last cells of auto's summary row: bodypoint's fastest own configuration delivering TOL (its step
+/// and evaluations), its time, auto's whole call over it in evaluations and in time, and what auto's
+/// search costs beyond its delivered run (evaluations).
+void write_own_cells(std::ostream& summary, const std::vector<TolRow>& rows, const TolRow& a, std::vector<double>& ratios) {
+  const TolRow* own = nullptr;
+  for (const TolRow& r : rows)
+    if (r.is_own && r.scene == a.scene && r.tol == a.tol && r.err <= a.tol) own = &r;  // marked by mark_own_bests
+  if (own && a.refusal.empty()) {
+    const double evals = static_cast<double>(a.force_evals) / static_cast<double>(std::max(1L, own->force_evals));
+    ratios.push_back(evals);
+    summary << own->method << " h=" << sci(own->h) << " (" << own->force_evals << " evals) | " << time_cell(own->time) << " | "
+            << std::setprecision(3) << evals << "x | "
+            << ratio_cell(&own->time, &a.time) << " | ";
+  } else {
+    summary << "none | - | - | - | ";
+  }
+  if (a.refusal.empty() && a.delivered_force_evals > 0)
+    summary << std::setprecision(3)
+            << static_cast<double>(a.force_evals - a.delivered_force_evals) / static_cast<double>(a.delivered_force_evals)
+            << "x |\n";
+  else
+    summary << "- |\n";
+}
+
 void write_tol_summary(std::ostream& summary, const std::vector<TolRow>& rows, std::size_t peer_count) {
   summary << "| scene | TOL | auto method | ds or h | estimate | delivered | met | time [ms] | cheapest peer meeting TOL "
              "| time [ms] | speed-up | peers meeting TOL | cheapest peer config delivering TOL | time [ms] | speed-up "
-             "| delivered run [ms] | speed-up if the search were free |\n"
-          << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+             "| delivered run [ms] | speed-up if the search were free | bodypoint's fastest config delivering TOL "
+             "| time [ms] | auto / it, evals | auto / it, time | auto's search / its delivered run, evals |\n"
+          << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   int met = 0, refused = 0, total = 0, faster3 = 0, compared = 0, oracle3 = 0, oracle_n = 0;
+  std::vector<double> own_ratios;  // auto over bodypoint's fastest configuration, force evaluations
   std::ostringstream refusals;
   for (const TolRow& a : rows) {
     if (!a.is_auto) continue;
@@ -266,12 +376,13 @@ void write_tol_summary(std::ostream& summary, const std::vector<TolRow>& rows, s
               << time_cell(oracle->time) << " | "
               << ratio_cell(&a.time, &oracle->time) << " | " << delivered_cell(a) << " | ";
       if (a.delivered_wall_s > 0.0 && a.time.flag().empty() && oracle->time.flag().empty())
-        summary << std::setprecision(3) << oracle->time.wall_s / a.delivered_wall_s << "x |\n";
+        summary << std::setprecision(3) << oracle->time.wall_s / a.delivered_wall_s << "x | ";
       else
-        summary << (a.delivered_wall_s > 0.0 ? "flagged" : "-") << " |\n";
+        summary << (a.delivered_wall_s > 0.0 ? "flagged" : "-") << " | ";
     } else {
-      summary << "none | - | - | " << delivered_cell(a) << " | - |\n";
+      summary << "none | - | - | " << delivered_cell(a) << " | - | ";
     }
+    write_own_cells(summary, rows, a, own_ratios);
   }
   summary << "\nauto met TOL in " << met << " of " << total << " cases";
   if (refused > 0) summary << " and refused " << refused << " with its reason (below)";
@@ -279,10 +390,33 @@ void write_tol_summary(std::ostream& summary, const std::vector<TolRow>& rows, s
           << "faster in " << faster3 << " of " << compared << "; against the cheapest peer configuration that "
           << "delivers TOL (its tolerance chosen afterwards), >= 3x in " << oracle3 << " of " << oracle_n
           << " (a comparison with a flagged time counts as not >= 3x).\n";
+  if (!own_ratios.empty()) {
+    std::sort(own_ratios.begin(), own_ratios.end());
+    summary << "\nauto against bodypoint's own fastest configuration delivering TOL, force evaluations of the whole call: "
+            << "median " << std::setprecision(3) << median(own_ratios) << "x, from " << own_ratios.front() << "x to "
+            << own_ratios.back() << "x (" << own_ratios.size() << " cases).\n";
+  }
   if (refused > 0) summary << "\nauto refused:\n\n" << refusals.str();
 }
 
 }  // namespace
+
+/// Keeps the own rows (from own_first) that are the fastest at one of the scene's TOLs (own_best_for), each
+/// stamped with that TOL (one copy per TOL it is fastest at), and drops the others: only they are timed.
+void mark_own_bests(std::vector<TolRow>& rows, std::size_t first, std::size_t own_first) {
+  std::vector<TolRow> bests;
+  for (std::size_t i = first; i < own_first; ++i) {
+    if (!rows[i].is_auto) continue;
+    if (TolRow* b = own_best_for(rows, rows[i])) {
+      TolRow copy = *b;
+      copy.tol = rows[i].tol;
+      copy.met = true;  // own_best_for: its error is at most TOL
+      bests.push_back(std::move(copy));
+    }
+  }
+  rows.resize(own_first);
+  for (TolRow& b : bests) rows.push_back(std::move(b));
+}
 
 /// Times every row of one scene (rows [first, end)) interleaved; auto's delivered run from its samples.
 void time_rows(std::vector<TolRow>& rows, std::size_t first, const TimingRules& rules) {
@@ -300,7 +434,7 @@ void time_rows(std::vector<TolRow>& rows, std::size_t first, const TimingRules& 
 }
 
 void run_by_tolerance(const std::vector<NamedScene>& scenes, const std::vector<double>& tols, const TimingRules& rules,
-                      std::ostream* csv, std::ostream& summary) {
+                      double max_evals, std::ostream* csv, std::ostream& summary) {
   std::vector<TolRow> rows;
   const std::vector<std::string> peers = peer_names();
   for (const NamedScene& ns : scenes) {
@@ -308,6 +442,13 @@ void run_by_tolerance(const std::vector<NamedScene>& scenes, const std::vector<d
     const std::size_t first = rows.size();
     measure_at_tolerances(ns, ref, tols, peers, rows);
     measure_peer_ladders(ns, ref, peers, rows);
+    const std::size_t own_first = rows.size();
+    double auto_evals = 0.0;
+    for (std::size_t i = first; i < own_first; ++i)
+      if (rows[i].is_auto) auto_evals = std::max(auto_evals, static_cast<double>(rows[i].force_evals));
+    const double own_cap = auto_evals > 0.0 ? std::min(max_evals, kOwnOverAuto * auto_evals) : max_evals;
+    measure_own_ladders(ns, ref, *std::min_element(tols.begin(), tols.end()), own_cap, rows);
+    mark_own_bests(rows, first, own_first);
     std::cerr << "  " << ns.name << ": timing " << rows.size() - first << " configurations, interleaved\n";
     time_rows(rows, first, rules);
   }

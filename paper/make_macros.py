@@ -755,7 +755,7 @@ def by_tol(res, out, M):
     for r in refused:
         where.setdefault(r["scene"], []).append(power_of_ten(num(r["tol"])))
     # Each peer run once, however many of the scene's refused TOLs it delivered.
-    reached = [p for p in rows if p["kind"] != "auto" and any(
+    reached = [p for p in rows if p["kind"] in ("at-tol", "ladder") and any(
         p["scene"] == r["scene"] and num(p["err"]) <= num(r["tol"]) for r in refused)]
     peers_did = (f"although {count(len(reached))} peer runs delivered it" if reached else "no peer run delivered it either")
     M.add("AutoRefusedClause", f" and refused the other {count(len(refused))}, saying why "
@@ -797,6 +797,17 @@ def by_tol(res, out, M):
     ratio_range("AutoAloneSpin", [r for scene, rs in alone.items() if scene != "material" for r in rs])
     ratio_range("AutoVsPeerSpin", [r for scene, rs in ratios.items() if scene != "material" for r in rs])
     ratio_range("AutoVsPeerMaterial", ratios.get("material", []))
+    # The price of trust (issue #55): auto's whole call against bodypoint's own fastest configuration
+    # delivering TOL, in force evaluations (column 19; its time, column 20, where both times count), and what
+    # its search costs beyond the run it delivers (column 21).
+    own = [num(row[19].rstrip("x")) for row in body if len(row) > 21 and row[19].endswith("x")]
+    own_time = [num(row[20].rstrip("x")) for row in body if len(row) > 21 and row[20].endswith("x")]
+    search = [num(row[21].rstrip("x")) for row in body if len(row) > 21 and row[21].endswith("x")]
+    M.add("AutoOverOwnEvals", f"a median ${sci(statistics.median(own))}$ times (${sci(min(own))}$ to ${sci(max(own))}$)"
+          if own else "not measured", math_mode=False)
+    M.add("AutoOverOwnTime", f"${sci(min(own_time))}$ to ${sci(max(own_time))}$ times in time" if own_time else
+          "untimed (every comparison's time flagged)", math_mode=False)
+    M.add("AutoSearchOverRun", f"${sci(min(search))}$ to ${sci(max(search))}$" if search else "n/a", math_mode=False)
     with open(os.path.join(out, "tab_by_tol.tex"), "w") as f:
         for row in body:
             f.write(" & ".join(latex_cell(row[i]) for i in keep) + " \\\\\n")

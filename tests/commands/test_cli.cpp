@@ -242,6 +242,33 @@ TEST(Cli, WorkPrecisionQuickWritesRowsForEveryMethodAndASummary) {
   fs::remove(out);
 }
 
+TEST(Cli, ByTolComparesAutoWithBodypointsOwnFastestConfiguration) {
+  // Issue #55: the price of auto against the fastest own configuration (a method at a step) that delivers
+  // TOL and whose next finer step delivers it too, in evaluations (no timing is asserted: --repeats 1).
+  const fs::path out = test::temp_path("bp_bytol.csv");
+  const Result r = run_cli("work-precision --by-tol --scenes thesis --tols 1e-4,1e-7 --repeats 1 --out " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("| bodypoint's fastest config delivering TOL | time [ms] | auto / it, evals |"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("auto against bodypoint's own fastest configuration delivering TOL, force evaluations of the "
+                       "whole call: median"), std::string::npos) << r.out;
+  std::ifstream in(out);
+  std::string line;
+  int own = 0;
+  while (std::getline(in, line)) {
+    if (line.find(",own,") == std::string::npos) continue;
+    ++own;
+    std::stringstream cells(line);
+    std::vector<std::string> c;
+    for (std::string cell; std::getline(cells, cell, ',');) c.push_back(cell);
+    ASSERT_GE(c.size(), 8u) << line;
+    EXPECT_FALSE(is_peer(method_or_throw(c[1]))) << line;  // bodypoint's own method
+    EXPECT_LE(std::stod(c[6]), std::stod(c[3])) << "it delivers its TOL: " << line;
+    EXPECT_EQ(c[7], "yes") << line;
+  }
+  EXPECT_EQ(own, 2) << "one per TOL";
+  fs::remove(out);
+}
+
 TEST(Cli, DivergedRunIsAnErrorNotANumber) {
   // A material point aimed at an attracting centre whose first drift lands exactly on it
   // (R0 = -1 i, v0 = 2 i, h = 0.5): the force there is undefined and the state turns into NaN.
