@@ -167,13 +167,21 @@ COARSE_H, SMALL_H = 1e-2, 1e-4
 WELL_CONSERVED = 1e-3
 
 
+# A run whose relative energy deviation exceeds this is diverged, as the paper defines it (sec. flags,
+# bodypoint's kDivergedEnergy): RK4 at h = 0.5 with dE = 6e34 is not a finite deviation to rank.
+DIVERGED_ENERGY = 1.0
+
+
 def deviations(rows, param, column):
-    """{value: {method: deviation}} for the thesis's seven; a non-finite deviation counts as infinite."""
+    """{value: {method: deviation}} for the thesis's seven; a diverged run (a non-finite deviation, or an
+    energy deviation above DIVERGED_ENERGY) counts as infinite."""
     out = {}
     for r in rows:
         if r["method"] in THESIS_SEVEN:
             v = num(r[column])
-            out.setdefault(num(r[param]), {})[r["method"]] = v if math.isfinite(v) else float("inf")
+            energy = num(r.get("max_rel_dE"))  # NaN where E is not an integral (the thesis code's force law)
+            diverged = not math.isfinite(v) or energy > DIVERGED_ENERGY
+            out.setdefault(num(r[param]), {})[r["method"]] = float("inf") if diverged else v
     return out
 
 

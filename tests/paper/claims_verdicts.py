@@ -71,6 +71,16 @@ def main():
             failures.append("a study that did not run is reported untimed")
     if verdict_accepted("--"):
         failures.append("check_paper accepts a claim without a verdict")
+    # A run is diverged where its energy deviation exceeds one, as the paper defines it, even with a finite
+    # deviation (RK4 at h = 0.5: dE = 6e34): it is n/a for a comparison, not a ranked number.
+    rows = [{"h": "0.5", "method": m, "dev": "0.3", "max_rel_dE": "6e34" if m in make_macros.STANDARD else "0.01"}
+            for m in make_macros.THESIS_SEVEN]
+    d = make_macros.deviations(rows, "h", "dev")[0.5]
+    if not make_macros.standard_diverged(d) or d["thesis-y6"] != 0.3:
+        failures.append(f"a run with dE above 1 is not diverged: {d}")
+    rows = [dict(r, max_rel_dE="nan") for r in rows]  # the thesis code's force law: E is no integral
+    if make_macros.standard_diverged(make_macros.deviations(rows, "h", "dev")[0.5]):
+        failures.append("an energy deviation of NaN (no integral) made the runs diverged")
     for f in failures:
         print(f"claims_verdicts: {f}", file=sys.stderr)
     return 1 if failures else 0
