@@ -462,10 +462,12 @@ Advance advance_for(const MethodInfo* m, const StepRequest& r) {
 
 Stepper::Stepper(const MethodInfo& method, Body body, std::vector<Centre> centres, double step, Options options)
     : method_(&method), body_(std::move(body)), centres_(std::move(centres)), step_(step), options_(options) {
-  validate(Scene{centres_, {body_}});
   require_positive(step_, is_time_transformed(method) ? "the fictitious step ds"
                           : is_step_controlled(method)  ? "the tolerance per step tol"
                                                         : "the step h");
+  // The whole request is checked here, once (its scene, its way of advancing time, its options): a
+  // segment (advance_to) is valid by construction and runs unchecked.
+  check_request(Scene{centres_, {body_}}, method_, segment(1.0), options_);
   // The time-step constant of a time-transformed method is fixed once, from the starting state, so
   // that every segment integrates the same transformed system.
   if (is_time_transformed(method) && options_.omega_c < 0.0)
@@ -473,9 +475,15 @@ Stepper::Stepper(const MethodInfo& method, Body body, std::vector<Centre> centre
   // A segment has no error estimate of its own (a companion per segment would compare segments that
   // start from one state, not the runs).
   options_.estimate_error = false;
-  // A departure through the start's distance is the stepper's start, not each segment's.
-  detail::validate_events(options_.events, centres_);
+  // A departure through the start's distance is the stepper's start, not each segment's (the events
+  // were checked with the request).
   options_.events = detail::resolved(options_.events, body_.p, centres_, body_.s0);
+}
+
+Advance Stepper::segment(double span) const {
+  if (is_time_transformed(*method_)) return FictitiousSteps{step_, EndTime{span}};
+  if (is_step_controlled(*method_)) return ControlledSteps{std::min(1e-3, span), span, step_};
+  return fixed_steps_to(span, step_);
 }
 
 Stepper::Stepper(std::string_view method, Body body, std::vector<Centre> centres, double step, Options options)
@@ -529,11 +537,15 @@ void Stepper::set_state(const State& s, double t) {
 Outcome Stepper::advance_to(double t) {
   if (!(std::isfinite(t) && t != t_))
     throw Error("advance_to needs a finite time other than the current one (" + fmt(t_) + "), got " + fmt(t));
-  const double span = std::abs(t - t_);  // before t_: backwards in time (integrate_body, is_backward)
-  Advance how;
-  if (is_time_transformed(*method_)) how = FictitiousSteps{step_, EndTime{span}};
-  else if (is_step_controlled(*method_)) how = ControlledSteps{std::min(1e-3, span), span, step_};
-  else how = fixed_steps_to(span, step_);
+  // A segment starts where the last one ended; a state that is no longer a motion (the last segment
+  // diverged) is not run on.
+  if (!(body_.s0.R.allFinite() && body_.s0.v.allFinite() && body_.s0.w.allFinite())) {
+    reason_ = "the stepper's state is not finite (" + (reason_.empty() ? std::string("a segment diverged") : reason_) +
+              "): set_state() a new one";
+    return Outcome::refused;
+  }
+  const double span = std::abs(t - t_);  // before t_: backwards in time (integrate_estimated, is_backward)
+  Advance how = segment(span);
   if (t < t_) how = backwards(how);
   // Samples carry absolute times (the segment's run starts at 0); a later segment's first sample is
   // the state the previous one ended with, already handed on.
@@ -548,7 +560,7 @@ Outcome Stepper::advance_to(double t) {
     };
     opt.sink = &shifted;
   }
-  const BodyResult r = integrate_body(body_, centres_, method_, how, opt);
+  const BodyResult r = integrate_estimated(body_, centres_, method_, how, opt);  // checked in the constructor
   if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) {
     reason_ = r.reason;
     return r.outcome;

@@ -343,6 +343,30 @@ TEST(Api, AStepperRefusesTimeThatDoesNotAdvanceAndKeepsItsState) {
   EXPECT_FALSE(ks.reason().empty());
 }
 
+TEST(Api, AStepperIsCheckedOnceAndDoesNotRunOnFromANonFiniteState) {
+  // The request is checked in the constructor (issue #54): a bad option throws there, not at a segment.
+  const Scene s = thesis();
+  Options bad;
+  bad.max_energy_error = -1.0;
+  EXPECT_THROW(Stepper("lp-y4", s.bodies.front(), s.centres, 0.01, bad), Error);
+  // A material point aimed at an attracting centre whose first drift lands on it (simulate's
+  // DivergedRunIsAnErrorNotANumber): the segment ends non-finite, and the next is refused with why.
+  SceneParams onto;
+  onto.A = 5.0;
+  onto.B = 0.0;
+  onto.start.K1 = 2.0;
+  onto.start.L = 1.0;
+  onto.start.d = 0.0;
+  onto.start.Kz = 0.0;
+  onto.start.Kx = 0.0;
+  const Scene fall = thesis_scene(onto);
+  Stepper stepper("thesis-euler", fall.bodies.front(), fall.centres, 0.5);
+  EXPECT_NE(stepper.advance_to(5.0), Outcome::ok);
+  ASSERT_FALSE(stepper.state().R.allFinite()) << "the scene no longer gives a non-finite state";
+  EXPECT_EQ(stepper.advance_to(10.0), Outcome::refused);
+  EXPECT_NE(stepper.reason().find("the stepper's state is not finite"), std::string::npos) << stepper.reason();
+}
+
 TEST(Api, EveryFamilyHandsOnStatesAtOutputTimes) {
   // dt_out = 0.3 is no multiple of the step: each output time lies inside a step (issue #23).
   const Scene s = thesis();

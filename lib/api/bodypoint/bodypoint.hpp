@@ -397,6 +397,8 @@ class Stepper {
   void set_state(const State& s, double t);
 
  private:
+  /// A segment of `span` (> 0) forwards: the step, fictitious step or tolerance per step it was built with.
+  [[nodiscard]] Advance segment(double span) const;
   Stepper(const Body& body, const std::vector<Centre>& centres, const BodyResult& searched, const Options& options,
           double t_end);
 
