@@ -49,6 +49,7 @@ struct TolRow {
   bool is_auto = false;
   bool is_ladder = false;  ///< a peer's run from its tolerance ladder (oracle view), not at TOL
   bool is_own = false;     ///< a configuration of bodypoint's own methods (own_ladders): a method and a step
+  bool method_is_exact = false;  ///< own: an exact flow (ks), whose force_evals count its steps
 };
 
 /// A peer's ladder stops once its delivered error is below this (the smallest TOL of the grid is 1e-12).
@@ -217,6 +218,7 @@ void measure_own_ladders(const NamedScene& ns, const State& ref, double smallest
       r.method = m.name;
       r.h = h;
       r.is_own = true;
+      r.method_is_exact = m.traits.exact_in_fictitious_time;
       try {
         const RunResult x = run_or_throw(m, body, ns.scene.centres, how, unobserved());
         r.err = adaptive::state_distance(x.final, ref);
@@ -323,11 +325,16 @@ void write_own_cells(std::ostream& summary, const std::vector<TolRow>& rows, con
   for (const TolRow& r : rows)
     if (r.is_own && r.scene == a.scene && r.tol == a.tol && r.err <= a.tol) own = &r;  // marked by mark_own_bests
   if (own && a.refusal.empty()) {
-    const double evals = static_cast<double>(a.force_evals) / static_cast<double>(std::max(1L, own->force_evals));
-    ratios.push_back(evals);
-    summary << own->method << " h=" << sci(own->h) << " (" << own->force_evals << " evals) | " << time_cell(own->time) << " | "
-            << std::setprecision(3) << evals << "x | "
-            << ratio_cell(&own->time, &a.time) << " | ";
+    summary << own->method << " h=" << sci(own->h) << " (" << own->force_evals << " evals) | " << time_cell(own->time) << " | ";
+    // ks evaluates no force (its flow is exact; its ladder counts steps): no ratio of evaluations.
+    if (a.force_evals > 0 && !own->method_is_exact) {
+      const double evals = static_cast<double>(a.force_evals) / static_cast<double>(std::max(1L, own->force_evals));
+      ratios.push_back(evals);
+      summary << std::setprecision(3) << evals << "x | ";
+    } else {
+      summary << "- (no force evaluations) | ";
+    }
+    summary << ratio_cell(&own->time, &a.time) << " | ";
   } else {
     summary << "none | - | - | - | ";
   }
