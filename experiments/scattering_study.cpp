@@ -110,14 +110,9 @@ Point run_point(const Series& s, double b, double psi) {
       p.failure = r.encounter.reason;
       return p;
     }
-    if (s.B == 0.0) {
-      add_start_distance_error(r.encounter, nullptr, true, r.run.error.value);
-    } else {
-      const Scene far = thesis_scene(thesis_params_twice_as_far(params, b, kNaN, phased(s) ? psi : kNaN));
-      const EncounterResult f = encounter_twice_as_far(far, twice_as_far_tol(p.tol), o);
-      p.force_evals += f.run.total_force_evals();
-      add_start_distance_error(r.encounter, &f, false, r.run.error.value);
-    }
+    p.force_evals += add_start_distance(
+        r.encounter, body, [&] { return thesis_scene(thesis_params_twice_as_far(params, b, kNaN, phased(s) ? psi : kNaN)); },
+        p.tol, r.run.error.value, "", o);
     p.sc = r.encounter.scattering;
     p.asymptote_error = r.encounter.asymptote_error;
     p.start_distance_error = r.encounter.start_distance_error;

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -240,21 +241,13 @@ class TrajectoryFile {
 
 /// The start distance's part of an encounter's error: the thesis's scene at 2L with the same asymptotic
 /// data, run to its departure by auto (twice_as_far_tol); not known for a scene file's states.
-void add_start_distance(Encounter& e, const po::variables_map& vm, const SceneOptions& so, const RunPlan& plan,
-                        const Body& body, double numerical) {
-  const bool material = body.p.B == 0.0;
-  if (vm.count("scene")) {
-    no_start_distance_error(e, material, numerical, "the scene file gives states, not the thesis's start distance L");
-    return;
-  }
-  if (material) {
-    add_start_distance_error(e, nullptr, true, numerical);
-    return;
-  }
-  const Scene far = thesis_scene(thesis_params_twice_as_far(so.params, so.b, so.v_inf, so.arrival_phase));
-  const EncounterResult r =
-      encounter_twice_as_far(far, twice_as_far_tol(plan.search ? std::optional<double>(plan.tol) : std::nullopt));
-  add_start_distance_error(e, &r, material, numerical);
+void add_start_distance_of(Encounter& e, const po::variables_map& vm, const SceneOptions& so, const RunPlan& plan,
+                           const Body& body, double numerical) {
+  std::function<Scene()> far;
+  if (!vm.count("scene"))
+    far = [&] { return thesis_scene(thesis_params_twice_as_far(so.params, so.b, so.v_inf, so.arrival_phase)); };
+  add_start_distance(e, body, far, plan.search ? std::optional<double>(plan.tol) : std::nullopt, numerical,
+                     "the scene file gives states, not the thesis's start distance L");
 }
 
 /// One body's run and, with --reference, the reference state at its end.
@@ -479,7 +472,7 @@ int cmd_simulate(int argc, char** argv) {
       enc[b] = measure_encounter(scene.bodies[b], scene.centres, runs[b].run.run, runs[b].run.events, o.body_events[b]);
       if (enc[b]->outcome != Outcome::ok)
         throw Error("body '" + scene.bodies[b].name + "': " + enc[b]->reason + "; no output written");
-      add_start_distance(*enc[b], vm, o.so, plan, scene.bodies[b], runs[b].run.error.value);
+      add_start_distance_of(*enc[b], vm, o.so, plan, scene.bodies[b], runs[b].run.error.value);
     }
   if (file) file->commit();
   if (o.json) {

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -173,6 +174,18 @@ EncounterResult encounter_twice_as_far(const Scene& far, double tol, const Optio
 void no_start_distance_error(Encounter& e, bool material, double numerical, const std::string& why) {
   add_start_distance_error(e, nullptr, material, numerical);
   if (!material) e.start_distance_basis = "not known: " + why;
+}
+
+long add_start_distance(Encounter& e, const Body& body, const std::function<Scene()>& far, std::optional<double> tol,
+                        double numerical, const std::string& no_far, const Options& options) {
+  const bool material = body.p.B == 0.0;
+  if (material || !far) {
+    no_start_distance_error(e, material, numerical, no_far);
+    return 0;
+  }
+  const EncounterResult r = encounter_twice_as_far(far(), twice_as_far_tol(tol), options);
+  add_start_distance_error(e, &r, false, numerical);
+  return r.run.total_force_evals();
 }
 
 SceneParams thesis_params_twice_as_far(SceneParams solved, double b, double v_inf, double arrival_phase) {

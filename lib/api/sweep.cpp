@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <functional>
 #include <exception>
 #include <map>
 #include <mutex>
@@ -150,27 +151,22 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
 /// The start distance's part of a row's encounter error: the same grid point with the start distance L
 /// doubled (an axis of L doubled too), its asymptotic data solved again, run to its departure by auto
 /// (twice_as_far_tol).
-void add_start_distance(Encounter& e, const SweepSpec& spec, const std::vector<double>& point, const Body& body,
-                        double numerical) {
-  if (body.p.B == 0.0) {
-    add_start_distance_error(e, nullptr, true, numerical);
-    return;
-  }
-  if (!spec.scene_text.empty()) {
-    no_start_distance_error(e, false, numerical, "a scene file's body has no thesis start distance to double");
-    return;
-  }
-  SweepSpec far = spec;
-  far.base.start.L *= 2.0;
-  std::vector<double> at = point;
-  for (std::size_t a = 0; a < spec.axes.size(); ++a)
-    if (spec.axes[a].param == "L") at[a] *= 2.0;
-  const Scene scene = thesis_scene(point_params(far, at));
+void add_row_start_distance(Encounter& e, const SweepSpec& spec, const std::vector<double>& point, const Body& body,
+                            double numerical) {
+  std::function<Scene()> far;
+  if (spec.scene_text.empty())
+    far = [&] {
+      SweepSpec twice = spec;
+      twice.base.start.L *= 2.0;
+      std::vector<double> at = point;
+      for (std::size_t a = 0; a < spec.axes.size(); ++a)
+        if (spec.axes[a].param == "L") at[a] *= 2.0;
+      return thesis_scene(point_params(twice, at));
+    };
   Options o;
   o.track_invariants = false;
   o.cancel = spec.cancel;
-  const EncounterResult r = encounter_twice_as_far(scene, twice_as_far_tol(spec.accuracy), o);
-  add_start_distance_error(e, &r, false, numerical);
+  add_start_distance(e, body, far, spec.accuracy, numerical, "a scene file's body has no thesis start distance to double", o);
 }
 
 /// The row of a run with its encounter (SweepSpec::scattering): integrate_body with the encounter's
@@ -183,7 +179,7 @@ SweepRow encounter_row(SweepRow row, const MethodInfo& method, const Scene& scen
   BodyResult r = integrate_body(body, scene.centres, &method, how, options);
   if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return result_row(std::move(row), std::move(r));
   Encounter e = measure_encounter(body, scene.centres, r.run, r.events, options.events);
-  if (e.outcome == Outcome::ok && r.outcome == Outcome::ok) add_start_distance(e, spec, row.point, body, r.error.value);
+  if (e.outcome == Outcome::ok && r.outcome == Outcome::ok) add_row_start_distance(e, spec, row.point, body, r.error.value);
   row.r_min = e.r_min;
   row.t_min = e.t_min;
   row.asymptote_error = e.asymptote_error;

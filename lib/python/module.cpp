@@ -532,18 +532,18 @@ py::dict encounter_py(const Scene& scene, const std::string& method, double tol,
   // The start distance's part of the error (bodypoint.hpp, add_start_distance_error): the thesis's scene
   // again from 2L; a scene given by its states has no L to double.
   const Body& body = scene.bodies.front();
-  if (r.encounter.outcome == Outcome::ok && (body.p.B == 0.0 || !thesis)) {
-    no_start_distance_error(r.encounter, body.p.B == 0.0, r.run.error.value,
-                            "the scene gives states, not the thesis's start distance L (thesis_scene() does)");
-  } else if (r.encounter.outcome == Outcome::ok) {
-    const Scene far = thesis_from(twice_as_far(*thesis));
-    EncounterResult f;
+  if (r.encounter.outcome == Outcome::ok) {
+    // The far scene is made here, under the GIL (from the thesis's parameters, a Python dict).
+    std::optional<Scene> far_scene;
+    if (thesis && body.p.B != 0.0) far_scene = thesis_from(twice_as_far(*thesis));
+    std::function<Scene()> far;
+    if (far_scene) far = [&far_scene] { return *far_scene; };
     {
       py::gil_scoped_release free;
-      f = encounter_twice_as_far(far, twice_as_far_tol(tol), o);
+      add_start_distance(r.encounter, body, far, tol, r.run.error.value,
+                         "the scene gives states, not the thesis's start distance L (thesis_scene() does)", o);
     }
     stop.raise();
-    add_start_distance_error(r.encounter, &f, false, r.run.error.value);
   }
   const Advance how = Accuracy{tol, r.run.run.t_end};
   return to_py(encounter_record(r.encounter).record("run", body_record(r.run, how, r.events)));

@@ -44,6 +44,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string>
@@ -338,6 +339,13 @@ EncounterResult encounter_twice_as_far(const Scene& far, double tol, const Optio
 /// The same when the start distance cannot be doubled (a scene given by its states): the part is not
 /// known (`why`), nor is the total, for B != 0.
 void no_start_distance_error(Encounter& e, bool material, double numerical, const std::string& why);
+/// The start distance's part of `e`'s error, one rule for every caller (simulate, sweep, the scattering
+/// study, Python): exact for a material point; not known (`no_far` says why) where the scene has no
+/// thesis start distance to double (`far` empty); otherwise the encounter from `far()` (the thesis's
+/// scene at thesis_params_twice_as_far) run by auto at twice_as_far_tol(tol). Returns the force
+/// evaluations of that second encounter (0 where none ran).
+long add_start_distance(Encounter& e, const Body& body, const std::function<Scene()>& far, std::optional<double> tol,
+                        double numerical, const std::string& no_far, const Options& options = {});
 /// The thesis's parameters `solved` (d, K1, phase solved for the asymptotic data) with the start distance L
 /// doubled and the data b, v_inf, arrival_phase (NaN: not given, d, K1, phase kept) solved for again.
 SceneParams thesis_params_twice_as_far(SceneParams solved, double b, double v_inf, double arrival_phase);
