@@ -129,6 +129,8 @@ constexpr double kCoarseTrusted = 1e-5;
 /// difference over 2^p - 1 was more than 3x low in 49 of the ladder's runs of order >= 6 and over
 /// 2^4 - 1 in 3; at order <= 4 Richardson's factor is kept.
 constexpr int kCoarseMaxOrder = 4;
+/// Below a ratio of 2 (a time-transformed run's coarse companion at 1.47 ds) the order is taken as at
+/// most this: with 4 there, 16 of the ladder's estimates were more than 3x low, with 2, 10.
 constexpr int kCoarseMaxOrderBelow2 = 2;
 /// The coarse companion's steps are kept this far inside the flags' limits (a step turning the spin by
 /// pi, the direction to a centre by pi/2) that the run's own steps, scaled by the ratio, predict: a
