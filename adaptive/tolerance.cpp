@@ -21,6 +21,7 @@
 #include "bodypoint/adaptive/tolerance.hpp"
 
 #include "bodypoint/adaptive/methods.hpp"
+#include "bodypoint/adaptive/richardson.hpp"
 #include "bodypoint/field.hpp"
 #include "bodypoint/invariants.hpp"
 
@@ -381,7 +382,7 @@ class Search {
   /// The same with the delivered run's estimate `current`, which the companion's can only raise.
   bool verified_at(std::vector<Level>& rungs, double h_c, double current) {
     Level half = run_at(0.5 * rungs.back().h, h_c, true);
-    const double e = state_distance(rungs.back().run.final, half.run.final) / (1.0 - std::pow(0.5, p_));
+    const double e = coarser_run_error(state_distance(rungs.back().run.final, half.run.final), 2.0, p_);
     if (e + std::max(floor_, 0.0) <= kAccept * tol_) {
       estimate_ = last_estimate_ = std::max(current, e + std::max(floor_, 0.0));
       return true;
@@ -438,7 +439,7 @@ class Search {
 
   /// Richardson's estimate of the finer run's error from a pair at steps h_c > h_f, order p.
   [[nodiscard]] double pair_estimate(const Level& c, const Level& f) const {
-    return state_distance(c.run.final, f.run.final) / (std::pow(c.h / f.h, p_) - 1.0);
+    return finer_run_error(state_distance(c.run.final, f.run.final), c.h / f.h, p_);
   }
 
   /// Methods without an order p (ks: exact in fictitious time; far-ip: spectral in its step, its error

@@ -2,6 +2,7 @@
 #include "estimate.hpp"
 
 #include "bodypoint/adaptive/methods.hpp"
+#include "bodypoint/adaptive/richardson.hpp"
 #include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/detail/run_support.hpp"
 #include "bodypoint/field.hpp"
@@ -82,7 +83,7 @@ std::optional<Companion> companion_of(const MethodInfo& m, const Body& body, con
                                       std::string& none) {
   const double ratio = std::pow(kStepRatio, level);
   const int p = fixed_order(m, body);
-  const double richardson = 1.0 / (1.0 - std::pow(ratio, -p));
+  const double richardson = adaptive::coarser_run_error(1.0, ratio, p);  // times what the two runs differ by
   const double fall = std::min(kMaxFall, std::pow(kStepRatio, p - kOrderSlack));
   if (const auto* f = std::get_if<FixedSteps>(&how)) {
     if (static_cast<double>(f->steps) * ratio > 1e15) {
@@ -291,7 +292,7 @@ std::optional<ErrorEstimate> coarse_estimate(const MethodInfo& m, const Body& bo
   const int p = std::min(c.ratio < kStepRatio ? kCoarseMaxOrderBelow2 : kCoarseMaxOrder, fixed_order(m, body));
   const double d = adaptive::state_distance(run, coarse);
   ErrorEstimate e;
-  e.value = d / (std::pow(c.ratio, p) - 1.0);
+  e.value = adaptive::finer_run_error(d, c.ratio, p);
   const bool h = std::holds_alternative<FixedSteps>(c.how);
   const std::string step = h ? "h" : "ds";
   e.basis = "companion run at " + (c.ratio == kStepRatio ? "2" + step : step + " x " + short_number(c.ratio)) +
@@ -441,7 +442,7 @@ ErrorEstimate fixed_step_estimate(const MethodInfo& m, const Body& body, const S
   const int p = fixed_order(m, body);
   e.basis = fixed_basis(p, kStepRatio);
   if (companion.R.allFinite() && companion.v.allFinite())
-    e.value = 1.0 / (1.0 - std::pow(kStepRatio, -p)) * adaptive::state_distance(run, companion);  // as companion_of
+    e.value = adaptive::coarser_run_error(adaptive::state_distance(run, companion), kStepRatio, p);
   else e.basis = "the " + e.basis + " did not end as the run did";
   return e;
 }
