@@ -167,47 +167,58 @@ State reference_of(const NamedScene& ns, std::ostringstream& refs) {
 }
 
 /// One method's ladder on one scene: halving ds (time-transformed) or h, or tolerances divided by 10,
-/// until two runs in a row are below the floor or a run exceeds the budget. A method that refuses the
-/// scene (MethodInfo::check: ks on a body-point, logh with an attracting centre) and a configuration
-/// that fails (a fictitious step too coarse for the encounter) are left out, with a note.
-void run_ladder(const NamedScene& ns, const MethodInfo& m, const State& ref, const Options& o, std::vector<Row>& rows) {
-  const Body& body = ns.scene.bodies.front();
-  if (const std::string why = refusal(m, body, ns.scene.centres); !why.empty()) {
-    std::cerr << "  " << ns.name << " " << m.name << ": refused (" << why << ")\n";
-    return;
+/// until two runs in a row are below the floor or a run exceeds the budget. A configuration that fails (a
+/// fictitious step too coarse for the encounter) is left out, with a note. One kind of ladder per method:
+/// an exact flow's single configuration, fictitious steps, tolerances per step, fixed steps.
+class Ladder {
+ public:
+  Ladder(const NamedScene& ns, const MethodInfo& m, const State& ref, const Options& o, std::vector<Row>& rows)
+      : ns_(ns), m_(m), body_(ns.scene.bodies.front()), ref_(ref), o_(o), rows_(rows),
+        // A peer's ladder has no evaluation cap but in --quick: it ends at its tolerance 1e-14, below the
+        // floor or at its round-off floor, so a peer that delivers a target is never cut to "-" by a budget.
+        capped_(!is_peer(m) || o.cap_peers) {}
+
+  void run() {
+    if (m_.traits.exact_in_fictitious_time) exact();
+    else if (is_time_transformed(m_)) fictitious();
+    else if (is_step_controlled(m_)) tolerances();
+    else fixed();
   }
-  auto try_measure = [&](double h, double tol, Row& row) {
+
+ private:
+  /// Measures m at step h or tolerance tol into `row`; false (with a note) where the run fails.
+  bool try_measure(double h, double tol, Row& row) {
     try {
-      row = measure(ns, m, body, ref, h, tol);
+      row = measure(ns_, m_, body_, ref_, h, tol);
       return true;
     } catch (const Error& e) {
-      std::cerr << "  " << ns.name << " " << m.name << (tol > 0 ? " tol=" : " h=") << fmt(tol > 0 ? tol : h)
+      std::cerr << "  " << ns_.name << " " << m_.name << (tol > 0 ? " tol=" : " h=") << fmt(tol > 0 ? tol : h)
                 << ": skipped (" << e.what() << ")\n";
       return false;
     }
-  };
-  int below = 0, failures = 0;
-  // A peer's ladder has no evaluation cap but in --quick: it ends at its tolerance 1e-14, below the
-  // floor or at its round-off floor, so a peer that delivers a target is never cut to "-" by a budget.
-  const bool capped = !is_peer(m) || o.cap_peers;
-  auto keep = [&](const Row& r) {  // true: the ladder goes on
-    rows.push_back(r);
-    below = r.err_rel < o.floor ? below + 1 : 0;
-    return below < 2 && (!capped || static_cast<double>(r.force_evals) <= o.max_evals);
-  };
-  Row r;
-  if (m.traits.exact_in_fictitious_time) {
-    // Exact in its fictitious time: one configuration, the run of one fictitious step to t_end (the
-    // first ds, doubled from 0.2, whose run takes a single step); a ladder would time one answer many times.
+  }
+  /// Keeps the row; true while the ladder goes on (not two rows below the floor, not over the budget).
+  bool keep(const Row& r) {
+    rows_.push_back(r);
+    below_ = r.err_rel < o_.floor ? below_ + 1 : 0;
+    return below_ < 2 && (!capped_ || static_cast<double>(r.force_evals) <= o_.max_evals);
+  }
+  /// Exact in its fictitious time: one configuration, the run of one fictitious step to t_end (the first
+  /// ds, doubled from 0.2, whose run takes a single step); a ladder would time one answer many times.
+  void exact() {
+    Row r;
     for (double ds = 0.2; ds <= 1e6; ds *= 2) {
       if (!try_measure(ds, 0, r)) break;
-      const RunResult one = run_or_throw(m, body, ns.scene.centres, FictitiousSteps{ds, EndTime{ns.t_end}}, unobserved());
+      const RunResult one = run_or_throw(m_, body_, ns_.scene.centres, FictitiousSteps{ds, EndTime{ns_.t_end}}, unobserved());
       if (one.steps <= 1) {
-        rows.push_back(r);
+        rows_.push_back(r);
         break;
       }
     }
-  } else if (is_time_transformed(m)) {
+  }
+  void fictitious() {
+    Row r;
+    int failures = 0;
     for (double ds = 0.2; ds >= 1e-5; ds /= 2) {
       if (!try_measure(ds, 0, r)) {
         if (++failures > 2) break;  // too coarse for the encounter three times
@@ -215,7 +226,9 @@ void run_ladder(const NamedScene& ns, const MethodInfo& m, const State& ref, con
       }
       if (!keep(r)) break;
     }
-  } else if (is_step_controlled(m)) {
+  }
+  void tolerances() {
+    Row r;
     double best = std::numeric_limits<double>::infinity();
     int stalled = 0;  // decades in a row that did not halve the best error: the peer's round-off floor
     for (double tol = 1e-3; tol >= 1e-14; tol /= 10) {
@@ -224,21 +237,42 @@ void run_ladder(const NamedScene& ns, const MethodInfo& m, const State& ref, con
       best = std::min(best, r.err_rel);
       if (stalled >= kPeerStallDecades) break;
     }
-  } else {
-    // far-ip's step is tens of radians of spin (far_field.hpp): its ladder starts at kFarFieldFirstStep,
-    // and a step too long for the scene's closest approach (its iteration diverges) is left out.
-    const bool far = m.traits.search == SearchStrategy::field_pair;
-    for (double h = far ? kFarFieldFirstStep : 0.5; ns.t_end / h * std::max(1, m.evals_per_step) <= o.max_evals; h /= 2) {
+  }
+  /// far-ip's step is tens of radians of spin (far_field.hpp): its ladder starts at kFarFieldFirstStep,
+  /// and a step too long for the scene's closest approach (its iteration diverges) is left out.
+  void fixed() {
+    Row r;
+    const bool far = m_.traits.search == SearchStrategy::field_pair;
+    for (double h = far ? kFarFieldFirstStep : 0.5; ns_.t_end / h * std::max(1, m_.evals_per_step) <= o_.max_evals; h /= 2) {
       if (far) {
         if (!try_measure(h, 0, r)) continue;
         if (!keep(r)) break;
         continue;
       }
-      rows.push_back(measure(ns, m, body, ref, h, 0));
-      below = rows.back().err_rel < o.floor ? below + 1 : 0;
-      if (below >= 2) break;
+      rows_.push_back(measure(ns_, m_, body_, ref_, h, 0));
+      below_ = rows_.back().err_rel < o_.floor ? below_ + 1 : 0;
+      if (below_ >= 2) break;
     }
   }
+
+  const NamedScene& ns_;
+  const MethodInfo& m_;
+  const Body& body_;
+  const State& ref_;
+  const Options& o_;
+  std::vector<Row>& rows_;
+  bool capped_;
+  int below_ = 0;
+};
+
+/// One method's ladder on one scene (Ladder); a method that refuses the scene (MethodInfo::check: ks on a
+/// body-point, logh with an attracting centre) is left out, with a note.
+void run_ladder(const NamedScene& ns, const MethodInfo& m, const State& ref, const Options& o, std::vector<Row>& rows) {
+  if (const std::string why = refusal(m, ns.scene.bodies.front(), ns.scene.centres); !why.empty()) {
+    std::cerr << "  " << ns.name << " " << m.name << ": refused (" << why << ")\n";
+    return;
+  }
+  Ladder(ns, m, ref, o, rows).run();
 }
 
 void write_rows(std::ostream& os, const std::vector<Row>& rows, const std::string& refs, const Options& o) {

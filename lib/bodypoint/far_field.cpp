@@ -77,14 +77,11 @@ Vec3 Stepper::force(const Vec3& R, Eigen::Matrix3d& jac, double& nearest) const 
   return F;
 }
 
-void Stepper::step(Momenta& x, double h) {
-  const double k1 = x.K1.norm();
-  if (!(k1 > 0.0)) throw Error("far-ip follows the drift along K1 and needs |K1| > 0 (here the body is at rest)");
-  const double angle = std::abs(spin_) * k1 * h;  // spin turned by the step, radians
+int Stepper::points_of_step(const Momenta& x, double h) const {
+  const double angle = std::abs(spin_) * x.K1.norm() * h;  // spin turned by the step, radians
   // The helix's radius over the closest the step comes to a centre: the guiding centre's straight path
   // over the step (the force bends it little where the step is long), less the radius.
   const Helix helix = helix_of(p_, x);
-  const double speed = ((p_.J * x.K1 - p_.B * x.K2) * inv_D_).norm();
   double closest = std::numeric_limits<double>::infinity();
   for (const Centre& k : centres_)
     if (k.A != 0.0) closest = std::min(closest, path_distance(helix, k.c, h) - helix.radius);  // A = 0: no field
@@ -93,10 +90,63 @@ void Stepper::step(Momenta& x, double h) {
     throw Error("far-ip: a step of h = " + detail::short_number(h) + " at |R| = " + detail::short_number(x.R.norm()) +
                 " is too long for the spin there: it turns it by " + detail::short_number(angle) + " rad, more than " +
                 std::to_string(kMaxPoints) + " points resolve; take a smaller step");
+  return n;
+}
+
+Stepper::Drifted Stepper::drift(const Vec3& yR, const Vec3& K1, const Vec3& yK2, double tau) const {
+  Drifted z;
+  z.kk = K1.norm();
+  z.u = K1 / z.kk;
+  const double theta = spin_ * z.kk * tau;  // y's K2 is K2 turned back by theta about u
+  z.s = std::sin(theta);
+  z.c = std::cos(theta);
+  z.uxy = z.u.cross(yK2);
+  z.par = z.u.dot(yK2);
+  z.K2 = z.c * yK2 - z.s * z.uxy + (z.par * (1.0 - z.c)) * z.u;
+  const Vec3 Vg = (p_.J * K1 - (p_.B * z.par) * z.u) * inv_D_;  // the guiding centre's velocity
+  z.d = z.K2 - yK2;
+  z.R = yR + tau * Vg - K1.cross(z.d) / (z.kk * z.kk);
+  return z;
+}
+
+void Stepper::pulled_back_field(const Nodes& nd, int N, double h, bool evaluate, double& nearest, double& strongest) {
+  for (int j = 0; j < N; ++j) {
+    const double tau = h * nd.sigma(j);
+    const Vec3 yR = Y_.block<1, 3>(j, 0).transpose(), K1 = Y_.block<1, 3>(j, 3).transpose(),
+               yK2 = Y_.block<1, 3>(j, 6).transpose();
+    const Drifted z = drift(yR, K1, yK2, tau);
+    Vec3 F;
+    if (evaluate) {
+      Eigen::Matrix3d jac;
+      F = force(z.R, jac, nearest);
+      strongest = std::max(strongest, F.norm());
+      lin_.block<1, 3>(j, 0) = z.R.transpose();
+      lin_.block<1, 3>(j, 3) = F.transpose();
+      lin_.block<1, 9>(j, 6) = Eigen::Map<const Eigen::Matrix<double, 1, 9>>(jac.data());
+    } else {
+      const Eigen::Matrix<double, 1, 9> stored = lin_.block<1, 9>(j, 6);
+      const Eigen::Map<const Eigen::Matrix3d> jac(stored.data());
+      F = lin_.block<1, 3>(j, 3).transpose() + jac * (z.R - lin_.block<1, 3>(j, 0).transpose());
+    }
+    const double uF = z.u.dot(F);
+    const Vec3 du = (F - uF * z.u) / z.kk;
+    const Vec3 dK2 = (spin_ * tau * uF) * z.uxy + z.s * du.cross(z.K2) + (1.0 - z.c) * (z.par * du + du.dot(z.K2) * z.u);
+    const Vec3 dVg = (p_.J * F - p_.B * (du.dot(z.K2) * z.u + z.par * du)) * inv_D_;
+    const double k2 = z.kk * z.kk;
+    const Vec3 dR = -tau * dVg + (F.cross(z.d) - K1.cross(dK2)) / k2 - (2.0 * K1.dot(F) / (k2 * k2)) * K1.cross(z.d);
+    G_.block<1, 3>(j, 0) = dR.transpose();
+    G_.block<1, 3>(j, 3) = F.transpose();
+    G_.block<1, 3>(j, 6) = dK2.transpose();
+  }
+}
+
+void Stepper::step(Momenta& x, double h) {
+  const double k1 = x.K1.norm();
+  if (!(k1 > 0.0)) throw Error("far-ip follows the drift along K1 and needs |K1| > 0 (here the body is at rest)");
+  const int n = points_of_step(x, h);
   const Nodes& nd = nodes_for(n);
   const int N = n + 1;
   points = N;
-
   if (Y_.rows() < N) {
     Y_.resize(N, 9);
     G_.resize(N, 9);
@@ -104,72 +154,23 @@ void Stepper::step(Momenta& x, double h) {
     lin_.resize(N, 15);
   }
   auto Y = Y_.topRows(N);
-  auto G = G_.topRows(N);
   auto next = next_.topRows(N);
   Eigen::Matrix<double, 1, 9> y0;
   y0 << x.R.transpose(), x.K1.transpose(), x.K2.transpose();
   Y = y0.replicate(N, 1);
   // The change of an iteration is measured per part against that part's size: R against |R| and the
   // distance the step travels, K1 and K2 against their lengths.
+  const double speed = ((p_.J * x.K1 - p_.B * x.K2) * inv_D_).norm();
   const double travel = x.R.norm() + h * speed;
   const double scale[3] = {travel > 0.0 ? travel : 1.0, k1, x.K2.norm() > 0.0 ? x.K2.norm() : 1.0};
-
-  // The drifted state at tau from y = (yR, K1, yK2); returns R and K2 and what the pull-back reuses.
-  struct Drifted {
-    Vec3 R, K2, u, uxy, d;
-    double kk, par, s, c;
-  };
-  auto drift = [this](const Vec3& yR, const Vec3& K1, const Vec3& yK2, double tau) {
-    Drifted z;
-    z.kk = K1.norm();
-    z.u = K1 / z.kk;
-    const double theta = spin_ * z.kk * tau;  // y's K2 is K2 turned back by theta about u
-    z.s = std::sin(theta);
-    z.c = std::cos(theta);
-    z.uxy = z.u.cross(yK2);
-    z.par = z.u.dot(yK2);
-    z.K2 = z.c * yK2 - z.s * z.uxy + (z.par * (1.0 - z.c)) * z.u;
-    const Vec3 Vg = (p_.J * K1 - (p_.B * z.par) * z.u) * inv_D_;  // the guiding centre's velocity
-    z.d = z.K2 - yK2;
-    z.R = yR + tau * Vg - K1.cross(z.d) / (z.kk * z.kk);
-    return z;
-  };
-
   double previous = std::numeric_limits<double>::infinity();
   bool evaluate = true;  // false: the force linearised about the last evaluated points (kLinearRemainder)
   for (int it = 1;; ++it) {
     double nearest = std::numeric_limits<double>::infinity(), strongest = 0.0;
-    for (int j = 0; j < N; ++j) {
-      const double tau = h * nd.sigma(j);
-      const Vec3 yR = Y.block<1, 3>(j, 0).transpose(), K1 = Y.block<1, 3>(j, 3).transpose(),
-                 yK2 = Y.block<1, 3>(j, 6).transpose();
-      const Drifted z = drift(yR, K1, yK2, tau);
-      Vec3 F;
-      if (evaluate) {
-        Eigen::Matrix3d jac;
-        F = force(z.R, jac, nearest);
-        strongest = std::max(strongest, F.norm());
-        lin_.block<1, 3>(j, 0) = z.R.transpose();
-        lin_.block<1, 3>(j, 3) = F.transpose();
-        lin_.block<1, 9>(j, 6) = Eigen::Map<const Eigen::Matrix<double, 1, 9>>(jac.data());
-      } else {
-        const Eigen::Matrix<double, 1, 9> stored = lin_.block<1, 9>(j, 6);
-        const Eigen::Map<const Eigen::Matrix3d> jac(stored.data());
-        F = lin_.block<1, 3>(j, 3).transpose() + jac * (z.R - lin_.block<1, 3>(j, 0).transpose());
-      }
-      const double uF = z.u.dot(F);
-      const Vec3 du = (F - uF * z.u) / z.kk;
-      const Vec3 dK2 = (spin_ * tau * uF) * z.uxy + z.s * du.cross(z.K2) + (1.0 - z.c) * (z.par * du + du.dot(z.K2) * z.u);
-      const Vec3 dVg = (p_.J * F - p_.B * (du.dot(z.K2) * z.u + z.par * du)) * inv_D_;
-      const double k2 = z.kk * z.kk;
-      const Vec3 dR = -tau * dVg + (F.cross(z.d) - K1.cross(dK2)) / k2 - (2.0 * K1.dot(F) / (k2 * k2)) * K1.cross(z.d);
-      G.block<1, 3>(j, 0) = dR.transpose();
-      G.block<1, 3>(j, 3) = F.transpose();
-      G.block<1, 3>(j, 6) = dK2.transpose();
-    }
+    pulled_back_field(nd, N, h, evaluate, nearest, strongest);
     if (evaluate) evals += N;
     ++iterations;
-    next.noalias() = h * (nd.Q * G);
+    next.noalias() = h * (nd.Q * G_.topRows(N));
     next.rowwise() += y0;
     double change = 0.0;
     for (int part = 0; part < 3; ++part)

@@ -100,6 +100,20 @@ class Stepper {
   /// F at R, its Jacobian into `jac`, and the distance to the nearest centre folded into `nearest`.
   Vec3 force(const Vec3& R, Eigen::Matrix3d& jac, double& nearest) const;
   const Nodes& nodes_for(int n);
+  /// The Chebyshev degree n of a step h from x (points_for: the spin it turns, its closest pass); throws
+  /// when more than kMaxPoints would be needed.
+  int points_of_step(const Momenta& x, double h) const;
+  /// The state drifted (the exact flow of the kinetic part) to tau from the pulled-back y = (yR, K1, yK2),
+  /// with what the pull-back of the force reuses.
+  struct Drifted {
+    Vec3 R, K2, u, uxy, d;
+    double kk, par, s, c;
+  };
+  Drifted drift(const Vec3& yR, const Vec3& K1, const Vec3& yK2, double tau) const;
+  /// The pulled-back field G at the N points of the iterate Y (rows of Y_, G_): the force evaluated with its
+  /// Jacobian (stored in lin_) where `evaluate`, otherwise linearised about the last evaluated points;
+  /// `nearest` and `strongest` fold in the nearest centre and the largest force met.
+  void pulled_back_field(const Nodes& nd, int N, double h, bool evaluate, double& nearest, double& strongest);
 
   using Block = Eigen::Matrix<double, Eigen::Dynamic, 9>;  ///< a row per point: y_R, y_K1, y_K2
   BodyPoint p_;
