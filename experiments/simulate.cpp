@@ -416,6 +416,21 @@ void report_text(const std::vector<SimulatedBody>& runs, const Scene& scene, con
   }
 }
 
+/// The events asked for (--event, --stop) and each body's: with --scattering, those of its encounter too
+/// (closest approach, and with no end given the departure that ends the run).
+void add_events(SimulateOptions& o, const Scene& scene, bool to_departure) {
+  for (const std::string& text : o.event_text) o.events.push_back(parse_event(text));
+  for (const std::string& text : o.stop_text) {
+    o.events.push_back(parse_event(text));
+    o.events.back().stop = true;
+  }
+  for (const Body& body : scene.bodies) {
+    Options with{};
+    with.events = o.events;
+    o.body_events.push_back(o.scattering ? encounter_options(body, scene.centres, with, to_departure).events : o.events);
+  }
+}
+
 }  // namespace
 
 int cmd_simulate(int argc, char** argv) {
@@ -443,16 +458,7 @@ int cmd_simulate(int argc, char** argv) {
   }
   if (plan.automatic) o.method_name = "auto";
   apply_output_options(vm, o, scene, plan);
-  for (const std::string& text : o.event_text) o.events.push_back(parse_event(text));
-  for (const std::string& text : o.stop_text) {
-    o.events.push_back(parse_event(text));
-    o.events.back().stop = true;
-  }
-  for (const Body& body : scene.bodies) {
-    Options with{};
-    with.events = o.events;
-    o.body_events.push_back(o.scattering ? encounter_options(body, scene.centres, with, to_departure).events : o.events);
-  }
+  add_events(o, scene, to_departure);
   if (o.dry_run) {
     print_dry_run(plan, o.method_name, scene);
     return 0;

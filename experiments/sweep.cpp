@@ -340,15 +340,10 @@ void apply_steps(const po::variables_map& vm, const StepOptions& st, SweepSpec& 
   }
 }
 
-SweepJob parse_sweep(int argc, char** argv, bool& help) {
-  SceneOptions so;
-  StepOptions st;
-  SweepJob job;
-  std::string methods_arg = "fixed", shard;
-  std::vector<std::string> grid;
-  po::options_description desc("bodypoint sweep");
-  add_scene_options(desc, so);
-  add_step_options(desc, st);
+/// What the sweep command takes beyond the scene and the steps: the axes, the methods, the accuracy,
+/// the output and the sharding; the text options into `methods`, `grid` and `shard`.
+void add_sweep_options(po::options_description& desc, SweepJob& job, std::string& methods_arg,
+                       std::vector<std::string>& grid, std::string& shard) {
   desc.add_options()
       ("param", po::value<std::string>(), "parameter to vary: d, L, h, Kx, Kz, K1, A, B, J, m, or the asymptotic data b "
        "(impact parameter; d is solved for it), v_inf (speed at infinity; K1 is solved for it) and arrival_phase; "
@@ -373,16 +368,11 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
        "deflection, impact parameter b, v_inf, time delay, K1 and spin turn (columns after reason)")
       ("no-simd", po::bool_switch(&job.no_simd), "run every trajectory alone instead of in batches of vector lanes (same numbers, slower; for comparison)")
       ("shard", po::value(&shard), "K/N: run only shard K of N (every method on every N-th grid point, staggered) and write a rows file for 'bodypoint merge'");
-  po::variables_map vm;
-  help = !parse(argc, argv, desc, vm,
-                "usage: bodypoint sweep (--param P (--from A --to B --step S | --log --from A --to B --points N | --values a,b,c)"
-                " | --grid P=... --grid Q=...) [options]\n"
-                "One CSV row per (grid point, method): the deviations of the invariants, the final position and the cost.");
-  if (help) return job;
-  job.spec.axes = parse_axes(vm, grid);
-  if (vm.count("shard")) parse_shard(shard, job);
-  if (job.resume && job.out.empty()) throw Error("--resume needs --out (the journal is <out>.journal)");
-  if (job.sharded && job.out.empty()) throw Error("--shard needs --out (the shard's rows file)");
+}
+
+/// The sweep's methods, base scene, data and steps from the parsed options: a value given is used or refused.
+void apply_sweep_options(const po::variables_map& vm, SceneOptions& so, StepOptions& st, const std::string& methods_arg,
+                         SweepJob& job) {
   job.spec.methods = methods_named(methods_arg);
   job.spec.base = so.params;
   // A value given is used, or refused: the tolerance per step whatever the methods, d or K1 beside
@@ -402,6 +392,29 @@ SweepJob parse_sweep(int argc, char** argv, bool& help) {
         throw Error("--" + std::string(q.name) + " is a thesis parameter: with --scene, set it in the file or sweep its key");
     job.spec = with_scene_file(std::move(job.spec), read_scene_text(so.scene_file), so.scene_file);
   }
+}
+
+SweepJob parse_sweep(int argc, char** argv, bool& help) {
+  SceneOptions so;
+  StepOptions st;
+  SweepJob job;
+  std::string methods_arg = "fixed", shard;
+  std::vector<std::string> grid;
+  po::options_description desc("bodypoint sweep");
+  add_scene_options(desc, so);
+  add_step_options(desc, st);
+  add_sweep_options(desc, job, methods_arg, grid, shard);
+  po::variables_map vm;
+  help = !parse(argc, argv, desc, vm,
+                "usage: bodypoint sweep (--param P (--from A --to B --step S | --log --from A --to B --points N | --values a,b,c)"
+                " | --grid P=... --grid Q=...) [options]\n"
+                "One CSV row per (grid point, method): the deviations of the invariants, the final position and the cost.");
+  if (help) return job;
+  job.spec.axes = parse_axes(vm, grid);
+  if (vm.count("shard")) parse_shard(shard, job);
+  if (job.resume && job.out.empty()) throw Error("--resume needs --out (the journal is <out>.journal)");
+  if (job.sharded && job.out.empty()) throw Error("--shard needs --out (the shard's rows file)");
+  apply_sweep_options(vm, so, st, methods_arg, job);
   job.command = science_command(argc, argv);
   job.max_seconds = vm["max-seconds"].as<double>();
   return job;

@@ -309,61 +309,60 @@ std::optional<ErrorEstimate> coarse_estimate(const MethodInfo& m, const Body& bo
   return e;
 }
 
-void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Advance& how,
-                    const Options& options, const Rerun& rerun) {
-  ErrorEstimate& e = r.error;
-  if (r.accuracy) {
-    e.value = r.accuracy->err_estimate;
-    e.basis = "the accuracy mode's step search (" + r.accuracy->basis + ")";
-    e.confirmed = true;
-    return;
-  }
-  if (!options.estimate_error) {
-    e.basis = "not asked for (estimate_error off)";
-    return;
-  }
-  if (r.outcome != Outcome::ok && r.outcome != Outcome::unresolved && r.outcome != Outcome::inaccurate) {
-    e.basis = "the run ended " + std::string(outcome_name(r.outcome));
-    return;
-  }
-  if (r.run.stopped && !stopped_by_event(r, options)) {
-    e.basis = "the run was ended early by its sink";
-    return;
-  }
-  const Options o = companion_options(body, centres, how, options);
-  if (estimated_by_coarse(r, body, centres, how, options, o, rerun)) return;
-  // A companion that takes no more steps than the run does not refine it: a time-transformed run whose
-  // steps are cut to land on t_end (one physical step ds/c beyond the whole span), a controlled run whose
-  // tolerance does not bind (its steps grow at the controller's largest rate from the first trial
-  // step: odeint-dopri5 at tol 1e-3 and 1e-4 on a far pass take the same 9 steps, 2.9e-8 off). The
-  // companion is refined until it does, up to kMaxLevels.
-  int level = 1;
-  std::optional<Companion> c;
+namespace {
+
+/// Why a run by step gets no estimate from companions ("" where it gets one): not asked for, a run that
+/// did not end (failed, stopped), a run its sink ended early.
+std::string why_no_companion(const BodyResult& r, const Options& options) {
+  if (!options.estimate_error) return "not asked for (estimate_error off)";
+  if (r.outcome != Outcome::ok && r.outcome != Outcome::unresolved && r.outcome != Outcome::inaccurate)
+    return "the run ended " + std::string(outcome_name(r.outcome));
+  if (r.run.stopped && !stopped_by_event(r, options)) return "the run was ended early by its sink";
+  return "";
+}
+
+/// A finer companion run and its level (h / 2^level).
+struct FineCompanion {
+  Companion c;
   BodyResult x;
-  for (;; ++level) {
-    if (!(c = companion_of(*r.method, body, how, level, e.basis))) return;
-    x = rerun(body, c->how, o);
+  int level;
+};
+
+/// The finer companion of the run r. A companion that takes no more steps than the run does not refine
+/// it: a time-transformed run whose steps are cut to land on t_end (one physical step ds/c beyond the
+/// whole span), a controlled run whose tolerance does not bind (its steps grow at the controller's largest
+/// rate from the first trial step: odeint-dopri5 at tol 1e-3 and 1e-4 on a far pass take the same 9 steps,
+/// 2.9e-8 off). The companion is refined until it does, up to kMaxLevels; nullopt (r.error.basis saying
+/// why, a companion that broke down flagged on r) where there is none.
+std::optional<FineCompanion> finer_companion(BodyResult& r, const Body& body, const Advance& how, const Options& options,
+                                             const Options& o, const Rerun& rerun) {
+  ErrorEstimate& e = r.error;
+  for (int level = 1;; ++level) {
+    std::optional<Companion> c = companion_of(*r.method, body, how, level, e.basis);
+    if (!c) return std::nullopt;
+    BodyResult x = rerun(body, c->how, o);
     e.force_evals += x.total_force_evals();
     e.wall_s += x.run.wall_s;
     if (!ended_alike(r, options, x, o)) {
       e.basis = "the " + c->basis + " did not end as the run did" + (x.reason.empty() ? "" : " (" + x.reason + ")");
       flag_broken_companion(r, x, c->basis);
-      return;
+      return std::nullopt;
     }
-    if (refines(how, r.run.steps, x.run.steps)) break;
+    if (refines(how, r.run.steps, x.run.steps)) return FineCompanion{std::move(*c), std::move(x), level};
     if (level == kMaxLevels) {
       e.basis = "companions down to the " + c->basis + " took no more steps than the run";
-      return;
+      return std::nullopt;
     }
   }
-  const double d = adaptive::state_distance(r.run.final, x.run.final);
-  e.value = c->factor * d;
-  e.basis = c->basis;
-  add_rounding_floor(e, r, body, how, options, o, rerun);
-  if (r.outcome != Outcome::unresolved && r.run.steps >= kFewSteps) return;
-  // A flagged run: a second companion one level finer tells whether the pair is in the asymptotic regime.
+}
+
+/// A flagged run, or one of fewer than kFewSteps: a second companion one level finer than `f` tells whether
+/// the pair is in the asymptotic regime (confirm), and bounds a run of a few steps.
+void second_companion(BodyResult& r, const Body& body, const Advance& how, const Options& options, const Options& o,
+                      const Rerun& rerun, const FineCompanion& f) {
+  ErrorEstimate& e = r.error;
   std::string none;
-  const std::optional<Companion> next = companion_of(*r.method, body, how, level + 1, none);
+  const std::optional<Companion> next = companion_of(*r.method, body, how, f.level + 1, none);
   if (!next) return;
   const BodyResult y = rerun(body, next->how, o);
   e.force_evals += y.total_force_evals();
@@ -374,7 +373,7 @@ void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& 
     // any asymptotic regime: its estimate is at least what it differs by from the finer companion, plus
     // what that one may still be off by (ttl-verlet at ds = 1 on the material pass: 1 step, 2.1e-5 off,
     // estimated 4.0e-6 from a companion of 2 steps; a second of 3 steps is 1.7e-5 from the run).
-    const double bound = adaptive::state_distance(r.run.final, y.run.final) + adaptive::state_distance(x.run.final, y.run.final);
+    const double bound = adaptive::state_distance(r.run.final, y.run.final) + adaptive::state_distance(f.x.run.final, y.run.final);
     if (bound > e.value) {
       e.value = bound;
       e.basis += "; a run of " + std::to_string(r.run.steps) + " steps: raised to what a second companion one level "
@@ -382,8 +381,33 @@ void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& 
     }
   }
   if (r.outcome != Outcome::unresolved) return;
-  if (alike) confirm(e, c->min_fall, r.run.final, x.run.final, y.run.final);
+  if (alike) confirm(e, f.c.min_fall, r.run.final, f.x.run.final, y.run.final);
   else e.basis += "; a second companion one level finer did not end as the run did";
+}
+
+}  // namespace
+
+void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Advance& how,
+                    const Options& options, const Rerun& rerun) {
+  ErrorEstimate& e = r.error;
+  if (r.accuracy) {
+    e.value = r.accuracy->err_estimate;
+    e.basis = "the accuracy mode's step search (" + r.accuracy->basis + ")";
+    e.confirmed = true;
+    return;
+  }
+  if (std::string why = why_no_companion(r, options); !why.empty()) {
+    e.basis = std::move(why);
+    return;
+  }
+  const Options o = companion_options(body, centres, how, options);
+  if (estimated_by_coarse(r, body, centres, how, options, o, rerun)) return;
+  const std::optional<FineCompanion> f = finer_companion(r, body, how, options, o, rerun);
+  if (!f) return;
+  e.value = f->c.factor * adaptive::state_distance(r.run.final, f->x.run.final);
+  e.basis = f->c.basis;
+  add_rounding_floor(e, r, body, how, options, o, rerun);
+  if (r.outcome == Outcome::unresolved || r.run.steps < kFewSteps) second_companion(r, body, how, options, o, rerun, *f);
 }
 
 bool at_rounding_level(const ErrorEstimate& e) { return e.value < kRoundingLevel; }
