@@ -112,45 +112,65 @@ TEST(Grid, LogAxesAndListsAndBadGrids) {
 
 constexpr const char* kShardSweep = "sweep --grid d=10,30,50 --grid L=100,200 --methods lp-y4,rk4,thesis-euler --steps 2000";
 
+/// The three shards of kShardSweep at h = 5e-3, each written with its own thread count into dir.
+std::vector<std::string> write_shards(const fs::path& dir) {
+  std::vector<std::string> files;
+  for (int k = 1; k <= 3; ++k) {
+    files.push_back((dir / ("s" + std::to_string(k) + ".rows")).string());
+    const auto r = run_cli(std::string(kShardSweep) + " --h 5e-3 --shard " + std::to_string(k) + "/3 --threads " + std::to_string(k) + " --out " + files.back());
+    EXPECT_EQ(r.code, 0) << r.err;
+  }
+  return files;
+}
+
+/// merge refused its inputs: exit code 2, the reason, nothing on standard output.
+void expect_merge_refused(const test::CliResult& r, const std::string& reason) {
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find(reason), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty());
+}
+
 TEST(Shards, MergedShardsEqualTheSingleProcessCsv) {
   const TempDir dir("bp_shards");
   const auto single = run_cli(std::string(kShardSweep) + " --h 5e-3 --threads 1");
   ASSERT_EQ(single.code, 0) << single.err;
-  std::vector<std::string> files;
-  for (int k = 1; k <= 3; ++k) {  // each shard with its own thread count
-    files.push_back((dir.path / ("s" + std::to_string(k) + ".rows")).string());
-    const auto r = run_cli(std::string(kShardSweep) + " --h 5e-3 --shard " + std::to_string(k) + "/3 --threads " + std::to_string(k) + " --out " + files.back());
-    ASSERT_EQ(r.code, 0) << r.err;
-  }
+  const std::vector<std::string> files = write_shards(dir.path);
   const auto merged = run_cli("merge --input " + files[2] + " " + files[0] + " " + files[1]);
   ASSERT_EQ(merged.code, 0) << merged.err;
   EXPECT_EQ(without_wall(merged.out), without_wall(single.out));
   EXPECT_EQ(data_rows(without_wall(merged.out)).size(), 18u);
+}
 
-  const auto missing = run_cli("merge --input " + files[0] + " " + files[2]);
-  EXPECT_NE(missing.err.find("the shards hold 12 of 18 rows"), std::string::npos) << missing.err;
-  const auto twice = run_cli("merge --input " + files[0] + " " + files[1] + " " + files[2] + " " + files[1]);
-  EXPECT_NE(twice.err.find("is in both"), std::string::npos) << twice.err;
+TEST(Shards, MergeRefusesAMissingARepeatedOrAForeignShard) {
+  const TempDir dir("bp_shards_sets");
+  const std::vector<std::string> files = write_shards(dir.path);
+  expect_merge_refused(run_cli("merge --input " + files[0] + " " + files[2]), "the shards hold 12 of 18 rows");
+  expect_merge_refused(run_cli("merge --input " + files[0] + " " + files[1] + " " + files[2] + " " + files[1]), "is in both");
   const std::string other = (dir.path / "other.rows").string();
   ASSERT_EQ(run_cli(std::string(kShardSweep) + " --h 4e-3 --shard 2/3 --out " + other).code, 0);
-  const auto foreign = run_cli("merge --input " + files[0] + " " + other + " " + files[2]);
-  EXPECT_NE(foreign.err.find("is a shard of another sweep"), std::string::npos) << foreign.err;
-  const auto not_rows = run_cli("merge --input " + std::string(BODYPOINT_SOURCE_DIR) + "/README.md");
-  EXPECT_NE(not_rows.err.find("is not a bodypoint rows file"), std::string::npos) << not_rows.err;
+  expect_merge_refused(run_cli("merge --input " + files[0] + " " + other + " " + files[2]), "is a shard of another sweep");
+  expect_merge_refused(run_cli("merge --input " + std::string(BODYPOINT_SOURCE_DIR) + "/README.md"),
+                       "is not a bodypoint rows file");
+  // Inputs that are not regular files are refused at once (a FIFO blocked, /dev/zero read 4 GB).
+  ASSERT_EQ(::mkfifo((dir.path / "fifo").c_str(), 0644), 0);
+  expect_merge_refused(run_cli("merge --input " + (dir.path / "fifo").string()), "is not a regular file");
+}
+
+TEST(Shards, MergeRefusesAnEditedShard) {
+  const TempDir dir("bp_shards_edited");
+  const std::vector<std::string> files = write_shards(dir.path);
   // One flipped digit in a row: its checksum no longer matches, and merge refuses the shard.
   std::string text = read(files[1]);
   const std::size_t at = text.find("\nR\t") + 8;
   text[at] = text[at] == '1' ? '2' : '1';
   std::ofstream(files[1], std::ios::trunc) << text;
-  const auto corrupt = run_cli("merge --input " + files[0] + " " + files[1] + " " + files[2]);
-  EXPECT_NE(corrupt.err.find("torn or corrupt"), std::string::npos) << corrupt.err;
+  expect_merge_refused(run_cli("merge --input " + files[0] + " " + files[1] + " " + files[2]), "torn or corrupt");
   // An edited header line (issue #24: headers carried no checksum and were merged as edited).
   std::string header = read(files[2]);
   header.replace(header.find("\nH\t") + 3, 1, "X");
   const fs::path edited = dir.path / "edited.rows";
   std::ofstream(edited) << header;
-  const auto headed = run_cli("merge --input " + files[0] + " " + edited.string());
-  EXPECT_NE(headed.err.find("torn or corrupt"), std::string::npos) << headed.err;
+  expect_merge_refused(run_cli("merge --input " + files[0] + " " + edited.string()), "torn or corrupt");
   // A shard whose header lines were removed (issue #40: merged into a CSV without its column names).
   std::string headless;
   {
@@ -160,8 +180,12 @@ TEST(Shards, MergedShardsEqualTheSingleProcessCsv) {
   }
   const fs::path no_header = dir.path / "headless.rows";
   std::ofstream(no_header) << headless;
-  const auto unheaded = run_cli("merge --input " + no_header.string() + " " + files[1] + " " + files[2]);
-  EXPECT_NE(unheaded.err.find("has no header lines"), std::string::npos) << unheaded.err;
+  expect_merge_refused(run_cli("merge --input " + no_header.string() + " " + files[1] + " " + files[2]), "has no header lines");
+}
+
+TEST(Shards, MergeRefusesTwoDifferentRowsForOneTask) {
+  const TempDir dir("bp_shards_dup");
+  const std::vector<std::string> files = write_shards(dir.path);
   // Two different rows under one task index: a file edited or mixed (the first was kept silently).
   std::string both = read(files[0]);
   const std::size_t rec = both.find("\nR\t") + 1;
@@ -175,16 +199,7 @@ TEST(Shards, MergedShardsEqualTheSingleProcessCsv) {
   const std::string foreign_text = read(dir.path / "o.rows");
   const std::size_t frec = foreign_text.find("\nR\t") + 1;
   std::ofstream(dup, std::ios::app) << foreign_text.substr(frec, foreign_text.find('\n', frec) + 1 - frec);
-  const auto mixed = run_cli("merge --input " + dup.string() + " " + files[1] + " " + files[2]);
-  EXPECT_NE(mixed.err.find("two different rows for task"), std::string::npos) << mixed.err;
-  // Inputs that are not regular files are refused at once (a FIFO blocked, /dev/zero read 4 GB).
-  ASSERT_EQ(::mkfifo((dir.path / "fifo").c_str(), 0644), 0);
-  const auto fifo = run_cli("merge --input " + (dir.path / "fifo").string());
-  EXPECT_NE(fifo.err.find("is not a regular file"), std::string::npos) << fifo.err;
-  for (const auto* r : {&missing, &twice, &foreign, &not_rows, &corrupt, &headed, &unheaded, &mixed, &fifo}) {
-    EXPECT_EQ(r->code, 2);
-    EXPECT_TRUE(r->out.empty());
-  }
+  expect_merge_refused(run_cli("merge --input " + dup.string() + " " + files[1] + " " + files[2]), "two different rows for task");
 }
 
 TEST(Shards, OneShardOfOneIsARowsFileToo) {

@@ -136,11 +136,8 @@ std::map<std::string, double> key_values(const fs::path& path) {
 // The published study's start is the harnesses' literal one, converted to momenta and back: a few roundings.
 constexpr double kHarnessStartTol = 1e-13;
 
-TEST(Study, QuickRecipesWriteEveryCsv) {
-  const fs::path dir = test::temp_path("bp_study");
-  fs::remove_all(dir);
-  const Result r = run_cli("study --quick --results " + dir.string());
-  ASSERT_EQ(r.code, 0) << r.err;
+/// The quick study's files, its d sweep (every fixed method at 6 values) and appendix 1 (P1.2 skipped: D < 0).
+void expect_every_file(const fs::path& dir) {
   for (const char* f : {"d_sweep.csv", "L_sweep.csv", "h_sweep.csv", "Kx_sweep.csv", "timing.csv",
                         "force_evals.csv", "appendix1/index.csv", "appendix1/P1.1.csv", "appendix1/P1.30.csv",
                         "errata.csv", "orders.csv"})
@@ -158,6 +155,10 @@ TEST(Study, QuickRecipesWriteEveryCsv) {
   EXPECT_NE(is.str().find("2,-0.5,1,0.7,0.2,200,50,5,5,2,\"skipped: body: D = m J - B^2 must be > 0"), std::string::npos)
       << "P1.2 has D < 0 and must be skipped, not integrated";
   EXPECT_FALSE(fs::exists(dir / "appendix1/P1.2.csv"));
+}
+
+/// Thesis table 4.1 beside the catalogue.
+void expect_table_4_1(const fs::path& dir) {
   // Thesis table 4.1 beside the catalogue: the seven counts, equal but for AB4 (the thesis's code
   // recomputes its four past right-hand sides; odeint's keeps them).
   std::ifstream ev(dir / "force_evals.csv");
@@ -171,6 +172,9 @@ TEST(Study, QuickRecipesWriteEveryCsv) {
     else EXPECT_EQ(row[5], row[3]) << row[0];
   }
   EXPECT_EQ(printed, 7);
+}
+
+void expect_errata_and_orders(const fs::path& dir) {
   // The errata, orders and published recipes (the paper's figures and macros are checked by PaperQuickPdf).
   const auto errata = key_values(dir / "errata.csv");
   EXPECT_GT(errata.at("ErrSignEnergy"), kPrintedSignEnergyLoss) << "eq. 1.10 as printed must break the energy";
@@ -187,6 +191,10 @@ TEST(Study, QuickRecipesWriteEveryCsv) {
   EXPECT_NEAR(encounter.at("thesis-y6"), 1.0, kSlopeTol) << "B != 0: every thesis scheme is first order";
   EXPECT_NEAR(encounter.at("lp-y4"), 4.0, kSlopeTol);
   EXPECT_NEAR(encounter.at("logh-kl6"), 6.0, kSlopeTol);
+}
+
+/// The published recipes: the thesis code's force law and the harnesses' A; the loop's n - 1 evaluations.
+void expect_published_recipes(const fs::path& dir) {
   for (const char* f : {"published_d_sweep.csv", "published_L_sweep.csv", "published_h_sweep.csv", "published_Kx_sweep.csv"}) {
     std::ifstream p(dir / f);
     std::stringstream ps;
@@ -199,6 +207,9 @@ TEST(Study, QuickRecipesWriteEveryCsv) {
       }
     }
   }
+}
+
+void expect_harness_start(const fs::path& dir) {
   // The harnesses' rounded start, v0 = (7.058, 0, 6.86) and w0 = (-2.941, 0, -9.8), and R0 = (-200, d' - 1, 0):
   // the d sweep's scene (its header's K1, Kx, Kz) at its first value, d' = 5, starts there.
   std::ifstream pd(dir / "published_d_sweep.csv");
@@ -219,6 +230,18 @@ TEST(Study, QuickRecipesWriteEveryCsv) {
   EXPECT_LT((s0.v - Vec3(7.058, 0, 6.86)).norm(), kHarnessStartTol);
   EXPECT_LT((s0.w - Vec3(-2.941, 0, -9.8)).norm(), kHarnessStartTol);
   EXPECT_LT((s0.R - Vec3(-200, 4, 0)).norm(), kHarnessStartTol);
+}
+
+TEST(Study, QuickRecipesWriteEveryCsv) {
+  const fs::path dir = test::temp_path("bp_study");
+  fs::remove_all(dir);
+  const Result r = run_cli("study --quick --results " + dir.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  expect_every_file(dir);
+  expect_table_4_1(dir);
+  expect_errata_and_orders(dir);
+  expect_published_recipes(dir);
+  expect_harness_start(dir);
   fs::remove_all(dir);
 }
 
