@@ -261,6 +261,7 @@ struct Reversal {
 struct SimulatedBody {
   BodyResult run;
   std::optional<State> reference;
+  std::string no_reference;  ///< with --reference and none: why (the reference run did not stay finite)
   std::optional<Reversal> reversal;
   /// With the reference: |R - R_ref| and the relative error as --tol measures it, max(|dR|/|R_ref|, |dv|/|v_ref|).
   [[nodiscard]] double err_R() const { return (run.run.final.R - reference->R).norm(); }
@@ -322,7 +323,13 @@ SimulatedBody simulate_body(const SimulateOptions& o, const RunPlan& plan, const
   }
   for (const std::string& w : br.warnings)
     std::cerr << "bodypoint: warning: body '" << body.name << "' (" << br.method->name << "): " << w << "\n";
-  if (o.with_reference) sb.reference = reference_state(body, scene.centres, br.run.t_end);
+  if (o.with_reference) {
+    // A close fall onto an attracting centre can take the reference's controlled steps to a non-finite
+    // state (A = 2, B = 0, d = 1): then there is no reference, said so, not an error of nan.
+    const State ref = reference_state(body, scene.centres, br.run.t_end);
+    if (ref.R.allFinite() && ref.v.allFinite()) sb.reference = ref;
+    else sb.no_reference = "the reference run (odeint rkf78 in long double) did not stay finite on this scene";
+  }
   if (o.reversibility) sb.reversal = run_back(plan, br, body, scene.centres);
   return sb;
 }
@@ -336,6 +343,10 @@ Record simulated_record(const SimulatedBody& b, const Advance& how, const std::v
     Record ref;
     ref.number("err_R", b.err_R()).number("err_rel", b.err_rel());
     ref.vector("R_ref", b.reference->R).vector("v_ref", b.reference->v);
+    r.insert_before(r.find("accepted_steps") ? "accepted_steps" : "force_evals", ref);
+  } else if (!b.no_reference.empty()) {
+    Record ref;
+    ref.null("err_R").null("err_rel").note("no_reference", b.no_reference);
     r.insert_before(r.find("accepted_steps") ? "accepted_steps" : "force_evals", ref);
   }
   if (e) r.record("scattering", encounter_record(*e));
@@ -390,6 +401,8 @@ void report_body(const SimulatedBody& body, const std::string& name) {
   if (body.reference)
     std::cout << std::setprecision(3) << std::scientific << "  |R - R_ref| (odeint rkf78, long double) = "
               << body.err_R() << ", relative error (as estimated) = " << body.err_rel() << "\n" << std::defaultfloat;
+  else if (!body.no_reference.empty())
+    std::cout << "  |R - R_ref|: none (" << body.no_reference << ")\n";
   std::cout << "  force evaluations = " << r.force_evals << ", wall time = " << std::setprecision(3) << r.wall_s
             << " s\n";
   if (body.reversal)

@@ -177,6 +177,26 @@ TEST(Tolerance, AutoDeliversTolWithAnHonestEstimate) {
               " for round-off\n", within_decade, runs, worst_cost, refused);
 }
 
+// Three centres of both signs, the body passing them at d = 10 with B = 0.8, at TOL 1e-7: the ladder's middle
+// run sat where the error passes through zero (relative errors 3.5e-5 / 5.5e-8 / 1.8e-8 at ds = 0.31 / 0.15 /
+// 0.095, an order of 9.3 over the three) and the delivered estimate was 8x below the error until a triple
+// whose order is more than kOrderExcess above p was no longer trusted.
+TEST(Tolerance, ATripleConvergingFarFasterThanOrderPIsNotTrusted) {
+  Scene s = named_scene("three-centres").scene;
+  SceneParams sp;
+  sp.B = 0.8;
+  sp.start.d = 10.0;
+  s.bodies.front() = thesis_scene(sp).bodies.front();
+  constexpr double kTol = 1e-7, kEnd = 80.0;
+  const Body& b = s.bodies.front();
+  const MethodInfo& m = choose_method(b, s.centres, kTol, nullptr);
+  const adaptive::ToleranceResult r = adaptive::run_to_tolerance(m, b, s.centres, Accuracy{kTol, kEnd}, kUnobserved, false);
+  const double err = adaptive::state_distance(r.result.final, reference_state(b, s.centres, kEnd, 1e-18L));
+  EXPECT_LE(err, kTol);
+  EXPECT_GE(r.err_estimate, err / kEstimateFactor) << m.name << " at ds " << r.h;
+  EXPECT_LE(r.err_estimate, kEstimateFactor * err) << m.name << " at ds " << r.h;
+}
+
 TEST(Tolerance, EveryFamilyAcceptsTol) {
   const NamedScene ns = named_scene("close");
   const Body& b = ns.scene.bodies.front();
