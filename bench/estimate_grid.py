@@ -169,13 +169,14 @@ def branches(binary, tols, out=None):
         missed = sum(r["err_rel"] > float(tol) for tol, r in ok)
         under = sum(r["err_estimate"] < r["err_rel"] / FACTOR for _, r in comparable)
         over = sum(r["err_estimate"] > FACTOR * r["err_rel"] for _, r in comparable)
-        worst = max((r["err_rel"] / r["err_estimate"] for _, r in comparable), default=0.0)
+        worst = max((r["err_rel"] / r["err_estimate"] for _, r in comparable), default=None)
         search = sum(r["search_force_evals"] for _, r in ok)
         delivered = sum(r["force_evals"] for _, r in ok)
+        worst_text = f"{worst:.2f}" if worst is not None else f"none (no error above {COMPARABLE:g})"
+        cost = f"{search / delivered:.2f}x their delivered runs" if delivered else "no force evaluations (an exact flow)"
         print(f"{branch}: {len(rows)} runs ({', '.join(methods)}; TOL {', '.join(tols)}, t = {T_END}): "
               f"refused {len(rows) - len(ok) - no_reference}, without a reference {no_reference}, missed TOL {missed}, estimate below error/{FACTOR:g} {under}, "
-              f"above {FACTOR:g} x error {over}, worst error/estimate {worst:.2f}; searches "
-              f"{search / delivered if delivered else float('nan'):.2f}x their delivered runs")
+              f"above {FACTOR:g} x error {over}, worst error/estimate {worst_text}; searches {cost}")
 
 
 if __name__ == "__main__":

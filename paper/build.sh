@@ -167,6 +167,12 @@ step by-tol by_tol_step
 # 20 s), against long-double references (no timing, two processes at a time).
 estimate_grid() { "$py" bench/estimate_grid.py "$bin" --out "$results/estimate_grid.csv" > "$results/estimate_grid.txt"; }
 step estimate-grid estimate_grid
+# The same on the accuracy mode's other branches (TTL, ks, the Lie-Poisson far field, several centres) and
+# far-ip under --tol, at TOL 1e-4 to 1e-12 (288 runs, about 10 s).
+estimate_branches() {
+  "$py" bench/estimate_grid.py "$bin" --branches --out "$results/estimate_branches.csv" > "$results/estimate_branches.txt"
+}
+step estimate-branches estimate_branches
 # Where a spinning body's steps go on the close scene (auto and the peers), and the far field's
 # resonances against the spin angle per step (the Python module, from the build tree).
 far_field() {

@@ -852,6 +852,41 @@ def estimate_grid(res, M):
     M.add("GridUnderMax", sci(max(below)))
 
 
+def estimate_branches(res, out, M):
+    """The accuracy mode on its other branches (bench/estimate_grid.py --branches): a row per branch of
+    tab_branches (runs, methods, refused, missed, estimates more than 3x below or above the error, the
+    worst error/estimate), and the counts the text quotes."""
+    with open(os.path.join(res, "estimate_branches.csv")) as f:
+        rows = list(csv.DictReader(f))
+    body, totals = [], {"runs": 0, "missed": 0, "under": 0}
+    for branch in dict.fromkeys(r["branch"] for r in rows):
+        group = [r for r in rows if r["branch"] == branch]
+        ran = [r for r in group if r["status"] == "ok" and r["err"]]
+        unchecked = sum(1 for r in group if r["status"] == "ok" and not r["err"])
+        # Below 1e-13 the reference's error and the run's round-off are of the error's size (estimate_grid.py).
+        comparable = [r for r in ran if num(r["err"]) > 1e-13 and num(r["err_estimate"]) > 0]
+        ratios = [num(r["err"]) / num(r["err_estimate"]) for r in comparable]
+        missed = sum(1 for r in ran if num(r["err"]) > num(r["tol"]))
+        under = sum(1 for x in ratios if x > 3)
+        over = sum(1 for x in ratios if x < 1 / 3)
+        methods = ", ".join(sorted({r["method"] for r in ran}))
+        worst = f"{max(ratios):.2f}" if ratios else "--"
+        refused = len(group) - len(ran) - unchecked
+        body.append([branch, count(len(group)), f"\\texttt{{{methods}}}", count(refused), count(unchecked),
+                     count(missed), count(under), count(over), worst])
+        totals["runs"] += len(group)
+        totals["missed"] += missed
+        totals["under"] += under
+    with open(os.path.join(out, "tab_branches.tex"), "w") as f:
+        for row in body:
+            f.write(" & ".join(row) + " \\\\\n")
+    M.add("BranchRuns", count(totals["runs"]))
+    M.add("BranchMissed", count(totals["missed"]))
+    M.add("BranchUnder", count(totals["under"]))
+    tols = sorted({num(r["tol"]) for r in rows}, reverse=True)
+    M.add("BranchTols", ", ".join(power_of_ten(t) for t in tols), math_mode=False)
+
+
 # The far pass's error is smooth in the step below this spin angle per step (radians): the largest
 # step of the table below it is the one quoted as the last smooth one (bench/far_field.py: 2.75 rad,
 # the next step, 3.09 rad, already meets the resonance at pi).
@@ -1235,6 +1270,7 @@ def main():
     close_table(res, out, M)
     by_tol(res, out, M)
     estimate_grid(res, M)
+    estimate_branches(res, out, M)
     far_field(res, out, M)
     stress(res, out, M)
     appendix(res, M)
