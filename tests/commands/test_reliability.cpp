@@ -40,8 +40,26 @@ using test::leftovers;
 using test::read;
 using test::spawn;
 
-/// A run long enough to be interrupted: signals arrive after kSignalDelay, well inside it.
+/// A run long enough to be interrupted (--max-seconds 0 or 1e9: its calibrated budget, which grows with the
+/// machine's load, must not refuse it first): signals arrive once it has made its first file (its signal
+/// handlers are installed by then), waiting at most kStartBound for it: a loaded machine (the sanitizers'
+/// start-up beside ctest -j2) only delays that. A fixed 700 ms delay sent SIGINT before the handlers were
+/// installed under ASan (the process died of the signal instead of stopping at a row boundary).
+constexpr auto kStartBound = std::chrono::seconds(120);
+/// ... and kSignalDelay after it: the file comes a few statements before the run's own handling of the
+/// signal is in place (a sweep opens its journal, then stops at row boundaries on a signal).
 constexpr auto kSignalDelay = std::chrono::milliseconds(700);
+
+/// Waits until `dir` holds a file whose name starts with `prefix`, then kSignalDelay; false after kStartBound.
+bool started(const fs::path& dir, const std::string& prefix) {
+  const auto until = std::chrono::steady_clock::now() + kStartBound;
+  while (leftovers(dir, prefix).empty()) {
+    if (std::chrono::steady_clock::now() > until) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::this_thread::sleep_for(kSignalDelay);
+  return true;
+}
 
 struct Example {
   std::string args, fragment;
@@ -261,11 +279,10 @@ TEST(Reliability, ASignalRemovesTemporaryAndLockFiles) {
     fs::create_directories(dir);
     // 2e8 steps take ~30 s: the signal arrives while the trajectory is being written (no companion run
     // for an error estimate: under the sanitizers its three runs' calibrated time came near the budget).
-    const pid_t pid = spawn({"simulate", "--steps", "200000000", "--every", "1000", "--quiet", "--no-error-estimate", "--out",
+    const pid_t pid = spawn({"simulate", "--steps", "200000000", "--every", "1000", "--quiet", "--no-error-estimate", "--max-seconds", "1e9", "--out",
                              (dir / "traj.csv").string()}, dir / "err.txt");
     ASSERT_GT(pid, 0);
-    std::this_thread::sleep_for(kSignalDelay);
-    EXPECT_FALSE(leftovers(dir, "traj.csv.lock").empty()) << "the run holds a lock while it writes";
+    ASSERT_TRUE(started(dir, "traj.csv.lock")) << "the run holds a lock while it writes";
     ::kill(pid, sig);
     int status = 0;
     ::waitpid(pid, &status, 0);
@@ -280,10 +297,10 @@ TEST(Reliability, ASweepStopsAtARowBoundaryOnSignal) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const pid_t pid = spawn({"sweep", "--param", "d", "--from", "5", "--to", "200", "--step", "5", "--methods",
-                           "lp-y4", "--steps", "2000000", "--threads", "1", "--out", (dir / "d.csv").string()},
+                           "lp-y4", "--steps", "2000000", "--threads", "1", "--max-seconds", "0", "--out", (dir / "d.csv").string()},
                           dir / "err.txt");
   ASSERT_GT(pid, 0);
-  std::this_thread::sleep_for(kSignalDelay);
+  ASSERT_TRUE(started(dir, "d.csv.journal")) << read(dir / "err.txt");
   ::kill(pid, SIGTERM);
   int status = 0;
   ::waitpid(pid, &status, 0);
@@ -305,10 +322,10 @@ TEST(Reliability, AFirstSignalEndsASweepInTheMiddleOfALongRow) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const pid_t pid = spawn({"sweep", "--param", "d", "--values", "5,10", "--methods", "lp-y4", "--steps", "2000000000",
-                           "--threads", "1", "--out", (dir / "d.csv").string()},
+                           "--threads", "1", "--max-seconds", "0", "--out", (dir / "d.csv").string()},
                           dir / "err.txt");
   ASSERT_GT(pid, 0);
-  std::this_thread::sleep_for(kSignalDelay);
+  ASSERT_TRUE(started(dir, "d.csv.journal")) << read(dir / "err.txt");
   const auto sent = std::chrono::steady_clock::now();
   ::kill(pid, SIGINT);
   int status = 0;
