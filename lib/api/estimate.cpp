@@ -74,6 +74,16 @@ std::string order_text(int p) { return "order " + std::to_string(p); }
 /// The order the estimate assumes: at least 1 (a method without a fixed order is taken as first order,
 /// which makes its estimate twice the difference).
 int fixed_order(const MethodInfo& m, const Body& body) { return std::max(1, adaptive::effective_order(m, body)); }
+
+/// Where the method's flow is exact (the Kepler split on a material point about one Coulomb centre),
+/// two runs differ by rounding alone, which no step refines: their whole difference is the estimate, not
+/// a Richardson fraction of it (bound orbit to t = 300, kep-y8 h = 1: 7.0e-10 off, the pair 3.2e-10 apart,
+/// estimated 1e-10 before).
+bool flow_is_exact(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres) {
+  const auto pulling = std::count_if(centres.begin(), centres.end(), [](const Centre& k) { return k.A != 0.0; });
+  return m.traits.orbit_exact && body.p.B == 0.0 && pulling == 1 && !non_coulomb(centres);
+}
+constexpr const char* kExactFlowBasis = "the method's flow is exact on this scene: they differ by rounding, taken whole";
 std::string fixed_basis(int p, double ratio) { return "companion run at h/" + short_number(ratio) + ", " + order_text(p); }
 
 /// The companion `level` levels finer than the run `how` (level >= 1): h or ds over 2^level with the
@@ -134,10 +144,12 @@ constexpr int kCoarseMaxOrder = 4;
 /// most this: with 4 there, 16 of the ladder's estimates were more than 3x low, with 2, 10.
 constexpr int kCoarseMaxOrderBelow2 = 2;
 /// The coarse companion's steps are kept this far inside the flags' limits (a step turning the spin by
-/// pi, the direction to a centre by pi/2) that the run's own steps, scaled by the ratio, predict: a
-/// time-transformed run whose constant c lets a far step turn the spin by 2 rad (adaptive/run.cpp) takes
-/// its companion at 1.41 ds, where 2 ds would alias the spin and be refused after it was paid for.
-constexpr double kCoarseAngleMargin = 0.9;
+/// pi, the direction to a centre by pi/2) that the run's own steps, scaled by the ratio, predict. At
+/// 0.9 (the flags' edge) a pair whose coarse steps turn the spin by 2-2.8 rad is not asymptotic: 6 of the
+/// estimate ladder's delivered estimates were more than 3x low (lp-bm4 at h = 0.2 on two spinning
+/// centres: 4.4e-6 for 1.0e-4); at 0.45 none of those, and the fine companion pays for such runs
+/// (docs/developers.md, "The estimate's coarse side").
+constexpr double kCoarseAngleMargin = 0.45;
 /// Below this ratio the pair differs too little to measure the error (ratio^p - 1 small against their
 /// rounding): the fine companion decides.
 constexpr double kMinCoarseRatio = 1.25;
@@ -250,7 +262,7 @@ bool estimated_by_coarse(BodyResult& r, const Body& body, const std::vector<Cent
   e.force_evals += x.total_force_evals();
   e.wall_s += x.run.wall_s;
   if (x.outcome != Outcome::ok || !ended_alike(r, options, x, oc) || !coarser(*c, x.run.steps, r.run.steps)) return false;
-  std::optional<ErrorEstimate> coarse = coarse_estimate(*r.method, body, *c, r.run.final, x.run.final);
+  std::optional<ErrorEstimate> coarse = coarse_estimate(*r.method, body, centres, *c, r.run.final, x.run.final);
   if (!coarse) return false;
   coarse->force_evals = e.force_evals;
   coarse->wall_s = e.wall_s;
@@ -286,18 +298,23 @@ std::optional<CoarseCompanion> coarse_companion(const MethodInfo& m, const Advan
   return CoarseCompanion{FictitiousSteps{f->ds * r, EndTime{f->t_end()}}, r};
 }
 
-std::optional<ErrorEstimate> coarse_estimate(const MethodInfo& m, const Body& body, const CoarseCompanion& c,
-                                             const State& run, const State& coarse) {
+std::optional<ErrorEstimate> coarse_estimate(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
+                                             const CoarseCompanion& c, const State& run, const State& coarse) {
   if (!(coarse.R.allFinite() && coarse.v.allFinite())) return std::nullopt;
   const int p = std::min(c.ratio < kStepRatio ? kCoarseMaxOrderBelow2 : kCoarseMaxOrder, fixed_order(m, body));
   const double d = adaptive::state_distance(run, coarse);
   ErrorEstimate e;
-  e.value = adaptive::finer_run_error(d, c.ratio, p);
   const bool h = std::holds_alternative<FixedSteps>(c.how);
   const std::string step = h ? "h" : "ds";
   e.basis = "companion run at " + (c.ratio == kStepRatio ? "2" + step : step + " x " + short_number(c.ratio)) +
-            " from a start moved by a rounding, " + order_text(p) +
-            (p < fixed_order(m, body) ? " (at most " + std::to_string(p) + " on the coarse side)" : "");
+            " from a start moved by a rounding, ";
+  if (flow_is_exact(m, body, centres)) {
+    e.value = d;
+    e.basis += kExactFlowBasis;
+    return e.value <= kCoarseTrusted ? std::optional<ErrorEstimate>(std::move(e)) : std::nullopt;
+  }
+  e.value = adaptive::finer_run_error(d, c.ratio, p);
+  e.basis += order_text(p) + (p < fixed_order(m, body) ? " (at most " + std::to_string(p) + " on the coarse side)" : "");
   // Where the pair differs by the scene's rounding, that difference is not divided: the run's own
   // rounding is of its size (the two runs' roundings are independent draws, the moved start's growth one more).
   if (const double floor = std::min(d, kRoundingLevel); floor > e.value) {
@@ -406,6 +423,10 @@ void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& 
   if (!f) return;
   e.value = f->c.factor * adaptive::state_distance(r.run.final, f->x.run.final);
   e.basis = f->c.basis;
+  if (flow_is_exact(*r.method, body, centres)) {
+    e.value = std::max(e.value, adaptive::state_distance(r.run.final, f->x.run.final));
+    e.basis += "; " + std::string(kExactFlowBasis);
+  }
   add_rounding_floor(e, r, body, how, options, o, rerun);
   if (r.outcome == Outcome::unresolved || r.run.steps < kFewSteps) second_companion(r, body, how, options, o, rerun, *f);
 }
@@ -461,13 +482,19 @@ void confirm(ErrorEstimate& e, const MethodInfo& m, const Body& body, const Stat
   confirm(e, std::min(kMaxFall, std::pow(kStepRatio, fixed_order(m, body) - kOrderSlack)), run, first, second);
 }
 
-ErrorEstimate fixed_step_estimate(const MethodInfo& m, const Body& body, const State& run, const State& companion) {
+ErrorEstimate fixed_step_estimate(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
+                                  const State& run, const State& companion) {
   ErrorEstimate e;
   const int p = fixed_order(m, body);
   e.basis = fixed_basis(p, kStepRatio);
-  if (companion.R.allFinite() && companion.v.allFinite())
+  if (!(companion.R.allFinite() && companion.v.allFinite())) {
+    e.basis = "the " + e.basis + " did not end as the run did";
+  } else if (flow_is_exact(m, body, centres)) {
+    e.value = adaptive::state_distance(run, companion);
+    e.basis = "companion run at h/2, " + std::string(kExactFlowBasis);
+  } else {
     e.value = adaptive::coarser_run_error(adaptive::state_distance(run, companion), kStepRatio, p);
-  else e.basis = "the " + e.basis + " did not end as the run did";
+  }
   return e;
 }
 

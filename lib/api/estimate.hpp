@@ -40,14 +40,15 @@ std::optional<CoarseCompanion> coarse_companion(const MethodInfo& m, const Advan
 double coarse_ratio_limit(const MethodInfo& m, const std::vector<Centre>& centres, const RunResult& run);
 /// The estimate from the run's and the coarse companion's final states; nullopt where it is not trusted
 /// (a coarse state not finite, an estimate above kCoarseTrusted, estimate.cpp): the fine companion decides.
-std::optional<ErrorEstimate> coarse_estimate(const MethodInfo& m, const Body& body, const CoarseCompanion& c,
-                                             const State& run, const State& coarse);
+std::optional<ErrorEstimate> coarse_estimate(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
+                                             const CoarseCompanion& c, const State& run, const State& coarse);
 
 /// A fixed-step run's companion `level` levels finer (h/2^level, 2^level times the steps), the estimate
 /// from the final states of the run and its first companion, and whether the second companion confirms
 /// it (the difference falls as h^p): for a batch's lanes, which run them outside integrate().
 FixedSteps fixed_companion(const FixedSteps& run, int level = 1);
-ErrorEstimate fixed_step_estimate(const MethodInfo& m, const Body& body, const State& run, const State& companion);
+ErrorEstimate fixed_step_estimate(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
+                                  const State& run, const State& companion);
 /// Whether the second companion confirms e (ErrorEstimate::confirmed), its basis saying so: the differences
 /// fall as the order says (min_fall), or at least geometrically, the estimate then raised to the bound
 /// that gives (estimate.cpp, kGeometricFall).

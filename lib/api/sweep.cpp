@@ -85,7 +85,8 @@ std::vector<std::optional<ErrorEstimate>> coarse_estimates(const MethodInfo& met
     cost[k].wall_s = coarse[k].wall_s;
     if (health[k].outcome != Outcome::ok && health[k].outcome != Outcome::inaccurate) continue;
     if (assess(coarse[k], checks_for(method, scenes[k].centres, detail::kCoarseEnergyBound)).outcome != Outcome::ok) continue;
-    out[k] = detail::coarse_estimate(method, scenes[k].bodies.front(), *c, results[k].final, coarse[k].final);
+    out[k] = detail::coarse_estimate(method, scenes[k].bodies.front(), scenes[k].centres, *c, results[k].final,
+                                     coarse[k].final);
     if (out[k]) out[k]->force_evals = coarse[k].force_evals, out[k]->wall_s = coarse[k].wall_s;
   }
   return out;
@@ -121,7 +122,8 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
     } else if (by_coarse[k]) {
       row.error = std::move(*by_coarse[k]);
     } else if (estimable(row.outcome)) {
-      row.error = detail::fixed_step_estimate(method, scenes[k].bodies.front(), row.result.final, companions[k].final);
+      row.error = detail::fixed_step_estimate(method, scenes[k].bodies.front(), scenes[k].centres, row.result.final,
+                                              companions[k].final);
       row.error.force_evals = coarse_cost[k].force_evals + companions[k].force_evals;
       row.error.wall_s = coarse_cost[k].wall_s + companions[k].wall_s;
       if (row.outcome == Outcome::unresolved)
