@@ -167,9 +167,8 @@ constexpr double kBudgetLateness = 5.0;
 TEST(Reliability, MaxSecondsStopsEveryLoopAlike) {
   // Loops that ran on past --max-seconds (issue #24): the accuracy search, a peer's stepper, the
   // reference; each stops with the budget's reason and leaves no output.
-  const fs::path dir = test::temp_path("bp_rel_budget");
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const test::TempDir tmp("bp_rel_budget");
+  const fs::path& dir = tmp.path;
   const std::string budget = " --max-seconds " + std::to_string(kBudgetSeconds) + " --out " + (dir / "o.csv").string();
   // timing and sweep calibrate their work first and refuse what would exceed the budget (issue #40):
   // refused at once, with the estimate, and no output.
@@ -199,7 +198,6 @@ TEST(Reliability, MaxSecondsStopsEveryLoopAlike) {
     EXPECT_TRUE(leftovers(dir, "o.csv.tmp").empty() && !fs::exists(dir / "o.csv.lock")) << args;
     fs::remove(dir / "o.csv.journal");
   }
-  fs::remove_all(dir);
 }
 
 TEST(Reliability, NoCommandIsAnErrorOnStandardError) {
@@ -293,9 +291,8 @@ TEST(Reliability, ASignalRemovesTemporaryAndLockFiles) {
 }
 
 TEST(Reliability, ASweepStopsAtARowBoundaryOnSignal) {
-  const fs::path dir = test::temp_path("bp_rel_sweep");
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const test::TempDir tmp("bp_rel_sweep");
+  const fs::path& dir = tmp.path;
   const pid_t pid = spawn({"sweep", "--param", "d", "--from", "5", "--to", "200", "--step", "5", "--methods",
                            "lp-y4", "--steps", "2000000", "--threads", "1", "--max-seconds", "0", "--out", (dir / "d.csv").string()},
                           dir / "err.txt");
@@ -310,7 +307,6 @@ TEST(Reliability, ASweepStopsAtARowBoundaryOnSignal) {
   EXPECT_NE(read(dir / "err.txt").find("finish with --resume"), std::string::npos) << read(dir / "err.txt");
   // No CSV, no temporary, no lock: only the journal of the finished rows, for --resume (test_ensembles).
   EXPECT_EQ(leftovers(dir, "d.csv"), std::vector<std::string>{"d.csv.journal"});
-  fs::remove_all(dir);
 }
 
 TEST(Reliability, AFirstSignalEndsASweepInTheMiddleOfALongRow) {
@@ -318,9 +314,8 @@ TEST(Reliability, AFirstSignalEndsASweepInTheMiddleOfALongRow) {
   // longer rows). Rows here take minutes; the sweep has a second's grace to reach a row boundary.
   // Bound: the grace plus the process's teardown, far below one row.
   constexpr auto kInterruptBound = std::chrono::seconds(10);
-  const fs::path dir = test::temp_path("bp_rel_sweep_long");
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const test::TempDir tmp("bp_rel_sweep_long");
+  const fs::path& dir = tmp.path;
   const pid_t pid = spawn({"sweep", "--param", "d", "--values", "5,10", "--methods", "lp-y4", "--steps", "2000000000",
                            "--threads", "1", "--max-seconds", "0", "--out", (dir / "d.csv").string()},
                           dir / "err.txt");
@@ -337,13 +332,11 @@ TEST(Reliability, AFirstSignalEndsASweepInTheMiddleOfALongRow) {
   EXPECT_NE(read(dir / "err.txt").find("interrupted by signal 2"), std::string::npos) << read(dir / "err.txt");
   EXPECT_NE(read(dir / "err.txt").find("finish with --resume"), std::string::npos) << read(dir / "err.txt");
   EXPECT_EQ(leftovers(dir, "d.csv"), std::vector<std::string>{"d.csv.journal"});
-  fs::remove_all(dir);
 }
 
 TEST(Reliability, OutputsCollideWithNothing) {
-  const fs::path dir = test::temp_path("bp_rel_out");
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const test::TempDir tmp("bp_rel_out");
+  const fs::path& dir = tmp.path;
   // Two outputs of one run on one path.
   const fs::path both = dir / "x.csv";
   const auto twice = run_cli("work-precision --quick --out " + both.string() + " --summary " + both.string());
@@ -384,7 +377,6 @@ TEST(Reliability, OutputsCollideWithNothing) {
     EXPECT_EQ(left, (std::vector<std::string>{"y.csv", "y.csv.tmp.notes"})) << "lock naming '" << names << "'";
     fs::remove(dir / "y.csv.tmp.notes");
   }
-  fs::remove_all(dir);
 }
 
 /// Lock races: this many trials of two writers of one path started together.
@@ -394,9 +386,8 @@ TEST(Reliability, TheLockAdmitsOneWriterAtATime) {
   // Two processes open one output at the same moment, each holding it for a random time up to 200 us;
   // a third of the trials start with a lock file left by a killed writer (naming a live pid, none, or
   // garbage). Shared memory counts how many hold the output at once: never more than one, in any trial.
-  const fs::path dir = test::temp_path("bp_rel_race");
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const test::TempDir tmp("bp_rel_race");
+  const fs::path& dir = tmp.path;
   const std::string out = (dir / "race.csv").string();
   struct Shared {
     std::atomic<int> go, holders, overlaps;
@@ -447,15 +438,13 @@ TEST(Reliability, TheLockAdmitsOneWriterAtATime) {
   std::printf("  %d trials: %d refused the second writer, %d ran one after the other, 0 overlapped\n",
               kLockRaceTrials, one, both);
   ::munmap(mem, sizeof(Shared));
-  fs::remove_all(dir);
 }
 
 // In folders of the tests' own: a FIFO, symbolic links, a directory and (as root) character devices made
 // with mknod, never the machine's /dev. Only a regular file is ever replaced.
 TEST(Reliability, ADirectoryOrAnOddNameIsRefusedAndALinkStaysALink) {
-  const fs::path dir = test::temp_path("bp_rel_names");
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const test::TempDir tmp("bp_rel_names");
+  const fs::path& dir = tmp.path;
   const std::string run = "simulate --steps 100 --out ";
   // A directory is refused before any work; '-' and a newline in the name are refused.
   fs::create_directory(dir / "folder");
@@ -475,13 +464,11 @@ TEST(Reliability, ADirectoryOrAnOddNameIsRefusedAndALinkStaysALink) {
   fs::create_symlink("loop2", dir / "loop1");
   fs::create_symlink("loop1", dir / "loop2");
   EXPECT_NE(run_cli(run + (dir / "loop1").string()).code, 0);
-  fs::remove_all(dir);
 }
 
 TEST(Reliability, AShellRedirectedStreamIsAppendedToInPlace) {
-  const fs::path dir = test::temp_path("bp_rel_redirect");
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const test::TempDir tmp("bp_rel_redirect");
+  const fs::path& dir = tmp.path;
   // The shell's stream redirected to a file (--out /dev/stdout >> log): appended to in place, so that
   // what the file had stays (it was renamed over before).
   const fs::path log = dir / "log.txt";
@@ -494,13 +481,11 @@ TEST(Reliability, AShellRedirectedStreamIsAppendedToInPlace) {
     EXPECT_EQ(text.rfind("kept line\n", 0), 0u) << cmd << ": the file's contents were lost";
     EXPECT_NE(text.find("body,t,Rx"), std::string::npos) << cmd;
   }
-  fs::remove_all(dir);
 }
 
 TEST(Reliability, AFifoIsWrittenOnlyWhileSomeoneReadsIt) {
-  const fs::path dir = test::temp_path("bp_rel_fifo");
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const test::TempDir tmp("bp_rel_fifo");
+  const fs::path& dir = tmp.path;
   const std::string run = "simulate --steps 100 --out ";
   // A FIFO: refused while nobody reads it, written directly (and left a FIFO) when someone does.
   ASSERT_EQ(::mkfifo((dir / "fifo").c_str(), 0644), 0);
@@ -515,20 +500,17 @@ TEST(Reliability, AFifoIsWrittenOnlyWhileSomeoneReadsIt) {
   struct stat st {};
   ASSERT_EQ(::lstat((dir / "fifo").c_str(), &st), 0);
   EXPECT_TRUE(S_ISFIFO(st.st_mode));
-  fs::remove_all(dir);
 }
 
 TEST(Reliability, ACharacterDeviceStaysADevice) {
-  const fs::path dir = test::temp_path("bp_rel_dev");
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const test::TempDir tmp("bp_rel_dev");
+  const fs::path& dir = tmp.path;
   const std::string run = "simulate --steps 100 --out ";
   struct stat st {};
   // Character devices (root only): null takes the output, full makes the write fail with a reason;
   // both stay devices, and a sweep keeps no journal beside them.
   if (::mknod((dir / "null").c_str(), S_IFCHR | 0666, makedev(1, 3)) != 0 ||
       ::mknod((dir / "full").c_str(), S_IFCHR | 0666, makedev(1, 7)) != 0) {
-    fs::remove_all(dir);
     GTEST_SKIP() << "mknod needs root: the device cases are left out";
   }
   EXPECT_EQ(run_cli(run + (dir / "null").string()).code, 0);
@@ -540,13 +522,11 @@ TEST(Reliability, ACharacterDeviceStaysADevice) {
     EXPECT_TRUE(S_ISCHR(st.st_mode)) << dev << " was replaced";
   }
   EXPECT_EQ(leftovers(dir, "null").size(), 1u) << "no journal, lock or temporary beside a device";
-  fs::remove_all(dir);
 }
 
 TEST(Reliability, AWritePastTheFileSizeLimitFailsWithItsReason) {
-  const fs::path dir = test::temp_path("bp_rel_fsize");
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const test::TempDir tmp("bp_rel_fsize");
+  const fs::path& dir = tmp.path;
   // Past `ulimit -f` (4 KiB) the write fails with a reason instead of SIGXFSZ killing the run.
   const std::string limited = "ulimit -f 4; exec '" + std::string(BODYPOINT_BIN) + "' simulate --steps 10000 --out '" +
                               (dir / "traj.csv").string() + "' 2>'" + (dir / "err.txt").string() + "'";
@@ -554,7 +534,6 @@ TEST(Reliability, AWritePastTheFileSizeLimitFailsWithItsReason) {
   EXPECT_TRUE(WIFEXITED(rc) && WEXITSTATUS(rc) == 2) << rc;
   EXPECT_NE(read(dir / "err.txt").find("file size limit"), std::string::npos) << read(dir / "err.txt");
   EXPECT_TRUE(leftovers(dir, "traj.csv").empty());
-  fs::remove_all(dir);
 }
 
 // AddressSanitizer reserves more address space than a memory limit of a few hundred MB allows (GCC
@@ -571,9 +550,8 @@ TEST(Reliability, OutOfMemoryIsOneLineWithItsReason) {
 #ifdef BODYPOINT_TEST_ASAN
   GTEST_SKIP() << "AddressSanitizer reserves more address space than the limit below allows";
 #endif
-  const fs::path dir = test::temp_path("bp_rel_oom");
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const test::TempDir tmp("bp_rel_oom");
+  const fs::path& dir = tmp.path;
   // 1e6 grid points x every method: the rows alone need more than the 400 MB of address space allowed.
   const std::string limited = "ulimit -v 400000; exec '" + std::string(BODYPOINT_BIN) +
                               "' sweep --param d --log --from 1 --to 10 --points 1000000 --methods all --steps 10 "
@@ -585,7 +563,6 @@ TEST(Reliability, OutOfMemoryIsOneLineWithItsReason) {
   EXPECT_EQ(err.find("bad_alloc"), std::string::npos) << err;
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
   EXPECT_FALSE(fs::exists(dir / "s.csv"));
-  fs::remove_all(dir);
 }
 
 }  // namespace
