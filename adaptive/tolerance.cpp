@@ -117,12 +117,20 @@ struct SearchLimit : Error {
   using Error::Error;
 };
 
+/// The samples a run that may be delivered keeps for the caller's sink, at most (112 bytes each: 117 MB).
+/// Beyond, they are dropped and the delivered run is made again with the sink (the same steps, the same
+/// bits): a scattering run to its departure under events at tol 1e-10 (B = 0.9, b = 1) kept every step
+/// of its finest rungs and reached 24 GB before the kernel killed it.
+constexpr std::size_t kMaxKeptSamples = std::size_t{1} << 20;
+
 struct Level {
   double h = 0.0;
   long steps = 0;
   double omega_c = 0.0;
   RunResult run;
   std::vector<KeptSample> samples;  ///< kept until the run is known to be the delivered one
+  bool samples_dropped = false;     ///< more than kMaxKeptSamples: the delivery runs it again
+  Advance how;                      ///< what it ran, for that run again
 };
 
 double speed_of(const Body& b) { return b.s0.v.norm(); }
@@ -196,9 +204,14 @@ class Search {
     out.total_force_evals = total_evals_;
     out.total_wall_s = total_wall_;
     // The delivered run is over: a sink's Flow::stop ends its samples, not the run.
-    if (delivery_.sink)
+    if (delivery_.sink && best.samples_dropped) {
+      replay(best);
+      out.total_force_evals = total_evals_;
+      out.total_wall_s = total_wall_;
+    } else if (delivery_.sink) {
       for (const KeptSample& k : best.samples)
         if ((*delivery_.sink)(k.sample()) == Flow::stop) break;
+    }
     return out;
   }
 
@@ -219,7 +232,12 @@ class Search {
     if (may_deliver) {
       o.every = delivery_.every;
       if (samples) {
-        keep = [&l](const Sample& x) { l.samples.push_back(KeptSample::of(x)); };
+        keep = [&l](const Sample& x) {
+          if (l.samples_dropped) return;
+          if (l.samples.size() < kMaxKeptSamples) return l.samples.push_back(KeptSample::of(x));
+          l.samples = {};
+          l.samples_dropped = true;
+        };
         o.sink = &keep;
       }
     }
@@ -238,11 +256,31 @@ class Search {
       l.h = h;
     }
     l.omega_c = o.omega_c;
+    l.how = how;
     spent_evals_ += static_cast<double>(std::max(l.run.force_evals, l.run.steps));
     total_wall_ += l.run.wall_s;
     total_evals_ += l.run.force_evals;
     ++runs_;
     return l;
+  }
+
+  /// The delivered run made again with the caller's sink, where it had more samples than were kept: the
+  /// same steps and constant c give the same states; the sink's Flow::stop ends its samples, not the run.
+  void replay(const Level& best) {
+    RunOptions o;
+    o.omega_c = best.omega_c;
+    o.cancel = delivery_.cancel;
+    o.track_invariants = delivery_.track_invariants;
+    o.every = delivery_.every;
+    bool ended = false;
+    SampleSink forward = [&](const Sample& x) {
+      if (!ended && (*delivery_.sink)(x) == Flow::stop) ended = true;
+    };
+    o.sink = &forward;
+    const RunResult again = m_.run(b_, c_, best.how, o);
+    total_evals_ += again.force_evals;
+    total_wall_ += again.wall_s;
+    ++runs_;
   }
 
   /// The pilot pair at h0 and h0/2 (a refused step halves h0); sets the first estimate and returns

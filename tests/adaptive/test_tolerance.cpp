@@ -197,6 +197,34 @@ TEST(Tolerance, ATripleConvergingFarFasterThanOrderPIsNotTrusted) {
   EXPECT_LE(r.err_estimate, kEstimateFactor * err) << m.name << " at ds " << r.h;
 }
 
+TEST(Tolerance, ADeliveredRunTooLongToKeepIsMadeAgainForItsSamples) {
+  // A run that may be delivered keeps its samples for the caller's sink up to 2^20 of them (adaptive/
+  // tolerance.cpp); a scattering run under events at tol 1e-10 kept every step of its finest rungs and was
+  // killed at 24 GB. Beyond that it drops them and makes the delivered run again with the sink.
+  constexpr long kKeptAtMost = 1L << 20;
+  const NamedScene ns = named_scene("thesis");
+  const Body& b = ns.scene.bodies.front();
+  const MethodInfo& m = method_or_throw("lp-verlet");
+  long count = 0, last_step = -1;
+  bool in_order = true;
+  State last;
+  SampleSink sink = [&](const Sample& x) {
+    in_order = in_order && x.step == last_step + 1;
+    last_step = x.step;
+    last = x.s;
+    ++count;
+  };
+  RunOptions o;
+  o.track_invariants = false;
+  o.sink = &sink;
+  const adaptive::ToleranceResult r = adaptive::run_to_tolerance(m, b, ns.scene.centres, Accuracy{1e-10, 40.0}, o, false);
+  ASSERT_GT(r.steps, kKeptAtMost) << "the delivered run must be longer than what is kept";
+  EXPECT_TRUE(in_order);
+  EXPECT_EQ(count, r.steps + 1) << "every step and the start";
+  EXPECT_EQ(last.R, r.result.final.R) << "the run made again is the delivered run, bit for bit";
+  EXPECT_EQ(last.v, r.result.final.v);
+}
+
 TEST(Tolerance, EveryFamilyAcceptsTol) {
   const NamedScene ns = named_scene("close");
   const Body& b = ns.scene.bodies.front();
