@@ -106,11 +106,15 @@ step stress "$bin" study "${q[@]}" --name stress --results "$results"
 step scattering "$bin" study "${q[@]}" --name scattering --results "$results"
 # The (d, L) stability map (thesis resolution in the full build), timed: its wall time is a number of
 # the paper.
+# One run (a study of minutes is not repeated), so its time is judged by the share of the cores other
+# processes used meanwhile (scripts/contention.sh; paper/timing_rule.py): wall seconds, cores, that share.
+source scripts/contention.sh
 dL_map() {
   local t0
   t0=$(now)
+  contention_start
   "$bin" study "${q[@]}" --resume --name dL-map --results "$results"
-  echo "$(since "$t0") $(nproc)" > "$results/dL_map_seconds.txt"
+  echo "$(since "$t0") $(nproc) $(contention_share)" > "$results/dL_map_seconds.txt"
 }
 step dL-map dL_map
 
@@ -210,8 +214,16 @@ bench_batch() {
 }
 step bench-batch bench_batch
 # One sweep run scalar, in lanes, on 2 threads, 2 MPI ranks and 2 shards: throughput and efficiency.
-scale=()
-[ $mode = quick ] && scale=(--quick)
+scale=(--repeats 5)
+[ $mode = quick ] && scale+=(--quick)
+# The options each step's command took in this mode (the paper's table of provenance prints them).
+{
+  echo "bodypoint study (every recipe): ${q[*]:-no option}"
+  echo "bodypoint work-precision: ${wp[*]:-no option}"
+  echo "bodypoint work-precision --by-tol: ${by_tol[*]:-no option}"
+  echo "bench_steps, bench_batch: ${bench[*]}"
+  echo "scripts/ensemble-scaling.sh: ${scale[*]}"
+} > "$results/build_options.txt"
 scaling() {
   scripts/ensemble-scaling.sh "${scale[@]}" --build "${BODYPOINT_BUILD_DIR:-build}" --csv "$results/scaling.csv" \
     > "$results/scaling.md"
@@ -229,7 +241,7 @@ awk -v n="$sittings" '{ s += $2 } END { printf "%.0f %d\n", s, n }' "$stages" > 
 out=paper/build
 mkdir -p "$out"
 "$py" paper/make_figures.py "$results" "$out/figures"
-"$py" paper/make_macros.py "$results" "$out/generated" "$mode"
+"$py" paper/make_macros.py "$results" "$out/generated" "$mode" "$out/figures"
 cp paper/bodypoint.tex paper/bodypoint.bib "$out/"
 (cd "$out" && latexmk -pdf -interaction=nonstopmode -halt-on-error bodypoint.tex > latexmk.out 2>&1) || {
   tail -40 "$out/latexmk.out" >&2

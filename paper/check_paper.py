@@ -7,7 +7,10 @@ usage: check_paper.py literals paper/bodypoint.tex
 literals: fails if the body of the .tex types a number that is not a scene parameter or a reference to
           the thesis (every measured figure must come from generated/macros.tex).
 pdf:      fails unless bodypoint.pdf exists with every required section, and the LaTeX log has no
-          undefined reference or citation and no overfull box wider than MAX_OVERFULL_PT.
+          undefined reference or citation and no overfull box wider than MAX_OVERFULL_PT; the text
+          states no number as "n/a" (a number it promised and lost: the sentence must say why in
+          words), and a copy whose parts lost every time to the timing rules carries the draft stamp
+          and its list (make_macros.py's ContendedStamp, ContendedNotice).
 """
 import re
 import sys
@@ -89,6 +92,7 @@ def pdf(build):
             failures.append(f"missing section: {title}")
     failures += repeated_pairs(build)
     failures += claims_without_verdict(build)
+    failures += numbers_lost(build)
     pages = re.search(r"Output written on bodypoint\.pdf \((\d+) pages", log)
     if failures:
         print("\n".join(failures))
@@ -109,6 +113,20 @@ def repeated_pairs(build):
     for a, b in re.findall(r"\\([A-Za-z]+)\\?\s+and\s+\\([A-Za-z]+)", body):
         if a in defs and b in defs and defs[a] == defs[b] and not defs[a].startswith("\\ensuremath"):
             found.append(f"text: \\{a} and \\{b} both read '{defs[a]}'")
+    return found
+
+
+def numbers_lost(build):
+    """Macros the text uses that read "n/a" where it promised a number ("agree within a factor of n/a"),
+    and a copy whose list of parts without a time is not empty but whose stamp is (or the other way)."""
+    with open(f"{build}/generated/macros.tex") as f:
+        defs = dict(re.findall(r"\\newcommand\{\\([A-Za-z]+)\}\{(.*)\}$", f.read(), re.M))
+    with open(f"{build}/bodypoint.tex") as f:
+        used = set(re.findall(r"\\([A-Za-z]+)", body_of(f.read())))
+    found = [f"text: \\{name} reads n/a" for name in sorted(used & set(defs))
+             if re.fullmatch(r"(\\ensuremath\{)?n/a\}?", defs[name])]
+    if bool(defs.get("ContendedNotice")) != bool(defs.get("ContendedStamp")):
+        found.append("a contended copy without its stamp and list on page 1 (ContendedNotice, ContendedStamp)")
     return found
 
 

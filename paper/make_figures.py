@@ -17,6 +17,7 @@ import re
 import sys
 
 from catalogue import families, family, load as load_catalogue
+import timing_rule
 
 import matplotlib
 
@@ -173,6 +174,25 @@ def sweep_figures(res, figs, listing):
         save(fig, os.path.join(figs, f"{name}.pdf"), listing, f"thesis fig. {tfig}: max relative {what} deviation against {param}")
 
 
+# What a figure lost to the timing rules: (what, why) per panel that has no counted time; main() writes
+# them to FIGURES_DIR/lost.csv for make_macros.py, which stamps the copy and lists them on its first page.
+LOST = []
+
+
+def lost(ax, what, flags):
+    """An empty panel: every time it would draw was flagged (or none was taken). The panel says so in
+    words instead of showing empty automatic axes."""
+    flags = [f for f in flags]
+    n_flagged = sum(1 for f in flags if f)
+    why = (f"{n_flagged} of {len(flags)} times flagged ({timing_rule.flag_words(flags)})" if n_flagged
+           else "no time taken")
+    ax.set_xticks([])
+    ax.set_yticks([])
+    ax.text(0.5, 0.5, "no counted time:\n" + why.replace(" (", "\n("), ha="center", va="center",
+            transform=ax.transAxes, fontsize=8)
+    LOST.append((what, why))
+
+
 def timing_figure(res, figs, listing):
     """Two panels of at most five named lines: the thesis's seven (the four its claims name in colour)
     and four exact splittings of rising order."""
@@ -183,6 +203,10 @@ def timing_figure(res, figs, listing):
     fig, axes = plt.subplots(1, 2, figsize=(WIDE * 2 / 3, 2.9))  # a scale per panel
     for ax, (title, named, grey) in zip(axes, panels):
         colour = iter(PANEL_COLOURS)
+        mine = [r for m in grey + named for r in groups.get(m, [])]
+        if not any(not r.get("flag") for r in mine):
+            lost(ax, "figure~\\ref{fig:timing}, panel " + title, [r.get("flag", "") for r in mine])
+            continue
         for m in grey + named:
             rs = [r for r in groups.get(m, []) if not r.get("flag")]  # a flagged time is not drawn
             xs, ys = [num(r["n"]) for r in rs], [num(r["median_s"]) * 1e3 for r in rs]
@@ -283,6 +307,7 @@ def work_precision_figures(res, figs, listing):
     for scene in scenes:
         fig, ax = plt.subplots(figsize=(WIDE / 2, 2.8))
         labels = []  # (time, error, text, colour) of the methods named on the fronts
+        drawn = False
         for fam, colour in family_colours():
             pts = [(num(r["wall_s"]) * 1e3, num(r["err_rel"]), r["method"]) for r in rows
                    if r["scene"] == scene and family(r["method"]) == fam and not r.get("flag")]  # flagged: no time
@@ -290,6 +315,7 @@ def work_precision_figures(res, figs, listing):
             front = pareto(pts)
             if not front:
                 continue
+            drawn = True
             ax.step([p[0] for p in front], [p[1] for p in front], where="post", color=colour, label=fam, linewidth=1)
             ax.plot([p[0] for p in front], [p[1] for p in front], ".", color=colour, markersize=3)
             # Label the methods that hold the longest stretches of the front (at most three).
@@ -300,6 +326,11 @@ def work_precision_figures(res, figs, listing):
                 mine = [p for p in front if p[2] == lab]
                 t, e, _ = mine[len(mine) // 2]  # the middle of its stretch: labels of one front spread out
                 labels.append((t, e, lab, colour))
+        ax.set_title(f"scene {scene}: Pareto front per family")
+        if not drawn:  # every time of the scene flagged: the panel says so
+            lost(ax, f"the work-precision figure of scene {scene}", [r.get("flag", "") for r in rows if r["scene"] == scene])
+            save(fig, os.path.join(figs, f"fig_wp_{scene}.pdf"), listing, f"work-precision on scene {scene}", width=0.49)
+            continue
         ax.set_xscale("log")
         ax.set_yscale("log")
         if scene in unresolved:  # errors the reference cannot resolve: greyed
@@ -307,7 +338,6 @@ def work_precision_figures(res, figs, listing):
         place_labels(ax, labels)
         ax.set_xlabel("run time [ms]")
         ax.set_ylabel("final-position error |dR|/|R|")
-        ax.set_title(f"scene {scene}: Pareto front per family")
         ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2, frameon=False)  # off the labels
         save(fig, os.path.join(figs, f"fig_wp_{scene}.pdf"), listing, f"work-precision on scene {scene}", width=0.49)
 
@@ -479,6 +509,10 @@ def main():
     far_field_figure(res, figs, listing)
     map_figure(res, figs, listing)
     scattering_figure(res, figs, listing)
+    with open(os.path.join(figs, "lost.csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["what", "why"])
+        w.writerows(LOST)
     with open(os.path.join(figs, "figures.md"), "w") as f:
         f.write("| file | what it shows |\n|---|---|\n")
         for name, what in listing:

@@ -16,6 +16,7 @@ import statistics
 import sys
 
 from catalogue import family, has_fictitious_step, load as load_catalogue
+import timing_rule
 
 THESIS_SEVEN = ["thesis-euler", "thesis-verlet", "thesis-ruth3", "thesis-fr4", "thesis-y6", "rk4", "ab4"]
 DIGITS = ["Zero", "One", "Two", "Three", "Four", "Five", "Six", "Seven", "Eight", "Nine"]
@@ -91,8 +92,10 @@ def count(n):
 
 
 class Macros:
-    def __init__(self):
+    def __init__(self, rule=None):
         self.defs = {}
+        self.rule = rule  # the timing rule (timing_rule.Rule) every printed time is judged by
+        self.ledger = timing_rule.Ledger()  # what printed no time, for the draft stamp
 
     def add(self, name, value, math_mode=True):
         if not re.fullmatch(r"[A-Za-z]+", name):
@@ -328,6 +331,9 @@ def claims_table(res, out, M):
         """The verdict of a cost claim whose methods lack a time: "untimed (...)" naming the flags that
         left a method without two counted times (a contended machine), or "--" when the study did not run."""
         why = seven_untimed(res, label, ns_by[label])
+        if why:
+            M.ledger.lost("the cost claims of table~\\ref{tab:claims} " + ("as published" if label == "code" else
+                                                                            "on the corrected model"), why)
         return f"untimed ({why})" if why else "--"
 
     def cost(test, text):
@@ -448,9 +454,14 @@ CONCLUSION_CLAIMS = {
 def survival(words):
     """'survives', 'does not survive', 'survives in part' or 'is not decided' from claim verdicts."""
     heads = [w.split(" ", 1)[0] for w in words]
-    decided = [h for h in heads if h in ("yes", "no", "partly")]  # tied, n/a and -- decide nothing
+    decided = [h for h in heads if h in ("yes", "no", "partly")]  # tied, n/a, untimed and -- decide nothing
     if not decided:
-        return "is not decided by these runs (tied or not applicable)"
+        # The reason is the claims' own: a tie of deviations, n/a (RK4 and AB4 diverge too), untimed
+        # (every time flagged: a contended machine) or no data.
+        why = {"tied": "tied", "n/a": "not applicable", "untimed": "untimed: every time flagged on a contended machine",
+               "--": "no data"}
+        reasons = list(dict.fromkeys(why.get(h, h) for h in heads))
+        return f"is not decided by these runs ({', '.join(reasons)})"
     if all(h == "yes" for h in decided):
         return "survives"
     if all(h == "no" for h in decided):
@@ -531,9 +542,8 @@ def timing_ns(res, name="timing.csv"):
 
 def flag_word(why):
     """A timing flag's reason in one word (experiments/stopwatch.cpp: "contended: wall 31 % above
-    CPU", "spread 22 %", "3 repeats (< 5)")."""
-    head = why.split(":")[0].split(" ")
-    return "repeats" if "repeat" in why else head[0]
+    CPU" -> contended, "spread 22 %" -> spread, "3 repeats (< 5)" -> repeats)."""
+    return timing_rule.flag_words([why])
 
 
 def untimed(res, name, methods):
@@ -576,17 +586,38 @@ def seven_untimed(res, label, ns):
     return untimed(res, TIMING_CSV[label], [csv_method(label, m) for m in THESIS_SEVEN if m not in ns])
 
 
-def bench_ns(res):
-    out = {}
-    path = os.path.join(res, "bench_steps.csv")
-    with open(path) as f:
-        lines = f.readlines()
-    start = next(i for i, line in enumerate(lines) if line.startswith("name,"))
-    for r in csv.DictReader(lines[start:]):
-        m = re.fullmatch(r"BM_Step/(.+)/thesis", r["name"])
+def bench_ns(res, rule):
+    """ns per step of each method from bench_steps (Google Benchmark's median), and the flags of those
+    whose time does not count under the timing rule: ({method: ns}, {method: flag})."""
+    out, flagged = {}, {}
+    for name, r in timing_rule.benchmark(os.path.join(res, "bench_steps.csv"), rule).items():
+        m = re.fullmatch(r"BM_Step/(.+)/thesis", name)
         if m and r.get("time_per_step"):
-            out[m.group(1)] = num(r["time_per_step"]) * 1e9
-    return out
+            if r["flag"]:
+                flagged[m.group(1)] = r["flag"]
+            else:
+                out[m.group(1)] = num(r["time_per_step"]) * 1e9
+    return out, flagged
+
+
+def timing_flagged(res, name="timing.csv"):
+    """{method: its flags} of the timing study's methods with no counted time (timing_ns leaves them out)."""
+    if not os.path.exists(os.path.join(res, name)):
+        return {}
+    rows, _ = read_csv(os.path.join(res, name))
+    fitted = timing_ns(res, name)
+    out = {}
+    for r in rows:
+        if r["method"] not in fitted and num(r["n"]) >= TIMING_MIN_STEPS:
+            out.setdefault(r["method"], []).append(r["flag"])
+    return {m: f for m, f in out.items() if any(f)}
+
+
+def lost_column(M, what, flags):
+    """Records a printed column or sentence whose every time was flagged."""
+    flags = [f for fs in flags for f in (fs if isinstance(fs, list) else [fs])]
+    words = timing_rule.flag_words(flags)
+    M.ledger.lost(what, f"{sum(1 for f in flags if f)} of {len(flags)} times flagged" + (f" ({words})" if words else ""))
 
 
 def methods_table(res, out, M):
@@ -598,15 +629,18 @@ def methods_table(res, out, M):
     M.add("TableFourOneAgree", count(len(printed) - len(differ)))
     M.add("TableFourOneDiffers", ", ".join(f"{tt(r['method'])} ({r['thesis_table_4_1']} there, {r['evals_per_step']} here)"
                                            for r in differ) or "none", math_mode=False)
-    orders, tns, bns = measured_orders(res), timing_ns(res), bench_ns(res)
+    orders, tns = measured_orders(res), timing_ns(res)
+    bns, bench_flags = bench_ns(res, M.rule)
+    tflags = timing_flagged(res)
     with open(os.path.join(out, "tab_methods.tex"), "w") as f:
         for r in rows:
             m = r["method"]
             nominal = "exact" if m == "ks" else r["order"] if r["order"] != "0" else "var."
             enc, orb = orders.get(m, (float("nan"), float("nan")))
             meas = " & ".join(f"{x:.2f}" if math.isfinite(x) else "--" for x in (enc, orb))
-            b = f"{bns[m]:.0f}" if m in bns else "--"
-            t = f"{tns[m]:.0f}" if m in tns else "--"
+            # A time that does not count reads "fl." (flagged), one not taken "--".
+            b = f"{bns[m]:.0f}" if m in bns else "\\emph{fl.}" if m in bench_flags else "--"
+            t = f"{tns[m]:.0f}" if m in tns else "\\emph{fl.}" if m in tflags else "--"
             f.write(f"{tt(m)} & {nominal} & {meas} & {r['evals_per_step']} & {sci(num(r['measured_per_step']), 3)} & {b} & {t} \\\\\n")
             if math.isfinite(enc):
                 M.add(f"Order{camel(m)}", f"{enc:.2f}")
@@ -619,17 +653,26 @@ def methods_table(res, out, M):
     # evaluation (not the Kepler split's Kepler solve), from the measured evaluations per step.
     per_eval = {r["method"]: bns[r["method"]] / num(r["measured_per_step"]) for r in rows
                 if r["method"] in bns and not r["method"].startswith("kep-") and num(r["measured_per_step"]) > 0}
+    if not bns:
+        lost_column(M, "table~\\ref{tab:methods}, column bench", list(bench_flags.values()))
+    if not tns:
+        lost_column(M, "table~\\ref{tab:methods}, column timing", list(tflags.values()))
     if per_eval:
         lo, hi = min(per_eval, key=per_eval.get), max(per_eval, key=per_eval.get)
-        M.add("NsPerEvalLow", f"{per_eval[lo]:.0f}")
-        M.add("NsPerEvalHigh", f"{per_eval[hi]:.0f}")
-        M.add("NsPerEvalLowMethod", tt(lo), math_mode=False)
-        M.add("NsPerEvalHighMethod", tt(hi), math_mode=False)
-        M.add("NsPerEvalMedian", f"{statistics.median(per_eval.values()):.0f}")
+        M.add("NsPerEval", f"per force evaluation a step costs ${per_eval[lo]:.0f}$~ns ({tt(lo)}) to "
+              f"${per_eval[hi]:.0f}$~ns ({tt(hi)}), median ${statistics.median(per_eval.values()):.0f}$~ns "
+              "(bench, the Kepler split's Kepler solves left out)", math_mode=False)
+    else:
+        M.add("NsPerEval", "what a step costs per force evaluation is untimed in this copy (every "
+              "\\cmd{bench\\_steps} time flagged)", math_mode=False)
     both = [m for m in bns if m in tns]
     gap = [max(bns[m], tns[m]) / min(bns[m], tns[m]) for m in both]
-    M.add("BenchTimingGap", f"{max(gap):.2f}" if gap else "n/a")
-    M.add("BenchTimingGapMedian", f"{statistics.median(gap):.2f}" if gap else "n/a")
+    M.add("BenchTimingAgreement", f"agree within a factor of ${max(gap):.2f}$ (median ${statistics.median(gap):.2f}$) "
+          f"for every method both time with a counted time" if gap else
+          "are not compared in this copy: no method has a counted time in both", math_mode=False)
+    ab4 = [bns.get(m) for m in ("ab4-thesis", "ab4")]
+    M.add("AbFourBench", f"${ab4[0]:.0f}$~ns per step against ${ab4[1]:.0f}$~ns, bench" if all(ab4) else
+          "its \\cmd{bench\\_steps} times flagged in this copy", math_mode=False)
 
 
 def md_table(path):
@@ -675,23 +718,55 @@ def ladder_budget(res, M):
 def reference_error(res, M):
     """The long-double reference's own error on each scene, as work-precision estimated it (the larger
     of its distances to the same integration at tolerance 1e-15 and to lp-ss10 at a small step)."""
-    _, header = read_csv(os.path.join(res, "work_precision.csv"))
-    rel = [float(m.group(1)) for line in header for m in [re.search(r"estimated error \S+ \(relative (\S+)\)", line)] if m]
+    rel = list(reference_errors(res).values())
     M.add("RefErrMax", sci(max(rel)) if rel else "n/a")
     M.add("RefScenes", count(len(rel)))
 
 
+def speedup_phrase(parts):
+    """Speed-ups in words with the force evaluations beside them (which do not depend on the machine):
+    "$2.0\\times$ and $2.9\\times$ as fast (the peer's force evaluations over bodypoint's: $3.1$ and
+    $4.0$)"; a flagged time reads "untimed (flagged)", a target nobody reached "not compared"."""
+    times = [f"${sp.rstrip('x')}\\times$" if sp.endswith("x") else "untimed (flagged)" if sp == "flagged"
+             else "not compared (a side reached no target)" for sp, _, _ in parts]
+    evals = [f"${sci(pe / e)}$" for _, e, pe in parts if e > 0 and pe > 0]
+    return (f"{' and '.join(times)} as fast" +
+            (f" (the peer's force evaluations over bodypoint's: {' and '.join(evals)})" if len(evals) == len(parts) else ""))
+
+
+def reference_errors(res):
+    """{scene: relative error of its long-double reference}, as work-precision estimated it."""
+    _, header = read_csv(os.path.join(res, "work_precision.csv"))
+    return {m.group(1): float(m.group(2)) for line in header
+            for m in [re.match(r"# reference (\S+): .* \(relative (\S+)\)", line)] if m}
+
+
 def speedup_table(res, out, M):
     head, body = md_table(os.path.join(res, "work_precision_summary.md"))
+    parts = {}
+    ref = reference_errors(res)
+    # A target below the reference's own error decides nothing: no error under it can be measured, so
+    # its row names no winner (the close and material references are about 2e-13 off).
+    unresolved = [row for row in body if num(row[1]) < ref.get(row[0], 0)]
     with open(os.path.join(out, "tab_speedup.tex"), "w") as f:
         for row in body:
+            if row in unresolved:
+                f.write(f"{row[0]} & {row[1]} & \\multicolumn{{9}}{{l}}{{not decided: the reference is "
+                        f"${sci(ref[row[0]])}$ off}} \\\\\n")
+                continue
             scene, target, best, cfg, evals, t, peer, pcfg, pevals, pt, sp = row
             f.write(" & ".join(latex_cell(c) for c in row) + " \\\\\n")
             key = f"{camel(scene)}{target_word(target)}"
             M.add(f"Speedup{key}", sp.rstrip("x") if sp.endswith("x") else "n/a")
+            parts[key] = (sp, num(evals), num(pevals))
             M.add(f"Best{key}", tt(best) if best != "-" else "none", math_mode=False)
             M.add(f"BestPeer{key}", tt(peer) if peer != "-" else "none", math_mode=False)
+    body = [row for row in body if row not in unresolved]
     M.add("NumSpeedupRows", count(len(body)))
+    if all(not row[10].endswith("x") for row in body):
+        lost_column(M, "table~\\ref{tab:speedup}, column speed-up", [row[10] for row in body if row[10] == "flagged"])
+    if "CloseSeven" in parts and "CloseTen" in parts:
+        M.add("SpeedupClosePair", speedup_phrase([parts["CloseSeven"], parts["CloseTen"]]), math_mode=False)
     # The pairs the text names together: one name once when both targets have the same.
     for first, second, name in [("BestCloseSeven", "BestCloseTen", "BestClosePair"),
                                 ("BestPeerCloseSeven", "BestPeerCloseTen", "BestPeerClosePair"),
@@ -799,12 +874,17 @@ def by_tol(res, out, M):
     M.add("AutoVsPeerAtTolSpin", clause, math_mode=False)
     # A ratio whose times do not count (flagged) is left out; none left: the range says so in words
     # (a contended machine), not "n/a to n/a times as fast".
-    def ratio_range(name, values):
+    def ratio_range(name, values, what):
         M.add(f"{name}Range", f"${sci(min(values))}$ to ${sci(max(values))}$ times as fast" if values else
               "untimed (every comparison's time flagged)", math_mode=False)
-    ratio_range("AutoAloneSpin", [r for scene, rs in alone.items() if scene != "material" for r in rs])
-    ratio_range("AutoVsPeerSpin", [r for scene, rs in ratios.items() if scene != "material" for r in rs])
-    ratio_range("AutoVsPeerMaterial", ratios.get("material", []))
+        if not values:
+            M.ledger.lost(what, "every comparison's time flagged")
+    ratio_range("AutoAloneSpin", [r for scene, rs in alone.items() if scene != "material" for r in rs],
+                "table~\\ref{tab:bytol}: auto's delivered run against the peers' best case (spinning scenes)")
+    ratio_range("AutoVsPeerSpin", [r for scene, rs in ratios.items() if scene != "material" for r in rs],
+                "table~\\ref{tab:bytol}: auto against the peers' best case (spinning scenes)")
+    ratio_range("AutoVsPeerMaterial", ratios.get("material", []),
+                "table~\\ref{tab:bytol}: auto against the peers' best case (material point)")
     # The price of trust (issue #55): auto's whole call against bodypoint's own fastest configuration
     # delivering TOL, in force evaluations (column 19; its time, column 20, where both times count), and what
     # its search costs beyond the run it delivers (column 21).
@@ -815,7 +895,11 @@ def by_tol(res, out, M):
           if own else "not measured", math_mode=False)
     M.add("AutoOverOwnTime", f"${sci(min(own_time))}$ to ${sci(max(own_time))}$ times in time" if own_time else
           "untimed (every comparison's time flagged)", math_mode=False)
-    M.add("AutoSearchOverRun", f"${sci(min(search))}$ to ${sci(max(search))}$" if search else "n/a", math_mode=False)
+    if not own_time:
+        M.ledger.lost("table~\\ref{tab:bytol}: auto against bodypoint's fastest configuration, in time",
+                      "every comparison's time flagged")
+    M.add("AutoSearchOverRun", f"${sci(min(search))}$ to ${sci(max(search))}$ times" if search else
+          "an unmeasured multiple of (no search of \\cmd{auto} in this copy's by-tol table)", math_mode=False)
     with open(os.path.join(out, "tab_by_tol.tex"), "w") as f:
         for row in body:
             f.write(" & ".join(latex_cell(row[i]) for i in keep) + " \\\\\n")
@@ -1076,10 +1160,20 @@ def ensembles(res, M):
     M.add("MapLs", count(len({r["L"] for r in rows})))
     M.add("MapMethods", count(len(methods)))
     M.add("MapRuns", count(len(rows)))
-    with open(os.path.join(res, "dL_map_seconds.txt")) as f:  # wall seconds, cores
-        seconds, cores = f.read().split()
-    M.add("MapSeconds", sci(float(seconds)))
-    M.add("MapCores", count(int(cores)))
+    with open(os.path.join(res, "dL_map_seconds.txt")) as f:  # wall seconds, cores, share others used
+        fields = f.read().split()
+    seconds, cores = float(fields[0]), int(fields[1])
+    # One run (a study of minutes is not repeated: the stated exemption); judged by the share of the
+    # cores other processes used while it ran.
+    others = num(fields[2]) if len(fields) > 2 else float("nan")
+    flag = M.rule.flag(None, others, 0.0, process=True)
+    M.ledger.count("the $(d, L)$ map's wall time", [flag])
+    if flag:
+        M.add("MapTime", f"(its wall time flagged: {latex_text(flag)})", math_mode=False)
+        M.ledger.lost("the $(d, L)$ map's wall time (section~\\ref{sec:map})", flag)
+    else:
+        M.add("MapTime", f"in ${sci(seconds)}$~s of wall time", math_mode=False)
+    M.add("MapCores", count(cores))
     # Share of the map each family keeps below 1e-10 relative energy error (status ok).
     def share(pick, bound=1e-10):
         rs = [r for r in rows if pick(r["method"])]
@@ -1089,37 +1183,67 @@ def ensembles(res, M):
     M.add("MapShareThesis", sci(share(lambda m: m.startswith("thesis-")), 3))
     M.add("MapShareRk", sci(share(lambda m: m in ("rk4", "ab4")), 3))
     M.add("MapNotOk", count(sum(1 for r in rows if r["status"] != "ok")))
-    # bench_batch: items_per_second of the scalar loop and of each width, per method.
-    rate = {}
-    with open(os.path.join(res, "bench_batch.csv")) as f:
-        lines = [line for line in f if line.startswith('"BM_') or line.startswith("name,")]
-    for r in csv.DictReader(lines):
-        name = r["name"].strip('"')
-        if not name.endswith("_cv"):  # the coefficient of variation rows are the spread, not a rate
-            rate[name.replace("_median", "")] = num(r["items_per_second"])
-    widths = sorted({int(k.rsplit("/w", 1)[1]) for k in rate if k.startswith("BM_SweepBatch/")})
+    # bench_batch: items_per_second of the scalar loop and of each width, per method; a speed-up only
+    # between two times that count under the timing rule.
+    bench = timing_rule.benchmark(os.path.join(res, "bench_batch.csv"), M.rule)
+    rate = {name: num(r["items_per_second"]) for name, r in bench.items() if not r["flag"]}
+    widths = sorted({int(k.rsplit("/w", 1)[1]) for k in bench if k.startswith("BM_SweepBatch/")})
     wide = widths[-1]
     M.add("BatchWidth", count(wide))
     M.add("MapBatchWidthText", f"{wide} lanes at a time on this machine", math_mode=False)
     ratios = {}
     for k, v in rate.items():
-        if k.startswith("BM_SweepScalar/"):
+        if k.startswith("BM_SweepScalar/") and f"BM_SweepBatch/{k.split('/', 1)[1]}/w{wide}" in rate:
             m = k.split("/", 1)[1]
             ratios[m] = rate[f"BM_SweepBatch/{m}/w{wide}"] / v
-            M.add("BatchSpeedup" + camel(m), sci(ratios[m]))
-            M.add("BatchScalarRate" + camel(m), sci(v))
-            M.add("BatchRate" + camel(m), sci(rate[f"BM_SweepBatch/{m}/w{wide}"]))
-    M.add("BatchSpeedupMin", sci(min(ratios.values())))
-    # scripts/ensemble-scaling.sh: one sweep every way it runs.
+    lp = "lp-y4"
+    if ratios:
+        text = f"${sci(min(ratios.values()))}$--${sci(max(ratios.values()))}$ times faster per core"
+        if lp in ratios:
+            text += (f" than the scalar loop (\\cmd{{bench\\_batch}}: ${sci(rate[f'BM_SweepBatch/{lp}/w{wide}'])}$ against "
+                     f"${sci(rate[f'BM_SweepScalar/{lp}'])}$ trajectory-steps per second for \\cmd{{{lp}}})")
+        else:
+            text += " than the scalar loop (\\cmd{bench\\_batch})"
+    else:
+        text = "faster per core than the scalar loop, by how much untimed in this copy (every \\cmd{bench\\_batch} pair flagged)"
+        lost_column(M, "the batch speed-ups (section~\\ref{sec:map})", [r["flag"] for r in bench.values()])
+    M.add("BatchSpeedupText", text, math_mode=False)
+    scaling_text(res, M)
+
+
+def scaling_text(res, M):
+    """scripts/ensemble-scaling.sh: one sweep every way it runs, each mode's median of interleaved
+    repeats judged by the timing rule (spread, the share of the cores others used); a speed-up or an
+    efficiency only between times that count."""
     scaling = {r["mode"]: r for r in read_csv(os.path.join(res, "scaling.csv"))[0]}
-    for mode, name in [("simd1", "Lanes"), ("simd2", "Threads"), ("mpi2", "Mpi"), ("shards2", "Shards")]:
-        row = scaling.get(mode, {})  # mpi2 is missing where mpirun is: n/a
-        M.add("Scale" + name + "Speedup", sci(num(row.get("speedup_vs_scalar"))))
-        M.add("Scale" + name + "Efficiency", sci(100 * num(row.get("parallel_efficiency")), 2))
-    M.add("ScaleMpiStartup", sci(num(scaling.get("mpi2-startup", {}).get("wall_s"))))
-    M.add("ScaleScalarRate", sci(num(scaling["scalar1"]["traj_steps_per_s"])))
-    M.add("ScaleLanesRate", sci(num(scaling["simd1"]["traj_steps_per_s"])))
-    M.add("BatchSpeedupMax", sci(max(ratios.values())))
+    flags = {m: M.rule.flag(int(num(r.get("repeats")) if r.get("repeats") else 1), num(r.get("others_share")),
+                            num(r.get("spread")), process=True) for m, r in scaling.items()}
+    M.ledger.count("parallel runs", flags.values())
+    ok = lambda *modes: all(m in scaling and not flags[m] for m in modes)  # noqa: E731
+    if ok("scalar1", "simd1"):
+        lanes = (f"lanes run ${sci(num(scaling['simd1']['speedup_vs_scalar']))}$ times the scalar loop's "
+                 f"${sci(num(scaling['scalar1']['traj_steps_per_s']))}$ trajectory-steps per second on one core")
+    else:
+        lanes = "the speed-up of lanes on one core is untimed in this copy (its times flagged)"
+    parts = []
+    for mode, words in [("simd2", "with two threads"), ("mpi2", "with two MPI ranks"),
+                        ("shards2", "with two shards and a merge")]:
+        if mode not in scaling:
+            parts.append(f"not measured {words} (no \\cmd{{mpirun}})")
+        elif ok(mode, "simd1"):
+            parts.append(f"${sci(100 * num(scaling[mode]['parallel_efficiency']), 2)}\\%$ {words}")
+        else:
+            parts.append(f"untimed {words} (flagged: {latex_text(flags[mode] or flags['simd1'])})")
+    efficiency = f"on two cores the parallel efficiency is {', '.join(parts[:-1])} and {parts[-1]}"
+    if ok("mpi2-startup"):
+        startup = (f"; starting and ending two MPI ranks alone takes ${sci(num(scaling['mpi2-startup']['wall_s']))}$~s, "
+                   "which a sweep of this size does not amortise")
+    else:
+        startup = ""
+    M.add("ScalingText", f"{lanes}; {efficiency} (start-up of the processes included{startup})", math_mode=False)
+    if not any(ok(m, "simd1") for m in ("simd2", "mpi2", "shards2")):
+        M.ledger.lost("the parallel efficiencies (section~\\ref{sec:map})",
+                      "; ".join(sorted({f for f in flags.values() if f})) or "not measured")
 
 
 def scattering(res, M):
@@ -1184,9 +1308,18 @@ def scattering(res, M):
 def latex_text(text):
     """Plain text (a CPU's or a compiler's name) safe inside a LaTeX paragraph."""
     for a, b in [("\\", "\\textbackslash{}"), ("&", "\\&"), ("%", "\\%"), ("$", "\\$"), ("#", "\\#"),
-                 ("_", "\\_"), ("{", "\\{"), ("}", "\\}"), ("~", "\\textasciitilde{}"), ("^", "\\textasciicircum{}")]:
+                 ("_", "\\_"), ("{", "\\{"), ("}", "\\}"), ("~", "\\textasciitilde{}"), ("^", "\\textasciicircum{}"),
+                 ("<", "\\textless{}"), (">", "\\textgreater{}")]:
         text = text.replace(a, b)
     return text
+
+
+def build_options(res, M):
+    """The options paper/build.sh gave each step's command in this mode (build_options.txt)."""
+    path = os.path.join(res, "build_options.txt")
+    lines = open(path).read().splitlines() if os.path.exists(path) else []
+    M.add("BuildOptions", "; ".join(f"\\cmd{{{latex_text(line.split(': ', 1)[0])}}}: \\cmd{{{latex_text(line.split(': ', 1)[1])}}}"
+                                    for line in lines if ": " in line) or "not recorded", math_mode=False)
 
 
 def build_time(res, M):
@@ -1217,13 +1350,6 @@ def platform(res, M):
 def timing_discipline(res, M):
     """How many times of this build count under the timing rules (experiments/stopwatch.hpp), the rules'
     margins as the CSVs state them, and GSL as bodypoint drives it against a plain C program."""
-    total = flagged = 0
-    for name in ["work_precision.csv", "by_tol.csv", "timing.csv"]:
-        rows, header = read_csv(os.path.join(res, name))
-        total += len(rows)
-        flagged += sum(1 for r in rows if r["flag"])
-    M.add("TimesTaken", count(total))
-    M.add("TimesFlagged", count(flagged))
     _, header = read_csv(os.path.join(res, "by_tol.csv"))
     rules = next(line for line in header if line.startswith("# flag:"))
     M.add("MaxWaitShare", re.search(r"by more than (\S+) %", rules).group(1))
@@ -1232,31 +1358,71 @@ def timing_discipline(res, M):
     M.add("TimingRepeats", re.search(r"then (\d+) repeats", timing).group(1))
     M.add("MinRepeatMs", re.search(r"lasting >= (\S+) ms", timing).group(1))
     path = os.path.join(res, "gsl_peer.csv")
+    rows = []
     if os.path.exists(path):
         with open(path) as f:
             rows = list(csv.DictReader(f))
-        ratios = [num(r["ratio_per_eval"]) for r in rows]
-        M.add("GslPeerRuns", count(len(rows)))
-        M.add("GslPeerLow", f"{min(ratios):.2f}")
-        M.add("GslPeerHigh", f"{max(ratios):.2f}")
-        M.add("GslPeerMedian", f"{statistics.median(ratios):.2f}")
+    # Only comparisons whose two times count (gsl_peer flags a row when either does not).
+    ratios = [num(r["ratio_per_eval"]) for r in rows if not r["flag"]]
+    if ratios:
+        text = (f"cost ${min(ratios):.2f}$ to ${max(ratios):.2f}$ (median ${statistics.median(ratios):.2f}$) times, "
+                f"per force evaluation, what a stand-alone C program costs")
+    elif rows:
+        text = "were not compared in this copy with what a stand-alone C program costs (every comparison flagged)"
+        lost_column(M, "GSL against a plain C program (section~\\ref{sec:timing})", [r["flag"] for r in rows])
     else:
-        for name in ["GslPeerRuns", "GslPeerLow", "GslPeerHigh", "GslPeerMedian"]:
-            M.add(name, "n/a")
+        text = "were not compared in this build with what a stand-alone C program costs (no GSL)"
+    M.add("GslPeerCost", text, math_mode=False)
+    M.add("GslPeerRuns", f"{count(len(ratios))} of {count(len(rows))} configurations whose times count", math_mode=False)
+
+
+def contention(res, figs, M):
+    """Every time of this build under the one timing rule: how many were taken and flagged (per study and
+    in all), and, when a figure, table column or stated comparison lost every time to flags (a
+    contended machine), the draft stamp on every page and the list on the first (ContendedStamp,
+    ContendedNotice; both empty for a copy that lost nothing)."""
+    for name, study in [("timing.csv", "timing study"), ("published_timing.csv", "timing study as published"),
+                        ("work_precision.csv", "work-precision"), ("by_tol.csv", "by-tol"),
+                        ("gsl_peer.csv", "GSL against plain C")]:
+        if os.path.exists(os.path.join(res, name)):
+            M.ledger.count(study, [r["flag"] for r in read_csv(os.path.join(res, name))[0]])
+    for name, study in [("bench_steps.csv", "\\cmd{bench\\_steps}"), ("bench_batch.csv", "\\cmd{bench\\_batch}")]:
+        if os.path.exists(os.path.join(res, name)):
+            M.ledger.count(study, [r["flag"] for r in timing_rule.benchmark(os.path.join(res, name), M.rule).values()])
+    taken, flagged = M.ledger.total()
+    M.add("TimesTaken", count(taken))
+    M.add("TimesFlagged", count(flagged))
+    M.add("TimesFlaggedByStudy", "; ".join(f"{study} {count(M.ledger.flagged[study])} of {count(n)}"
+                                           for study, n in M.ledger.taken.items()), math_mode=False)
+    path = os.path.join(figs, "lost.csv") if figs else ""
+    if path and os.path.exists(path):
+        with open(path, newline="") as f:
+            for r in csv.DictReader(f):
+                M.ledger.lost(r["what"], r["why"])
+    if not M.ledger.lost_items:
+        M.add("ContendedStamp", "", math_mode=False)
+        M.add("ContendedNotice", "", math_mode=False)
+        return
+    items = " ".join(f"\\item {what}: {latex_text(why)}" for what, why in M.ledger.lost_items)
+    M.add("ContendedStamp", "\\contendedstamp", math_mode=False)
+    M.add("ContendedNotice", "\\contendednotice{" + f"{count(flagged)} of {count(taken)}" + "}{" + items + "}",
+          math_mode=False)
 
 
 def main():
-    if len(sys.argv) != 4:
-        sys.exit("usage: make_macros.py RESULTS_DIR OUT_DIR MODE")
-    res, out, mode = sys.argv[1:]
+    if len(sys.argv) not in (4, 5):
+        sys.exit("usage: make_macros.py RESULTS_DIR OUT_DIR MODE [FIGURES_DIR]")
+    res, out, mode = sys.argv[1:4]
+    figs = sys.argv[4] if len(sys.argv) == 5 else None  # make_figures.py's lost.csv: empty panels
     load_catalogue(res)
     os.makedirs(out, exist_ok=True)
-    M = Macros()
+    M = Macros(timing_rule.Rule.of(res))
     _, header = read_csv(os.path.join(res, "d_sweep.csv"))
     M.add("Revision", f"\\texttt{{{revision_of(header)}}}", math_mode=False)
     M.add("BuildMode", mode, math_mode=False)
     platform(res, M)
     build_time(res, M)
+    build_options(res, M)
     timing_discipline(res, M)
     errata(res, M)
     sweeps(res, M)
@@ -1276,6 +1442,7 @@ def main():
     appendix(res, M)
     ensembles(res, M)
     scattering(res, M)
+    contention(res, figs, M)
     M.write(os.path.join(out, "macros.tex"))
     print(f"wrote {len(M.defs)} macros and the tables to {out}")
 
