@@ -1242,8 +1242,7 @@ def scaling_text(res, M):
         startup = ""
     M.add("ScalingText", f"{lanes}; {efficiency} (start-up of the processes included{startup})", math_mode=False)
     if not any(ok(m, "simd1") for m in ("simd2", "mpi2", "shards2")):
-        M.ledger.lost("the parallel efficiencies (section~\\ref{sec:map})",
-                      "; ".join(sorted({f for f in flags.values() if f})) or "not measured")
+        lost_column(M, "the parallel efficiencies (section~\\ref{sec:map})", list(flags.values()))
 
 
 def scattering(res, M):
