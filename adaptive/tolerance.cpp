@@ -223,14 +223,10 @@ class Search {
   Level run_at(double h, double h_c, bool may_deliver, const Body* from = nullptr) {
     const bool samples = may_deliver && delivery_.sink;
     const Advance how = step_advance(m_, h, t_end_, samples ? dt_out_ : 0.0);
-    RunOptions o;
-    o.omega_c = automatic_omega_c(b_, c_, h_c);
-    o.cancel = delivery_.cancel;
-    o.track_invariants = may_deliver && delivery_.track_invariants;
+    RunOptions o = run_options(automatic_omega_c(b_, c_, h_c), may_deliver);
     Level l;
     SampleSink keep;
     if (may_deliver) {
-      o.every = delivery_.every;
       if (samples) {
         keep = [&l](const Sample& x) {
           if (l.samples_dropped) return;
@@ -264,14 +260,21 @@ class Search {
     return l;
   }
 
+  /// The options of a search's run with constant c omega_c: the caller's cancel, and where it may be
+  /// delivered, the caller's observers (invariants, every k-th step; its sink is the caller's to attach).
+  RunOptions run_options(double omega_c, bool may_deliver) const {
+    RunOptions o;
+    o.omega_c = omega_c;
+    o.cancel = delivery_.cancel;
+    o.track_invariants = may_deliver && delivery_.track_invariants;
+    if (may_deliver) o.every = delivery_.every;
+    return o;
+  }
+
   /// The delivered run made again with the caller's sink, where it had more samples than were kept: the
   /// same steps and constant c give the same states; the sink's Flow::stop ends its samples, not the run.
   void replay(const Level& best) {
-    RunOptions o;
-    o.omega_c = best.omega_c;
-    o.cancel = delivery_.cancel;
-    o.track_invariants = delivery_.track_invariants;
-    o.every = delivery_.every;
+    RunOptions o = run_options(best.omega_c, true);
     bool ended = false;
     SampleSink forward = [&](const Sample& x) {
       if (!ended && (*delivery_.sink)(x) == Flow::stop) ended = true;
