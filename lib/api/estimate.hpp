@@ -55,6 +55,10 @@ ErrorEstimate fixed_step_estimate(const MethodInfo& m, const Body& body, const s
 void confirm(ErrorEstimate& e, double min_fall, const State& run, const State& first, const State& second);
 void confirm(ErrorEstimate& e, const MethodInfo& m, const Body& body, const State& run, const State& first,
              const State& second);
+/// A flagged run that confirm() left unconfirmed, given a third companion one level finer again: where the
+/// finer companions' differences fall at least geometrically, the run is off by at most what it differs by
+/// from the third plus what the third may still be off by; e is raised to that and confirmed (estimate.cpp).
+void confirm_deeper(ErrorEstimate& e, const State& run, const State& first, const State& second, const State& third);
 
 /// Whether the estimate e is at the scene's rounding level (below kRoundingLevel, estimate.cpp), where the
 /// companion pair can agree by chance: the run is repeated from start_moved_by_rounding and what the two

@@ -126,10 +126,29 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
                                               companions[k].final);
       row.error.force_evals = coarse_cost[k].force_evals + companions[k].force_evals;
       row.error.wall_s = coarse_cost[k].wall_s + companions[k].wall_s;
-      if (row.outcome == Outcome::unresolved)
+      if (row.outcome == Outcome::unresolved) {
+        row.error.force_evals += second[k].force_evals;
+        row.error.wall_s += second[k].wall_s;
         detail::confirm(row.error, method, scenes[k].bodies.front(), row.result.final, companions[k].final, second[k].final);
+      }
     } else {
       row.error.basis = "the run ended " + std::string(outcome_name(row.outcome));
+    }
+  }
+  // As integrate(): flagged lanes the second companion did not confirm get a third, one level finer again.
+  const auto deeper = [&](std::size_t k) {
+    return spec.estimate_error && !by_coarse[k] && rows[k].outcome == Outcome::unresolved && !rows[k].error.confirmed &&
+           rows[k].error.known();
+  };
+  bool any_deeper = false;
+  for (std::size_t k = 0; k < rows.size(); ++k) any_deeper = any_deeper || deeper(k);
+  if (any_deeper) {
+    const auto third = batch::run(method, members, detail::fixed_companion(how, 3));
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      if (!deeper(k)) continue;
+      rows[k].error.force_evals += third[k].force_evals;
+      rows[k].error.wall_s += third[k].wall_s;
+      detail::confirm_deeper(rows[k].error, rows[k].result.final, companions[k].final, second[k].final, third[k].final);
     }
   }
   // As integrate(): lanes whose fine estimate is at the rounding level add a repeat from their start moved

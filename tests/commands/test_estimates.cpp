@@ -147,6 +147,32 @@ TEST(Estimates, TheCoarseCompanionCostsHalfARunAndFallsBackWhereItCannotBeTruste
   EXPECT_GT(json_num(lost.out, "err_estimate"), json_num(lost.out, "err_rel") / kHonestFactor) << lost.out;
 }
 
+TEST(Estimates, ARunAliasingTheSpinIsKeptWhereAThirdCompanionBoundsIt) {
+  // Two repelling centres and the thesis's spinning body: lp-bm4 at h = 1 turns the spin by 6.86 rad per
+  // step and is 8.1e-4 off (right by aliasing), its companion at h/2 aliases too (2.7e-3 off), so the
+  // first two differences do not fall (1.1x) and the run was refused though right. A third companion (h/8)
+  // resolves the spin: the run is bounded through it and kept, by integrate() and by a sweep's lanes alike.
+  const auto scene = test::temp_path("two-centres-spin.toml");
+  std::ofstream(scene) << "[[centre]]\nposition = [0.0, 0.0, 0.0]\nA = -2.0\n[[centre]]\nposition = [40.0, 6.0, 0.0]\n"
+                          "A = -1.0\n[[body]]\nname = \"spinning\"\nm = 1.0\nB = 0.7\nJ = 1.0\nd = 10.0\nL = 200.0\n"
+                          "K1 = 5.0\nKx = 2.0\nKz = 5.0\n";
+  const std::string run = "--scene " + scene.string() + " --t-end 60 --h 1";
+  const auto r = run_cli("simulate --json --reference --method lp-bm4 " + run);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("turned the spin by 6.86 rad"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("a third companion one level finer again"), std::string::npos) << r.out;
+  const double est = json_num(r.out, "err_estimate"), err = json_num(r.out, "err_rel");
+  EXPECT_LT(err, 1e-3) << r.out;
+  EXPECT_GE(est, err) << "the bound through the third companion is an upper bound: " << r.out;
+  EXPECT_LT(est, 1e-2) << r.out;
+  const auto swept = run_cli("sweep --param body.B --values 0.7 --methods lp-bm4 " + run);
+  ASSERT_EQ(swept.code, 0) << swept.err;
+  EXPECT_NE(swept.out.find(",ok,"), std::string::npos) << swept.out;
+  EXPECT_NE(swept.out.find("a third companion one level finer again"), std::string::npos) << swept.out;
+  // The sweep's estimate counts its three companions' evaluations: 2 + 4 + 8 runs of 360.
+  EXPECT_NE(swept.out.find(",5040,"), std::string::npos) << swept.out;
+}
+
 TEST(Estimates, AnExactFlowIsEstimatedByItsWholeRounding) {
   // The Kepler split on a material point about one centre is exact: its runs at h and 2h differ by
   // rounding alone (bound orbit to t = 300, kep-y8 h = 1: 7.0e-10 off, the pair 3.3e-10 apart), which a
