@@ -166,7 +166,7 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
                                 " time_delay = against free motion, Coulomb logarithm removed; asymptote_error = the"
                                 " asymptotes' model error in the deflection (estimated from half the start distance);"
                                 " start_distance_error, time_delay_error = what the start distance L leaves against L ->"
-                                " infinity (the point again from 2L; 0 for B = 0); deflection_error = the deflection's total;"
+                                " infinity (the point again from 2L); deflection_error = the deflection's total;"
                                 " a run that ended before the body left is status incomplete, without them;"
                                 " K1_turn, spin_turn ="
                                 " angles K1 and K2 turned over the run (rad); K1x,K1y,K1z = final K1;"
@@ -306,17 +306,22 @@ std::vector<Axis> parse_axes(const po::variables_map& vm, const std::vector<std:
   return {{param, linear_range(from, to, vm["step"].as<double>())}};
 }
 
-/// Fixed asymptotic data (--b, --v-inf): a one-value axis each, solved for at every grid point (a
-/// sweep over L keeps b, not d).
+/// Fixed asymptotic data (--b, --v-inf, --arrival-phase): a one-value axis each, solved for at every grid
+/// point (a sweep over L keeps b, not d; a sweep over b keeps the arrival phase, not the start phase:
+/// kept as a base parameter instead, the start phase solved at the base's d gave b = 10 an arrival phase
+/// other than the one asked for, its deflection 1.7e-7 from simulate's at the same data).
 void apply_fixed_data(const po::variables_map& vm, const SceneOptions& so, SweepSpec& spec) {
   struct Fixed {
     const char* option;
     std::string param;
     double value;
+    bool positive;  ///< b and v_inf: > 0; a phase: any finite number
   };
-  for (const Fixed& f : {Fixed{"b", "b", so.b}, Fixed{"v-inf", "v_inf", so.v_inf}}) {
+  for (const Fixed& f : {Fixed{"b", "b", so.b, true}, Fixed{"v-inf", "v_inf", so.v_inf, true},
+                         Fixed{"arrival-phase", "arrival_phase", so.arrival_phase, false}}) {
     if (!vm.count(f.option)) continue;
-    if (!(std::isfinite(f.value) && f.value > 0.0)) throw Error(std::string("--") + f.option + " must be a finite number > 0");
+    if (!(std::isfinite(f.value) && (f.value > 0.0 || !f.positive)))
+      throw Error(std::string("--") + f.option + " must be a finite number" + (f.positive ? " > 0" : ""));
     if (std::any_of(spec.axes.begin(), spec.axes.end(), [&f](const Axis& a) { return a.param == f.param; }))
       throw Error(std::string("--") + f.option + " is fixed and varied at once");
     spec.axes.push_back(Axis{f.param, {f.value}});

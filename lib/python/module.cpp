@@ -473,11 +473,22 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
   for (const auto& [param, values] : axes) s.axes.push_back({param, values});
   for (const std::string& list : methods)
     for (const MethodInfo* m : methods_named(list)) s.methods.push_back(m);
-  for (const auto& [k, v] : base) scene_field(s.base, k.cast<std::string>()) = number_of(v, k.cast<std::string>());
   // A datum swept beside the parameter it solves would silently replace it (the command line's rule).
   std::vector<std::string> swept, given;
   for (const Axis& a : s.axes) swept.push_back(a.param);
-  for (const auto& [k, v] : base) given.push_back(k.cast<std::string>());
+  for (const auto& [k, v] : base) {
+    const auto key = k.cast<std::string>();
+    const double x = number_of(v, key);
+    if (key == "b" || key == "v_inf" || key == "arrival_phase") {
+      // Fixed asymptotic data: a one-value axis, solved for at every point (as sweep --b, --v-inf, --arrival-phase).
+      if (std::find(swept.begin(), swept.end(), key) != swept.end()) throw Error(key + " is fixed and varied at once");
+      s.axes.push_back({key, {x}});
+      continue;
+    }
+    scene_field(s.base, key) = x;
+    given.push_back(key);
+  }
+  for (std::size_t a = swept.size(); a < s.axes.size(); ++a) swept.push_back(s.axes[a].param);
   check_data_beside_solved(swept, given);
   s.base.law = parse_force_law(force_law);
   s.scattering = scattering;

@@ -595,3 +595,14 @@ def test_a_named_method_is_not_refused_where_auto_delivers_it():
     named = bp.encounter(scene, method=auto["run"]["method"], tol=1e-9)
     assert named["outcome"] == "ok" and named["run"]["err_estimate"] <= 1e-9
     assert named["deflection"] == auto["deflection"]  # one search rule: the same run
+
+
+def test_sweep_holds_fixed_asymptotic_data_at_every_point():
+    # sweep(..., arrival_phase=0) said "unknown scene parameter 'arrival_phase'"; as the command line's
+    # --arrival-phase it is a one-value axis, solved for at every point: the row is encounter()'s run.
+    cols = bp.sweep({"b": [10.0]}, ["lp-kl8"], accuracy=1e-10, scattering=True, arrival_phase=0.0, progress=False)
+    assert list(cols["arrival_phase"]) == [0.0]
+    one = bp.encounter(bp.thesis_scene(b=10.0, arrival_phase=0.0), method="lp-kl8", tol=1e-10)
+    assert cols["deflection"][0] == pytest.approx(one["deflection"], abs=1e-12)
+    with pytest.raises(bp.Error, match="b is fixed and varied at once"):
+        bp.sweep({"b": [10.0]}, ["lp-kl8"], accuracy=1e-10, scattering=True, b=3.0, progress=False)

@@ -351,7 +351,8 @@ def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, accuracy=None
     is swept as the thesis's parameters. ``methods``: names, a list of
     names separated by commas, "fixed" (every fixed-step method but the Kepler split) or "all", as
     ``bodypoint sweep --methods`` takes them (named methods: "auto" is not one; ``accuracy`` below is the
-    accuracy mode for each). ``base``: fixed scene parameters; ``force_law`` as
+    accuracy mode for each). ``base``: fixed scene parameters, and fixed asymptotic data (b, v_inf,
+    arrival_phase: solved for at every point, a column each, as ``bodypoint sweep --b``); ``force_law`` as
     thesis_scene()'s. Steps of h: ``steps`` of them, or to ``t_end``; ``tol``: the step-size-controlled
     peers' tolerance per step. ``accuracy``: the accuracy mode, every other method delivering this
     relative error of the final state at ``t_end`` (its step searched per row: columns h_chosen,
