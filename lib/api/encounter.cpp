@@ -142,7 +142,7 @@ double encounter_span(const Body& body, const std::vector<Centre>& centres) {
 void add_start_distance_error(Encounter& at_L, const EncounterResult* at_2L, bool material, double numerical) {
   if (material) {
     at_L.start_distance_error = at_L.time_delay_error = 0.0;
-    at_L.start_distance_basis = "exact: a material point's Kepler hyperbola does not depend on where it starts";
+    at_L.start_distance_basis = "exact: a material point's Kepler hyperbola is that of its states, wherever they are";
   } else if (!at_2L || at_2L->run.outcome != Outcome::ok || at_2L->encounter.outcome != Outcome::ok ||
              !std::isfinite(at_2L->encounter.scattering.deflection)) {
     const std::string why = !at_2L ? "" : at_2L->run.outcome != Outcome::ok ? at_2L->run.reason : at_2L->encounter.reason;
@@ -178,9 +178,11 @@ void no_start_distance_error(Encounter& e, bool material, double numerical, cons
 
 long add_start_distance(Encounter& e, const Body& body, const std::function<Scene()>& far, std::optional<double> tol,
                         double numerical, const std::string& no_far, const Options& options) {
-  const bool material = body.p.B == 0.0;
-  if (material || !far) {
-    no_start_distance_error(e, material, numerical, no_far);
+  // A thesis scene's material point is run from 2L too: at the scene's K1 its speed at infinity moves
+  // with L (the potential at L is part of the start's energy), and with it the deflection (B = 0, b = 10:
+  // 0.0159869 from L = 200, 0.0159981 from 1600); a scene file's states are its own asymptotic data.
+  if (!far) {
+    no_start_distance_error(e, body.p.B == 0.0, numerical, no_far);
     return 0;
   }
   const EncounterResult r = encounter_twice_as_far(far(), twice_as_far_tol(tol), options);
@@ -189,6 +191,10 @@ long add_start_distance(Encounter& e, const Body& body, const std::function<Scen
 }
 
 SceneParams thesis_params_twice_as_far(SceneParams solved, double b, double v_inf, double arrival_phase) {
+  // The limit L -> infinity is of the scene as given: its K1 or v_inf, its d or b, kept. Its start phase
+  // has no limit (the helix turns on the longer way in: doubling L moves the arrival phase by whatever
+  // the extra turn is), so where no arrival phase is given the scene's own at L is kept instead.
+  if (std::isnan(arrival_phase) && solved.B != 0.0) arrival_phase = bodypoint::arrival_phase(solved);
   solved.start.L *= 2.0;
   return with_asymptotic_data(solved, b, v_inf, arrival_phase);
 }

@@ -169,20 +169,35 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
                    detail::final_energy_error(scenes[k].bodies.front(), scenes[k].centres, rows[k].result.final));
 }
 
-/// The start distance's part of a row's encounter error: the same grid point with the start distance L
-/// doubled (an axis of L doubled too), its asymptotic data solved again, run to its departure by auto
-/// (twice_as_far_tol).
+/// A grid point's thesis parameters, and the asymptotic data its axes give (NaN: not given), solved in.
+struct PointData {
+  SceneParams params;
+  double b = Scattering::kNaN, v_inf = Scattering::kNaN, arrival = Scattering::kNaN;
+};
+
+PointData point_data(const SweepSpec& spec, const std::vector<double>& point) {
+  PointData d{spec.base};
+  for (std::size_t a = 0; a < spec.axes.size(); ++a) {
+    const std::string& name = spec.axes[a].param;
+    if (name == "b") d.b = point[a];
+    else if (name == "v_inf") d.v_inf = point[a];
+    else if (name == "arrival_phase") d.arrival = point[a];
+    else if (name != "h") scene_field(d.params, name) = point[a];
+  }
+  if (!(std::isnan(d.b) && std::isnan(d.v_inf) && std::isnan(d.arrival))) d.params = with_asymptotic_data(d.params, d.b, d.v_inf, d.arrival);
+  return d;
+}
+
+/// The start distance's part of a row's encounter error: the grid point's scene from twice its start
+/// distance (thesis_params_twice_as_far: the point's data b, v_inf, arrival phase solved for again, the
+/// rest kept), run to its departure by auto (twice_as_far_tol).
 void add_row_start_distance(Encounter& e, const SweepSpec& spec, const std::vector<double>& point, const Body& body,
                             double numerical) {
   std::function<Scene()> far;
   if (spec.scene_text.empty())
     far = [&] {
-      SweepSpec twice = spec;
-      twice.base.start.L *= 2.0;
-      std::vector<double> at = point;
-      for (std::size_t a = 0; a < spec.axes.size(); ++a)
-        if (spec.axes[a].param == "L") at[a] *= 2.0;
-      return thesis_scene(point_params(twice, at));
+      const PointData d = point_data(spec, point);
+      return thesis_scene(thesis_params_twice_as_far(d.params, d.b, d.v_inf, d.arrival));
     };
   Options o;
   o.track_invariants = false;
@@ -236,19 +251,7 @@ std::vector<double> grid_point(const SweepSpec& spec, std::size_t p) {
   return point;
 }
 
-SceneParams point_params(const SweepSpec& spec, const std::vector<double>& point) {
-  SceneParams p = spec.base;
-  // asymptotic data: solved for once the rest is set
-  double b = Scattering::kNaN, v_inf = Scattering::kNaN, arrival = Scattering::kNaN;
-  for (std::size_t a = 0; a < spec.axes.size(); ++a) {
-    const std::string& name = spec.axes[a].param;
-    if (name == "b") b = point[a];
-    else if (name == "v_inf") v_inf = point[a];
-    else if (name == "arrival_phase") arrival = point[a];
-    else if (name != "h") scene_field(p, name) = point[a];
-  }
-  return std::isnan(b) && std::isnan(v_inf) && std::isnan(arrival) ? p : with_asymptotic_data(p, b, v_inf, arrival);
-}
+SceneParams point_params(const SweepSpec& spec, const std::vector<double>& point) { return point_data(spec, point).params; }
 
 SweepSpec with_scene_file(SweepSpec spec, std::string text, std::string origin) {
   const Scene scene = parse_scene(text, origin);

@@ -104,7 +104,13 @@ std::vector<std::string> thesis_keywords() {
 }
 
 /// The thesis's scene from keyword parameters (model.hpp scene_parameters(); b and v_inf: asymptotic data).
-Scene thesis_from(const py::dict& kw) {
+/// The thesis's parameters from thesis_scene()'s keywords, the asymptotic data given among them solved in.
+struct ThesisParams {
+  SceneParams solved;
+  AsymptoticData data;
+};
+
+ThesisParams thesis_params_from(const py::dict& kw) {
   SceneParams sp;
   AsymptoticData data;
   std::vector<std::string> given;
@@ -125,8 +131,10 @@ Scene thesis_from(const py::dict& kw) {
       given.push_back(key);
     }
   }
-  return thesis_scene(with_asymptotic_data(sp, data, given));
+  return {with_asymptotic_data(sp, data, given), data};
 }
+
+Scene thesis_from(const py::dict& kw) { return thesis_scene(thesis_params_from(kw).solved); }
 
 /// What stops a call into the library early: Ctrl-C (SIGINT, in the main thread: the handler in place
 /// is put back after the call) and a budget of max_seconds of wall-clock time (a watchdog thread). Both
@@ -517,13 +525,13 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
 }
 
 /// The encounter's record with its run's (`run`: method, steps, t_end, err_estimate, force_evals, ...).
-/// The thesis keywords `kw` (thesis_scene's) with the start distance L doubled, the asymptotic data kept.
-py::dict twice_as_far(const py::dict& kw) {
-  py::dict far;
-  for (const auto& [k, v] : kw) far[k] = v;
-  const double L = kw.contains("L") ? number_of(kw["L"], "L") : SceneParams{}.start.L;
-  far["L"] = 2.0 * L;
-  return far;
+/// The scene of thesis_scene()'s keywords `kw` from twice its start distance (thesis_params_twice_as_far:
+/// the data given solved for again, the rest kept, the arrival phase the scene's own where none is given).
+Scene twice_as_far(const py::dict& kw) {
+  const ThesisParams t = thesis_params_from(kw);
+  constexpr double kNotGiven = std::numeric_limits<double>::quiet_NaN();
+  return thesis_scene(thesis_params_twice_as_far(t.solved, t.data.b.value_or(kNotGiven), t.data.v_inf.value_or(kNotGiven),
+                                                 t.data.arrival_phase.value_or(kNotGiven)));
 }
 
 py::dict encounter_py(const Scene& scene, const std::string& method, double tol, double t_end, double max_seconds,
@@ -546,7 +554,7 @@ py::dict encounter_py(const Scene& scene, const std::string& method, double tol,
   if (r.encounter.outcome == Outcome::ok) {
     // The far scene is made here, under the GIL (from the thesis's parameters, a Python dict).
     std::optional<Scene> far_scene;
-    if (thesis && body.p.B != 0.0) far_scene = thesis_from(twice_as_far(*thesis));
+    if (thesis) far_scene = twice_as_far(*thesis);
     std::function<Scene()> far;
     if (far_scene) far = [&far_scene] { return *far_scene; };
     {

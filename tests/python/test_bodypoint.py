@@ -464,8 +464,17 @@ def test_encounter_states_its_start_distance_error():
     far = bp.encounter(bp.thesis_scene(B=0.7, b=1.0, arrival_phase=1.0, L=1600.0), tol=1e-10)
     assert abs(near["deflection"] - far["deflection"]) + far["deflection_error"] <= near["deflection_error"]
     assert near["start_distance_error"] > near["asymptote_error"]
+    # A material point at the scene's K1: its v_inf, and so its deflection, moves with L too.
     material = bp.encounter(bp.thesis_scene(B=0.0, b=1.0), tol=1e-10)
-    assert material["start_distance_error"] == 0.0 and material["deflection_error"] is not None
+    material_far = bp.encounter(bp.thesis_scene(B=0.0, b=1.0, L=1600.0), tol=1e-10)
+    assert (abs(material["deflection"] - material_far["deflection"]) + material_far["deflection_error"]
+            <= material["deflection_error"])
+    # Without an arrival phase the scene's own is kept from 2L (a start phase kept has no limit in L):
+    # the same start distance error as with that arrival phase given.
+    psi = bp._core._arrival_phase({"B": 0.7, "d": 3.0})
+    own = bp.encounter(bp.thesis_scene(B=0.7, d=3.0), tol=1e-10)
+    given = bp.encounter(bp.thesis_scene(B=0.7, d=3.0, arrival_phase=psi), tol=1e-10)
+    assert own["start_distance_error"] == pytest.approx(given["start_distance_error"], rel=1e-3)
 
 
 def test_sweep_takes_any_scene_and_its_rows_equal_integrate_of_the_scene_with_the_key_set():

@@ -280,9 +280,10 @@ struct Encounter {
   double asymptote_error = Scattering::kNaN;
   std::string asymptote_basis;  ///< how asymptote_error was obtained, or why it is not known
   /// The error of the deflection and of the time delay that the start's finite distance L leaves against
-  /// the limit L -> infinity at the same asymptotic data (a spinning body's observables converge as 1/L:
-  /// 2 |x(L) - x(2L)| from the same encounter started at 2L, add_start_distance_error). 0 for B = 0 (a
-  /// Kepler hyperbola's observables do not depend on where it starts); NaN when not known.
+  /// the limit L -> infinity of the scene as given (thesis_params_twice_as_far; the observables converge as
+  /// 1/L: 3 |x(L) - x(2L)| from the same scene started at 2L, add_start_distance_error; a material point
+  /// too where its K1 is given, its v_inf moving with L). 0 for a scene file's material point (its hyperbola
+  /// is that of its states); NaN when not known.
   double start_distance_error = Scattering::kNaN, time_delay_error = Scattering::kNaN;
   std::string start_distance_basis = "not known: not measured";
   /// The deflection's total error: the run's estimated error (a relative error of the final state, which
@@ -347,7 +348,8 @@ void no_start_distance_error(Encounter& e, bool material, double numerical, cons
 long add_start_distance(Encounter& e, const Body& body, const std::function<Scene()>& far, std::optional<double> tol,
                         double numerical, const std::string& no_far, const Options& options = {});
 /// The thesis's parameters `solved` (d, K1, phase solved for the asymptotic data) with the start distance L
-/// doubled and the data b, v_inf, arrival_phase (NaN: not given, d, K1, phase kept) solved for again.
+/// doubled and the data b, v_inf (NaN: not given, d, K1 kept) solved for again; the arrival phase as given,
+/// or (NaN) the scene's own at L (a start phase kept has no limit L -> infinity: the extra way in turns it).
 SceneParams thesis_params_twice_as_far(SceneParams solved, double b, double v_inf, double arrival_phase);
 
 /// One body advanced in segments: advance_to(t) integrates from the current time to t and may be

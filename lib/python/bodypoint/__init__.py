@@ -395,7 +395,8 @@ def encounter(scene, *, t_end=None, method="auto", tol=1e-10, max_seconds=DEFAUL
     time_delay are None), reason, deflection, out_of_plane, b, v_inf, time_delay, asymptote_error (the
     asymptotes' model error in the deflection; 0 for B = 0) and asymptote_basis, start_distance_error and
     time_delay_error (what the finite start distance L leaves against L -> infinity: a scene of
-    thesis_scene() is run again from 2L; 0 for B = 0; None for a scene given by its states) and
+    thesis_scene() is run again from 2L, a material point too; for a scene given by its states 0 for B = 0,
+    None otherwise) and
     start_distance_basis, deflection_error (the deflection's total: the run's estimate, the asymptotes' and
     the start distance's; None where a part is not known), K1_turn, spin_turn,
     r_min, t_min (the closest approach to any centre), asymptotes, direction_in and direction_out, K1,
