@@ -615,3 +615,14 @@ def test_sweep_holds_fixed_asymptotic_data_at_every_point():
     assert cols["deflection"][0] == pytest.approx(one["deflection"], abs=1e-12)
     with pytest.raises(bp.Error, match="b is fixed and varied at once"):
         bp.sweep({"b": [10.0]}, ["lp-kl8"], accuracy=1e-10, scattering=True, b=3.0, progress=False)
+
+
+def test_a_stepper_without_invariants_is_not_flagged_by_them_when_it_has_events():
+    # Events are found by observing every step; that observer reported invariants as well, and a stepper
+    # asked for none was refused "unresolved" by them (rkf78 at 1e-13 far out: 3.6 rad of spin per step).
+    scene = bp.thesis_scene(B=0.7, Kx=5.0, Kz=0.0, b=1e-3, L=800.0)
+    flagged = bp.Stepper(scene, "odeint-rkf78", 1e-13, stop_at=["r=1600"])
+    assert flagged.advance_to(1e7) == bp.Outcome.unresolved
+    plain = bp.Stepper(scene, "odeint-rkf78", 1e-13, stop_at=["r=1600"], invariants=False)
+    assert plain.advance_to(1e7) == bp.Outcome.ok and plain.stopped
+    assert plain.time == flagged.time  # the same steps, the same stop
