@@ -222,6 +222,12 @@ namespace {
 /// dt/ds = |G|/|u| (steps of ds move G by a fixed fraction of its distance) until G's periapsis (or
 /// the turn where u changes sign): returns the helix's turn on the way, -(B/D) int |K1| dt.
 constexpr double kPhaseStep = 2e-3;     ///< ds: RK4's error per unit ln r is ~ds^4, far below 1e-10 rad
+/// Near a head-on periapsis the force turns K1 in a time over which G barely moves (|K1| and u small): a
+/// step of ds = 2e-3 there changed K1 by far more than 2e-3 of itself, and the arrival phase came out
+/// 6.2e-3 rad off (B = 0.5, d = 0.03163, L = 400: 1.324058 for 1.330283), which moved the scattering
+/// study's start and its deflection by 3e-5, out of its stated error. Each step also changes K1 by at
+/// most this fraction of itself (a kick dt |F| <= kPhaseKick |K1|).
+constexpr double kPhaseKick = 2e-3;
 constexpr long kPhaseMaxSteps = 5000000;  ///< ~ln(r0/r_min)/ds steps; beyond: no periapsis (error)
 
 struct GuidingModel {
@@ -244,6 +250,11 @@ struct GuidingModel {
     return Y{y.G + ds / 6 * (k1.G + 2 * k2.G + 2 * k3.G + k4.G), y.K + ds / 6 * (k1.K + 2 * k2.K + 2 * k3.K + k4.K),
              y.phase + ds / 6 * (k1.phase + 2 * k2.phase + 2 * k3.phase + k4.phase)};
   }
+  /// The step in s: kPhaseStep, or less where the force would change K by more than kPhaseKick of itself.
+  [[nodiscard]] double ds(const Y& y, double u_floor) const {
+    const double r = y.G.norm(), kick = std::abs(A) / (r * r) * dt_ds(y, u_floor);  // |dK/ds|
+    return kick > 0.0 ? std::min(kPhaseStep, kPhaseKick * y.K.norm() / kick) : kPhaseStep;
+  }
   /// G.dG/dt: < 0 on the way in.
   [[nodiscard]] double radial(const Y& y) const { return u(y) * y.G.dot(y.K); }
 };
@@ -260,9 +271,10 @@ double helix_turn_to_periapsis(const SceneParams& p) {
   if (!(u_floor > 0.0)) throw Error("the guiding centre does not drift (u = 0): it has no arrival phase");
   if (!(model.radial(y) < 0.0)) return 0.0;  // not approaching: the start is its arrival
   for (long i = 0; i < kPhaseMaxSteps; ++i) {
-    const GuidingModel::Y next = model.step(y, kPhaseStep, u_floor);
+    const double ds = model.ds(y, u_floor);
+    const GuidingModel::Y next = model.step(y, ds, u_floor);
     if (model.radial(next) >= 0.0) {
-      double lo = 0.0, hi = kPhaseStep;
+      double lo = 0.0, hi = ds;
       for (int it = 0; it < kPhaseBisections; ++it) {
         const double mid = 0.5 * (lo + hi);
         (model.radial(model.step(y, mid, u_floor)) < 0.0 ? lo : hi) = mid;
