@@ -219,10 +219,7 @@ RunResult observe(const BodyPoint& p, const Field& field, const State& s0, const
       r.stopped = true;
     }
     r.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
-    // Observed for a sink alone (events, samples), the run has no invariants to report or to be flagged
-    // by: a Stepper with invariants=False and a stop event was refused as "unresolved" far out, where a
-    // controlled step turned the spin by 3.6 rad at a tolerance per step of 1e-13.
-    if (options.track_invariants) r.invariants = mon.stats();
+    r.invariants = mon.stats();
   } else {
     Unobserved none;
     none.cancel.cancel = options.cancel;
