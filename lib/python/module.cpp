@@ -103,8 +103,8 @@ std::vector<std::string> thesis_keywords() {
   return names;
 }
 
-/// The thesis's scene from keyword parameters (model.hpp scene_parameters(); b and v_inf: asymptotic data).
-/// The thesis's parameters from thesis_scene()'s keywords, the asymptotic data given among them solved in.
+/// The thesis's parameters from thesis_scene()'s keywords (model.hpp scene_parameters(); b, v_inf and
+/// arrival_phase: asymptotic data), the asymptotic data given among them solved in.
 struct ThesisParams {
   SceneParams solved;
   AsymptoticData data;
@@ -134,6 +134,7 @@ ThesisParams thesis_params_from(const py::dict& kw) {
   return {with_asymptotic_data(sp, data, given), data};
 }
 
+/// The thesis's scene from thesis_scene()'s keywords.
 Scene thesis_from(const py::dict& kw) { return thesis_scene(thesis_params_from(kw).solved); }
 
 /// What stops a call into the library early: Ctrl-C (SIGINT, in the main thread: the handler in place
@@ -524,7 +525,6 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
   return sweep_columns(s, rows);
 }
 
-/// The encounter's record with its run's (`run`: method, steps, t_end, err_estimate, force_evals, ...).
 /// The scene of thesis_scene()'s keywords `kw` from twice its start distance (thesis_params_twice_as_far:
 /// the data given solved for again, the rest kept, the arrival phase the scene's own where none is given).
 Scene twice_as_far(const py::dict& kw) {
@@ -534,6 +534,7 @@ Scene twice_as_far(const py::dict& kw) {
                                                  t.data.arrival_phase.value_or(kNotGiven)));
 }
 
+/// The encounter's record with its run's (`run`: method, steps, t_end, err_estimate, force_evals, ...).
 py::dict encounter_py(const Scene& scene, const std::string& method, double tol, double t_end, double max_seconds,
                       const std::optional<py::dict>& thesis) {
   const MethodInfo* m = method == "auto" ? nullptr : &method_or_throw(method);
