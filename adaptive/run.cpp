@@ -296,31 +296,43 @@ std::string ks_check(const MethodInfo& m, const Body& body, const std::vector<Ce
 }
 
 /// The Kustaanheimo-Stiefel motion as a Stepper: exact in fictitious time, so the last step and the
-/// outputs are exact advances in physical time.
+/// outputs are exact advances in physical time. The physical time is summed compensated (Kahan), as the
+/// time-transformed kernels' (TimeState): a plain sum loses a rounding of t per step (ks, ds = 0.01 on a
+/// bound orbit to t = 300, 16,806 steps: 1.1e-12 off the Kepler orbit summed plainly, 1.5e-13 compensated).
 struct KsStepper {
-  using X = std::pair<KsMotion, double>;  // (motion, t)
+  struct X {
+    KsMotion motion;
+    double t = 0.0;
+    double t_err = 0.0;  ///< what the sum t has not taken in (t - t_err is the time)
+  };
   static constexpr std::string_view prefix = "ks: ";
   static StepAdvance step(X& x, double ds) {
-    const double dt = x.first.step(ds);
-    x.second = x.second + dt;
-    return {x.second, dt};
+    const double dt = x.motion.step(ds);
+    const double y = dt - x.t_err;
+    const double sum = x.t + y;
+    x.t_err = (sum - x.t) - y;
+    x.t = sum;
+    return {time(x), dt};
   }
-  static double time(const X& x) { return x.second; }
-  static bool physical_finite(const X& x) { return x.first.state().R.allFinite(); }
-  static void land(X& x, double t, double) { x.first.advance_time(t - x.second); }
-  static void set_time(X& x, double t) { x.second = t; }
+  static double time(const X& x) { return x.t - x.t_err; }
+  static bool physical_finite(const X& x) { return x.motion.state().R.allFinite(); }
+  static void land(X& x, double t, double) { x.motion.advance_time(t - time(x)); }
+  static void set_time(X& x, double t) {
+    x.t = t;
+    x.t_err = 0.0;
+  }
   static State at(const X& prev, double t) {
-    KsMotion side = prev.first;
-    if (t > prev.second) side.advance_time(t - prev.second);
+    KsMotion side = prev.motion;
+    if (t > time(prev)) side.advance_time(t - time(prev));
     return side.state();
   }
-  static State physical(const X& x) { return x.first.state(); }
+  static State physical(const X& x) { return x.motion.state(); }
 };
 
 RunResult run_ks(const Body& body, const std::vector<Centre>& centres, const Advance& how, const RunOptions& options) {
   CentreList field{centres};  // for the invariants (K2Q about c)
   KsStepper stepper;
-  RunResult r = run_fictitious(stepper, KsStepper::X{KsMotion(body.p, centres.front(), body.s0), 0.0}, body, field,
+  RunResult r = run_fictitious(stepper, KsStepper::X{KsMotion(body.p, centres.front(), body.s0)}, body, field,
                                std::get<FictitiousSteps>(how), options);
   r.force_evals = 0;  // the regularised flow is exact: no force evaluations
   return r;
