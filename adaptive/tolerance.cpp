@@ -87,8 +87,7 @@ constexpr double kMaxEvals = 2e9;
 /// of the floor: with one, and the estimate the larger of truncation and floor, 3 of the 256 scenes of
 /// `bench/estimate_grid.py --tols 1e-12` missed it (up to 2.2e-12); with the larger of two, measured
 /// on each run about to be delivered, and the estimate their sum (both errors are in the delivered run),
-/// none did, for 24 refusals instead of 18 and 28 % more force evaluations.
-constexpr double kProbeShift = 1e-9;
+/// none did, for 24 refusals instead of 18 and 28 % more force evaluations. (kProbeShift: tolerance.hpp.)
 /// far-ip's pair (exact_flow) starts its finer run from the start moved by this relative amount: one unit
 /// in the last place, the rounding the start's conversion to momenta makes; its third run's start moves by
 /// kStartShift the other way.

@@ -35,6 +35,15 @@ struct CoarseCompanion {
 constexpr double kCoarseEnergyBound = kDefaultMaxEnergyError;
 /// ratio at most max_ratio (coarse_ratio_limit), nullopt below kMinCoarseRatio.
 std::optional<CoarseCompanion> coarse_companion(const MethodInfo& m, const Advance& how, long run_steps, double max_ratio);
+/// `how` with its steps off its own grid (k fixed steps more; a fictitious step longer by a relative
+/// k adaptive::kProbeShift; a controlled run as it is): a draw of the rounding whose steps land nowhere the
+/// first's do. Repeats at the same step share the rounding of every point they share (ttl-kl8, ds = 0.02
+/// on a bound spinning orbit: coarse runs from starts moved either way 2e-13 and 1.5e-12 from a run
+/// 1.1e-11 off; off the grid, 1.2e-11).
+Advance off_grid(const Advance& how, int k = 1);
+/// The way the k-th rounding draw moves its start (start_moved_by_rounding): the first draw, the run's
+/// own companion, +1; then -1, +1, ...
+double rounding_way(int k);
 /// The largest ratio at which the run's steps, scaled by it, stay inside the flags' angles (what its
 /// invariants saw; kStepRatio where it tracked none).
 double coarse_ratio_limit(const MethodInfo& m, const std::vector<Centre>& centres, const RunResult& run);
@@ -61,13 +70,21 @@ void confirm(ErrorEstimate& e, const MethodInfo& m, const Body& body, const Stat
 void confirm_deeper(ErrorEstimate& e, const State& run, const State& first, const State& second, const State& third);
 
 /// Whether the estimate e is at the scene's rounding level (below kRoundingLevel, estimate.cpp), where the
-/// companion pair can agree by chance: the run is repeated from start_moved_by_rounding and what the two
-/// differ by is added (add_rounding_spread).
+/// companion pair can agree by chance: ErrorEstimate::kRoundingDraws - 1 more draws of the rounding are
+/// added (add_rounding_spread): repeats of the run (fine companions) or coarse runs (coarse companion),
+/// off the run's grid from its start moved by a rounding; the sum is taken ErrorEstimate::kRoundingBound
+/// times.
 bool at_rounding_level(const ErrorEstimate& e);
-/// The state s with R scaled by 1 + 4 eps and v by 1 - 4 eps: a start moved by a rounding.
-State start_moved_by_rounding(State s);
-/// Adds to e what the run's final state and its repeat's from the moved start differ by, and its cost.
-void add_rounding_spread(ErrorEstimate& e, const State& run, const State& repeat, long force_evals, double wall_s);
+/// What add_rounding_spread's draws are.
+inline const std::string kRepeatRoundingDraw = "a repeat off the run's grid from its start moved by a rounding";
+inline const std::string kCoarseRoundingDraw = "a coarse run off the run's grid from its start moved by a rounding";
+/// The state s with R scaled by 1 + 4 eps and v by 1 - 4 eps (`way` -1: the other way): a start moved by a
+/// rounding.
+State start_moved_by_rounding(State s, double way = 1.0);
+/// Adds to e what the run's final state and `repeat` (another draw of its rounding, made as `what` says)
+/// differ by, and its cost.
+void add_rounding_spread(ErrorEstimate& e, const State& run, const State& repeat, long force_evals, double wall_s,
+                         const std::string& what = kRepeatRoundingDraw);
 
 /// The relative energy error of the state `end` of a run of `body` (NaN where E is not an integral).
 double final_energy_error(const Body& body, const std::vector<Centre>& centres, const State& end);

@@ -89,6 +89,20 @@ std::vector<std::optional<ErrorEstimate>> coarse_estimates(const MethodInfo& met
                                      coarse[k].final);
     if (out[k]) out[k]->force_evals = coarse[k].force_evals, out[k]->wall_s = coarse[k].wall_s;
   }
+  // As integrate(): lanes whose coarse estimate is at the rounding level add more draws of it, coarse
+  // batches off the run's grid from their start moved by a rounding (and take the sum as a bound).
+  std::vector<bool> at_rounding(members.size());  // decided before the draws, as integrate() does
+  for (std::size_t k = 0; k < members.size(); ++k) at_rounding[k] = out[k] && detail::at_rounding_level(*out[k]);
+  const bool any = std::find(at_rounding.begin(), at_rounding.end(), true) != at_rounding.end();
+  for (int draw = 1; any && draw < ErrorEstimate::kRoundingDraws; ++draw) {
+    for (std::size_t k = 0; k < members.size(); ++k)
+      moved[k].s0 = detail::start_moved_by_rounding(members[k].s0, detail::rounding_way(draw));
+    const auto other = batch::run(method, moved, std::get<FixedSteps>(detail::off_grid(c->how, draw)));
+    for (std::size_t k = 0; k < members.size(); ++k)
+      if (at_rounding[k])
+        detail::add_rounding_spread(*out[k], results[k].final, other[k].final, other[k].force_evals, other[k].wall_s,
+                                    detail::kCoarseRoundingDraw);
+  }
   return out;
 }
 
@@ -151,17 +165,18 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
       detail::confirm_deeper(rows[k].error, rows[k].result.final, companions[k].final, second[k].final, third[k].final);
     }
   }
-  // As integrate(): lanes whose fine estimate is at the rounding level add a repeat from their start moved
-  // by a rounding (estimate.hpp), run as one more batch.
-  const auto repeat = [&](std::size_t k) { return spec.estimate_error && !by_coarse[k] && detail::at_rounding_level(rows[k].error); };
-  bool any_repeat = false;
-  for (std::size_t k = 0; k < rows.size(); ++k) any_repeat = any_repeat || repeat(k);
-  if (any_repeat) {
+  // As integrate(): lanes whose fine estimate is at the rounding level add more draws of it, repeats off
+  // their grid from their start moved by a rounding (estimate.hpp), each run as one more batch.
+  std::vector<bool> repeat(rows.size());  // decided before the draws, as integrate() does
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    repeat[k] = spec.estimate_error && !by_coarse[k] && detail::at_rounding_level(rows[k].error);
+  const bool any_repeat = std::find(repeat.begin(), repeat.end(), true) != repeat.end();
+  for (int draw = 1; any_repeat && draw < ErrorEstimate::kRoundingDraws; ++draw) {
     std::vector<batch::Member> moved = members;
-    for (batch::Member& m : moved) m.s0 = detail::start_moved_by_rounding(m.s0);
-    const auto repeats = batch::run(method, moved, how);
+    for (batch::Member& m : moved) m.s0 = detail::start_moved_by_rounding(m.s0, detail::rounding_way(draw));
+    const auto repeats = batch::run(method, moved, std::get<FixedSteps>(detail::off_grid(how, draw)));
     for (std::size_t k = 0; k < rows.size(); ++k)
-      if (repeat(k))
+      if (repeat[k])
         detail::add_rounding_spread(rows[k].error, rows[k].result.final, repeats[k].final, repeats[k].force_evals, repeats[k].wall_s);
   }
   for (std::size_t k = 0; k < rows.size(); ++k)

@@ -162,6 +162,15 @@ struct ErrorEstimate {
   /// What an estimate costs in runs where its coarse companion is trusted (the fine one costs
   /// kStepRatio runs more): budgets count this.
   static constexpr double kTypicalCost = 1.0 / kStepRatio;
+  /// Draws of the rounding where the estimate is at the scene's rounding level (below 1e-10): the
+  /// companion's and this many less one more runs off the run's grid (a coarse companion's: half a run
+  /// each), what they differ by summed and taken kRoundingBound times, a bound rather than a value. Under
+  /// independent draws the estimate is more than 3x below the error 1 in 10 times with one draw, 1 in 150
+  /// with two, 1 in 620 with two doubled (at a median 5x the error), 1 in 3,400 with three (half a run
+  /// more). bench/estimate_ladder.py, estimates more than 3x below an error above 1e-12 at this level:
+  /// 1 with one draw, 1 with two, 0 with two doubled.
+  static constexpr int kRoundingDraws = 2;
+  static constexpr double kRoundingBound = 2.0;
   double value = std::numeric_limits<double>::quiet_NaN();  ///< the estimate; NaN when the run has none
   std::string basis;       ///< how it was obtained ("companion run at 2h ..., order 4"), or why there is none
   long force_evals = 0;    ///< what the companion cost (the accuracy mode: counted in its search)
