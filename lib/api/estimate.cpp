@@ -245,9 +245,7 @@ void add_rounding_draws(ErrorEstimate& e, const BodyResult& r, const Body& body,
     }
     add_rounding_spread(e, r.run.final, p.run.final, p.total_force_evals(), p.run.wall_s, what);
   }
-  e.value *= ErrorEstimate::kRoundingBound;
-  e.basis += "; taken " + short_number(ErrorEstimate::kRoundingBound) + " times: a bound from " +
-             std::to_string(ErrorEstimate::kRoundingDraws) + " draws of the rounding";
+  bound_from_draws(e);
 }
 
 /// The estimate of the coarse companion where the run has one and it is trusted (true); otherwise its
@@ -322,6 +320,12 @@ Advance off_grid(const Advance& how, int k) {
 }
 
 double rounding_way(int k) { return k % 2 == 1 ? -1.0 : 1.0; }
+
+void bound_from_draws(ErrorEstimate& e) {
+  e.value *= ErrorEstimate::kRoundingBound;
+  e.basis += "; taken " + short_number(ErrorEstimate::kRoundingBound) + " times: a bound from " +
+             std::to_string(ErrorEstimate::kRoundingDraws) + " draws of the rounding";
+}
 
 std::optional<ErrorEstimate> coarse_estimate(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
                                              const CoarseCompanion& c, const State& run, const State& coarse) {

@@ -44,6 +44,9 @@ Advance off_grid(const Advance& how, int k = 1);
 /// The way the k-th rounding draw moves its start (start_moved_by_rounding): the first draw, the run's
 /// own companion, +1; then -1, +1, ...
 double rounding_way(int k);
+/// The estimate e, summed over ErrorEstimate::kRoundingDraws draws of the rounding, taken as a bound
+/// (kRoundingBound times the sum), its basis saying so.
+void bound_from_draws(ErrorEstimate& e);
 /// The largest ratio at which the run's steps, scaled by it, stay inside the flags' angles (what its
 /// invariants saw; kStepRatio where it tracked none).
 double coarse_ratio_limit(const MethodInfo& m, const std::vector<Centre>& centres, const RunResult& run);

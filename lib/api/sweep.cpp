@@ -103,6 +103,8 @@ std::vector<std::optional<ErrorEstimate>> coarse_estimates(const MethodInfo& met
         detail::add_rounding_spread(*out[k], results[k].final, other[k].final, other[k].force_evals, other[k].wall_s,
                                     detail::kCoarseRoundingDraw);
   }
+  for (std::size_t k = 0; k < members.size(); ++k)
+    if (at_rounding[k]) detail::bound_from_draws(*out[k]);
   return out;
 }
 
@@ -179,6 +181,8 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
       if (repeat[k])
         detail::add_rounding_spread(rows[k].error, rows[k].result.final, repeats[k].final, repeats[k].force_evals, repeats[k].wall_s);
   }
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    if (repeat[k]) detail::bound_from_draws(rows[k].error);
   for (std::size_t k = 0; k < rows.size(); ++k)
     detail::settle(rows[k].outcome, rows[k].reason, rows[k].warnings, rows[k].error, spec.max_error, spec.max_energy_error,
                    detail::final_energy_error(scenes[k].bodies.front(), scenes[k].centres, rows[k].result.final));
