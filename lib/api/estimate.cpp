@@ -220,7 +220,7 @@ void flag_broken_companion(BodyResult& r, const BodyResult& x, const std::string
 /// A companion difference below kRoundingLevel is at the scene's rounding level, where the pair can agree
 /// by chance (one draw of the rounding each; rk4 at h = 5e-4 on a bound orbit: estimated 3.3e-12 for an
 /// error of 2.9e-11; kep-y4 at h = 1 on a bound orbit, an exact flow: 7.3e-14 from its coarse companion
-/// for a state 4.8e-12 off the Kepler orbit). There the estimate adds what kRoundingDraws - 1 more runs
+/// for a state 5.3e-12 off the Kepler orbit). There the estimate adds what kRoundingDraws - 1 more runs
 /// differ from the run by, off the run's grid (off_grid) from its start moved by adaptive::kStartShift,
 /// either way in turn, as the accuracy mode adds its rounding probes below the same level (tolerance.hpp,
 /// kProbeBelowTol): repeats of the run (fine companions), or coarse runs (coarse companion: half a run
