@@ -308,10 +308,7 @@ struct KsStepper {
   static constexpr std::string_view prefix = "ks: ";
   static StepAdvance step(X& x, double ds) {
     const double dt = x.motion.step(ds);
-    const double y = dt - x.t_err;
-    const double sum = x.t + y;
-    x.t_err = (sum - x.t) - y;
-    x.t = sum;
+    splitting::compensated_add(x.t, x.t_err, dt);
     return {time(x), dt};
   }
   static double time(const X& x) { return x.t - x.t_err; }

@@ -183,15 +183,6 @@ class KsMotion {
   /// terms far larger than it (r = 5000 from L = 4000: 2.5e4 each for q = -1), its rounding 1e4 times
   /// the drift it would correct (the time delay of such a pass moved by 1.9e-8); a pass is not long
   /// enough for the drift to matter there.
-  /// |u'|^2 - (h/2)|u|^2, which the flow conserves (it is mu/2: |u'|^2 = r|v|^2/4). A sub-step's matrix
-  /// [[c0, ds c1], [(h/2) ds c1, c0]] has determinant 1 only up to rounding, and with a fixed ds the same
-  /// rounding every sub-step: the oscillator's amplitude grew one way, the energy with it and the phase
-  /// as the square of the steps (ds = 0.01 on a bound orbit to t = 300: 7e-12 in energy, 2.9e-10 in the
-  /// state). On a bound orbit (h < 0: both terms positive, q formed to a rounding) each sub-step scales u
-  /// and u' back to the start's value (1.5e-13 in the state). Unbound (h >= 0) q is the difference of
-  /// terms far larger than it (r = 5000 from L = 4000: 2.5e4 each for q = -1), its rounding 1e4 times
-  /// the drift it would correct (the time delay of such a pass moved by 1.9e-8); a pass is not long
-  /// enough for the drift to matter there.
   [[nodiscard]] double oscillator_energy() const { return up_.squaredNorm() - 0.5 * h_ * u_.squaredNorm(); }
 
   Vec3 c_, w_;

@@ -55,12 +55,7 @@ struct TimeState {
   [[nodiscard]] double time() const { return t - t_err; }
 };
 
-inline void advance_time(TimeState& x, double dt) {
-  const double y = dt - x.t_err;
-  const double s = x.t + y;
-  x.t_err = (s - x.t) - y;
-  x.t = s;
-}
+inline void advance_time(TimeState& x, double dt) { splitting::compensated_add(x.t, x.t_err, dt); }
 
 template <class Field, bool Spin>
 struct LogHKernel {

@@ -25,6 +25,7 @@
 
 #include <array>
 #include <cmath>
+#include <type_traits>
 
 namespace bodypoint::splitting {
 
@@ -46,10 +47,12 @@ inline LieState to_lie(const Momenta& q) {
 /// The represented values: Kahan's err holds what was added in excess, so the sum is x - err.
 inline Momenta from_lie(const LieState& x) { return {x.R - x.R_err, x.K1 - x.K1_err, x.K2}; }
 
-/// x += dx with Kahan compensation; err accumulates the excess that rounding added to x.
-inline void compensated_add(Vec3& x, Vec3& err, const Vec3& dx) {
-  const Vec3 y = dx - err;
-  const Vec3 t = x + y;
+/// x += dx with Kahan compensation; err accumulates the excess that rounding added to x (a vector, or a
+/// time: the time-transformed kernels' and ks's physical time).
+template <class V>
+inline void compensated_add(V& x, V& err, const std::type_identity_t<V>& dx) {
+  const V y = dx - err;
+  const V t = x + y;
   err = (t - x) - y;
   x = t;
 }
