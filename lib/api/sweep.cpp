@@ -62,6 +62,27 @@ SweepRow result_row(SweepRow row, BodyResult r) {
 /// Whether a lane's run ended so that it has an estimate (estimate_error of integrate(): ok, or a flag).
 bool estimable(Outcome o) { return o == Outcome::ok || o == Outcome::unresolved || o == Outcome::inaccurate; }
 
+/// integrate()'s rounding draws (estimate.cpp, add_rounding_draws) for a batch's lanes: for each lane with
+/// an estimate in `drawn` (nullptr: none; decided before the draws, as integrate() does),
+/// ErrorEstimate::kRoundingDraws - 1 more batches off the grid of `how` from starts moved by a rounding,
+/// what each lane's `finals` differs from them by added, the sum then taken as a bound.
+void lane_rounding_draws(const MethodInfo& method, const std::vector<batch::Member>& members, const FixedSteps& how,
+                         const std::vector<const State*>& finals, const std::vector<ErrorEstimate*>& drawn,
+                         const std::string& what) {
+  if (std::all_of(drawn.begin(), drawn.end(), [](const ErrorEstimate* e) { return e == nullptr; })) return;
+  std::vector<batch::Member> moved = members;
+  for (int draw = 1; draw < ErrorEstimate::kRoundingDraws; ++draw) {
+    for (std::size_t k = 0; k < members.size(); ++k)
+      moved[k].s0 = detail::start_moved_by_rounding(members[k].s0, detail::rounding_way(draw));
+    const auto other = batch::run(method, moved, std::get<FixedSteps>(detail::off_grid(how, draw)));
+    for (std::size_t k = 0; k < members.size(); ++k)
+      if (drawn[k] != nullptr)
+        detail::add_rounding_spread(*drawn[k], *finals[k], other[k].final, other[k].force_evals, other[k].wall_s, what);
+  }
+  for (ErrorEstimate* e : drawn)
+    if (e != nullptr) detail::bound_from_draws(*e);
+}
+
 /// The lanes' estimates from the coarse companion batch (estimate.hpp, CoarseCompanion), as integrate()
 /// makes them: nullopt for a lane the fine companions decide (flagged, or its coarse estimate not trusted),
 /// whose estimate then counts the coarse lane's cost in `cost` as integrate() does.
@@ -90,21 +111,14 @@ std::vector<std::optional<ErrorEstimate>> coarse_estimates(const MethodInfo& met
     if (out[k]) out[k]->force_evals = coarse[k].force_evals, out[k]->wall_s = coarse[k].wall_s;
   }
   // As integrate(): lanes whose coarse estimate is at the rounding level add more draws of it, coarse
-  // batches off the run's grid from their start moved by a rounding (and take the sum as a bound).
-  std::vector<bool> at_rounding(members.size());  // decided before the draws, as integrate() does
-  for (std::size_t k = 0; k < members.size(); ++k) at_rounding[k] = out[k] && detail::at_rounding_level(*out[k]);
-  const bool any = std::find(at_rounding.begin(), at_rounding.end(), true) != at_rounding.end();
-  for (int draw = 1; any && draw < ErrorEstimate::kRoundingDraws; ++draw) {
-    for (std::size_t k = 0; k < members.size(); ++k)
-      moved[k].s0 = detail::start_moved_by_rounding(members[k].s0, detail::rounding_way(draw));
-    const auto other = batch::run(method, moved, std::get<FixedSteps>(detail::off_grid(c->how, draw)));
-    for (std::size_t k = 0; k < members.size(); ++k)
-      if (at_rounding[k])
-        detail::add_rounding_spread(*out[k], results[k].final, other[k].final, other[k].force_evals, other[k].wall_s,
-                                    detail::kCoarseRoundingDraw);
+  // batches off the run's grid.
+  std::vector<const State*> finals(members.size());
+  std::vector<ErrorEstimate*> drawn(members.size(), nullptr);
+  for (std::size_t k = 0; k < members.size(); ++k) {
+    finals[k] = &results[k].final;
+    if (out[k] && detail::at_rounding_level(*out[k])) drawn[k] = &*out[k];
   }
-  for (std::size_t k = 0; k < members.size(); ++k)
-    if (at_rounding[k]) detail::bound_from_draws(*out[k]);
+  lane_rounding_draws(method, members, std::get<FixedSteps>(c->how), finals, drawn, detail::kCoarseRoundingDraw);
   return out;
 }
 
@@ -168,21 +182,14 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
     }
   }
   // As integrate(): lanes whose fine estimate is at the rounding level add more draws of it, repeats off
-  // their grid from their start moved by a rounding (estimate.hpp), each run as one more batch.
-  std::vector<bool> repeat(rows.size());  // decided before the draws, as integrate() does
-  for (std::size_t k = 0; k < rows.size(); ++k)
-    repeat[k] = spec.estimate_error && !by_coarse[k] && detail::at_rounding_level(rows[k].error);
-  const bool any_repeat = std::find(repeat.begin(), repeat.end(), true) != repeat.end();
-  for (int draw = 1; any_repeat && draw < ErrorEstimate::kRoundingDraws; ++draw) {
-    std::vector<batch::Member> moved = members;
-    for (batch::Member& m : moved) m.s0 = detail::start_moved_by_rounding(m.s0, detail::rounding_way(draw));
-    const auto repeats = batch::run(method, moved, std::get<FixedSteps>(detail::off_grid(how, draw)));
-    for (std::size_t k = 0; k < rows.size(); ++k)
-      if (repeat[k])
-        detail::add_rounding_spread(rows[k].error, rows[k].result.final, repeats[k].final, repeats[k].force_evals, repeats[k].wall_s);
+  // their grid (estimate.hpp).
+  std::vector<const State*> finals(rows.size());
+  std::vector<ErrorEstimate*> drawn(rows.size(), nullptr);
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    finals[k] = &rows[k].result.final;
+    if (spec.estimate_error && !by_coarse[k] && detail::at_rounding_level(rows[k].error)) drawn[k] = &rows[k].error;
   }
-  for (std::size_t k = 0; k < rows.size(); ++k)
-    if (repeat[k]) detail::bound_from_draws(rows[k].error);
+  lane_rounding_draws(method, members, how, finals, drawn, detail::kRepeatRoundingDraw);
   for (std::size_t k = 0; k < rows.size(); ++k)
     detail::settle(rows[k].outcome, rows[k].reason, rows[k].warnings, rows[k].error, spec.max_error, spec.max_energy_error,
                    detail::final_energy_error(scenes[k].bodies.front(), scenes[k].centres, rows[k].result.final));
