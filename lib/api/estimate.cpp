@@ -4,12 +4,14 @@
 #include "bodypoint/adaptive/methods.hpp"
 #include "bodypoint/adaptive/richardson.hpp"
 #include "bodypoint/adaptive/tolerance.hpp"
+#include "bodypoint/batch.hpp"
 #include "bodypoint/detail/run_support.hpp"
 #include "bodypoint/field.hpp"
 #include "bodypoint/invariants.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string>
@@ -140,8 +142,9 @@ constexpr double kCoarseTrusted = 1e-5;
 /// difference over 2^p - 1 was more than 3x low in 49 of the ladder's runs of order >= 6 and over
 /// 2^4 - 1 in 3; at order <= 4 Richardson's factor is kept.
 constexpr int kCoarseMaxOrder = 4;
-/// Below a ratio of 2 (a time-transformed run's coarse companion at 1.47 ds) the order is taken as at
-/// most this: with 4 there, 16 of the ladder's estimates were more than 3x low, with 2, 10.
+/// Where the flags' angles limit the ratio below 2 (a time-transformed run's coarse companion at 1.47 ds)
+/// the order is taken as at most this: with 4 there, 16 of the ladder's estimates were more than 3x low,
+/// with 2, 10. (An odd number of fixed steps, whose companion takes half as many rounded up, asked for 2.)
 constexpr int kCoarseMaxOrderBelow2 = 2;
 /// The coarse companion's steps are kept this far inside the flags' limits (a step turning the spin by
 /// pi, the direction to a centre by pi/2) that the run's own steps, scaled by the ratio, predict. At
@@ -224,20 +227,22 @@ void flag_broken_companion(BodyResult& r, const BodyResult& x, const std::string
 /// differ from the run by, off the run's grid (off_grid) from its start moved by adaptive::kStartShift,
 /// either way in turn, as the accuracy mode adds its rounding probes below the same level (tolerance.hpp,
 /// kProbeBelowTol): repeats of the run (fine companions), or coarse runs (coarse companion: half a run
-/// each), and the sum is taken kRoundingBound times (ErrorEstimate). Draws at twice the coarse step cost
+/// each; at fixed steps the companion's twin, its own steps from the start moved the other way, the two
+/// lanes of one batch where the method has a kernel: coarse_lanes), and the sum is taken kRoundingBound
+/// times (ErrorEstimate). The twin shares half the run's points, yet on the estimate ladder its 414
+/// estimates of errors in (1e-12, 1e-10) were at least 0.93x the error (a coarse run off the grid:
+/// 0.62x), none more than 3x low either way. Draws at twice the coarse step cost
 /// less, but their truncation is 2^p times the companion's: far-ip at h = 0.5 on the attracting material
 /// pass read 4.3e-6 for an error of 4.5e-14.
 constexpr double kRoundingLevel = adaptive::kProbeBelowTol;
 
-/// `how`: the draws' steps (the run's own, or its coarse companion's); `o`: their options; `options`: the
-/// run's (its events index them); `what`: what they are, for the basis.
-void add_rounding_draws(ErrorEstimate& e, const BodyResult& r, const Body& body, const Advance& how,
-                        const Options& options, const Options& o, const Rerun& rerun, const std::string& what) {
+/// `draw(k)`: the k-th draw (k >= 1), from the start moved rounding_way(k); `o`: the draws' options;
+/// `options`: the run's (its events index them); `what`: what they are, for the basis.
+void add_rounding_draws(ErrorEstimate& e, const BodyResult& r, const Options& options, const Options& o,
+                        const std::function<BodyResult(int)>& draw, const std::string& what) {
   if (!at_rounding_level(e)) return;
   for (int k = 1; k < ErrorEstimate::kRoundingDraws; ++k) {
-    Body moved = body;
-    moved.s0 = start_moved_by_rounding(body.s0, rounding_way(k));
-    const BodyResult p = rerun(moved, off_grid(how, k), o);
+    const BodyResult p = draw(k);
     if (!ended_alike(r, options, p, o)) {
       e.force_evals += p.total_force_evals();
       e.wall_s += p.run.wall_s;
@@ -246,6 +251,48 @@ void add_rounding_draws(ErrorEstimate& e, const BodyResult& r, const Body& body,
     add_rounding_spread(e, r.run.final, p.run.final, p.total_force_evals(), p.run.wall_s, what);
   }
   bound_from_draws(e);
+}
+
+/// The draws at the run's own step where the fine companion decides: repeats off its grid.
+std::function<BodyResult(int)> repeat_draws(const Body& body, const Advance& how, const Options& o, const Rerun& rerun) {
+  return [&body, &how, &o, &rerun](int k) {
+    Body moved = body;
+    moved.s0 = start_moved_by_rounding(body.s0, rounding_way(k));
+    return rerun(moved, off_grid(how, k), o);
+  };
+}
+
+/// The lanes of one batch (batch.hpp) are the coarse companion and its first rounding draw where the
+/// method has a batch kernel for the scene and the companion's steps are off the run's grid: two lanes
+/// cost about what one scalar run does (lp-y4, 250,001 steps: 0.07-0.08 s for the pair, 0.07 s for one
+/// alone), so the draw the rounding level asks for is nearly free. Each lane computes the scalar run's
+/// bits (tests/lib/test_batch.cpp), judged as integrate() judges the scalar companion; the batch polls
+/// the run's cancellation.
+constexpr std::size_t kDrawLanes = 2;
+static_assert(ErrorEstimate::kRoundingDraws == kDrawLanes, "the batch holds the companion and every further draw");
+
+std::optional<std::vector<BodyResult>> coarse_lanes(const MethodInfo& m, const Body& body,
+                                                    const std::vector<Centre>& centres, const CoarseCompanion& c,
+                                                    const Options& oc) {
+  const auto* f = std::get_if<FixedSteps>(&c.how);
+  if (f == nullptr || !c.twin_draw || !oc.events.empty() || !batch::accepts(m, body, centres)) return std::nullopt;
+  std::vector<batch::Member> members;
+  for (std::size_t k = 0; k < kDrawLanes; ++k)
+    members.push_back({body.p, start_moved_by_rounding(body.s0, rounding_way(static_cast<int>(k))), centres.front().A});
+  std::vector<BodyResult> lanes(kDrawLanes);
+  try {
+    std::vector<RunResult> runs = batch::run(m, members, *f, kDrawLanes, oc.cancel);
+    for (std::size_t k = 0; k < kDrawLanes; ++k) {
+      lanes[k].method = &m;
+      lanes[k].run = std::move(runs[k]);
+      Health h = assess(lanes[k].run, checks_for(m, centres, oc.max_energy_error));
+      lanes[k].outcome = h.outcome;
+      lanes[k].reason = std::move(h.why);
+    }
+  } catch (const StoppedOnRequest&) {
+    for (BodyResult& lane : lanes) lane.method = &m, lane.outcome = Outcome::failed, lane.reason = kStoppedOnRequest;
+  }
+  return lanes;
 }
 
 /// The estimate of the coarse companion where the run has one and it is trusted (true); otherwise its
@@ -258,25 +305,37 @@ bool estimated_by_coarse(BodyResult& r, const Body& body, const std::vector<Cent
   const std::optional<CoarseCompanion> c =
       coarse_companion(*r.method, how, r.run.steps, coarse_ratio_limit(*r.method, centres, r.run));
   if (!c) return false;
-  Body moved = body;
-  moved.s0 = start_moved_by_rounding(body.s0);
   // The coarse run is held to the default flags whether or not the run tracks its invariants: a coarse
   // step that aliases the spin, skips past a centre or loses the energy can agree with the run by
   // chance (rk4 at h = 0.2 on two-centres-spin, 70 % off: its coarse companion 1.5e-5 away, 0.63 in energy).
   Options oc = o;
   oc.track_invariants = true;
   oc.max_energy_error = kCoarseEnergyBound;
-  const BodyResult x = rerun(moved, c->how, oc);
+  const auto draw = [&](int k) {
+    Body moved = body;
+    moved.s0 = start_moved_by_rounding(body.s0, rounding_way(k));
+    return rerun(moved, coarse_draw(*c, k), oc);
+  };
+  std::optional<std::vector<BodyResult>> lanes = coarse_lanes(*r.method, body, centres, *c, oc);
+  const BodyResult x = lanes ? std::move(lanes->front()) : draw(0);
   ErrorEstimate& e = r.error;
   e.force_evals += x.total_force_evals();
   e.wall_s += x.run.wall_s;
-  if (x.outcome != Outcome::ok || !ended_alike(r, options, x, oc) || !coarser(*c, x.run.steps, r.run.steps)) return false;
-  std::optional<ErrorEstimate> coarse = coarse_estimate(*r.method, body, centres, *c, r.run.final, x.run.final);
+  // The batch's further lanes ran whether or not a draw is wanted: counted once, used where one is.
+  const auto lane_cost = [&](ErrorEstimate& to) {
+    for (std::size_t k = 1; lanes && k < lanes->size(); ++k) to.force_evals += (*lanes)[k].total_force_evals(), to.wall_s += (*lanes)[k].run.wall_s;
+  };
+  std::optional<ErrorEstimate> coarse;
+  if (x.outcome == Outcome::ok && ended_alike(r, options, x, oc) && coarser(*c, x.run.steps, r.run.steps))
+    coarse = coarse_estimate(*r.method, body, centres, *c, r.run.final, x.run.final);
+  if (!coarse || !at_rounding_level(*coarse)) lane_cost(coarse ? *coarse : e);
   if (!coarse) return false;
-  coarse->force_evals = e.force_evals;
-  coarse->wall_s = e.wall_s;
+  coarse->force_evals += e.force_evals;
+  coarse->wall_s += e.wall_s;
   e = std::move(*coarse);
-  add_rounding_draws(e, r, body, c->how, options, oc, rerun, kCoarseRoundingDraw);
+  const std::string& what = coarse_draw_text(*c);
+  if (lanes) add_rounding_draws(e, r, options, oc, [&](int k) { return std::move((*lanes)[static_cast<std::size_t>(k)]); }, what);
+  else add_rounding_draws(e, r, options, oc, draw, what);
   return true;
 }
 
@@ -297,15 +356,28 @@ std::optional<CoarseCompanion> coarse_companion(const MethodInfo& m, const Advan
   const double r = std::min(kStepRatio, max_ratio);
   if (run_steps < kCoarseMinSteps || !(r >= kMinCoarseRatio)) return std::nullopt;
   if (const auto* f = std::get_if<FixedSteps>(&how)) {
-    // Whole steps to the same end: ceil(n / r) of them, at the step that lands there.
+    // Whole steps to the same end: ceil(n / r) of them, at the step that lands there. Off the run's
+    // grid (one step more) the pair is no Richardson pair where the error depends on where the steps
+    // fall about a close approach: attracting-close lp-bm4 at h = 0.01, 3.6e-8 off, read 5.3e-10 for
+    // 3.3e-8 on the grid; off it, 10 of the estimate ladder's estimates were more than 3x low, on it 4.
     const long n = f->steps, coarse = static_cast<long>(std::ceil(static_cast<double>(n) / r));
     const double ratio = static_cast<double>(n) / static_cast<double>(coarse);
     if (!(ratio >= kMinCoarseRatio)) return std::nullopt;
-    return CoarseCompanion{FixedSteps{f->h * ratio, coarse}, ratio};
+    return CoarseCompanion{FixedSteps{f->h * ratio, coarse}, ratio, r, true};
   }
   const auto* f = std::get_if<FictitiousSteps>(&how);
   if (f == nullptr || f->end.index() != 0 || m.traits.exact_in_fictitious_time) return std::nullopt;
-  return CoarseCompanion{FictitiousSteps{f->ds * r, EndTime{f->t_end()}}, r};
+  return CoarseCompanion{FictitiousSteps{f->ds * r, EndTime{f->t_end()}}, r, r, false};
+}
+
+const std::string& coarse_draw_text(const CoarseCompanion& c) {
+  return c.twin_draw ? kCoarseTwinDraw : kCoarseRoundingDraw;
+}
+
+Advance coarse_draw(const CoarseCompanion& c, int k) {
+  if (k == 0) return c.how;
+  if (!c.twin_draw) return off_grid(c.how, k);
+  return k == 1 ? c.how : off_grid(c.how, k - 1);
 }
 
 Advance off_grid(const Advance& how, int k) {
@@ -330,12 +402,13 @@ void bound_from_draws(ErrorEstimate& e) {
 std::optional<ErrorEstimate> coarse_estimate(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
                                              const CoarseCompanion& c, const State& run, const State& coarse) {
   if (!(coarse.R.allFinite() && coarse.v.allFinite())) return std::nullopt;
-  const int p = std::min(c.ratio < kStepRatio ? kCoarseMaxOrderBelow2 : kCoarseMaxOrder, fixed_order(m, body));
+  const int p = std::min(c.asked < kStepRatio ? kCoarseMaxOrderBelow2 : kCoarseMaxOrder, fixed_order(m, body));
   const double d = adaptive::state_distance(run, coarse);
   ErrorEstimate e;
   const bool h = std::holds_alternative<FixedSteps>(c.how);
   const std::string step = h ? "h" : "ds";
-  e.basis = "companion run at " + (c.ratio == kStepRatio ? "2" + step : step + " x " + short_number(c.ratio)) +
+  const std::string ratio = short_number(c.ratio);
+  e.basis = "companion run at " + (ratio == "2" ? "2" + step : step + " x " + ratio) +
             " from a start moved by a rounding, ";
   if (flow_is_exact(m, body, centres)) {
     e.value = d;
@@ -467,7 +540,7 @@ void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& 
     e.value = std::max(e.value, adaptive::state_distance(r.run.final, f->x.run.final));
     e.basis += "; " + std::string(kExactFlowBasis);
   }
-  add_rounding_draws(e, r, body, how, options, o, rerun, kRepeatRoundingDraw);
+  add_rounding_draws(e, r, options, o, repeat_draws(body, how, o, rerun), kRepeatRoundingDraw);
   if (r.outcome == Outcome::unresolved || r.run.steps < kFewSteps) second_companion(r, body, how, options, o, rerun, *f);
 }
 
@@ -556,7 +629,9 @@ ErrorEstimate fixed_step_estimate(const MethodInfo& m, const Body& body, const s
     e.value = adaptive::state_distance(run, companion);
     e.basis = "companion run at h/2, " + std::string(kExactFlowBasis);
   } else {
-    e.value = adaptive::coarser_run_error(adaptive::state_distance(run, companion), kStepRatio, p);
+    // As integrate()'s companion: its factor times the difference (not the difference over 1 - 2^-p,
+    // which rounds otherwise: a sweep's lane and the same run alone were an ulp apart).
+    e.value = adaptive::coarser_run_error(1.0, kStepRatio, p) * adaptive::state_distance(run, companion);
   }
   return e;
 }

@@ -22,13 +22,17 @@ void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& 
 
 /// The coarse companion of a run by step: up to twice its step (h, or ds with the same time-step
 /// constant; a fixed-step run of an odd number of steps: half as many rounded up, at the step that lands
-/// on the same end), from its start moved by a rounding. It costs half a run; in the asymptotic regime it
-/// differs from the run by the run's error times ratio^p - 1 (Richardson on the coarse side, the fine run
+/// on the same end), from its start moved by a rounding. It costs half a run; in the asymptotic regime it differs
+/// from the run by the run's error times ratio^p - 1 (Richardson on the coarse side, the fine run
 /// delivered), plus what the moved start grows to. nullopt where a run has none: step-size control, KS,
 /// a counted number of fictitious steps, fewer than kCoarseMinSteps steps (estimate.cpp).
 struct CoarseCompanion {
   Advance how;
   double ratio = 2.0;  ///< the companion's step over the run's
+  double asked = 2.0;  ///< the ratio asked for: below 2 where the flags' angles limit it (coarse_ratio_limit)
+  /// Whether its first rounding draw is its twin, its own steps from the start moved the other way (fixed
+  /// steps: coarse_draw), so that the two are lanes of one batch.
+  bool twin_draw = false;
 };
 /// The coarse companion is trusted only where the default flags pass it: no aliased spin, no skipped
 /// centre, its energy within this bound.
@@ -41,6 +45,9 @@ std::optional<CoarseCompanion> coarse_companion(const MethodInfo& m, const Advan
 /// on a bound spinning orbit: coarse runs from starts moved either way 2e-13 and 1.5e-12 from a run
 /// 1.1e-11 off; off the grid, 1.2e-11).
 Advance off_grid(const Advance& how, int k = 1);
+/// How the k-th draw of the rounding of the coarse companion c advances (k = 0: c itself): its twin (c's
+/// own steps, the start moved the other way) where c.twin_draw, else off_grid(c.how, k).
+Advance coarse_draw(const CoarseCompanion& c, int k);
 /// The way the k-th rounding draw moves its start (start_moved_by_rounding): the first draw, the run's
 /// own companion, +1; then -1, +1, ...
 double rounding_way(int k);
@@ -81,6 +88,9 @@ bool at_rounding_level(const ErrorEstimate& e);
 /// What add_rounding_spread's draws are.
 inline const std::string kRepeatRoundingDraw = "a repeat off the run's grid from its start moved by a rounding";
 inline const std::string kCoarseRoundingDraw = "a coarse run off the run's grid from its start moved by a rounding";
+inline const std::string kCoarseTwinDraw = "the coarse run from its start moved the other way";
+/// What the coarse companion c's rounding draws are (kCoarseTwinDraw for its twin).
+const std::string& coarse_draw_text(const CoarseCompanion& c);
 /// The state s with R scaled by 1 + 4 eps and v by 1 - 4 eps (`way` -1: the other way): a start moved by a
 /// rounding.
 State start_moved_by_rounding(State s, double way = 1.0);

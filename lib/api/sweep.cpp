@@ -64,17 +64,17 @@ bool estimable(Outcome o) { return o == Outcome::ok || o == Outcome::unresolved 
 
 /// integrate()'s rounding draws (estimate.cpp, add_rounding_draws) for a batch's lanes: for each lane with
 /// an estimate in `drawn` (nullptr: none; decided before the draws, as integrate() does),
-/// ErrorEstimate::kRoundingDraws - 1 more batches off the grid of `how` from starts moved by a rounding,
-/// what each lane's `finals` differs from them by added, the sum then taken as a bound.
-void lane_rounding_draws(const MethodInfo& method, const std::vector<batch::Member>& members, const FixedSteps& how,
-                         const std::vector<const State*>& finals, const std::vector<ErrorEstimate*>& drawn,
-                         const std::string& what) {
+/// ErrorEstimate::kRoundingDraws - 1 more batches, the k-th advancing as `how(k)` from starts moved by a
+/// rounding, what each lane's `finals` differs from them by added, the sum then taken as a bound.
+void lane_rounding_draws(const MethodInfo& method, const std::vector<batch::Member>& members,
+                         const std::function<Advance(int)>& how, const std::vector<const State*>& finals,
+                         const std::vector<ErrorEstimate*>& drawn, const std::string& what) {
   if (std::all_of(drawn.begin(), drawn.end(), [](const ErrorEstimate* e) { return e == nullptr; })) return;
   std::vector<batch::Member> moved = members;
   for (int draw = 1; draw < ErrorEstimate::kRoundingDraws; ++draw) {
     for (std::size_t k = 0; k < members.size(); ++k)
       moved[k].s0 = detail::start_moved_by_rounding(members[k].s0, detail::rounding_way(draw));
-    const auto other = batch::run(method, moved, std::get<FixedSteps>(detail::off_grid(how, draw)));
+    const auto other = batch::run(method, moved, std::get<FixedSteps>(how(draw)));
     for (std::size_t k = 0; k < members.size(); ++k)
       if (drawn[k] != nullptr)
         detail::add_rounding_spread(*drawn[k], *finals[k], other[k].final, other[k].force_evals, other[k].wall_s, what);
@@ -118,7 +118,8 @@ std::vector<std::optional<ErrorEstimate>> coarse_estimates(const MethodInfo& met
     finals[k] = &results[k].final;
     if (out[k] && detail::at_rounding_level(*out[k])) drawn[k] = &*out[k];
   }
-  lane_rounding_draws(method, members, std::get<FixedSteps>(c->how), finals, drawn, detail::kCoarseRoundingDraw);
+  lane_rounding_draws(method, members, [&c](int k) { return detail::coarse_draw(*c, k); }, finals, drawn,
+                      detail::coarse_draw_text(*c));
   return out;
 }
 
@@ -189,7 +190,8 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
     finals[k] = &rows[k].result.final;
     if (spec.estimate_error && !by_coarse[k] && detail::at_rounding_level(rows[k].error)) drawn[k] = &rows[k].error;
   }
-  lane_rounding_draws(method, members, how, finals, drawn, detail::kRepeatRoundingDraw);
+  lane_rounding_draws(method, members, [&how](int k) { return detail::off_grid(how, k); }, finals, drawn,
+                      detail::kRepeatRoundingDraw);
   for (std::size_t k = 0; k < rows.size(); ++k)
     detail::settle(rows[k].outcome, rows[k].reason, rows[k].warnings, rows[k].error, spec.max_error, spec.max_energy_error,
                    detail::final_energy_error(scenes[k].bodies.front(), scenes[k].centres, rows[k].result.final));

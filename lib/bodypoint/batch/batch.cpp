@@ -32,7 +32,7 @@ struct Isa {
   std::size_t width;
   const char* name;
   bool (*supports)(int);
-  long (*run)(int, const double*, std::size_t, double, long, double*);
+  long (*run)(int, const double*, std::size_t, double, long, double*, abi::Poll, const void*);
 };
 
 /// The units this CPU runs, widest first.
@@ -86,7 +86,7 @@ bool accepts(const MethodInfo& method, const Body& body, const std::vector<Centr
 }
 
 std::vector<RunResult> run(const MethodInfo& method, const std::vector<Member>& members, const FixedSteps& spec,
-                           std::size_t width) {
+                           std::size_t width, const std::atomic<bool>* cancel) {
   const Isa& isa = width == 0 ? isa_in_use() : unit(width);
   if (!isa.supports(method.batch_kernel)) throw Error(method.name + " has no batch kernel");
   if (members.empty() || members.size() > isa.width)
@@ -99,7 +99,10 @@ std::vector<RunResult> run(const MethodInfo& method, const std::vector<Member>& 
     for (int k = 0; k < 3; ++k) x[4 + k] = m.s0.R[k], x[7 + k] = m.s0.v[k], x[10 + k] = m.s0.w[k];
   }
   const auto t0 = std::chrono::steady_clock::now();
-  const long evals = isa.run(method.batch_kernel, in.data(), members.size(), spec.h, spec.steps, out.data());
+  const abi::Poll poll = [](const void* flag) { return static_cast<const std::atomic<bool>*>(flag)->load(std::memory_order_relaxed); };
+  const long evals = isa.run(method.batch_kernel, in.data(), members.size(), spec.h, spec.steps, out.data(),
+                             cancel != nullptr ? poll : nullptr, cancel);
+  if (evals == abi::kStopped) throw StoppedOnRequest();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::vector<RunResult> results(members.size());
   for (std::size_t i = 0; i < members.size(); ++i) {

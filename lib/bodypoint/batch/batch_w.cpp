@@ -14,6 +14,7 @@
 #include "bodypoint/batch/lanes.hpp"
 
 #include "bodypoint/detail/batch_abi.hpp"
+#include "bodypoint/run.hpp"
 #include "bodypoint/splitting/catalogue.hpp"
 #include "bodypoint/splitting/lie_poisson.hpp"
 
@@ -123,16 +124,30 @@ class Monitor {
   V3 K2Q0_, prev_R_;
 };
 
-/// The engine's observer: the physical state of every step, to the monitor.
+/// What ends a run whose Poll said stop; `run` turns it into abi::kStopped.
+struct Stopped {};
+
+/// The run's cancellation: polled every kPollStride steps (run.hpp), as the scalar loops poll theirs.
+struct Canceller {
+  abi::Poll poll = nullptr;
+  const void* context = nullptr;
+  void operator()(long i) const {
+    if (poll != nullptr && i % kPollStride == 0 && poll(context)) throw Stopped{};
+  }
+};
+
+/// The engine's observer: the physical state of every step, to the monitor; the engine's poll.
 template <class Kernel>
 struct Observer {
   static constexpr bool active = true;
   const Kernel& kernel;
   Monitor& monitor;
+  Canceller cancel;
   template <class X>
   void operator()(long, const X& x) {
     monitor.step(kernel.to_physical(x));
   }
+  void poll(long i) const { cancel(i); }
 };
 
 // --- the Lie-Poisson kernel (splitting::LiePoissonKernel<OriginCentre, true>) ---------------------
@@ -247,9 +262,10 @@ void report(const Physical& f, const Monitor& monitor, std::size_t count, double
 
 /// Runs `Seq` with kernel K on the lanes; returns the force evaluations.
 template <const auto& Seq, class K>
-long run_splitting(K kernel, const Physical& s0, double h, long steps, std::size_t count, double* out) {
+long run_splitting(K kernel, const Physical& s0, double h, long steps, std::size_t count, double* out,
+                   Canceller cancel) {
   Monitor monitor(kernel.p, s0, h);
-  Observer<K> obs{kernel, monitor};
+  Observer<K> obs{kernel, monitor, cancel};
   typename K::state_type x = kernel.initial_state(s0);
   sp::integrate<Seq>(kernel, x, h, steps, obs);
   report(kernel.to_physical(x), monitor, count, out);
@@ -283,7 +299,8 @@ Ode stage(const Ode& x, int n, const double* a, const Ode* const* k) {
   return r;
 }
 
-long run_rk4(const Params& p, const Physical& s0, double h, long steps, std::size_t count, double* out) {
+long run_rk4(const Params& p, const Physical& s0, double h, long steps, std::size_t count, double* out,
+             Canceller cancel) {
   const Lane D = p.m * p.J - p.B * p.B;
   const Rhs f{p.J / D, p.B * p.B / D, p.B / D, p.m * p.B / D, p};
   Monitor monitor(p, s0, h);
@@ -302,19 +319,21 @@ long run_rk4(const Params& p, const Physical& s0, double h, long steps, std::siz
     k[3] = &k4;
     x = stage(x, 4, b, k);
     monitor.step({x.R, x.v, x.w});
+    cancel(i + 1);
   }
   report({x.R, x.v, x.w}, monitor, count, out);
   return 4 * steps;
 }
 
-using Runner = long (*)(const Params&, const Physical&, double, long, std::size_t, double*);
+using Runner = long (*)(const Params&, const Physical&, double, long, std::size_t, double*, Canceller);
 template <const auto& Seq>
-long lie(const Params& p, const Physical& s0, double h, long steps, std::size_t count, double* out) {
-  return run_splitting<Seq>(LieKernel{p}, s0, h, steps, count, out);
+long lie(const Params& p, const Physical& s0, double h, long steps, std::size_t count, double* out, Canceller cancel) {
+  return run_splitting<Seq>(LieKernel{p}, s0, h, steps, count, out, cancel);
 }
 template <const auto& Seq>
-long thesis(const Params& p, const Physical& s0, double h, long steps, std::size_t count, double* out) {
-  return run_splitting<Seq>(ThesisKernel{p}, s0, h, steps, count, out);
+long thesis(const Params& p, const Physical& s0, double h, long steps, std::size_t count, double* out,
+            Canceller cancel) {
+  return run_splitting<Seq>(ThesisKernel{p}, s0, h, steps, count, out, cancel);
 }
 
 /// Every batch runner, numbered as the catalogue numbers them (splitting/catalogue.hpp kBatchRk4,
@@ -339,13 +358,18 @@ std::size_t width() { return W; }
 
 bool supports(int kernel) { return runner(kernel) != nullptr; }
 
-long run(int kernel, const double* in, std::size_t count, double h, long steps, double* out) {
+long run(int kernel, const double* in, std::size_t count, double h, long steps, double* out, abi::Poll poll,
+         const void* context) {
   const Runner r = runner(kernel);
   if (!r || count == 0 || count > W) return -1;
   Params p{lane_of(in, count, 0), lane_of(in, count, 1), lane_of(in, count, 2), lane_of(in, count, 3), {}};
   p.inv_D = 1.0 / (p.m * p.J - p.B * p.B);
   const Physical s0{v3_of(in, count, 4), v3_of(in, count, 7), v3_of(in, count, 10)};
-  return r(p, s0, h, steps, count, out);
+  try {
+    return r(p, s0, h, steps, count, out, Canceller{poll, context});
+  } catch (const Stopped&) {
+    return abi::kStopped;
+  }
 }
 
 }  // namespace bodypoint::batch::BODYPOINT_BATCH_NS

@@ -17,11 +17,19 @@ inline constexpr std::size_t kOut = 16;
 /// splitting::drift_functions(x) as {S1, C1, S3}, built for the baseline (batch.cpp).
 void scalar_drift_functions(double x, double* out);
 
+/// A run's cancellation as the units see it: called with `context` every kPollStride steps (run.hpp),
+/// true ends the run; the units then return kStopped. Built for the baseline (batch.cpp), so the units
+/// load no atomic of their own.
+using Poll = bool (*)(const void* context);
+/// What a unit's run returns when its Poll ended it.
+inline constexpr long kStopped = -2;
+
 }  // namespace bodypoint::batch::abi
 
 #define BODYPOINT_BATCH_DECLARE(ns)                                                                          \
   namespace bodypoint::batch::ns {                                                                           \
   std::size_t width();                                                                                       \
   bool supports(int kernel);                                                                                 \
-  long run(int kernel, const double* in, std::size_t count, double h, long steps, double* out);            \
+  long run(int kernel, const double* in, std::size_t count, double h, long steps, double* out,             \
+           abi::Poll poll, const void* context);                                                             \
   }
