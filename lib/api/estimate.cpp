@@ -321,9 +321,11 @@ bool estimated_by_coarse(BodyResult& r, const Body& body, const std::vector<Cent
   ErrorEstimate& e = r.error;
   e.force_evals += x.total_force_evals();
   e.wall_s += x.run.wall_s;
-  // The batch's further lanes ran whether or not a draw is wanted: counted once, used where one is.
+  // The batch's twin ran whether or not a draw is wanted. Unused, its share of the batch's time is the
+  // companion's (the lanes run in the same instructions), and its evaluations are not the estimate's: a
+  // run's estimate then counts what a sweep's batch of it counts, where twins run only when wanted.
   const auto lane_cost = [&](ErrorEstimate& to) {
-    for (std::size_t k = 1; lanes && k < lanes->size(); ++k) to.force_evals += (*lanes)[k].total_force_evals(), to.wall_s += (*lanes)[k].run.wall_s;
+    for (std::size_t k = 1; lanes && k < lanes->size(); ++k) to.wall_s += (*lanes)[k].run.wall_s;
   };
   std::optional<ErrorEstimate> coarse;
   if (x.outcome == Outcome::ok && ended_alike(r, options, x, oc) && coarser(*c, x.run.steps, r.run.steps))

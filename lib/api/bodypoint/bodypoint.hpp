@@ -173,7 +173,11 @@ struct ErrorEstimate {
   static constexpr double kRoundingBound = 2.0;
   double value = std::numeric_limits<double>::quiet_NaN();  ///< the estimate; NaN when the run has none
   std::string basis;       ///< how it was obtained ("companion run at 2h ..., order 4"), or why there is none
-  long force_evals = 0;    ///< what the companion cost (the accuracy mode: counted in its search)
+  /// What the companions whose states it used cost (the accuracy mode: counted in its search). A
+  /// companion's twin run beside it in a vector lane and not needed (above the rounding level) is not
+  /// counted: it takes no time of its own, and a sweep's batches, which run twins only where wanted, count
+  /// the same.
+  long force_evals = 0;
   double wall_s = 0.0;
   /// Where the run was flagged unresolved: a second companion one level finer showed the error falling
   /// as the step's order says, so the estimate may overrule the flag (the accuracy mode: always).
