@@ -8,8 +8,12 @@ case the medians, the spread (min-max) and the force evaluations of the run and 
 ratio of the medians. Take it on a machine doing nothing else: a timing beside a build or a test says
 nothing (the script prints the load average before and after).
 
+With --python DIR (the build's python/ folder), the same for the Python module's integrate(), timed in
+this process (time.process_time, warm): bodypoint.integrate(thesis_scene(), method, h, t_end) with and
+without estimate_error.
+
 Usage (from the repository, after the build):
-    /usr/bin/python3 bench/estimate_cost.py [build/bin/bodypoint] [--repeats 7]
+    /usr/bin/python3 bench/estimate_cost.py [build/bin/bodypoint] [--repeats 7] [--python build/python]
 """
 import argparse
 import json
@@ -17,6 +21,7 @@ import os
 import resource
 import statistics
 import subprocess
+import sys
 import time
 
 # The cases: the README's run (the default scene, lp-y4 at h = 1e-4, 500,000 steps) and runs by step of
@@ -39,10 +44,43 @@ def timed(cmd):
     return cpu, wall, json.loads(out)
 
 
+# The Python cases: the README's run and one of a method auto delivers, as integrate() keywords.
+PY_CASES = [
+    ("python integrate lp-y4 h=1e-4 t=50", dict(method="lp-y4", h=1e-4, t_end=50.0)),
+    ("python integrate lp-kl8 h=0.05 t=40", dict(method="lp-kl8", h=0.05, t_end=40.0)),
+]
+
+
+def python_cases(folder, repeats):
+    sys.path.insert(0, folder)
+    import bodypoint  # noqa: E402 (the build's module, found through --python)
+
+    scene = bodypoint.thesis_scene()
+
+    def one(kw, estimate):
+        t0, w0 = time.process_time(), time.perf_counter()
+        r = bodypoint.integrate(scene, kw["method"], h=kw["h"], t_end=kw["t_end"], estimate_error=estimate)
+        return time.process_time() - t0, time.perf_counter() - w0, r
+
+    for name, kw in PY_CASES:
+        one(kw, True), one(kw, False)  # warm
+        w, wo = [], []
+        for _ in range(repeats):
+            w.append(one(kw, True))
+            wo.append(one(kw, False))
+        cw, cwo = [x[0] for x in w], [x[0] for x in wo]
+        body = w[0][2]["bodies"][0]
+        print(f"{name} | {statistics.median(cw):.3f} ({min(cw):.3f}-{max(cw):.3f}) | {statistics.median(cwo):.3f} "
+              f"({min(cwo):.3f}-{max(cwo):.3f}) | {statistics.median(cw) / statistics.median(cwo):.2f} | "
+              f"{statistics.median([x[1] for x in w]):.3f} / {statistics.median([x[1] for x in wo]):.3f} | "
+              f"{body['force_evals']} + {body['estimate_force_evals']} | {body['err_basis'][:70]}")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("binary", nargs="?", default="build/bin/bodypoint")
     ap.add_argument("--repeats", type=int, default=7)
+    ap.add_argument("--python", help="the build's python/ folder: time the module's integrate() too")
     a = ap.parse_args()
     print(f"load average before: {os.getloadavg()[0]:.2f}")
     print("case | CPU s with estimate (min-max) | without | ratio of medians | wall with / without | "
@@ -62,6 +100,8 @@ def main():
               f"({min(cwo):.3f}-{max(cwo):.3f}) | {statistics.median(cw) / statistics.median(cwo):.2f} | "
               f"{statistics.median(ww):.3f} / {statistics.median(wwo):.3f} | {run['force_evals']} + "
               f"{run['estimate_force_evals']} | {run['err_basis'][:70]}")
+    if a.python:
+        python_cases(a.python, a.repeats)
     print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 

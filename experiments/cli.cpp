@@ -76,7 +76,8 @@ void add_step_options(po::options_description& desc, StepOptions& o) {
        "flag a run whose estimated relative error of the final state exceeds this bound as inaccurate (inf: no "
        "bound)")
       ("no-error-estimate", po::bool_switch(&o.no_error_estimate),
-       "no companion run to estimate the error of a run by step (it costs about half the run, 2.5 runs where a companion at half the step decides); the outputs "
+       "no companion run to estimate the error of a run by step (it costs about half the run's time; a run at the rounding level "
+       "without a batch kernel, one run; 2.5 runs where a companion at half the step decides); the outputs "
        "then say the run has no estimate");
 }
 
