@@ -12,10 +12,15 @@ With --python DIR (the build's python/ folder), the same for the Python module's
 this process (time.process_time, warm): bodypoint.integrate(thesis_scene(), method, h, t_end) with and
 without estimate_error.
 
+With --csv FILE every case is also written as a row: the medians, the spread of each side (interquartile
+range over the median), how far each side's median wall time exceeds its CPU time (a waiting process:
+contended), the force evaluations; paper/make_macros.py judges them by the paper's timing rule.
+
 Usage (from the repository, after the build):
-    /usr/bin/python3 bench/estimate_cost.py [build/bin/bodypoint] [--repeats 7] [--python build/python]
+    /usr/bin/python3 bench/estimate_cost.py [build/bin/bodypoint] [--repeats 7] [--python build/python] [--csv FILE]
 """
 import argparse
+import csv
 import json
 import os
 import resource
@@ -32,6 +37,29 @@ CASES = [
     ("logh-kl6 ds=0.05 t=40", ["--method", "logh-kl6", "--h", "0.05", "--t-end", "40"]),
     ("lp-verlet h=0.002 t=40", ["--method", "lp-verlet", "--h", "0.002", "--t-end", "40"]),
 ]
+
+
+def spread(xs):
+    """Interquartile range over the median (quartiles by linear interpolation), as the paper's rule reads it."""
+    q = statistics.quantiles(xs, n=4, method="inclusive")
+    return (q[2] - q[0]) / statistics.median(xs)
+
+
+ROWS = []  # one per case, for --csv
+
+
+def report(name, w, wo, evals_run, evals_estimate, basis):
+    """Prints a case's line and keeps its row: w, wo are (CPU s, wall s) per repeat with and without."""
+    cw, cwo = [x[0] for x in w], [x[0] for x in wo]
+    ww, wwo = [x[1] for x in w], [x[1] for x in wo]
+    print(f"{name} | {statistics.median(cw):.3f} ({min(cw):.3f}-{max(cw):.3f}) | {statistics.median(cwo):.3f} "
+          f"({min(cwo):.3f}-{max(cwo):.3f}) | {statistics.median(cw) / statistics.median(cwo):.2f} | "
+          f"{statistics.median(ww):.3f} / {statistics.median(wwo):.3f} | {evals_run} + {evals_estimate} | {basis[:70]}")
+    ROWS.append(dict(case=name, repeats=len(w), cpu_with_s=statistics.median(cw), cpu_without_s=statistics.median(cwo),
+                     ratio=statistics.median(cw) / statistics.median(cwo), spread_with=spread(cw),
+                     spread_without=spread(cwo), wait_with=statistics.median(ww) / statistics.median(cw) - 1,
+                     wait_without=statistics.median(wwo) / statistics.median(cwo) - 1, force_evals=evals_run,
+                     estimate_force_evals=evals_estimate, basis=basis))
 
 
 def timed(cmd):
@@ -68,12 +96,8 @@ def python_cases(folder, repeats):
         for _ in range(repeats):
             w.append(one(kw, True))
             wo.append(one(kw, False))
-        cw, cwo = [x[0] for x in w], [x[0] for x in wo]
         body = w[0][2]["bodies"][0]
-        print(f"{name} | {statistics.median(cw):.3f} ({min(cw):.3f}-{max(cw):.3f}) | {statistics.median(cwo):.3f} "
-              f"({min(cwo):.3f}-{max(cwo):.3f}) | {statistics.median(cw) / statistics.median(cwo):.2f} | "
-              f"{statistics.median([x[1] for x in w]):.3f} / {statistics.median([x[1] for x in wo]):.3f} | "
-              f"{body['force_evals']} + {body['estimate_force_evals']} | {body['err_basis'][:70]}")
+        report(name, w, wo, body["force_evals"], body["estimate_force_evals"], body["err_basis"])
 
 
 def main():
@@ -81,6 +105,7 @@ def main():
     ap.add_argument("binary", nargs="?", default="build/bin/bodypoint")
     ap.add_argument("--repeats", type=int, default=7)
     ap.add_argument("--python", help="the build's python/ folder: time the module's integrate() too")
+    ap.add_argument("--csv", help="also write the cases as CSV rows to this file")
     a = ap.parse_args()
     print(f"load average before: {os.getloadavg()[0]:.2f}")
     print("case | CPU s with estimate (min-max) | without | ratio of medians | wall with / without | "
@@ -93,16 +118,17 @@ def main():
         for _ in range(a.repeats):
             w.append(timed(with_cmd))
             wo.append(timed(without_cmd))
-        cw, cwo = [x[0] for x in w], [x[0] for x in wo]
-        ww, wwo = [x[1] for x in w], [x[1] for x in wo]
         run = w[0][2]
-        print(f"{name} | {statistics.median(cw):.3f} ({min(cw):.3f}-{max(cw):.3f}) | {statistics.median(cwo):.3f} "
-              f"({min(cwo):.3f}-{max(cwo):.3f}) | {statistics.median(cw) / statistics.median(cwo):.2f} | "
-              f"{statistics.median(ww):.3f} / {statistics.median(wwo):.3f} | {run['force_evals']} + "
-              f"{run['estimate_force_evals']} | {run['err_basis'][:70]}")
+        report(name, w, wo, run["force_evals"], run["estimate_force_evals"], run["err_basis"])
     if a.python:
         python_cases(a.python, a.repeats)
     print(f"load average after: {os.getloadavg()[0]:.2f}")
+    if a.csv:
+        with open(a.csv + ".tmp", "w", newline="") as f:
+            out = csv.DictWriter(f, fieldnames=list(ROWS[0]))
+            out.writeheader()
+            out.writerows(ROWS)
+        os.replace(a.csv + ".tmp", a.csv)
 
 
 if __name__ == "__main__":

@@ -194,6 +194,13 @@ gsl_peer() {
   fi
 }
 step gsl-peer gsl_peer
+# What a run's error estimate costs: simulate and Python's integrate with and without it, CPU time of 5
+# interleaved warm repeats (bench/estimate_cost.py; a few seconds).
+estimate_cost() {
+  "$py" bench/estimate_cost.py "$bin" --repeats 5 --python "${BODYPOINT_BUILD_DIR:-build}/python" \
+    --csv "$results/estimate_cost.csv" > "$results/estimate_cost.md"
+}
+step estimate-cost estimate_cost
 # Google Benchmark's medians keep their names; the coefficient of variation rows (_cv) are the spread.
 bench_medians() {
   grep -v '^"BM_[A-Za-z]*/.*_\(mean\|stddev\)"' "$1" | sed 's#_median"#"#' > "$1.2" && mv "$1.2" "$1"

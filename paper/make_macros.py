@@ -905,6 +905,29 @@ def by_tol(res, out, M):
             f.write(" & ".join(latex_cell(row[i]) for i in keep) + " \\\\\n")
 
 
+def estimate_cost(res, M):
+    """The price of a run's error estimate (bench/estimate_cost.py): the default simulate's and Python's
+    integrate's CPU time with it over without it, each side's median under the paper's timing rule."""
+    path = os.path.join(res, "estimate_cost.csv")
+    rows = read_csv(path)[0] if os.path.exists(path) else []
+    cases = {"default simulate": "the README's run", "python integrate lp-y4 h=1e-4 t=50": "Python's integrate of it"}
+    parts, flags = [], []
+    for r in rows:
+        if r["case"] not in cases:
+            continue
+        repeats = int(r["repeats"])
+        why = "; ".join(w for w in (M.rule.flag(repeats, num(r["wait_with"]), num(r["spread_with"])),
+                                    M.rule.flag(repeats, num(r["wait_without"]), num(r["spread_without"]))) if w)
+        flags.append(why)
+        parts.append(f"{cases[r['case']]} " + (f"untimed ({latex_text(why)})" if why else f"${num(r['ratio']):.2f}$ times"))
+    M.ledger.count("estimate price", flags)
+    if flags and all(flags):
+        M.ledger.lost("the price of a run's error estimate (what trust costs)", f"{len(flags)} of {len(flags)} times flagged")
+    M.add("EstimatePrice", ("its CPU time with the estimate over without it: " + ", ".join(parts) +
+                            " (\\cmd{bench/estimate\\_cost.py}, medians of " + rows[0]["repeats"] + " interleaved repeats)")
+          if parts else "not measured in this copy", math_mode=False)
+
+
 def estimate_grid(res, M):
     """The accuracy mode on bench/estimate_grid.py's 768 runs: misses, the error against its estimate
     (its distribution) and how far below TOL the delivered error lies."""
@@ -1435,6 +1458,7 @@ def main():
     close_table(res, out, M)
     by_tol(res, out, M)
     estimate_grid(res, M)
+    estimate_cost(res, M)
     estimate_branches(res, out, M)
     far_field(res, out, M)
     stress(res, out, M)
