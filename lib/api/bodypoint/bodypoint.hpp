@@ -163,8 +163,10 @@ struct ErrorEstimate {
   /// kStepRatio runs more): budgets count this.
   static constexpr double kTypicalCost = 1.0 / kStepRatio;
   /// Draws of the rounding where the estimate is at the scene's rounding level (below 1e-10): the
-  /// companion's and this many less one more runs off the run's grid (a coarse companion's: half a run
-  /// each), what they differ by summed and taken kRoundingBound times, a bound rather than a value. Under
+  /// companion's and this many less one more from the start moved the other way (a fixed-step coarse
+  /// companion's twin, its own steps, a second vector lane beside it where the method has a batch kernel;
+  /// otherwise runs off the run's grid, a coarse one half a run), what they differ by summed and taken
+  /// kRoundingBound times, a bound rather than a value. Under
   /// independent draws the estimate is more than 3x below the error 1 in 10 times with one draw, 1 in 150
   /// with two, 1 in 620 with two doubled (at a median 5x the error), 1 in 3,400 with three (half a run
   /// more). bench/estimate_ladder.py, estimates more than 3x below an error above 1e-12 at this level:
