@@ -18,6 +18,7 @@
 #include <memory>
 #include <sstream>
 #include <thread>
+#include <tuple>
 #include <utility>
 #include <unistd.h>
 
@@ -311,21 +312,9 @@ std::vector<Axis> parse_axes(const po::variables_map& vm, const std::vector<std:
 /// kept as a base parameter instead, the start phase solved at the base's d gave b = 10 an arrival phase
 /// other than the one asked for, its deflection 1.7e-7 from simulate's at the same data).
 void apply_fixed_data(const po::variables_map& vm, const SceneOptions& so, SweepSpec& spec) {
-  struct Fixed {
-    const char* option;
-    std::string param;
-    double value;
-    bool positive;  ///< b and v_inf: > 0; a phase: any finite number
-  };
-  for (const Fixed& f : {Fixed{"b", "b", so.b, true}, Fixed{"v-inf", "v_inf", so.v_inf, true},
-                         Fixed{"arrival-phase", "arrival_phase", so.arrival_phase, false}}) {
-    if (!vm.count(f.option)) continue;
-    if (!(std::isfinite(f.value) && (f.value > 0.0 || !f.positive)))
-      throw Error(std::string("--") + f.option + " must be a finite number" + (f.positive ? " > 0" : ""));
-    if (std::any_of(spec.axes.begin(), spec.axes.end(), [&f](const Axis& a) { return a.param == f.param; }))
-      throw Error(std::string("--") + f.option + " is fixed and varied at once");
-    spec.axes.push_back(Axis{f.param, {f.value}});
-  }
+  for (const auto& [option, datum, value] : {std::tuple{"b", "b", so.b}, std::tuple{"v-inf", "v_inf", so.v_inf},
+                                             std::tuple{"arrival-phase", "arrival_phase", so.arrival_phase}})
+    if (vm.count(option)) fix_asymptotic_datum(spec, datum, value, std::string("--") + option);
 }
 
 /// --h, --steps or --t-end, and the energy bound: every method of the sweep ends at one time.

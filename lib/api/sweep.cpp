@@ -342,6 +342,15 @@ std::string point_label(const SweepSpec& spec, const std::vector<double>& point)
   return s;
 }
 
+void fix_asymptotic_datum(SweepSpec& spec, const std::string& datum, double value, const std::string& named_as) {
+  const bool positive = datum != "arrival_phase";  // b and v_inf; a phase is any finite number
+  if (!(std::isfinite(value) && (value > 0.0 || !positive)))
+    throw Error(named_as + " must be a finite number" + (positive ? " > 0" : ""));
+  if (std::any_of(spec.axes.begin(), spec.axes.end(), [&datum](const Axis& a) { return a.param == datum; }))
+    throw Error(named_as + " is fixed and varied at once");
+  spec.axes.push_back(Axis{datum, {value}});
+}
+
 void validate_sweep(const SweepSpec& spec) {
   if (spec.methods.empty()) throw Error("the method list is empty");
   check_energy_bound(spec.max_energy_error);

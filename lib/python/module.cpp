@@ -489,9 +489,7 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
     const auto key = k.cast<std::string>();
     const double x = number_of(v, key);
     if (key == "b" || key == "v_inf" || key == "arrival_phase") {
-      // Fixed asymptotic data: a one-value axis, solved for at every point (as sweep --b, --v-inf, --arrival-phase).
-      if (std::find(swept.begin(), swept.end(), key) != swept.end()) throw Error(key + " is fixed and varied at once");
-      s.axes.push_back({key, {x}});
+      fix_asymptotic_datum(s, key, x, key);  // as sweep --b, --v-inf, --arrival-phase
       continue;
     }
     scene_field(s.base, key) = x;

@@ -615,6 +615,11 @@ def test_sweep_holds_fixed_asymptotic_data_at_every_point():
     assert cols["deflection"][0] == pytest.approx(one["deflection"], abs=1e-12)
     with pytest.raises(bp.Error, match="b is fixed and varied at once"):
         bp.sweep({"b": [10.0]}, ["lp-kl8"], accuracy=1e-10, scattering=True, b=3.0, progress=False)
+    # The same rule as the command line's (one library function): a datum that is no finite number,
+    # or a b or v_inf not above 0, is named as the keyword given (before: "the sweep's values of b").
+    for datum, value in [("b", float("nan")), ("v_inf", -1.0), ("arrival_phase", float("inf"))]:
+        with pytest.raises(bp.Error, match=f"^{datum} must be a finite number"):
+            bp.sweep({"d": [5.0]}, ["lp-y4"], steps=10, progress=False, **{datum: value})
 
 
 def test_a_stepper_without_invariants_is_not_flagged_by_them_when_it_has_events():

@@ -112,6 +112,12 @@ std::string point_label(const SweepSpec& spec, const std::vector<double>& point)
 /// Throws Error for an empty sweep, or a grid point whose scene or step is invalid (the point named).
 void validate_sweep(const SweepSpec& spec);
 
+/// A fixed asymptotic datum (b, v_inf or arrival_phase) of the sweep: a one-value axis, solved for at every
+/// grid point as a varied one is (a sweep over L keeps b, not d; a sweep over b keeps the arrival phase, not
+/// the start phase). Throws Error naming it `named_as` (the command's option, Python's keyword) unless it is
+/// a finite number (b and v_inf: > 0) that is not an axis of the sweep already.
+void fix_asymptotic_datum(SweepSpec& spec, const std::string& datum, double value, const std::string& named_as);
+
 /// One task's result.
 struct SweepRow {
   std::size_t task = 0;
