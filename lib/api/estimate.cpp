@@ -262,8 +262,8 @@ std::function<BodyResult(int)> repeat_draws(const Body& body, const Advance& how
   };
 }
 
-/// The lanes of one batch (batch.hpp) are the coarse companion and its first rounding draw where the
-/// method has a batch kernel for the scene and the companion's steps are off the run's grid: two lanes
+/// The lanes of one batch (batch.hpp) are the coarse companion and its twin, its first rounding draw, where
+/// the method has a batch kernel for the scene and the run stops at no event (a batch locates none): two lanes
 /// cost about what one scalar run does (lp-y4, 250,001 steps: 0.07-0.08 s for the pair, 0.07 s for one
 /// alone), so the draw the rounding level asks for is nearly free. Each lane computes the scalar run's
 /// bits (tests/lib/test_batch.cpp), judged as integrate() judges the scalar companion; the batch polls
