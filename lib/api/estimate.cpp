@@ -253,12 +253,14 @@ void add_rounding_draws(ErrorEstimate& e, const BodyResult& r, const Options& op
   bound_from_draws(e);
 }
 
-/// The draws at the run's own step where the fine companion decides: repeats off its grid.
-std::function<BodyResult(int)> repeat_draws(const Body& body, const Advance& how, const Options& o, const Rerun& rerun) {
-  return [&body, &how, &o, &rerun](int k) {
+/// The k-th draw of the rounding (k = 0: the first) as a scalar run: from the start moved rounding_way(k),
+/// advancing as how_of(k) (repeats off the run's grid, or the coarse companion and its draws: coarse_draw).
+std::function<BodyResult(int)> rerun_draws(const Body& body, std::function<Advance(int)> how_of, const Options& o,
+                                           const Rerun& rerun) {
+  return [&body, how_of = std::move(how_of), &o, &rerun](int k) {
     Body moved = body;
     moved.s0 = start_moved_by_rounding(body.s0, rounding_way(k));
-    return rerun(moved, off_grid(how, k), o);
+    return rerun(moved, how_of(k), o);
   };
 }
 
@@ -311,11 +313,7 @@ bool estimated_by_coarse(BodyResult& r, const Body& body, const std::vector<Cent
   Options oc = o;
   oc.track_invariants = true;
   oc.max_energy_error = kCoarseEnergyBound;
-  const auto draw = [&](int k) {
-    Body moved = body;
-    moved.s0 = start_moved_by_rounding(body.s0, rounding_way(k));
-    return rerun(moved, coarse_draw(*c, k), oc);
-  };
+  const auto draw = rerun_draws(body, [&c](int k) { return coarse_draw(*c, k); }, oc, rerun);
   std::optional<std::vector<BodyResult>> lanes = coarse_lanes(*r.method, body, centres, *c, oc);
   const BodyResult x = lanes ? std::move(lanes->front()) : draw(0);
   ErrorEstimate& e = r.error;
@@ -542,7 +540,8 @@ void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& 
     e.value = std::max(e.value, adaptive::state_distance(r.run.final, f->x.run.final));
     e.basis += "; " + std::string(kExactFlowBasis);
   }
-  add_rounding_draws(e, r, options, o, repeat_draws(body, how, o, rerun), kRepeatRoundingDraw);
+  add_rounding_draws(e, r, options, o, rerun_draws(body, [&how](int k) { return off_grid(how, k); }, o, rerun),
+                     kRepeatRoundingDraw);
   if (r.outcome == Outcome::unresolved || r.run.steps < kFewSteps) second_companion(r, body, how, options, o, rerun, *f);
 }
 
