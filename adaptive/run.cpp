@@ -340,8 +340,10 @@ template <template <class, bool> class K, class E>
 MethodInfo transformed_row(std::string_view prefix, std::string_view family, SceneCheck check) {
   using T = typename E::type;
   const int s = static_cast<int>(sp::ops_of<T>.kicks());
-  return {std::string(prefix) + std::string(E::tag), Family::TimeTransformed, T::order, s, s, sp::describe<T>(family),
-          &run_time_transformed<K, sp::ops_of<T>>, check};
+  MethodInfo m{std::string(prefix) + std::string(E::tag), Family::TimeTransformed, T::order, s, s,
+               sp::describe<T>(family), &run_time_transformed<K, sp::ops_of<T>>, check};
+  m.table = E::tag;
+  return m;
 }
 
 }  // namespace

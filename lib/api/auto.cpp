@@ -5,6 +5,7 @@
 
 #include "bodypoint/adaptive/methods.hpp"
 #include "bodypoint/adaptive/tolerance.hpp"
+#include "bodypoint/field.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -35,36 +36,33 @@ const MethodInfo& detail::choose_method_for(const Body& body, const std::vector<
   // evaluations of the whole search): Yoshida 4 (3 stages) is cheapest down to 1e-5 (thesis 3,648
   // against 10,944 for Kahan-Li 6), Kahan-Li 6 down to 1e-10 (close 1e-9: 21,690 against 33,218 for
   // Kahan-Li 8), Kahan-Li 8 below.
-  const char* table = tol >= kLooseTolerance ? "y4" : tol >= kTightTolerance ? "kl6" : "kl8";
+  const std::string_view table = tol >= kLooseTolerance ? "y4" : tol >= kTightTolerance ? "kl6" : "kl8";
   std::ostringstream os;
-  bool repulsive = true;
   double potential_at_closest = 0.0;  // at the guiding centre's closest approach to each centre
   const Helix helix = helix_of(body.p, to_momenta(body.p, body.s0));
-  for (const Centre& c : centres) {
-    repulsive = repulsive && c.A < 0.0;
+  for (const Centre& c : centres)
     potential_at_closest += std::abs(c.A) / std::max(path_distance(helix, c.c, std::numeric_limits<double>::infinity()), 1e-300);
-  }
   const double c = adaptive::automatic_omega_c(body, centres, 0.0);
-  std::string name;
-  if (body.p.B == 0.0 && centres.size() == 1) {
-    name = "ks";
-    os << "ks: a material point and one centre (exact Kepler/Rutherford flow)";
+  // What each branch needs is asked of the catalogue: the regularised flow where it accepts the scene (a
+  // material point, one centre), the Lie-Poisson splitting far from every centre, else the first
+  // time-transformed method of the table that accepts the scene (logH before TTL: logH refuses attraction).
+  const MethodInfo* m = method_of(Family::Regularised, "", body, centres);
+  if (m && refusal(*m, body, centres).empty()) {
+    os << m->name << ": a material point and one centre (exact Kepler/Rutherford flow)";
   } else if (c > 0.0 && potential_at_closest < kFarFraction * c) {
-    name = std::string("lp-") + table;
-    os << name << ": the body stays far from every centre (sum |A|/r_min ~ " << potential_at_closest
+    m = method_of(Family::LiePoisson, table, body, centres);
+    os << m->name << ": the body stays far from every centre (sum |A|/r_min ~ " << potential_at_closest
        << " < c/10 = " << 0.1 * c << ", so a time transformation would hardly change the step)";
-  } else if (repulsive) {
-    name = std::string("logh-") + table;
-    os << name << ": every centre repels (logarithmic Hamiltonian, step ~ distance to the centres)";
   } else {
-    name = std::string("ttl-") + table;
-    os << name << ": an attracting centre (time-transformed leapfrog, step ~ distance to the centres)";
+    m = method_of(Family::TimeTransformed, table, body, centres);
+    os << m->name << (all_repulsive(centres) ? ": every centre repels (logarithmic Hamiltonian, step ~ distance to the centres)"
+                                             : ": an attracting centre (time-transformed leapfrog, step ~ distance to the centres)");
   }
-  if (name != "ks")
+  if (m->table == table)
     os << "; " << (tol >= kLooseTolerance ? "Yoshida 4 for tol >= 1e-5"
                    : tol >= kTightTolerance ? "Kahan-Li 6 for 1e-10 <= tol < 1e-5" : "Kahan-Li 8 for tol < 1e-10");
   if (why) *why = os.str();
-  return method_or_throw(name);
+  return *m;
 }
 
 }  // namespace bodypoint

@@ -1,5 +1,6 @@
 // bodypoint: the registry of every method (methods.hpp).
 #include "bodypoint/methods.hpp"
+#include "choice.hpp"
 
 #include "bodypoint/adaptive/methods.hpp"
 #include "bodypoint/io.hpp"
@@ -41,6 +42,17 @@ const MethodInfo& method_or_throw(std::string_view name) {
   const std::string near = closest_method(name);
   throw Error("unknown method '" + std::string(name) + "'" + (near.empty() ? "" : " (did you mean " + near + "?)") +
               " (see 'bodypoint methods')");
+}
+
+const MethodInfo* detail::method_of(Family family, std::string_view table, const Body& body,
+                                    const std::vector<Centre>& centres) {
+  const MethodInfo* first = nullptr;
+  for (const MethodInfo& m : methods()) {
+    if (m.family != family || (!table.empty() && m.table != table)) continue;
+    if (refusal(m, body, centres).empty()) return &m;
+    if (!first) first = &m;
+  }
+  return first;
 }
 
 std::vector<const MethodInfo*> methods_named(std::string_view list) {

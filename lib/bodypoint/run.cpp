@@ -84,10 +84,12 @@ template <class E>
 MethodInfo lie_row(int batch_kernel) {
   using T = typename E::type;
   constexpr const auto& seq = sp::ops_of<T>;
-  return {"lp-" + std::string(E::tag), Family::LiePoisson, T::order, static_cast<int>(seq.kicks()),
-          static_cast<int>(seq.kicks_merged()),
-          sp::describe<T>("exact Lie-Poisson"),
-          &run_splitting<sp::LiePoissonKernel, seq>, nullptr, batch_kernel};
+  MethodInfo m{"lp-" + std::string(E::tag), Family::LiePoisson, T::order, static_cast<int>(seq.kicks()),
+               static_cast<int>(seq.kicks_merged()),
+               sp::describe<T>("exact Lie-Poisson"),
+               &run_splitting<sp::LiePoissonKernel, seq>, nullptr, batch_kernel};
+  m.table = E::tag;
+  return m;
 }
 
 /// The Kepler split's assumption: Coulomb's law (its Kepler flow is built on -A/|R|).
@@ -110,9 +112,11 @@ template <class E>
 MethodInfo kepler_row() {
   using T = typename E::type;
   const int k = static_cast<int>(sp::ops_of<T>.kicks());
-  return {"kep-" + std::string(E::tag), Family::KeplerSplit, T::order, k, k,
-          sp::describe<T>("Kepler split (a stage is a Kepler solve about the first centre)"),
-          &run_kepler_split<T>, &kepler_split_check};
+  MethodInfo m{"kep-" + std::string(E::tag), Family::KeplerSplit, T::order, k, k,
+               sp::describe<T>("Kepler split (a stage is a Kepler solve about the first centre)"),
+               &run_kepler_split<T>, &kepler_split_check};
+  m.table = E::tag;
+  return m;
 }
 
 /// The far-field collocation's assumption: Coulomb's law (its force is -A (R - c)/|R - c|^3).

@@ -276,6 +276,9 @@ struct MethodInfo {
   int batch_kernel = -1;
   /// What differs between methods beyond the above (set by the catalogue from the family).
   MethodTraits traits = {};
+  /// The composition table a splitting method applies (its tag: "y4", "kl6", ...; the part of its name
+  /// after the family's prefix); empty for the others. Asked by `auto` (methods.hpp: method_of).
+  std::string table = {};
 };
 
 /// Why `m` refuses the scene (empty: it accepts it). `run` throws this reason; sweeps, studies,

@@ -186,5 +186,23 @@ TEST(Tables, ForceEvaluationsPerStep) {
   }
 }
 
+// A splitting method's catalogue row names the composition table it applies (auto asks the catalogue for
+// a family and a table, not for a name): the table is what its name says after the family's prefix, and
+// every splitting family (Lie-Poisson, Kepler split, time-transformed) carries one.
+TEST(Tables, EverySplittingRowNamesItsTable) {
+  int with_table = 0;
+  for (const MethodInfo& m : methods()) {
+    if (m.table.empty()) continue;
+    ++with_table;
+    const std::string tail = "-" + m.table;
+    ASSERT_GE(m.name.size(), tail.size()) << m.name;
+    EXPECT_EQ(m.name.substr(m.name.size() - tail.size()), tail) << m.name << " applies table " << m.table;
+  }
+  for (const char* name : {"lp-y4", "kep-kl6", "logh-kl8", "ttl-y4"})
+    EXPECT_FALSE(method_or_throw(name).table.empty()) << name;
+  EXPECT_TRUE(method_or_throw("rk4").table.empty());
+  EXPECT_GT(with_table, 40);  // 4 splitting families of at least 10 tables each
+}
+
 }  // namespace
 }  // namespace bodypoint::splitting
