@@ -50,6 +50,10 @@ struct TolRow {
   bool is_ladder = false;  ///< a peer's run from its tolerance ladder (oracle view), not at TOL
   bool is_own = false;     ///< a configuration of bodypoint's own methods (own_ladders): a method and a step
   bool method_is_exact = false;  ///< own: an exact flow (ks), whose force_evals count its steps
+  /// own: the same configuration run as `simulate --h` runs it by default (invariants on, the error
+  /// estimate made): what its estimate cost in force evaluations, and the estimate; -1 / NaN where it has none
+  long estimate_force_evals = -1;
+  double own_estimate = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// A peer's ladder stops once its delivered error is below this (the smallest TOL of the grid is 1e-12).
@@ -254,7 +258,7 @@ TolRow* own_best_for(std::vector<TolRow>& rows, const TolRow& a) {
 
 void write_tol_rows(std::ostream& csv, const std::vector<TolRow>& rows, const TimingRules& rules) {
   csv << "scene,method,kind,tol,h,err_estimate,err,met,runs,force_evals,wall_s,cpu_s,spread,repeats,flag,"
-         "delivered_force_evals,delivered_wall_s\n"
+         "delivered_force_evals,delivered_wall_s,estimate_force_evals,own_estimate\n"
       << "# bodypoint work-precision --by-tol, revision " << git_revision() << "\n"
       << "# err = max(|dR|/|R_ref|, |dv|/|v_ref|) against odeint rkf78 in long double at tol 1e-18; met = err <= tol\n"
       << "# met: refused where auto refused TOL with a reason (the summary gives it); a call is the whole request "
@@ -263,13 +267,17 @@ void write_tol_rows(std::ostream& csv, const std::vector<TolRow>& rows, const Ti
          "fewest force evaluations on ladders from h = 0.5 down by factors sqrt 2 whose next finer rung delivers TOL too)\n"
       << timing_rules_note(rules)
       << "# delivered_* (auto only): the delivered run alone (delivered_wall_s: median of its step loop in the timed "
-         "calls), the cost if the search were free\n";
+         "calls), the cost if the search were free\n"
+      << "# estimate_force_evals, own_estimate (own only): the same configuration run as simulate --h runs it by default "
+         "(invariants, error estimate): the force evaluations its estimate took beyond the run, and the estimate\n";
   for (const TolRow& r : rows)
     csv << CsvLine().text(r.scene).text(r.method).text(r.is_auto ? "auto" : r.is_ladder ? "ladder" : r.is_own ? "own" : "at-tol")
                .num(r.tol).num_if(r.is_auto || r.is_own, r.h).num_if(r.is_auto, r.err_estimate).num(r.err)
                .text(r.met ? "yes" : r.refusal.empty() ? "no" : "refused").count(r.runs).count(r.force_evals).num(r.time.wall_s)
                .num(r.time.cpu_s).num(r.time.spread()).count(r.time.repeats).quoted(r.time.flag())
-               .num_if(r.is_auto, static_cast<double>(r.delivered_force_evals)).num_if(r.is_auto, r.delivered_wall_s).str()
+               .num_if(r.is_auto, static_cast<double>(r.delivered_force_evals)).num_if(r.is_auto, r.delivered_wall_s)
+               .num_if(r.is_own && r.estimate_force_evals >= 0, static_cast<double>(r.estimate_force_evals))
+               .num_if(r.is_own && r.estimate_force_evals >= 0, r.own_estimate).str()
         << '\n';
 }
 
@@ -319,7 +327,8 @@ std::string delivered_cell(const TolRow& a) {
 
 /// The last cells of auto's summary row: bodypoint's fastest own configuration delivering TOL (its step
 /// and evaluations), its time, auto's whole call over it in evaluations and in time, and what auto's
-/// search costs beyond its delivered run (evaluations).
+/// search costs beyond its delivered run (evaluations), and what the fastest configuration's default error
+/// estimate costs beyond it (evaluations; measure_own_estimates).
 void write_own_cells(std::ostream& summary, const std::vector<TolRow>& rows, const TolRow& a, std::vector<double>& ratios) {
   const TolRow* own = nullptr;
   for (const TolRow& r : rows)
@@ -341,7 +350,14 @@ void write_own_cells(std::ostream& summary, const std::vector<TolRow>& rows, con
   if (a.refusal.empty() && a.delivered_force_evals > 0)
     summary << std::setprecision(3)
             << static_cast<double>(a.force_evals - a.delivered_force_evals) / static_cast<double>(a.delivered_force_evals)
-            << "x |\n";
+            << "x | ";
+  else
+    summary << "- | ";
+  // What knowing its error costs that configuration (simulate --h's default estimate), and that estimate.
+  if (own && own->estimate_force_evals >= 0 && own->force_evals > 0)
+    summary << std::setprecision(3)
+            << static_cast<double>(own->estimate_force_evals) / static_cast<double>(own->force_evals) << "x ("
+            << sci(own->own_estimate) << " for " << sci(own->err) << ") |\n";
   else
     summary << "- |\n";
 }
@@ -350,8 +366,9 @@ void write_tol_summary(std::ostream& summary, const std::vector<TolRow>& rows, s
   summary << "| scene | TOL | auto method | ds or h | estimate | delivered | met | time [ms] | cheapest peer meeting TOL "
              "| time [ms] | speed-up | peers meeting TOL | cheapest peer config delivering TOL | time [ms] | speed-up "
              "| delivered run [ms] | speed-up if the search were free | bodypoint's fastest config delivering TOL "
-             "| time [ms] | auto / it, evals | auto / it, time | auto's search / its delivered run, evals |\n"
-          << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+             "| time [ms] | auto / it, evals | auto / it, time | auto's search / its delivered run, evals "
+             "| its estimate / it, evals (estimate for error) |\n"
+          << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   int met = 0, refused = 0, total = 0, faster3 = 0, compared = 0, oracle3 = 0, oracle_n = 0;
   std::vector<double> own_ratios;  // auto over bodypoint's fastest configuration, force evaluations
   std::ostringstream refusals;
@@ -403,10 +420,38 @@ void write_tol_summary(std::ostream& summary, const std::vector<TolRow>& rows, s
             << "median " << std::setprecision(3) << median(own_ratios) << "x, from " << own_ratios.front() << "x to "
             << own_ratios.back() << "x (" << own_ratios.size() << " cases).\n";
   }
+  std::vector<double> estimate_prices;  // the fastest configurations' default estimate over their run, evaluations
+  for (const TolRow& r : rows)
+    if (r.is_own && r.estimate_force_evals >= 0 && r.force_evals > 0 && !r.method_is_exact)
+      estimate_prices.push_back(static_cast<double>(r.estimate_force_evals) / static_cast<double>(r.force_evals));
+  if (!estimate_prices.empty()) {
+    std::sort(estimate_prices.begin(), estimate_prices.end());
+    summary << "\nThe default error estimate of bodypoint's fastest configuration (simulate --h), force evaluations "
+            << "beyond the run: median " << std::setprecision(3) << median(estimate_prices) << "x, from "
+            << estimate_prices.front() << "x to " << estimate_prices.back() << "x (" << estimate_prices.size()
+            << " configurations).\n";
+  }
   if (refused > 0) summary << "\nauto refused:\n\n" << refusals.str();
 }
 
 }  // namespace
+
+/// The price of the default error estimate on each own row from `first` (mark_own_bests' rows): the row's
+/// configuration made again as `simulate --method M --h h` makes it (Options' defaults: invariants tracked, the
+/// estimate on), untimed; its estimate's force evaluations beside the run's. A run that does not end ok leaves
+/// the row without them.
+void measure_own_estimates(const NamedScene& ns, std::vector<TolRow>& rows, std::size_t first) {
+  const Body& body = ns.scene.bodies.front();
+  for (std::size_t i = first; i < rows.size(); ++i) {
+    TolRow& r = rows[i];
+    if (!r.is_own) continue;
+    const MethodInfo& m = method_or_throw(r.method);
+    const BodyResult x = integrate_body(body, ns.scene.centres, &m, own_advance(m, r.h, ns.t_end), Options{});
+    if (x.outcome != Outcome::ok || !x.error.known()) continue;
+    r.estimate_force_evals = x.error.force_evals;
+    r.own_estimate = x.error.value;
+  }
+}
 
 /// Keeps the own rows (from own_first) that are the fastest at one of the scene's TOLs (own_best_for), each
 /// stamped with that TOL (one copy per TOL it is fastest at), and drops the others: only they are timed.
@@ -456,6 +501,7 @@ void run_by_tolerance(const std::vector<NamedScene>& scenes, const std::vector<d
     const double own_cap = auto_evals > 0.0 ? std::min(max_evals, kOwnOverAuto * auto_evals) : max_evals;
     measure_own_ladders(ns, ref, *std::min_element(tols.begin(), tols.end()), own_cap, rows);
     mark_own_bests(rows, first, own_first);
+    measure_own_estimates(ns, rows, own_first);
     std::cerr << "  " << ns.name << ": timing " << rows.size() - first << " configurations, interleaved\n";
     time_rows(rows, first, rules);
   }

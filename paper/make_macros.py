@@ -900,6 +900,14 @@ def by_tol(res, out, M):
                       "every comparison's time flagged")
     M.add("AutoSearchOverRun", f"${sci(min(search))}$ to ${sci(max(search))}$ times" if search else
           "an unmeasured multiple of (no search of \\cmd{auto} in this copy's by-tol table)", math_mode=False)
+    # The second price on the same configurations: their default error estimate (simulate --h), in force
+    # evaluations beyond the run (by_tol.csv's own rows; ks, whose estimate evaluates no force, left out).
+    prices = [num(r["estimate_force_evals"]) / num(r["force_evals"]) for r in rows
+              if r["kind"] == "own" and r.get("estimate_force_evals") and num(r["estimate_force_evals"]) > 0
+              and num(r["force_evals"]) > 0]
+    M.add("OwnEstimatePrice", f"a median ${sci(statistics.median(prices))}$ times their run's force evaluations "
+          f"(${sci(min(prices))}$ to ${sci(max(prices))}$, {count(len(prices))} configurations)" if prices else
+          "not measured (no own configuration of this copy's by-tol table has an estimate)", math_mode=False)
     with open(os.path.join(out, "tab_by_tol.tex"), "w") as f:
         for row in body:
             f.write(" & ".join(latex_cell(row[i]) for i in keep) + " \\\\\n")

@@ -264,8 +264,16 @@ TEST(Cli, ByTolComparesAutoWithBodypointsOwnFastestConfiguration) {
     EXPECT_FALSE(is_peer(method_or_throw(c[1]))) << line;  // bodypoint's own method
     EXPECT_LE(std::stod(c[6]), std::stod(c[3])) << "it delivers its TOL: " << line;
     EXPECT_EQ(c[7], "yes") << line;
+    // The second price: the configuration run as simulate --h runs it, its default estimate's evaluations
+    // beyond the run and the estimate, which may be high but never more than the ladder's 3x low.
+    constexpr double kLowestHonest = 1.0 / 3.0;  // bench/estimate_ladder.py's bound on an estimate below the error
+    ASSERT_GE(c.size(), 19u) << line;
+    EXPECT_GT(std::stod(c[17]), 0.0) << "its estimate's force evaluations: " << line;
+    EXPECT_GE(std::stod(c[18]), kLowestHonest * std::stod(c[6])) << "its estimate: " << line;
   }
   EXPECT_EQ(own, 2) << "one per TOL";
+  EXPECT_NE(r.out.find("The default error estimate of bodypoint's fastest configuration (simulate --h), force "
+                       "evaluations beyond the run: median"), std::string::npos) << r.out;
   fs::remove(out);
 }
 
