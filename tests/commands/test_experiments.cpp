@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -278,6 +280,19 @@ TEST(Study, ScatteringAgreesWithRutherfordAndReportsEverySeries) {
   EXPECT_EQ(material, 2);
   for (const char* name : {"scattering.csv", "scattering_rainbows.csv", "scattering_cross_section.csv"})
     EXPECT_TRUE(fs::exists(dir / name)) << name;
+  // Issue #56: every row's deflection carries its total error (the run's, the asymptotes' and the start
+  // distance's), the widest passes (b = 316, 1000) too: they start from L = 4b and come within half of it.
+  std::ifstream g(dir / "scattering.csv");
+  std::stringstream all;
+  all << g.rdbuf();
+  int rows_with_error = 0;
+  for (const auto& row : csv_rows(all.str())) {
+    ASSERT_GE(row.size(), 10u);
+    EXPECT_TRUE(std::isfinite(std::stod(row[9]))) << row[0] << " b = " << row[4] << ": asymptote_error";
+    EXPECT_TRUE(std::isfinite(std::stod(row.back()))) << row[0] << " b = " << row[4] << ": deflection_error";
+    rows_with_error += std::isfinite(std::stod(row.back())) ? 1 : 0;
+  }
+  EXPECT_GT(rows_with_error, 200);  // the quick study's 299 rows
 }
 
 }  // namespace
