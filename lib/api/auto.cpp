@@ -15,7 +15,8 @@
 namespace bodypoint {
 namespace {
 
-/// auto's table: Yoshida 4 from this tolerance up, Kahan-Li 6 from kTightTolerance, Kahan-Li 8 below.
+/// auto's table: Yoshida 4 from this tolerance up, Kahan-Li 6 from kTightTolerance, Kahan-Li 8 below. Each
+/// constant's measurement: docs/developers.md, "Tuned constants".
 constexpr double kLooseTolerance = 1e-5;
 constexpr double kTightTolerance = 1e-10;
 
@@ -32,10 +33,8 @@ const MethodInfo& choose_method(const Body& body, const std::vector<Centre>& cen
 
 const MethodInfo& detail::choose_method_for(const Body& body, const std::vector<Centre>& centres, double tol,
                                             std::string* why) {
-  // The table by tolerance, measured (logh on the close, thesis and two-centres scenes, force
-  // evaluations of the whole search): Yoshida 4 (3 stages) is cheapest down to 1e-5 (thesis 3,648
-  // against 10,944 for Kahan-Li 6), Kahan-Li 6 down to 1e-10 (close 1e-9: 21,690 against 33,218 for
-  // Kahan-Li 8), Kahan-Li 8 below.
+  // The table by tolerance (docs/developers.md, "Tuned constants"): Yoshida 4 (3 stages) down to 1e-5,
+  // Kahan-Li 6 down to 1e-10, Kahan-Li 8 below.
   const std::string_view table = tol >= kLooseTolerance ? "y4" : tol >= kTightTolerance ? "kl6" : "kl8";
   std::ostringstream os;
   double potential_at_closest = 0.0;  // at the guiding centre's closest approach to each centre

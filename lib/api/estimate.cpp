@@ -20,46 +20,38 @@
 namespace bodypoint::detail {
 namespace {
 
+// Each constant's measurement: docs/developers.md, "Tuned constants".
+
 /// The companion of a fixed or fictitious step h runs at h / kStepRatio: it costs kStepRatio runs, and
-/// its error is kStepRatio^-p of the run's, so what the two differ by is the run's error to within
-/// that fraction (a coarser companion would cost less but leave the estimate to the asymptotic
-/// regime: at 2h an estimate |x_h - x_2h|/(2^p - 1) is 15x low where round-off dominates).
+/// its error is kStepRatio^-p of the run's, so what the two differ by is the run's error to within that fraction.
 constexpr double kStepRatio = ErrorEstimate::kStepRatio;
 /// A step-size-controlled method's companion runs at the tolerance per step over kTolRatio: its
 /// global error is about 1/kTolRatio of the run's (the controllers aim at an error proportional to tol).
 constexpr double kTolRatio = 10.0;
 /// A time-transformed companion that takes fewer than this many times the run's steps did not refine it
-/// (a controlled one: no more steps); it is refined again, up to kMaxLevels levels (ds/1024, tol/1e10).
+/// (a controlled one: no more steps); it is refined again, up to kMaxCompanionLevels levels (ds/1024, tol/1e10).
 constexpr double kRefined = 1.5;
-constexpr int kMaxLevels = 10;
+constexpr int kMaxCompanionLevels = 10;
 /// The smallest tolerance per step a companion is run with (run.cpp refuses smaller ones).
 constexpr double kMinCompanionTol = 1e-15;
 
 /// A final state whose relative energy error exceeds this many times its estimated error has an error
-/// the estimate does not account for (the energy changes by at most a few times the relative change
-/// of v and R); below kEnergyRoundOff it is round-off.
+/// the estimate does not account for; below kEnergyRoundOff it is round-off.
 constexpr double kEnergyPerState = 10.0;
 constexpr double kEnergyRoundOff = 1e-12;
 
 /// A run flagged unresolved may be kept on its estimate only where a second companion, one level finer,
 /// shows the error falling as h^p: the first pair's difference is at least 2^(p - kOrderSlack) times the
-/// second's (a step-size-controlled pair: kMinTolFall times). A pair that both alias the spin differ by
-/// what aliasing leaves, not by the error (kep-ss10 at h = 0.5 and 0.25 on B = 0.9: 9.5 and 9.1 % off,
-/// 0.4 % apart), while exact splittings at 6.9 rad of spin per step are smooth in h (lp-y4, h = 1 on
-/// table 3.1: 9.2e-6 off, estimated 9.9e-6).
-/// A fall of kMaxFall is enough at any order: then the first companion's error is at most an eighth of
-/// the run's, and the first difference is the run's error to within that (at order 10 a fall of 2^9 would
-/// ask the finer pair to differ by less than round-off: lp-ss10 at h = 0.5 on table 3.1, 2.05e-12 off,
-/// estimated 2.05e-12, its companions 1e-13 apart).
+/// second's (a step-size-controlled pair: kMinTolFall times), or kMaxFall times at any order (the first
+/// companion's error is then at most an eighth of the run's). A pair that both alias the spin differ by
+/// what aliasing leaves, not by the error.
 constexpr double kOrderSlack = 1.0;
 constexpr double kMaxFall = 8.0;
 constexpr double kMinTolFall = 3.0;
 /// Below the order's fall, differences that still fall by kGeometricFall per level converge at least
 /// geometrically: the second companion is then off by at most what it differs by from the first, and the
 /// run by at most what it differs by from the second plus that. The estimate is raised to that bound and
-/// kept (two-centres-spin lp-y8 at h = 0.5: 3.6e-5 off, refused at a fall of 7.2 where order 8 asks 8;
-/// kep-kl8 at h = 1: 6.0e-4 off, fall 2.8). The aliasing runs the flag exists for fall by less than 1
-/// (strong-spin rk4 h = 0.1, 0.815 off: 2.5e-5; kep-ss10 h = 0.5: 0.047; lp-kl8 h = 0.5: 0.16).
+/// kept; the aliasing runs the flag exists for fall by less than 1.
 constexpr double kGeometricFall = 2.0;
 /// A run of fewer steps than this has no asymptotic regime of its own: a second companion bounds it too.
 constexpr long kFewSteps = 4;
@@ -134,24 +126,18 @@ constexpr long kCoarseMinSteps = 16;
 /// The coarse companion's estimate is trusted up to this value: a run estimated above it is near the end
 /// of its own asymptotic regime, where the coarse run at twice the step may be beyond it (aliasing the
 /// spin, unstable), which Richardson on the coarse side would take for the run's error; such runs are
-/// estimated by the fine companion at h/2 as before (bench/estimate_ladder.py, docs/developers.md).
+/// estimated by the fine companion at h/2.
 constexpr double kCoarseTrusted = 1e-5;
 /// On the coarse side the order is taken as at most this: at twice the step a method of order 6 to 10
-/// is rarely in its asymptotic regime where it matters (lp-ss10 at h = 0.2 on the attracting scene:
-/// 7.4e-5 off, its coarse companion 3.5e-4 away, a fall of 5 where order 10 says 1023), so the
-/// difference over 2^p - 1 was more than 3x low in 49 of the ladder's runs of order >= 6 and over
-/// 2^4 - 1 in 3; at order <= 4 Richardson's factor is kept.
+/// is rarely in its asymptotic regime where it matters; at order <= 4 Richardson's factor is kept.
 constexpr int kCoarseMaxOrder = 4;
 /// Where the flags' angles limit the ratio below 2 (a time-transformed run's coarse companion at 1.47 ds)
-/// the order is taken as at most this: with 4 there, 16 of the ladder's estimates were more than 3x low,
-/// with 2, 10. (An odd number of fixed steps, whose companion takes half as many rounded up, asked for 2.)
+/// the order is taken as at most this. (An odd number of fixed steps, whose companion takes half as many
+/// rounded up, asked for 2.)
 constexpr int kCoarseMaxOrderBelow2 = 2;
 /// The coarse companion's steps are kept this far inside the flags' limits (a step turning the spin by
-/// pi, the direction to a centre by pi/2) that the run's own steps, scaled by the ratio, predict. At
-/// 0.9 (the flags' edge) a pair whose coarse steps turn the spin by 2-2.8 rad is not asymptotic: 6 of the
-/// estimate ladder's delivered estimates were more than 3x low (lp-bm4 at h = 0.2 on two spinning
-/// centres: 4.4e-6 for 1.0e-4); at 0.45 none of those, and the fine companion pays for such runs
-/// (docs/developers.md, "The estimate's coarse side").
+/// pi, the direction to a centre by pi/2) that the run's own steps, scaled by the ratio, predict: a pair
+/// whose coarse steps turn the spin by 2-2.8 rad is not asymptotic.
 constexpr double kCoarseAngleMargin = 0.45;
 /// Below this ratio the pair differs too little to measure the error (ratio^p - 1 small against their
 /// rounding): the fine companion decides.
@@ -221,19 +207,13 @@ void flag_broken_companion(BodyResult& r, const BodyResult& x, const std::string
 }
 
 /// A companion difference below kRoundingLevel is at the scene's rounding level, where the pair can agree
-/// by chance (one draw of the rounding each; rk4 at h = 5e-4 on a bound orbit: estimated 3.3e-12 for an
-/// error of 2.9e-11; kep-y4 at h = 1 on a bound orbit, an exact flow: 7.3e-14 from its coarse companion
-/// for a state 5.3e-12 off the Kepler orbit). There the estimate adds what kRoundingDraws - 1 more runs
+/// by chance (one draw of the rounding each). There the estimate adds what kRoundingDraws - 1 more runs
 /// differ from the run by, off the run's grid (off_grid) from its start moved by adaptive::kStartShift,
 /// either way in turn, as the accuracy mode adds its rounding probes below the same level (tolerance.hpp,
 /// kProbeBelowTol): repeats of the run (fine companions), or coarse runs (coarse companion: half a run
 /// each; at fixed steps the companion's twin, its own steps from the start moved the other way, the two
 /// lanes of one batch where the method has a kernel: coarse_lanes), and the sum is taken kRoundingBound
-/// times (ErrorEstimate). The twin shares half the run's points, yet on the estimate ladder its 414
-/// estimates of errors in (1e-12, 1e-10) were at least 0.93x the error (a coarse run off the grid:
-/// 0.62x), none more than 3x low either way. Draws at twice the coarse step cost
-/// less, but their truncation is 2^p times the companion's: far-ip at h = 0.5 on the attracting material
-/// pass read 4.3e-6 for an error of 4.5e-14.
+/// times (ErrorEstimate).
 constexpr double kRoundingLevel = adaptive::kProbeBelowTol;
 
 /// `draw(k)`: the k-th draw (k >= 1), from the start moved rounding_way(k); `o`: the draws' options;
@@ -266,8 +246,7 @@ std::function<BodyResult(int)> rerun_draws(const Body& body, std::function<Advan
 
 /// The lanes of one batch (batch.hpp) are the coarse companion and its twin, its first rounding draw, where
 /// the method has a batch kernel for the scene and the run stops at no event (a batch locates none): two lanes
-/// cost about what one scalar run does (lp-y4, 250,001 steps: 0.07-0.08 s for the pair, 0.07 s for one
-/// alone), so the draw the rounding level asks for is nearly free. Each lane computes the scalar run's
+/// cost about what one scalar run does, so the draw the rounding level asks for is nearly free. Each lane computes the scalar run's
 /// bits (tests/lib/test_batch.cpp), judged as integrate() judges the scalar companion; the batch polls
 /// the run's cancellation.
 constexpr std::size_t kDrawLanes = 2;
@@ -451,7 +430,7 @@ struct FineCompanion {
 /// it: a time-transformed run whose steps are cut to land on t_end (one physical step ds/c beyond the
 /// whole span), a controlled run whose tolerance does not bind (its steps grow at the controller's largest
 /// rate from the first trial step: odeint-dopri5 at tol 1e-3 and 1e-4 on a far pass take the same 9 steps,
-/// 2.9e-8 off). The companion is refined until it does, up to kMaxLevels; nullopt (r.error.basis saying
+/// 2.9e-8 off). The companion is refined until it does, up to kMaxCompanionLevels; nullopt (r.error.basis saying
 /// why, a companion that broke down flagged on r) where there is none.
 std::optional<FineCompanion> finer_companion(BodyResult& r, const Body& body, const Advance& how, const Options& options,
                                              const Options& o, const Rerun& rerun) {
@@ -468,7 +447,7 @@ std::optional<FineCompanion> finer_companion(BodyResult& r, const Body& body, co
       return std::nullopt;
     }
     if (refines(how, r.run.steps, x.run.steps)) return FineCompanion{std::move(*c), std::move(x), level};
-    if (level == kMaxLevels) {
+    if (level == kMaxCompanionLevels) {
       e.basis = "companions down to the " + c->basis + " took no more steps than the run";
       return std::nullopt;
     }

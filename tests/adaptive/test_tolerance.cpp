@@ -199,7 +199,7 @@ TEST(Tolerance, ATripleConvergingFarFasterThanOrderPIsNotTrusted) {
 
 TEST(Tolerance, ADeliveredRunTooLongToKeepIsMadeAgainForItsSamples) {
   // A run that may be delivered keeps its samples for the caller's sink up to 2^20 of them (adaptive/
-  // tolerance.cpp); a scattering run under events at tol 1e-10 kept every step of its finest rungs and was
+  // search/runs.cpp); a scattering run under events at tol 1e-10 kept every step of its finest rungs and was
   // killed at 24 GB. Beyond that it drops them and makes the delivered run again with the sink.
   constexpr long kKeptAtMost = 1L << 20;
   const NamedScene ns = named_scene("thesis");
@@ -268,7 +268,7 @@ TEST(Tolerance, AutoChoosesByTheScene) {
 }
 
 // far-ip's estimate is the largest difference of its run to a run at h/1.25 and a run from a start moved
-// by 4 ulp (tolerance.cpp, exact_flow): draws of the scene's amplified rounding, which is most of its error.
+// by 4 ulp (search/exact_pair.cpp): draws of the scene's amplified rounding, which is most of its error.
 // It may stand above the delivered run's error by more than kEstimateFactor (its own rounding is about one
 // ulp of the start; a close pass: 5.96e-12 for 1.77e-12; bench/estimate_grid.py --method far-ip: a median of
 // 2.4x over its 366 measurable runs, above 10x only for errors of at most 1.5e-12), by at most this much on

@@ -8,8 +8,8 @@
 // Equations I, 2nd ed., Springer 1993, sec. II.4, "Richardson extrapolation" and its use for global
 // error estimation): in the asymptotic regime err(h) = C h^p, so two runs at h and h/r differ by
 // C h^p (1 - r^-p) and the finer one's error is their difference over r^p - 1. The run delivered is
-// the run reported: it carries the observers (RunOptions), nothing is integrated again. See
-// tolerance.cpp for the steps of the search.
+// the run reported: it carries the observers (RunOptions), nothing is integrated again. The steps of
+// the search: adaptive/search/ladder.cpp; each tuned constant's measurement: docs/developers.md.
 //
 // `--method auto` (which method for a scene and a tol) is one layer up: bodypoint/methods.hpp.
 #pragma once
@@ -30,9 +30,8 @@ inline constexpr double kMinTolerance = 1e-13;
 
 /// Below this tolerance a run about to be delivered is repeated kProbeRuns times: with its roundings
 /// changed (all but one), and once from its start moved by a rounding; what they differ by is added to the estimate
-/// (tolerance.cpp): an encounter amplifies round-off, which Richardson's estimate cannot tell from
-/// truncation. The search then costs that many delivered runs more. (At 1e-11, unprobed, lp-rkn6
-/// delivered 2.6e-11 on a close pass with an estimate of 8.9e-13: bench/accuracy_grid.py.)
+/// (search/rounding.cpp): an encounter amplifies round-off, which Richardson's estimate cannot tell from
+/// truncation. The search then costs that many delivered runs more.
 inline constexpr double kProbeBelowTol = 1e-10;
 inline constexpr int kProbeRuns = 3;
 /// The rounding probe's relative move of the starting state (R scaled by 1 + kStartShift, v by 1 -

@@ -1,0 +1,248 @@
+// bodypoint: the search of a method of order p (search.hpp), in as few integrations as the scene allows.
+//
+// Runs that share one time-step constant c (time-transformed methods; a pair compared by Richardson must be
+// one method) form a ladder, coarse to fine; each new run's error is estimated from the run before it,
+// est = |x_a - x_b|/((h_a/h_b)^p - 1) (richardson.hpp), and the estimate is trusted when the error behaves
+// like C h^p there: the three last runs fit an order between p - kOrderSlack and p + kOrderExcess, or (a
+// ladder of two) the estimate is what the coarser runs predicted for it, within kAgree.
+// 1. Pilot pair: runs at a coarse step h0 (start.cpp) and h0/2, with the c of h0. A run the method refuses
+//    (logH's E - T + c <= 0, a non-finite state) halves h0.
+// 2. The latest estimate predicts the step h* that gives kTarget tol. When h*'s own c is well below the
+//    ladder's (far from the centres a run costs ~c/ds steps per unit time), a new ladder starts: the answer
+//    at h* and its companion at kCompanionRatio h* (half the cost of the answer). Otherwise the answer at
+//    h* joins the ladder, whose finest run is its companion: one run.
+// 3. A trusted estimate at most kAccept tol delivers the answer (below kProbeBelowTol with the round-off
+//    probe's floor added, rounding.cpp); otherwise back to 2.
+// Differences that stop shrinking far below 1 are round-off: the search reports the floor it met (what the
+// finest runs still differ by). Each constant's measurement: docs/developers.md, "Tuned constants".
+#include "search.hpp"
+
+#include "bodypoint/adaptive/methods.hpp"
+#include "bodypoint/adaptive/richardson.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <utility>
+
+namespace bodypoint::adaptive::detail {
+namespace {
+
+/// The predicted step aims at this fraction of tol (a prediction from a coarser pair is uncertain by a
+/// factor of a few, and a miss costs one more run).
+constexpr double kTarget = 0.3;
+/// The answer's companion runs at this multiple of its step: it costs 1/kCompanionRatio of the answer.
+constexpr double kCompanionRatio = 2.0;
+/// A triple whose observed order is this much below p is not smooth in h there.
+constexpr double kOrderSlack = 1.0;
+/// A triple whose observed order is more than this above p is not in the asymptotic range either, unless the
+/// triple before it showed the same.
+constexpr double kOrderExcess = 2.0;
+/// Orders above this are not told apart (the fit's bracket).
+constexpr double kMaxOrder = 40.0;
+/// A new run's estimate agrees with the one the coarser runs predicted for it within this factor.
+constexpr double kAgree = 10.0;
+/// A new ladder is started for a predicted step whose own constant c is below this fraction of the ladder's.
+constexpr double kNewConstantGain = 0.5;
+/// Estimates that stop falling where the runs differ by less than this are a floor (kMaxStalls refinements in
+/// a row end the search); above it the step is still outside the asymptotic regime (kMaxFarStalls allowed).
+constexpr double kStallBelow = 1e-8;
+constexpr int kMaxFarStalls = 8;
+/// With the round-off floor known, the next step aims its truncation at what the floor leaves of tol, but at
+/// no less than this share of tol.
+constexpr double kMinAimShare = 0.1;
+/// Runs that differ by more than this relative amount follow no common trajectory: their difference
+/// predicts no step.
+constexpr double kUnresolvedPair = 1.0;
+/// Differences at or below this relative size are at the round-off level of a run of 1e3..1e6 steps.
+constexpr double kRoundOff = 1e-13;
+
+}  // namespace
+
+/// The pilot pair at h0 and h0/2 (a refused step halves h0); sets the first estimate and returns the finer
+/// run, never delivered (docs/developers.md, "Limits, measured": a pilot pair's estimate alone was 25x low).
+Level Search::pilot(Level& coarse) {
+  double h = initial_step(m_, b_, c_, t_end_);
+  for (int k = 0;; ++k) {
+    try {
+      coarse = run_at(h, h, false);
+      Level fine = run_at(0.5 * coarse.h, h, false);
+      // A pair that differs by more than kUnresolvedPair is no trajectory yet: the pair moves down by
+      // halvings, each run one more at half the step (their sum at most the last pair's cost), with the same
+      // constant c, until it differs by less.
+      for (int d = 0; state_distance(coarse.run.final, fine.run.final) > kUnresolvedPair && d < kMaxRefinements; ++d) {
+        coarse = std::move(fine);
+        fine = run_at(0.5 * coarse.h, h, false);
+      }
+      estimate_ = pair_estimate(coarse, fine);
+      return fine;
+    } catch (const SearchLimit&) {
+      throw;
+    } catch (const StoppedOnRequest&) {
+      throw;
+    } catch (const Error&) {
+      if (k >= kMaxRefinements) throw;
+      h *= 0.5;
+    }
+  }
+}
+
+/// Runs that share one time-step constant c form a ladder; each new run is estimated from the run before it
+/// (Richardson, order p) and checked by the run before that (file comment).
+Level Search::ladder() {
+  std::vector<Level> rungs;  // runs sharing the constant c of step h_c, coarse to fine
+  Level coarse;
+  Level fine = pilot(coarse);
+  double h_c = coarse.h;
+  rungs.push_back(std::move(coarse));
+  rungs.push_back(std::move(fine));
+  double best_bound = std::numeric_limits<double>::infinity();
+  int stalled = 0;
+  bool verified_finer = false;  // the newest rung is a verification's companion: estimate it first
+  for (int k = 0; k < kMaxRefinements; ++k) {
+    const double expected = verified_finer ? estimate_ * std::pow(0.5, p_) : refine(rungs, h_c);
+    verified_finer = false;
+    Level& a = rungs[rungs.size() - 2];
+    a.samples = {};  // only the newest run can still be delivered: its predecessors' samples go
+    estimate_ = pair_estimate(a, rungs.back());
+    last_estimate_ = estimate_;
+    const double d = state_distance(a.run.final, rungs.back().run.final);
+    if (d <= kRoundOff && estimate_ > kAccept * tol_)
+      throw Error("tol " + fmt_tol() + " is below the round-off floor of " + std::string(m_.name) +
+                  " on this scene (estimate " + short_number(estimate_) + ")");
+    if (deliverable(rungs.back(), h_c, smooth(rungs, expected) || d <= kRoundOff)) {
+      if (verified(rungs, h_c)) return std::move(rungs.back());
+      verified_finer = true;  // its companion joined the ladder
+      continue;
+    }
+    // A search whose estimates stop falling (round-off, or resonances that refinement does not remove) says
+    // so instead of spending its whole budget; larger differences are not a floor but a step still outside
+    // the asymptotic regime (kStallBelow).
+    if (estimate_ < best_bound / kStallFactor) {
+      best_bound = estimate_;
+      stalled = 0;
+    } else if (++stalled < (d > kStallBelow ? kMaxFarStalls : kMaxStalls)) {
+      continue;
+    } else if (d <= tol_) {
+      // The finest runs differ by less than tol but their estimates are not trusted (not smooth in h): what
+      // they differ by bounds the finer one's error once its own companion agrees (kep-kl6 on a material
+      // close pass was refused at every tol with runs 4.98e-12 apart). A refusal never quotes a difference
+      // below the tol asked (logh-kl6 at 1e-9: "still differ by 9.39e-10").
+      if (verified_at(rungs, h_c, d)) return std::move(rungs.back());
+      verified_finer = true;
+      stalled = 0;
+    } else {
+      // The floor is what finer runs still disagree by, not the smallest estimate: an early pair can agree
+      // by chance (B = 0.9, b = 1 at tol 1e-12: first estimate 9.9e-15, then three refinements each 4e-12
+      // apart, which one of them must be wrong by half of).
+      throw Error("tol " + fmt_tol() + " is out of reach of " + std::string(m_.name) +
+                  " on this scene: runs at finer steps still differ by " + short_number(d) +
+                  " (round-off amplified by the scene, or resonances that refinement does not remove)");
+    }
+  }
+  throw Error("tol " + fmt_tol() + ": " + std::string(m_.name) + " did not reach it in " +
+              std::to_string(kMaxRefinements) + " refinements");
+}
+
+/// Whether the newest estimate is trusted: the error behaves like C h^p there. The three last runs of the
+/// ladder show an order within [p - kOrderSlack, p + kOrderExcess], or (two runs) the estimate is what the
+/// model carried over from the coarser runs predicted (`expected`), within kAgree.
+bool Search::smooth(const std::vector<Level>& rungs, double expected) const {
+  const std::size_t n = rungs.size();
+  if (n < 3) return estimate_ <= kAgree * expected && estimate_ >= expected / kAgree;
+  // An order far above p is trusted where the triple before showed it too: a scattering run's final state
+  // converges faster than h^p throughout (the error at the end of an encounter is that of a processed
+  // method), where one run sitting at a zero of the error shows it once.
+  const double q = observed_order(rungs[n - 3], rungs[n - 2], rungs[n - 1]);
+  const bool again = n >= 4 && observed_order(rungs[n - 4], rungs[n - 3], rungs[n - 2]) > p_ + kOrderExcess;
+  return q >= p_ - kOrderSlack && (q <= p_ + kOrderExcess || again);
+}
+
+/// Adds the ladder's next run, at the step the estimate predicts for what TOL leaves to truncation; far finer
+/// than the ladder so far, it starts a new ladder (h_c changes). Returns the error the model C h^p expects of
+/// the new run.
+double Search::refine(std::vector<Level>& rungs, double& h_c) {
+  // Once a round-off floor was measured (below kProbeBelowTol), the truncation aims at what it leaves.
+  const double aim = kTarget * std::max(tol_ - std::max(floor_, 0.0) / kAccept, kMinAimShare * tol_);
+  const double predicted = rungs.back().h * std::pow(aim / std::max(estimate_, kRoundOff), 1.0 / p_);
+  if (automatic_omega_c(b_, c_, kCompanionRatio * predicted) < kNewConstantGain * rungs.back().omega_c) {
+    // Far finer than the ladder so far: a new ladder whose constant c is that of the companion's step, so
+    // that the answer does not pay for the coarse runs' larger c in the far field.
+    h_c = kCompanionRatio * predicted;
+    rungs.clear();
+    rungs.push_back(run_at(h_c, h_c, false));
+    rungs.push_back(run_at(predicted, h_c, true));
+    return kTarget * tol_;
+  }
+  const double h = std::min(predicted, rungs.back().h / kMinRefinement);
+  const double expected = estimate_ * std::pow(h / rungs.back().h, p_);
+  rungs.push_back(run_at(h, h_c, true));
+  return expected;
+}
+
+/// Whether the newest run `l` may be delivered: its estimate (and the round-off floor measured so far) within
+/// TOL, and the estimate `trusted`. Below kProbeBelowTol the round-off is probed on `l` itself and added to
+/// the estimate; round-off alone above TOL throws.
+bool Search::deliverable(const Level& l, double h_c, bool trusted) {
+  if (!(estimate_ + std::max(floor_, 0.0) <= kAccept * tol_ && trusted)) return false;
+  if (tol_ >= kProbeBelowTol) return true;
+  // Measured on the run that may be delivered: a floor measured on another run is another draw of the
+  // round-off (reused from a coarser run, 2 of 256 scenes at tol 1e-12 missed it).
+  floor_ = rounding_floor(l, h_c);
+  if (floor_ > kAccept * tol_)
+    throw Error("tol " + fmt_tol() + " is out of reach of " + std::string(m_.name) +
+                " on this scene: runs that differ only in rounding differ by " + short_number(floor_) +
+                " (round-off amplified by the scene)");
+  // Truncation and round-off add up in the delivered run: its estimate is their sum. Where the sum is above
+  // what may be delivered, a finer run lowers the truncation part.
+  if (estimate_ + floor_ > kAccept * tol_) return false;
+  estimate_ = last_estimate_ = estimate_ + floor_;
+  return true;
+}
+
+/// Whether the ladder's newest run may be delivered as it is: without verification (auto: its choices'
+/// estimates were measured honest), or when its companion at half its step, run now, agrees within TOL (its
+/// difference over 1 - 2^-p: the error of the run at h). A companion that does not agree joins the ladder as
+/// its newest run (false): the search goes on from there.
+bool Search::verified(std::vector<Level>& rungs, double h_c) { return !verify_ || verified_at(rungs, h_c, estimate_); }
+
+/// The same with the delivered run's estimate `current`, which the companion's can only raise.
+bool Search::verified_at(std::vector<Level>& rungs, double h_c, double current) {
+  Level half = run_at(0.5 * rungs.back().h, h_c, true);
+  const double e = coarser_run_error(state_distance(rungs.back().run.final, half.run.final), 2.0, p_);
+  if (e + std::max(floor_, 0.0) <= kAccept * tol_) {
+    estimate_ = last_estimate_ = std::max(current, e + std::max(floor_, 0.0));
+    return true;
+  }
+  rungs.back().samples = {};
+  rungs.push_back(std::move(half));
+  return false;
+}
+
+/// The order q with which x(h) = x* + C h^q fits three runs at steps h1 > h2 > h3: the root of
+/// (h1^q - h2^q)/(h2^q - h3^q) = d12/d23 (increasing in q), by bisection on [0, kMaxOrder].
+double Search::observed_order(const Level& l1, const Level& l2, const Level& l3) const {
+  const double d12 = state_distance(l1.run.final, l2.run.final), d23 = state_distance(l2.run.final, l3.run.final);
+  if (!(d23 > 0.0)) return kMaxOrder;
+  const double target = d12 / d23;
+  auto ratio = [&](double q) {
+    const double a = std::pow(l1.h / l3.h, q), b = std::pow(l2.h / l3.h, q);
+    return (a - b) / (b - 1.0);
+  };
+  double lo = 1e-3, hi = kMaxOrder;
+  if (ratio(lo) >= target) return 0.0;
+  if (ratio(hi) <= target) return kMaxOrder;
+  for (int it = 0; it < 60; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (ratio(mid) < target ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+/// Richardson's estimate of the finer run's error from a pair at steps h_c > h_f, order p.
+double Search::pair_estimate(const Level& c, const Level& f) const {
+  return finer_run_error(state_distance(c.run.final, f.run.final), c.h / f.h, p_);
+}
+
+}  // namespace bodypoint::adaptive::detail
