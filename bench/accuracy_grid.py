@@ -102,12 +102,16 @@ def main():
         print(f"estimate / error over {len(ratios)} delivered runs with error > {REFERENCE_ERROR:g}: median "
               f"{statistics.median(ratios):.3g}, 5 % {q[0]:.3g}, 95 % {q[-1]:.3g}, min {min(ratios):.3g}")
     if a.csv:
-        with open(a.csv, "w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow(["scene", "method", "tol", "exit", "error", "estimate", "reason"])
-            for r in rows:
-                w.writerow([r["scene"], r["method"], r["tol"], r["exit"], r.get("error", ""),
-                            r["out"]["err_estimate"] if r["out"] else "", r["reason"]])
+        write_rows(a.csv, rows)
+
+
+def write_rows(path, rows):
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["scene", "method", "tol", "exit", "error", "estimate", "reason"])
+        for r in rows:
+            w.writerow([r["scene"], r["method"], r["tol"], r["exit"], r.get("error", ""),
+                        r["out"]["err_estimate"] if r["out"] else "", r["reason"]])
 
 
 if __name__ == "__main__":

@@ -204,24 +204,33 @@ def main():
     for r in right_refused[:10]:
         print(f"   {r['scene']} {r['method']} {r['step']}: error {r['error']:.3g}, estimate {r['estimate']}: {r['reason'][:150]}")
     for label, pairs in ratios.items():
-        x = [p[0] for p in pairs]
-        if len(x) < 2:
-            continue
-        q = statistics.quantiles(x, n=20)
-        within = sum(1 for v in x if 1 / FACTOR <= v <= FACTOR)
-        low = sorted((p for p in pairs if p[0] < 1 / FACTOR), key=lambda p: p[0])
-        print(f"estimate / error, {label}, {len(x)} runs with error in ({COMPARABLE:g}, {LOST:g}]: median {statistics.median(x):.3g}, "
-              f"5 % {q[0]:.3g}, 95 % {q[-1]:.3g}, min {min(x):.3g}, max {max(x):.3g}; within {FACTOR:g}x: "
-              f"{within} ({100 * within / len(x):.1f} %), more than {FACTOR:g}x low: {len(low)}")
-        for v, r in low[:8]:
-            print(f"   {r['scene']} {r['method']} {r['step']}: error {r['error']:.3g}, estimate {r['estimate']:.3g}")
+        print_ratios(label, pairs)
     if a.csv:
-        with open(a.csv, "w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow(["scene", "method", "step", "exit", "error", "estimate", "reason"])
-            for r in rows:
-                w.writerow([r["scene"], r["method"], r["step"], r["exit"], r.get("error", ""), r.get("estimate", ""),
-                            r["reason"]])
+        write_rows(a.csv, rows)
+
+
+def print_ratios(label, pairs):
+    """Estimate over error of the runs `pairs` ((ratio, run)): quantiles, within FACTOR, the lowest."""
+    x = [p[0] for p in pairs]
+    if len(x) < 2:
+        return
+    q = statistics.quantiles(x, n=20)
+    within = sum(1 for v in x if 1 / FACTOR <= v <= FACTOR)
+    low = sorted((p for p in pairs if p[0] < 1 / FACTOR), key=lambda p: p[0])
+    print(f"estimate / error, {label}, {len(x)} runs with error in ({COMPARABLE:g}, {LOST:g}]: median {statistics.median(x):.3g}, "
+          f"5 % {q[0]:.3g}, 95 % {q[-1]:.3g}, min {min(x):.3g}, max {max(x):.3g}; within {FACTOR:g}x: "
+          f"{within} ({100 * within / len(x):.1f} %), more than {FACTOR:g}x low: {len(low)}")
+    for v, r in low[:8]:
+        print(f"   {r['scene']} {r['method']} {r['step']}: error {r['error']:.3g}, estimate {r['estimate']:.3g}")
+
+
+def write_rows(path, rows):
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["scene", "method", "step", "exit", "error", "estimate", "reason"])
+        for r in rows:
+            w.writerow([r["scene"], r["method"], r["step"], r["exit"], r.get("error", ""), r.get("estimate", ""),
+                        r["reason"]])
 
 
 if __name__ == "__main__":

@@ -29,6 +29,7 @@
 #include <iostream>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 namespace bodypoint::cli {
 namespace {
@@ -362,6 +363,28 @@ void write_own_cells(std::ostream& summary, const std::vector<TolRow>& rows, con
     summary << "- |\n";
 }
 
+/// The two prices under the table: auto over bodypoint's own fastest configuration (`own_ratios`, force
+/// evaluations of the whole call) and that configuration's default error estimate over its run.
+void write_price_medians(std::ostream& summary, const std::vector<TolRow>& rows, std::vector<double> own_ratios) {
+  if (!own_ratios.empty()) {
+    std::sort(own_ratios.begin(), own_ratios.end());
+    summary << "\nauto against bodypoint's own fastest configuration delivering TOL, force evaluations of the whole call: "
+            << "median " << std::setprecision(3) << median(own_ratios) << "x, from " << own_ratios.front() << "x to "
+            << own_ratios.back() << "x (" << own_ratios.size() << " cases).\n";
+  }
+  std::vector<double> estimate_prices;  // the fastest configurations' default estimate over their run, evaluations
+  for (const TolRow& r : rows)
+    if (r.is_own && r.estimate_force_evals >= 0 && r.force_evals > 0 && !r.method_is_exact)
+      estimate_prices.push_back(static_cast<double>(r.estimate_force_evals) / static_cast<double>(r.force_evals));
+  if (!estimate_prices.empty()) {
+    std::sort(estimate_prices.begin(), estimate_prices.end());
+    summary << "\nThe default error estimate of bodypoint's fastest configuration (simulate --h), force evaluations "
+            << "beyond the run: median " << std::setprecision(3) << median(estimate_prices) << "x, from "
+            << estimate_prices.front() << "x to " << estimate_prices.back() << "x (" << estimate_prices.size()
+            << " configurations).\n";
+  }
+}
+
 void write_tol_summary(std::ostream& summary, const std::vector<TolRow>& rows, std::size_t peer_count) {
   summary << "| scene | TOL | auto method | ds or h | estimate | delivered | met | time [ms] | cheapest peer meeting TOL "
              "| time [ms] | speed-up | peers meeting TOL | cheapest peer config delivering TOL | time [ms] | speed-up "
@@ -414,23 +437,7 @@ void write_tol_summary(std::ostream& summary, const std::vector<TolRow>& rows, s
           << "faster in " << faster3 << " of " << compared << "; against the cheapest peer configuration that "
           << "delivers TOL (its tolerance chosen afterwards), >= 3x in " << oracle3 << " of " << oracle_n
           << " (a comparison with a flagged time counts as not >= 3x).\n";
-  if (!own_ratios.empty()) {
-    std::sort(own_ratios.begin(), own_ratios.end());
-    summary << "\nauto against bodypoint's own fastest configuration delivering TOL, force evaluations of the whole call: "
-            << "median " << std::setprecision(3) << median(own_ratios) << "x, from " << own_ratios.front() << "x to "
-            << own_ratios.back() << "x (" << own_ratios.size() << " cases).\n";
-  }
-  std::vector<double> estimate_prices;  // the fastest configurations' default estimate over their run, evaluations
-  for (const TolRow& r : rows)
-    if (r.is_own && r.estimate_force_evals >= 0 && r.force_evals > 0 && !r.method_is_exact)
-      estimate_prices.push_back(static_cast<double>(r.estimate_force_evals) / static_cast<double>(r.force_evals));
-  if (!estimate_prices.empty()) {
-    std::sort(estimate_prices.begin(), estimate_prices.end());
-    summary << "\nThe default error estimate of bodypoint's fastest configuration (simulate --h), force evaluations "
-            << "beyond the run: median " << std::setprecision(3) << median(estimate_prices) << "x, from "
-            << estimate_prices.front() << "x to " << estimate_prices.back() << "x (" << estimate_prices.size()
-            << " configurations).\n";
-  }
+  write_price_medians(summary, rows, std::move(own_ratios));
   if (refused > 0) summary << "\nauto refused:\n\n" << refusals.str();
 }
 

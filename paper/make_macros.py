@@ -290,110 +290,126 @@ def harness(res, M):
         M.add(f"Harness{camel(key)}", f"{value:.5g}")
 
 
-def claims_table(res, out, M):
-    """Every claim of thesis chapter 4 and of its conclusions, tested on the sweeps as published (the
-    code's harnesses, force law, slip and loop) and on the corrected model (table 3.1)."""
-    data = {}
-    for label, prefix in [("code", "published_"), ("model", "")]:
-        for param in ["d", "L", "h", "Kx"]:
-            rows, _ = read_csv(os.path.join(res, f"{prefix}{param}_sweep.csv"))
-            for column in ["max_rel_dE", "max_rel_dK2sq"]:
-                data[label, param, column] = deviations(rows, param, column)
-    E, K = "max_rel_dE", "max_rel_dK2sq"
-    # Costs under each column's own law: the timing study on table 3.1 (corrected) and on the harness's
-    # scene under the code's force law (published_timing.csv).
-    ns_by = {label: seven_ns(res, label) for label in TIMING_CSV}
-    evals, _ = read_csv(os.path.join(res, "force_evals.csv"))
-    printed = {r["method"]: r for r in evals if r.get("thesis_table_4_1")}
+class ClaimTests:
+    """The tests behind table~\\ref{tab:claims}: each takes a label ("code": the sweeps as published, the
+    code's harnesses, force law, slip and loop; "model": the corrected model, table 3.1) and returns the
+    verdict printed in that column."""
 
-    def sweep_claim(param, column, test, where=lambda v: True):
-        return lambda label: verdict(*tally(data[label, param, column], test, where))
+    def __init__(self, res, M):
+        self.res, self.M = res, M
+        self.data = {}
+        for label, prefix in [("code", "published_"), ("model", "")]:
+            for param in ["d", "L", "h", "Kx"]:
+                rows, _ = read_csv(os.path.join(res, f"{prefix}{param}_sweep.csv"))
+                for column in ["max_rel_dE", "max_rel_dK2sq"]:
+                    self.data[label, param, column] = deviations(rows, param, column)
+        # Costs under each column's own law: the timing study on table 3.1 (corrected) and on the harness's
+        # scene under the code's force law (published_timing.csv).
+        self.ns_by = {label: seven_ns(res, label) for label in TIMING_CSV}
+        evals, _ = read_csv(os.path.join(res, "force_evals.csv"))
+        self.measured = {r["method"]: num(r["measured_per_step"]) for r in evals}
 
-    def near_far(label):
-        pts = data[label, "d", E]
+    def sweep(self, param, column, test, where=lambda v: True):
+        return lambda label: verdict(*tally(self.data[label, param, column], test, where))
+
+    def near_far(self, label):
+        pts = self.data[label, "d", "max_rel_dE"]
         lo, hi = min(pts), max(pts)
         ratios = [pts[lo][m] / pts[hi][m] for m in THESIS_SEVEN]
         ties = sum(1 for m in THESIS_SEVEN if tied(pts[lo][m], pts[hi][m]))
         k = sum(1 for m, r in zip(THESIS_SEVEN, ratios) if r > 1 and not tied(pts[lo][m], pts[hi][m]))
         return f"{verdict(k, len(THESIS_SEVEN) - ties, ties)[:-1]}; ratio ${sci(min(ratios))}$ to ${sci(max(ratios))}$)"
 
-    def y6_overall(label):
+    def y6_overall(self, label):
         total = [0, 0, 0, 0]
         for param, where in [("d", lambda v: True), ("L", lambda v: True), ("h", lambda v: v <= SMALL_H)]:
-            total = [x + y for x, y in zip(total, tally(data[label, param, E], smallest("thesis-y6", SYMPLECTIC), where))]
+            total = [x + y for x, y in zip(total, tally(self.data[label, param, "max_rel_dE"],
+                                                        smallest("thesis-y6", SYMPLECTIC), where))]
         return verdict(*total)
 
-    def well_conserved(label):
-        worst = max(d[m] for v, d in data[label, "h", K].items() if abs(v - SMALL_H) < 1e-12 * SMALL_H for m in THESIS_SEVEN)
+    def well_conserved(self, label):
+        worst = max(d[m] for v, d in self.data[label, "h", "max_rel_dK2sq"].items()
+                    if abs(v - SMALL_H) < 1e-12 * SMALL_H for m in THESIS_SEVEN)
         return f"{'yes' if worst < WELL_CONSERVED else 'no'} (max ${sci(worst)}$)"
 
-    def not_timed(label):
+    def not_timed(self, label):
         """The verdict of a cost claim whose methods lack a time: "untimed (...)" naming the flags that
         left a method without two counted times (a contended machine), or "--" when the study did not run."""
-        why = seven_untimed(res, label, ns_by[label])
+        why = seven_untimed(self.res, label, self.ns_by[label])
         if why:
-            M.ledger.lost("the cost claims of table~\\ref{tab:claims} " + ("as published" if label == "code" else
-                                                                            "on the corrected model"), why)
+            self.M.ledger.lost("the cost claims of table~\\ref{tab:claims} " + ("as published" if label == "code" else
+                                                                                 "on the corrected model"), why)
         return f"untimed ({why})" if why else "--"
 
-    def cost(test, text):
+    def cost(self, test, text):
         def claim(label):
-            ns = ns_by[label]
+            ns = self.ns_by[label]
             if not all(m in ns for m in THESIS_SEVEN):
-                return not_timed(label)
+                return self.not_timed(label)
             return f"{'yes' if test(ns) else 'no'} ({text(ns)})"
         return claim
 
-    ns_of = lambda ns, m: f"{ns[m]:.0f}"
-    rank = lambda ns: sorted(THESIS_SEVEN, key=ns.get)
-    named = lambda ns, m: f"{m.replace('thesis-', '')} {ns_of(ns, m)}"
-
-    def euler_cheap_and_better(label):
-        ns = ns_by[label]
-        k, n, ties, na = tally(data[label, "d", E], below(["thesis-euler"], STANDARD))
+    def euler_cheap_and_better(self, label):
+        ns = self.ns_by[label]
+        k, n, ties, na = tally(self.data[label, "d", "max_rel_dE"], below(["thesis-euler"], STANDARD))
         if not all(m in ns for m in THESIS_SEVEN):
-            return not_timed(label)
+            return self.not_timed(label)
         if n == 0:
             return "--"
         holds = ns["thesis-euler"] < min(ns["rk4"], ns["ab4"]) and k == n
         return (f"{'yes' if holds else 'no'} ({ns_of(ns, 'thesis-euler')} ns against {ns_of(ns, 'rk4')}, "
                 f"{ns_of(ns, 'ab4')}; energy {verdict(k, n, ties, na).split(' ', 1)[1][1:-1]})")
-    measured = {r["method"]: num(r["measured_per_step"]) for r in evals}
 
-    def table41(label):
+    def table41(self, label):
         # As published: the thesis's code's AB4 (ab4-thesis) re-evaluates the four past right-hand sides
         # every step; corrected: bodypoint's (odeint's) keeps them. Both counted over a run.
         m = csv_method(label, "ab4")
-        if m not in measured:
+        if m not in self.measured:
             return "--"
-        return f"{'yes' if round(measured[m]) == 4 else 'no'} ({measured[m]:.2f} measured, \\texttt{{{m}}})"
+        return f"{'yes' if round(self.measured[m]) == 4 else 'no'} ({self.measured[m]:.2f} measured, \\texttt{{{m}}})"
 
-    claims = [
+
+def ns_of(ns, m):
+    return f"{ns[m]:.0f}"
+
+
+def cost_rank(ns):
+    return sorted(THESIS_SEVEN, key=ns.get)
+
+
+def ns_named(ns, m):
+    return f"{m.replace('thesis-', '')} {ns_of(ns, m)}"
+
+
+def thesis_claims(t):
+    """Every claim of thesis chapter 4 and of its conclusions: (claim, where in the thesis, its test)."""
+    E, K, sweep, cost, rank, named = "max_rel_dE", "max_rel_dK2sq", t.sweep, t.cost, cost_rank, ns_named
+    return [
         ("Symplectic schemes lose less energy than RK4 and AB4 at every $d$", "4.1, fig.~4.1",
-         sweep_claim("d", E, below(SYMPLECTIC, STANDARD))),
+         sweep("d", E, below(SYMPLECTIC, STANDARD))),
         ("Yoshida~6 loses the least energy of the symplectic schemes at every $d$", "4.1, fig.~4.2",
-         sweep_claim("d", E, smallest("thesis-y6", SYMPLECTIC))),
+         sweep("d", E, smallest("thesis-y6", SYMPLECTIC))),
         (f"Near the centre ($L \\le {NEAR_L}$) symplectic schemes lose more energy than RK4 and AB4", "4.2, fig.~4.3",
-         sweep_claim("L", E, below(STANDARD, SYMPLECTIC), lambda v: v <= NEAR_L)),
+         sweep("L", E, below(STANDARD, SYMPLECTIC), lambda v: v <= NEAR_L)),
         (f"Farther out ($L > {NEAR_L}$) they lose less", "4.2, fig.~4.3",
-         sweep_claim("L", E, below(SYMPLECTIC, STANDARD), lambda v: v > NEAR_L)),
+         sweep("L", E, below(SYMPLECTIC, STANDARD), lambda v: v > NEAR_L)),
         ("Yoshida~6 is the most accurate symplectic scheme over $L$", "4.2, fig.~4.4",
-         sweep_claim("L", E, smallest("thesis-y6", SYMPLECTIC))),
+         sweep("L", E, smallest("thesis-y6", SYMPLECTIC))),
         ("Symplectic Euler, first order, is accurate: below RK4 and AB4 over $L$", "4.2, fig.~4.4",
-         sweep_claim("L", E, below(["thesis-euler"], STANDARD))),
+         sweep("L", E, below(["thesis-euler"], STANDARD))),
         (f"At coarse steps ($h \\ge {sci(COARSE_H)}$) symplectic schemes lose far more energy than RK4 and AB4", "4.3, fig.~4.5",
-         sweep_claim("h", E, below(STANDARD, SYMPLECTIC), lambda v: v >= COARSE_H)),
+         sweep("h", E, below(STANDARD, SYMPLECTIC), lambda v: v >= COARSE_H)),
         (f"At small steps ($h \\le {sci(SMALL_H)}$) they lose less", "4.3, fig.~4.6",
-         sweep_claim("h", E, below(SYMPLECTIC, STANDARD), lambda v: v <= SMALL_H)),
+         sweep("h", E, below(SYMPLECTIC, STANDARD), lambda v: v <= SMALL_H)),
         (f"Yoshida~6 is best at small steps ($h \\le {sci(SMALL_H)}$)", "4.3, fig.~4.7",
-         sweep_claim("h", E, smallest("thesis-y6", SYMPLECTIC), lambda v: v <= SMALL_H)),
+         sweep("h", E, smallest("thesis-y6", SYMPLECTIC), lambda v: v <= SMALL_H)),
         ("RK4 and AB4 conserve $|\\Ktwo|^2$ better than the symplectic schemes (over $h$)", "4.4, fig.~4.8",
-         sweep_claim("h", K, below(STANDARD, SYMPLECTIC))),
+         sweep("h", K, below(STANDARD, SYMPLECTIC))),
         ("Ruth~3 has the largest $|\\Ktwo|^2$ deviation of the symplectic schemes", "4.4, fig.~4.9",
-         sweep_claim("h", K, largest("thesis-ruth3", SYMPLECTIC))),
+         sweep("h", K, largest("thesis-ruth3", SYMPLECTIC))),
         ("RK4 and AB4 conserve $|\\Ktwo|^2$ better at every $K_x$", "4.5, fig.~4.10--4.11",
-         sweep_claim("Kx", K, below(STANDARD, SYMPLECTIC))),
-        ("Table 4.1: AB4 evaluates the right-hand side 4 times per step", "4.6, table~4.1", table41),
+         sweep("Kx", K, below(STANDARD, SYMPLECTIC))),
+        ("Table 4.1: AB4 evaluates the right-hand side 4 times per step", "4.6, table~4.1", t.table41),
         ("Yoshida~6 is the costliest method (ns per step)", "4.6, fig.~4.12",
          cost(lambda ns: rank(ns)[-1] == "thesis-y6", lambda ns: f"{named(ns, rank(ns)[-1])}, then {named(ns, rank(ns)[-2])} ns")),
         ("Forest--Ruth~4 is faster than RK4 and AB4", "4.6, fig.~4.12",
@@ -402,14 +418,21 @@ def claims_table(res, out, M):
         ("Symplectic Euler's time grows slowest", "4.6, fig.~4.13",
          cost(lambda ns: rank(ns)[0] == "thesis-euler", lambda ns: f"euler {ns_of(ns, 'thesis-euler')}; least {named(ns, rank(ns)[0])} ns")),
         ("Near the centre every method loses more energy (smallest $d$ against largest)", "conclusions",
-         near_far),
+         t.near_far),
         ("Symplectic Euler is faster than RK4 and AB4 and keeps the energy better (over $d$)", "conclusions",
-         euler_cheap_and_better),
+         t.euler_cheap_and_better),
         (f"$|\\Ktwo|^2$ is well conserved by every method (below ${sci(WELL_CONSERVED)}$ at $h = {sci(SMALL_H)}$)", "conclusions",
-         well_conserved),
+         t.well_conserved),
         ("Yoshida~6 gives the smallest energy deviations of the symplectic schemes ($d$, $L$, small $h$)", "conclusions",
-         y6_overall),
+         t.y6_overall),
     ]
+
+
+def claims_table(res, out, M):
+    """Every claim of thesis chapter 4 and of its conclusions, tested on the sweeps as published (the
+    code's harnesses, force law, slip and loop) and on the corrected model (table 3.1)."""
+    t = ClaimTests(res, M)
+    claims = thesis_claims(t)
     held = {"code": 0, "model": 0}
     verdicts = {}
     with open(os.path.join(out, "tab_claims.tex"), "w") as f:
@@ -425,7 +448,7 @@ def claims_table(res, out, M):
     # How many digits the five drift/kick schemes' energy deviations share over d (median over the points).
     for label, name in [("code", "TieAgreeCode"), ("model", "TieAgreeModel")]:
         digits = []
-        for d in data[label, "d", E].values():
+        for d in t.data[label, "d", "max_rel_dE"].values():
             vals = [d[m] for m in SYMPLECTIC if m in d and math.isfinite(d[m]) and d[m] > 0]
             if len(vals) == len(SYMPLECTIC):
                 spread = (max(vals) - min(vals)) / max(vals)
@@ -824,12 +847,35 @@ def close_table(res, out, M):
 
 
 
-def by_tol(res, out, M):
-    rows, _ = read_csv(os.path.join(res, "by_tol.csv"))
-    auto = [r for r in rows if r["kind"] == "auto"]
-    met = [r for r in auto if r["met"] == "yes"]
-    M.add("AutoRuns", count(len(auto)))
-    M.add("AutoMet", count(len(met)))
+def trust_prices(rows, body, M):
+    """The two prices of trust (issue #55) from the by-tol summary's rows `body` and by_tol.csv's `rows`."""
+    # The price of trust (issue #55): auto's whole call against bodypoint's own fastest configuration
+    # delivering TOL, in force evaluations (column 19; its time, column 20, where both times count), and what
+    # its search costs beyond the run it delivers (column 21).
+    own = [num(row[19].rstrip("x")) for row in body if len(row) > 21 and row[19].endswith("x")]
+    own_time = [num(row[20].rstrip("x")) for row in body if len(row) > 21 and row[20].endswith("x")]
+    search = [num(row[21].rstrip("x")) for row in body if len(row) > 21 and row[21].endswith("x")]
+    M.add("AutoOverOwnEvals", f"a median ${sci(statistics.median(own))}$ times (${sci(min(own))}$ to ${sci(max(own))}$)"
+          if own else "not measured", math_mode=False)
+    M.add("AutoOverOwnTime", f"${sci(min(own_time))}$ to ${sci(max(own_time))}$ times in time" if own_time else
+          "untimed (every comparison's time flagged)", math_mode=False)
+    if not own_time:
+        M.ledger.lost("table~\\ref{tab:bytol}: auto against bodypoint's fastest configuration, in time",
+                      "every comparison's time flagged")
+    M.add("AutoSearchOverRun", f"${sci(min(search))}$ to ${sci(max(search))}$ times" if search else
+          "an unmeasured multiple of (no search of \\cmd{auto} in this copy's by-tol table)", math_mode=False)
+    # The second price on the same configurations: their default error estimate (simulate --h), in force
+    # evaluations beyond the run (by_tol.csv's own rows; ks, whose estimate evaluates no force, left out).
+    prices = [num(r["estimate_force_evals"]) / num(r["force_evals"]) for r in rows
+              if r["kind"] == "own" and r.get("estimate_force_evals") and num(r["estimate_force_evals"]) > 0
+              and num(r["force_evals"]) > 0]
+    M.add("OwnEstimatePrice", f"a median ${sci(statistics.median(prices))}$ times their run's force evaluations "
+          f"(${sci(min(prices))}$ to ${sci(max(prices))}$, {count(len(prices))} configurations)" if prices else
+          "not measured (no own configuration of this copy's by-tol table has an estimate)", math_mode=False)
+
+
+def refusal_clause(rows, auto, M):
+    """The text's clause on auto's refusals in the by-tol table."""
     # A refusal is not a miss: auto says why it will not try (runs that differ only in rounding differ by
     # more than TOL on the scene, or the search's budget). The clause names where, and whether any peer
     # configuration delivered that TOL there (then the refusal turned away a reachable answer).
@@ -844,6 +890,15 @@ def by_tol(res, out, M):
     M.add("AutoRefusedClause", f" and refused the other {count(len(refused))}, saying why "
           f"({'; '.join(f'{tt(k)} at ' + ', '.join(v) for k, v in where.items())}; {peers_did})" if refused else "",
           math_mode=False)
+
+
+def by_tol(res, out, M):
+    rows, _ = read_csv(os.path.join(res, "by_tol.csv"))
+    auto = [r for r in rows if r["kind"] == "auto"]
+    met = [r for r in auto if r["met"] == "yes"]
+    M.add("AutoRuns", count(len(auto)))
+    M.add("AutoMet", count(len(met)))
+    refusal_clause(rows, auto, M)
     ratios = [num(r["err_estimate"]) / num(r["err"]) for r in met if num(r["err"]) > 0]
     M.add("AutoEstLow", sci(min(ratios)) if ratios else "n/a")
     M.add("AutoEstHigh", sci(max(ratios)) if ratios else "n/a")
@@ -885,29 +940,7 @@ def by_tol(res, out, M):
                 "table~\\ref{tab:bytol}: auto against the peers' best case (spinning scenes)")
     ratio_range("AutoVsPeerMaterial", ratios.get("material", []),
                 "table~\\ref{tab:bytol}: auto against the peers' best case (material point)")
-    # The price of trust (issue #55): auto's whole call against bodypoint's own fastest configuration
-    # delivering TOL, in force evaluations (column 19; its time, column 20, where both times count), and what
-    # its search costs beyond the run it delivers (column 21).
-    own = [num(row[19].rstrip("x")) for row in body if len(row) > 21 and row[19].endswith("x")]
-    own_time = [num(row[20].rstrip("x")) for row in body if len(row) > 21 and row[20].endswith("x")]
-    search = [num(row[21].rstrip("x")) for row in body if len(row) > 21 and row[21].endswith("x")]
-    M.add("AutoOverOwnEvals", f"a median ${sci(statistics.median(own))}$ times (${sci(min(own))}$ to ${sci(max(own))}$)"
-          if own else "not measured", math_mode=False)
-    M.add("AutoOverOwnTime", f"${sci(min(own_time))}$ to ${sci(max(own_time))}$ times in time" if own_time else
-          "untimed (every comparison's time flagged)", math_mode=False)
-    if not own_time:
-        M.ledger.lost("table~\\ref{tab:bytol}: auto against bodypoint's fastest configuration, in time",
-                      "every comparison's time flagged")
-    M.add("AutoSearchOverRun", f"${sci(min(search))}$ to ${sci(max(search))}$ times" if search else
-          "an unmeasured multiple of (no search of \\cmd{auto} in this copy's by-tol table)", math_mode=False)
-    # The second price on the same configurations: their default error estimate (simulate --h), in force
-    # evaluations beyond the run (by_tol.csv's own rows; ks, whose estimate evaluates no force, left out).
-    prices = [num(r["estimate_force_evals"]) / num(r["force_evals"]) for r in rows
-              if r["kind"] == "own" and r.get("estimate_force_evals") and num(r["estimate_force_evals"]) > 0
-              and num(r["force_evals"]) > 0]
-    M.add("OwnEstimatePrice", f"a median ${sci(statistics.median(prices))}$ times their run's force evaluations "
-          f"(${sci(min(prices))}$ to ${sci(max(prices))}$, {count(len(prices))} configurations)" if prices else
-          "not measured (no own configuration of this copy's by-tol table has an estimate)", math_mode=False)
+    trust_prices(rows, body, M)
     with open(os.path.join(out, "tab_by_tol.tex"), "w") as f:
         for row in body:
             f.write(" & ".join(latex_cell(row[i]) for i in keep) + " \\\\\n")

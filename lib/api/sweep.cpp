@@ -123,6 +123,28 @@ std::vector<std::optional<ErrorEstimate>> coarse_estimates(const MethodInfo& met
   return out;
 }
 
+/// As integrate(): a batch's flagged lanes that the second companion did not confirm get a third companion,
+/// one level finer again (estimate.hpp, confirm_deeper).
+void confirm_deeper_lanes(std::vector<SweepRow>& rows, const SweepSpec& spec, const MethodInfo& method,
+                          const std::vector<batch::Member>& members, const FixedSteps& how,
+                          const std::vector<std::optional<ErrorEstimate>>& by_coarse,
+                          const std::vector<RunResult>& companions, const std::vector<RunResult>& second) {
+  const auto deeper = [&](std::size_t k) {
+    return spec.estimate_error && !by_coarse[k] && rows[k].outcome == Outcome::unresolved && !rows[k].error.confirmed &&
+           rows[k].error.known();
+  };
+  bool any_deeper = false;
+  for (std::size_t k = 0; k < rows.size(); ++k) any_deeper = any_deeper || deeper(k);
+  if (!any_deeper) return;
+  const auto third = batch::run(method, members, detail::fixed_companion(how, 3));
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    if (!deeper(k)) continue;
+    rows[k].error.force_evals += third[k].force_evals;
+    rows[k].error.wall_s += third[k].wall_s;
+    detail::confirm_deeper(rows[k].error, rows[k].result.final, companions[k].final, second[k].final, third[k].final);
+  }
+}
+
 /// The rows of a batch: its lanes, judged by assess() and, with SweepSpec::estimate_error, by the
 /// estimate from a coarse companion batch or, where that is not trusted, from companion batches at h/2
 /// (and h/4 for flagged lanes): the same kernel and the same rule as integrate() alone (estimate.cpp).
@@ -166,22 +188,7 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
       row.error.basis = "the run ended " + std::string(outcome_name(row.outcome));
     }
   }
-  // As integrate(): flagged lanes the second companion did not confirm get a third, one level finer again.
-  const auto deeper = [&](std::size_t k) {
-    return spec.estimate_error && !by_coarse[k] && rows[k].outcome == Outcome::unresolved && !rows[k].error.confirmed &&
-           rows[k].error.known();
-  };
-  bool any_deeper = false;
-  for (std::size_t k = 0; k < rows.size(); ++k) any_deeper = any_deeper || deeper(k);
-  if (any_deeper) {
-    const auto third = batch::run(method, members, detail::fixed_companion(how, 3));
-    for (std::size_t k = 0; k < rows.size(); ++k) {
-      if (!deeper(k)) continue;
-      rows[k].error.force_evals += third[k].force_evals;
-      rows[k].error.wall_s += third[k].wall_s;
-      detail::confirm_deeper(rows[k].error, rows[k].result.final, companions[k].final, second[k].final, third[k].final);
-    }
-  }
+  confirm_deeper_lanes(rows, spec, method, members, how, by_coarse, companions, second);
   // As integrate(): lanes whose fine estimate is at the rounding level add more draws of it, repeats off
   // their grid (estimate.hpp).
   std::vector<const State*> finals(rows.size());

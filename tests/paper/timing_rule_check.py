@@ -39,8 +39,8 @@ def scaling_csv(directory, others):
           "".join(f"{m},{c},{w},1e6,{sp},{e},5,0.02,{others}\n" for m, c, w, sp, e in rows))
 
 
-def main():
-    failures = []
+def check_rules(failures):
+    """The rule read from a header, benchmark flags, parallel runs and the stamp."""
     with tempfile.TemporaryDirectory() as res:
         write(res, "by_tol.csv", "scene,flag\n" + FLAG_LINE)
         rule = timing_rule.Rule.of(res)
@@ -73,6 +73,8 @@ def main():
             if stamped != bool(lost) or (not lost and M.defs["ContendedNotice"]):
                 failures.append(f"lost {lost}: stamp {M.defs['ContendedStamp']!r}, notice {M.defs['ContendedNotice']!r}")
 
+
+def check_figure(failures):
     # A timing figure whose times were all flagged draws its panels with words, and says what it lost.
     try:
         import make_figures
@@ -88,6 +90,8 @@ def main():
             if len(make_figures.LOST) != 2 or "14 of 14" not in make_figures.LOST[0][1] or not listing:
                 failures.append(f"a timing figure without a counted time: lost {make_figures.LOST}, drawn {listing}")
 
+
+def check_paper_refusals(failures):
     # check_paper refuses a number the text promised and lost ("n/a"), and a stamp without its list.
     with tempfile.TemporaryDirectory() as build:
         os.makedirs(os.path.join(build, "generated"))
@@ -101,6 +105,12 @@ def main():
             if ok != (not found):
                 failures.append(f"check_paper on gap {gap!r}, notice {notice!r}, stamp {stamp!r}: {found}")
 
+
+def main():
+    failures = []
+    check_rules(failures)
+    check_figure(failures)
+    check_paper_refusals(failures)
     if failures:
         print("\n".join(failures))
         return 1
