@@ -39,8 +39,6 @@ constexpr double kOrderSlack = 1.0;
 /// A triple whose observed order is more than this above p is not in the asymptotic range either, unless the
 /// triple before it showed the same.
 constexpr double kOrderExcess = 2.0;
-/// Orders above this are not told apart (the fit's bracket).
-constexpr double kMaxOrder = 40.0;
 /// A new run's estimate agrees with the one the coarser runs predicted for it within this factor.
 constexpr double kAgree = 10.0;
 /// A new ladder is started for a predicted step whose own constant c is below this fraction of the ladder's.
@@ -220,24 +218,10 @@ bool Search::verified_at(std::vector<Level>& rungs, double h_c, double current) 
   return false;
 }
 
-/// The order q with which x(h) = x* + C h^q fits three runs at steps h1 > h2 > h3: the root of
-/// (h1^q - h2^q)/(h2^q - h3^q) = d12/d23 (increasing in q), by bisection on [0, kMaxOrder].
+/// The order with which three runs of the ladder converge (richardson.hpp, observed_order).
 double Search::observed_order(const Level& l1, const Level& l2, const Level& l3) const {
-  const double d12 = state_distance(l1.run.final, l2.run.final), d23 = state_distance(l2.run.final, l3.run.final);
-  if (!(d23 > 0.0)) return kMaxOrder;
-  const double target = d12 / d23;
-  auto ratio = [&](double q) {
-    const double a = std::pow(l1.h / l3.h, q), b = std::pow(l2.h / l3.h, q);
-    return (a - b) / (b - 1.0);
-  };
-  double lo = 1e-3, hi = kMaxOrder;
-  if (ratio(lo) >= target) return 0.0;
-  if (ratio(hi) <= target) return kMaxOrder;
-  for (int it = 0; it < 60; ++it) {
-    const double mid = 0.5 * (lo + hi);
-    (ratio(mid) < target ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
+  return adaptive::observed_order(state_distance(l1.run.final, l2.run.final), state_distance(l2.run.final, l3.run.final),
+                                  l1.h / l3.h, l2.h / l3.h);
 }
 
 /// Richardson's estimate of the finer run's error from a pair at steps h_c > h_f, order p.
