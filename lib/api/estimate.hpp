@@ -25,7 +25,7 @@ void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& 
 /// on the same end), from its start moved by a rounding. It costs half a run; in the asymptotic regime it differs
 /// from the run by the run's error times ratio^p - 1 (Richardson on the coarse side, the fine run
 /// delivered), plus what the moved start grows to. nullopt where a run has none: step-size control, KS,
-/// a counted number of fictitious steps, fewer than kCoarseMinSteps steps (estimate.cpp).
+/// a counted number of fictitious steps, fewer than kCoarseMinSteps steps (estimate/coarse.cpp).
 struct CoarseCompanion {
   Advance how;
   double ratio = 2.0;  ///< the companion's step over the run's
@@ -58,7 +58,7 @@ void bound_from_draws(ErrorEstimate& e);
 /// invariants saw; kStepRatio where it tracked none).
 double coarse_ratio_limit(const MethodInfo& m, const std::vector<Centre>& centres, const RunResult& run);
 /// The estimate from the run's and the coarse companion's final states; nullopt where it is not trusted
-/// (a coarse state not finite, an estimate above kCoarseTrusted, estimate.cpp): the fine companion decides.
+/// (a coarse state not finite, an estimate above kCoarseTrusted, estimate/coarse.cpp): the fine companion decides.
 std::optional<ErrorEstimate> coarse_estimate(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
                                              const CoarseCompanion& c, const State& run, const State& coarse);
 
@@ -70,16 +70,16 @@ ErrorEstimate fixed_step_estimate(const MethodInfo& m, const Body& body, const s
                                   const State& run, const State& companion);
 /// Whether the second companion confirms e (ErrorEstimate::confirmed), its basis saying so: the differences
 /// fall as the order says (min_fall), or at least geometrically, the estimate then raised to the bound
-/// that gives (estimate.cpp, kGeometricFall).
+/// that gives (estimate/fine.cpp, kGeometricFall).
 void confirm(ErrorEstimate& e, double min_fall, const State& run, const State& first, const State& second);
 void confirm(ErrorEstimate& e, const MethodInfo& m, const Body& body, const State& run, const State& first,
              const State& second);
 /// A flagged run that confirm() left unconfirmed, given a third companion one level finer again: where the
 /// finer companions' differences fall at least geometrically, the run is off by at most what it differs by
-/// from the third plus what the third may still be off by; e is raised to that and confirmed (estimate.cpp).
+/// from the third plus what the third may still be off by; e is raised to that and confirmed (estimate/fine.cpp).
 void confirm_deeper(ErrorEstimate& e, const State& run, const State& first, const State& second, const State& third);
 
-/// Whether the estimate e is at the scene's rounding level (below kRoundingLevel, estimate.cpp), where the
+/// Whether the estimate e is at the scene's rounding level (below kRoundingLevel, estimate/parts.hpp), where the
 /// companion pair can agree by chance: ErrorEstimate::kRoundingDraws - 1 more draws of the rounding are
 /// added (add_rounding_spread): repeats of the run (fine companions) or coarse runs (coarse companion),
 /// off the run's grid from its start moved by a rounding; the sum is taken ErrorEstimate::kRoundingBound
@@ -102,7 +102,7 @@ void add_rounding_spread(ErrorEstimate& e, const State& run, const State& repeat
 /// The relative energy error of the state `end` of a run of `body` (NaN where E is not an integral).
 double final_energy_error(const Body& body, const std::vector<Centre>& centres, const State& end);
 
-/// An outcome in the light of the run's error estimate e (estimate.cpp): the heuristic flag
+/// An outcome in the light of the run's error estimate e (estimate/settle.cpp): the heuristic flag
 /// (unresolved) becomes a warning when the estimate is within both bounds and its companion resolved
 /// the scene; the energy's flag when the final state's energy error final_rel_dE is within its bound
 /// and accounted for by the estimate; an estimate above max_error makes an ok run inaccurate.

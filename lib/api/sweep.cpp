@@ -62,7 +62,7 @@ SweepRow result_row(SweepRow row, BodyResult r) {
 /// Whether a lane's run ended so that it has an estimate (estimate_error of integrate(): ok, or a flag).
 bool estimable(Outcome o) { return o == Outcome::ok || o == Outcome::unresolved || o == Outcome::inaccurate; }
 
-/// integrate()'s rounding draws (estimate.cpp, add_rounding_draws) for a batch's lanes: for each lane with
+/// integrate()'s rounding draws (estimate/rounding.cpp, add_rounding_draws) for a batch's lanes: for each lane with
 /// an estimate in `drawn` (nullptr: none; decided before the draws, as integrate() does),
 /// ErrorEstimate::kRoundingDraws - 1 more batches, the k-th advancing as `how(k)` from starts moved by a
 /// rounding, what each lane's `finals` differs from them by added, the sum then taken as a bound.
@@ -147,7 +147,7 @@ void confirm_deeper_lanes(std::vector<SweepRow>& rows, const SweepSpec& spec, co
 
 /// The rows of a batch: its lanes, judged by assess() and, with SweepSpec::estimate_error, by the
 /// estimate from a coarse companion batch or, where that is not trusted, from companion batches at h/2
-/// (and h/4 for flagged lanes): the same kernel and the same rule as integrate() alone (estimate.cpp).
+/// (and h/4 for flagged lanes): the same kernel and the same rule as integrate() alone (estimate/).
 void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const MethodInfo& method,
                 const std::vector<batch::Member>& members, const std::vector<Scene>& scenes) {
   const FixedSteps how = std::get<FixedSteps>(point_advance(spec, method, rows.front().point));

@@ -1,6 +1,6 @@
 // bodypoint: Richardson's estimate of a run's error from a companion run of the same method (order p)
 // whose step differs by a factor `ratio` > 1: the one rule behind the accuracy mode's search
-// (search/ladder.cpp), the estimate of a run by step and the sweep's vector lanes (lib/api/estimate.cpp).
+// (search/ladder.cpp), the estimate of a run by step and the sweep's vector lanes (lib/api/estimate/).
 // With x(h) = x* + C h^p, runs at h and h/ratio differ by C h^p (1 - ratio^-p) (docs/physics.md, "Error
 // estimate"). Internal: not installed.
 #pragma once

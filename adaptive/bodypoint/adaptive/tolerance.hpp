@@ -36,11 +36,11 @@ inline constexpr double kProbeBelowTol = 1e-10;
 inline constexpr int kProbeRuns = 3;
 /// The rounding probe's relative move of the starting state (R scaled by 1 + kStartShift, v by 1 -
 /// kStartShift): a few units in the last place of a double (the rounding of a decimal input such as
-/// Kz = 0.1 is half of one). The run-by-step estimate at the rounding level moves it alike (estimate.cpp).
+/// Kz = 0.1 is half of one). The run-by-step estimate at the rounding level moves it alike (lib/api/estimate/rounding.cpp).
 inline constexpr double kStartShift = 4.0 * std::numeric_limits<double>::epsilon();
 /// The rounding probe's relative move of a fictitious step (k kProbeShift for its k-th repeat): its
 /// steps then land nowhere the run's do, and its truncation error moves by far less than a tolerance.
-/// The run-by-step estimate's second coarse draw moves its step alike (estimate.cpp, off_grid).
+/// The run-by-step estimate's second coarse draw moves its step alike (lib/api/estimate/rounding.cpp, off_grid).
 inline constexpr double kProbeShift = 1e-9;
 
 /// Why the accuracy mode refuses a scene with a centre that does not follow Coulomb's law.

@@ -1,0 +1,199 @@
+// bodypoint: the coarse companion of a run by step (estimate/parts.hpp, estimate.hpp CoarseCompanion): up to
+// twice its step from its start moved by a rounding, half a run, Richardson on the coarse side; trusted only where
+// the default flags pass it and its estimate is small.
+#include "estimate/parts.hpp"
+
+#include "bodypoint/adaptive/richardson.hpp"
+#include "bodypoint/batch.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace bodypoint::detail {
+namespace {
+
+/// The coarse companion (CoarseCompanion, estimate.hpp) needs this many steps of the run: below, the
+/// coarse run has no asymptotic regime of its own (kFewSteps), and the fine companion decides.
+constexpr long kCoarseMinSteps = 16;
+
+/// The coarse companion's estimate is trusted up to this value: a run estimated above it is near the end
+/// of its own asymptotic regime, where the coarse run at twice the step may be beyond it (aliasing the
+/// spin, unstable), which Richardson on the coarse side would take for the run's error; such runs are
+/// estimated by the fine companion at h/2.
+constexpr double kCoarseTrusted = 1e-5;
+
+/// On the coarse side the order is taken as at most this: at twice the step a method of order 6 to 10
+/// is rarely in its asymptotic regime where it matters; at order <= 4 Richardson's factor is kept.
+constexpr int kCoarseMaxOrder = 4;
+
+/// Where the flags' angles limit the ratio below 2 (a time-transformed run's coarse companion at 1.47 ds)
+/// the order is taken as at most this. (An odd number of fixed steps, whose companion takes half as many
+/// rounded up, asked for 2.)
+constexpr int kCoarseMaxOrderBelow2 = 2;
+
+/// The coarse companion's steps are kept this far inside the flags' limits (a step turning the spin by
+/// pi, the direction to a centre by pi/2) that the run's own steps, scaled by the ratio, predict: a pair
+/// whose coarse steps turn the spin by 2-2.8 rad is not asymptotic.
+constexpr double kCoarseAngleMargin = 0.45;
+
+/// Below this ratio the pair differs too little to measure the error (ratio^p - 1 small against their
+/// rounding): the fine companion decides.
+constexpr double kMinCoarseRatio = 1.25;
+
+/// Whether a coarse companion that took `coarse_steps` is coarser than the run of `run_steps`: a
+/// time-transformed pair whose steps were not cut by the ratio (the landing step, steps bound by
+/// something else) is no Richardson pair; it must take at most 1 / (1 + (ratio - 1) / 2) of the steps,
+/// as the fine companion must take kRefined = 1.5 times the run's at ratio 2.
+bool coarser(const CoarseCompanion& c, long coarse_steps, long run_steps) {
+  if (!std::holds_alternative<FictitiousSteps>(c.how)) return true;
+  return static_cast<double>(run_steps) >= (1.0 + (c.ratio - 1.0) / 2.0) * static_cast<double>(coarse_steps);
+}
+
+/// The lanes of one batch (batch.hpp) are the coarse companion and its twin, its first rounding draw, where
+/// the method has a batch kernel for the scene and the run stops at no event (a batch locates none): two lanes
+/// cost about what one scalar run does, so the draw the rounding level asks for is nearly free. Each lane computes the scalar run's
+/// bits (tests/lib/test_batch.cpp), judged as integrate() judges the scalar companion; the batch polls
+/// the run's cancellation.
+constexpr std::size_t kDrawLanes = 2;
+static_assert(ErrorEstimate::kRoundingDraws == kDrawLanes, "the batch holds the companion and every further draw");
+
+std::optional<std::vector<BodyResult>> coarse_lanes(const MethodInfo& m, const Body& body,
+                                                    const std::vector<Centre>& centres, const CoarseCompanion& c,
+                                                    const Options& oc) {
+  const auto* f = std::get_if<FixedSteps>(&c.how);
+  if (f == nullptr || !c.twin_draw || !oc.events.empty() || !batch::accepts(m, body, centres)) return std::nullopt;
+  std::vector<batch::Member> members;
+  for (std::size_t k = 0; k < kDrawLanes; ++k)
+    members.push_back({body.p, start_moved_by_rounding(body.s0, rounding_way(static_cast<int>(k))), centres.front().A});
+  std::vector<BodyResult> lanes(kDrawLanes);
+  try {
+    std::vector<RunResult> runs = batch::run(m, members, *f, kDrawLanes, oc.cancel);
+    for (std::size_t k = 0; k < kDrawLanes; ++k) {
+      lanes[k].method = &m;
+      lanes[k].run = std::move(runs[k]);
+      Health h = assess(lanes[k].run, checks_for(m, centres, oc.max_energy_error));
+      lanes[k].outcome = h.outcome;
+      lanes[k].reason = std::move(h.why);
+    }
+  } catch (const StoppedOnRequest&) {
+    for (BodyResult& lane : lanes) lane.method = &m, lane.outcome = Outcome::failed, lane.reason = kStoppedOnRequest;
+  }
+  return lanes;
+}
+
+}  // namespace
+
+/// The estimate of the coarse companion where the run has one and it is trusted (true); otherwise its
+/// cost is counted and the fine companion decides (false). A coarse run that breaks down or that the
+/// run does not refine says nothing of the run; a flagged run is left to the fine pair, which can
+/// confirm it.
+bool estimated_by_coarse(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Advance& how,
+                         const Options& options, const Options& o, const Rerun& rerun) {
+  if (r.outcome == Outcome::unresolved) return false;
+  const std::optional<CoarseCompanion> c =
+      coarse_companion(*r.method, how, r.run.steps, coarse_ratio_limit(*r.method, centres, r.run));
+  if (!c) return false;
+  // The coarse run is held to the default flags whether or not the run tracks its invariants: a coarse
+  // step that aliases the spin, skips past a centre or loses the energy can agree with the run by
+  // chance (rk4 at h = 0.2 on two-centres-spin, 70 % off: its coarse companion 1.5e-5 away, 0.63 in energy).
+  Options oc = o;
+  oc.track_invariants = true;
+  oc.max_energy_error = kCoarseEnergyBound;
+  const auto draw = rerun_draws(body, [&c](int k) { return coarse_draw(*c, k); }, oc, rerun);
+  std::optional<std::vector<BodyResult>> lanes = coarse_lanes(*r.method, body, centres, *c, oc);
+  const BodyResult x = lanes ? std::move(lanes->front()) : draw(0);
+  ErrorEstimate& e = r.error;
+  e.force_evals += x.total_force_evals();
+  e.wall_s += x.run.wall_s;
+  // The batch's twin ran whether or not a draw is wanted. Unused, its share of the batch's time is the
+  // companion's (the lanes run in the same instructions), and its evaluations are not the estimate's: a
+  // run's estimate then counts what a sweep's batch of it counts, where twins run only when wanted.
+  const auto lane_cost = [&](ErrorEstimate& to) {
+    for (std::size_t k = 1; lanes && k < lanes->size(); ++k) to.wall_s += (*lanes)[k].run.wall_s;
+  };
+  std::optional<ErrorEstimate> coarse;
+  if (x.outcome == Outcome::ok && ended_alike(r, options, x, oc) && coarser(*c, x.run.steps, r.run.steps))
+    coarse = coarse_estimate(*r.method, body, centres, *c, r.run.final, x.run.final);
+  if (!coarse || !at_rounding_level(*coarse)) lane_cost(coarse ? *coarse : e);
+  if (!coarse) return false;
+  coarse->force_evals += e.force_evals;
+  coarse->wall_s += e.wall_s;
+  e = std::move(*coarse);
+  const std::string& what = coarse_draw_text(*c);
+  if (lanes) add_rounding_draws(e, r, options, oc, [&](int k) { return std::move((*lanes)[static_cast<std::size_t>(k)]); }, what);
+  else add_rounding_draws(e, r, options, oc, draw, what);
+  return true;
+}
+
+double coarse_ratio_limit(const MethodInfo& m, const std::vector<Centre>& centres, const RunResult& run) {
+  if (!run.invariants) return kStepRatio;
+  const Checks checks = checks_for(m, centres);
+  double limit = kStepRatio;
+  if (!checks.spin_exact && !checks.macro_steps && run.invariants->max_spin_angle > 0.0)
+    limit = std::min(limit, kCoarseAngleMargin * kMaxSpinAngle / run.invariants->max_spin_angle);
+  const double turn = std::acos(std::clamp(run.invariants->min_turn_cos, -1.0, 1.0));
+  if (!checks.orbit_exact && !checks.macro_steps && turn > 0.0) limit = std::min(limit, kCoarseAngleMargin * kMaxTurnAngle / turn);
+  return limit;
+}
+
+std::optional<CoarseCompanion> coarse_companion(const MethodInfo& m, const Advance& how, long run_steps, double max_ratio) {
+  const double r = std::min(kStepRatio, max_ratio);
+  if (run_steps < kCoarseMinSteps || !(r >= kMinCoarseRatio)) return std::nullopt;
+  if (const auto* f = std::get_if<FixedSteps>(&how)) {
+    // Whole steps to the same end: ceil(n / r) of them, at the step that lands there. Off the run's
+    // grid (one step more) the pair is no Richardson pair where the error depends on where the steps
+    // fall about a close approach: attracting-close lp-bm4 at h = 0.01, 3.6e-8 off, read 5.3e-10 for
+    // 3.3e-8 on the grid; off it, 10 of the estimate ladder's estimates were more than 3x low, on it 4.
+    const long n = f->steps, coarse = static_cast<long>(std::ceil(static_cast<double>(n) / r));
+    const double ratio = static_cast<double>(n) / static_cast<double>(coarse);
+    if (!(ratio >= kMinCoarseRatio)) return std::nullopt;
+    return CoarseCompanion{FixedSteps{f->h * ratio, coarse}, ratio, r, true};
+  }
+  const auto* f = std::get_if<FictitiousSteps>(&how);
+  if (f == nullptr || f->end.index() != 0 || m.traits.exact_in_fictitious_time) return std::nullopt;
+  return CoarseCompanion{FictitiousSteps{f->ds * r, EndTime{f->t_end()}}, r, r, false};
+}
+
+const std::string& coarse_draw_text(const CoarseCompanion& c) {
+  return c.twin_draw ? kCoarseTwinDraw : kCoarseRoundingDraw;
+}
+
+Advance coarse_draw(const CoarseCompanion& c, int k) {
+  if (k == 0) return c.how;
+  if (!c.twin_draw) return off_grid(c.how, k);
+  return k == 1 ? c.how : off_grid(c.how, k - 1);
+}
+
+std::optional<ErrorEstimate> coarse_estimate(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
+                                             const CoarseCompanion& c, const State& run, const State& coarse) {
+  if (!(coarse.R.allFinite() && coarse.v.allFinite())) return std::nullopt;
+  const int p = std::min(c.asked < kStepRatio ? kCoarseMaxOrderBelow2 : kCoarseMaxOrder, fixed_order(m, body));
+  const double d = adaptive::state_distance(run, coarse);
+  ErrorEstimate e;
+  const bool h = std::holds_alternative<FixedSteps>(c.how);
+  const std::string step = h ? "h" : "ds";
+  const std::string ratio = short_number(c.ratio);
+  e.basis = "companion run at " + (ratio == "2" ? "2" + step : step + " x " + ratio) +
+            " from a start moved by a rounding, ";
+  if (flow_is_exact(m, body, centres)) {
+    e.value = d;
+    e.basis += kExactFlowBasis;
+    return e.value <= kCoarseTrusted ? std::optional<ErrorEstimate>(std::move(e)) : std::nullopt;
+  }
+  e.value = adaptive::finer_run_error(d, c.ratio, p);
+  e.basis += order_text(p) + (p < fixed_order(m, body) ? " (at most " + std::to_string(p) + " on the coarse side)" : "");
+  // Where the pair differs by the scene's rounding, that difference is not divided: the run's own
+  // rounding is of its size (the two runs' roundings are independent draws, the moved start's growth one more).
+  if (const double floor = std::min(d, kRoundingLevel); floor > e.value) {
+    e.value = floor;
+    e.basis += floor == d ? "; at the scene's rounding level: their whole difference"
+                          : "; raised to the rounding level " + short_number(kRoundingLevel) + ", below which they may differ by rounding alone";
+  }
+  if (!(e.value <= kCoarseTrusted)) return std::nullopt;
+  return e;
+}
+
+}  // namespace bodypoint::detail
