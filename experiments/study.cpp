@@ -397,9 +397,9 @@ int cmd_study(int argc, char** argv) {
   c.quick = quick;
   c.threads = thread_count(threads);
   c.progress = ::isatty(2) == 1;
-  bool found = false;
-  for (const auto& [name, fn] : recipes()) found = found || name == which;
-  if (!found && which != "all") throw Error("unknown study '" + which + "' (d, L, h, Kx, timing, evals, appendix, errata, orders, published, all, stress, dL-map, scattering)");
+  std::vector<std::string> names{"all"};
+  for (const auto& [name, fn] : recipes()) names.push_back(name);
+  if (std::find(names.begin(), names.end(), which) == names.end()) throw Error(unknown_name("study", which, names));
   std::error_code ec;
   fs::create_directories(c.dir, ec);
   if (ec || !fs::is_directory(c.dir)) throw Error("cannot create results folder '" + results + "'");

@@ -61,9 +61,9 @@ std::vector<const Observable*> select_observables(const std::vector<Centre>& cen
     for (const Observable& o : observables())
       if (o.name == name) found = &o;
     if (!found) {
-      std::string known;
-      for (const Observable& o : observables()) known += (known.empty() ? "" : ", ") + std::string(o.name);
-      throw Error("unknown observable '" + name + "' (" + known + ")");
+      std::vector<std::string> known;
+      for (const Observable& o : observables()) known.emplace_back(o.name);
+      throw Error(unknown_name("observable", name, known));
     }
     if (!found->applies(centres)) throw Error("observable '" + name + "' does not apply to this scene");
     bool present = false;

@@ -11,6 +11,7 @@
 // and the two scenes on which orders are measured (tests/lib/test_convergence.cpp, `study --name orders`).
 #pragma once
 
+#include "bodypoint/io.hpp"
 #include "bodypoint/model.hpp"
 
 #include <string>
@@ -54,7 +55,7 @@ inline NamedScene named_scene(const std::string& name) {
     validate(s);
     return {name, s, 60.0};
   }
-  throw Error("unknown scene '" + name + "' (thesis, close, material, long, two-centres, three-centres)");
+  throw Error(unknown_name("scene", name, named_scene_names()));
 }
 
 /// The encounter used for convergence: table 3.1 moved close (L = 20, d = 1), stopped at t = 3,

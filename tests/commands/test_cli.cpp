@@ -342,6 +342,23 @@ TEST(Cli, ObserveAddsTheSpinAngleColumn) {
                                                          {"--observe spin_angle", "--observe needs --out"}});
 }
 
+// An unknown name is worded one way wherever it is given: what it is, the name, the nearest valid one and the
+// valid ones (io.hpp, unknown_name).
+TEST(Cli, UnknownNamesAreWordedAlike) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"simulate --method lp-y4 --steps 10 --out x.csv --observe spin_angl",
+       "unknown observable 'spin_angl' (did you mean 'spin_angle'?); valid: t, Rx, "},
+      {"study --name dl-map --quick", "unknown study 'dl-map' (did you mean 'dL-map'?); valid: all, "},
+      {"work-precision --scenes thesys", "unknown scene 'thesys' (did you mean 'thesis'?); valid: thesis, close, "},
+  };
+  for (const auto& [args, message] : cases) {
+    const Result r = run_cli(args);
+    EXPECT_NE(r.code, 0) << args;
+    EXPECT_NE(r.err.find(message), std::string::npos) << args << " -> " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << " -> " << r.err;
+  }
+}
+
 TEST(Cli, ScatteringAndEventsAreTheLibrarysToTheLastBit) {
   // 5000 steps (t = 10): the body, at speed ~5 from L = 20, is back beyond its start distance, receding.
   const Result r = run_cli("simulate --method lp-y8 --h 2e-3 --steps 5000 --B 0 --d 2 --L 20 --scattering --event r=5 --json");
