@@ -156,7 +156,7 @@ void apply_output_options(const po::variables_map& vm, const SimulateOptions& o,
     std::visit([&o](auto& a) { a.dt_out = o.dt_out; }, plan.how);
   }
   if (vm.count("observe") && !vm.count("out")) throw Error("--observe needs --out");
-  plan.options.every = require_count(o.every, "every (write every k-th step)");
+  plan.options.every = check_every(o.every);
   plan.options.omega_c = o.omega_c;
   plan.options.track_invariants = !o.no_invariants;
   require_positive(o.max_seconds, "the budget max_seconds");

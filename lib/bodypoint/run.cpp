@@ -382,8 +382,10 @@ double output_interval(const Advance& how) {
   return std::visit([](const auto& a) -> double { return a.dt_out; }, how);
 }
 
+long check_every(long every) { return require_count(every, "every (the sampling interval in steps)"); }
+
 void check(const RunOptions& options) {
-  require_count(options.every, "every (the sampling interval in steps)");
+  check_every(options.every);
   if (std::isnan(options.omega_c) || options.omega_c == std::numeric_limits<double>::infinity())
     throw Error("the time-step constant omega_c must be a finite number >= 0 (< 0: chosen from the scene), got " +
                 detail::short_number(options.omega_c));

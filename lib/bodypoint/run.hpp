@@ -211,8 +211,11 @@ inline constexpr const char* kStoppedOnRequest = "stopped on request (an interru
 struct StoppedOnRequest : Error {
   StoppedOnRequest() : Error(kStoppedOnRequest) {}
 };
-/// Throws Error unless every >= 1 and omega_c is finite (< 0: automatic).
+/// Throws Error unless every >= 1 (check_every) and omega_c is finite (< 0: automatic).
 void check(const RunOptions& options);
+/// Returns `every`, the sampling interval in steps; throws Error unless it is a count >= 1 (the one wording
+/// of that rule: the API's options, simulate's --every).
+long check_every(long every);
 
 /// Why a method cannot run a (valid) scene, in one line; empty when it can. A family's assumptions:
 /// Coulomb's law and the sign of A for the time transformations, B = 0 and one centre for ks.

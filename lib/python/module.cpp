@@ -587,7 +587,7 @@ struct PyStepper {
     if (tol) {
       if (step) throw Error("give a step or a tolerance tol, not both (the accuracy mode chooses the step)");
       if (!t_end) throw Error("a Stepper with a tolerance needs the end time t_end the accuracy is searched for");
-      if (omega_c) throw Error("the accuracy mode chooses the time-step constant omega_c itself: do not give it");
+      if (omega_c) check_time_step_constant(*omega_c, nullptr, true);
       return Stepper(method, scene.bodies[body], scene.centres, Accuracy{*tol, *t_end}, o);
     }
     if (t_end) throw Error("t_end is the span a tolerance is searched for: give tol too, or leave t_end out");
