@@ -96,6 +96,7 @@ std::vector<std::string> run_sweep(const SweepSpec& spec, const SweepControl& co
   SweepRunner runner;
   runner.threads = control.threads;
   runner.simd = control.simd;
+  runner.validated = control.validated;
   runner.stop = [] { return interrupted(); };
   runner.on_row = [&](SweepRow&& r) {  // one call at a time: the rows, the journal, the progress bar
     rows[r.task] = format_row(spec, r);
@@ -519,7 +520,7 @@ void run_job(const SweepJob& job) {
   std::unique_ptr<AtomicFile> file;
   if (!job.out.empty()) file = std::make_unique<AtomicFile>(job.out);
   const std::unique_ptr<RowJournal> journal = open_journal(job, file.get());
-  SweepControl control{thread_count(job.threads), ::isatty(2) == 1, job.shard, job.shards, journal.get(), !job.no_simd};
+  SweepControl control{thread_count(job.threads), ::isatty(2) == 1, job.shard, job.shards, journal.get(), !job.no_simd, true};
   std::vector<std::string> rows;
   try {
     rows = run_sweep(job.spec, control);

@@ -40,6 +40,8 @@ struct SweepControl {
   /// Run tasks that share method and step in batches of vector lanes (bodypoint/batch.hpp): the
   /// same bits, faster; false runs every task alone (--no-simd, for comparison).
   bool simd = true;
+  /// validate_sweep ran on the spec in this process already (run_job, before its journal exists).
+  bool validated = false;
 };
 
 /// Runs the tasks of this shard that the journal does not hold yet, on control.threads threads, and

@@ -6,6 +6,7 @@
 #include "bodypoint/io.hpp"
 #include "bodypoint/field.hpp"
 #include "bodypoint/invariants.hpp"
+#include "checked.hpp"
 #include "choice.hpp"
 #include "estimate.hpp"
 #include "events.hpp"
@@ -390,6 +391,11 @@ void check_time_step_constant(double omega_c, const MethodInfo* method, bool acc
   if (method && !takes_time_step_constant(*method))
     throw Error("the time-step constant omega_c is for the time-transformed methods (logh-*, ttl-*); " + method->name +
                 " does not take it");
+}
+
+BodyResult detail::integrate_checked(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
+                                     const Advance& how, const Options& options) {
+  return integrate_estimated(body, centres, method, how, options);
 }
 
 BodyResult integrate_body(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,

@@ -6,6 +6,7 @@
 #include "bodypoint/threads.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/scene_file.hpp"
+#include "checked.hpp"
 #include "estimate.hpp"
 
 #include <algorithm>
@@ -240,14 +241,14 @@ void add_row_start_distance(Encounter& e, const SweepSpec& spec, const std::vect
   add_start_distance(e, body, far, spec.accuracy, numerical, "a scene file's body has no thesis start distance to double", o);
 }
 
-/// The row of a run with its encounter (SweepSpec::scattering): integrate_body with the encounter's
+/// The row of a run with its encounter (SweepSpec::scattering): integrate_checked with the encounter's
 /// events (encounter_options: it stops at the departure, the sweep's end the latest), measured by
 /// measure_encounter; an encounter that did not finish by the end is the row's outcome (incomplete).
 SweepRow encounter_row(SweepRow row, const MethodInfo& method, const Scene& scene, const Advance& how,
                        const SweepSpec& spec) {
   const Body& body = scene.bodies.front();
   const Options options = encounter_options(body, scene.centres, sweep_options(spec), true);
-  BodyResult r = integrate_body(body, scene.centres, &method, how, options);
+  BodyResult r = detail::integrate_checked(body, scene.centres, &method, how, options);  // checked by validate_sweep
   if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return result_row(std::move(row), std::move(r));
   Encounter e = measure_encounter(body, scene.centres, r.run, r.events, options.events);
   if (e.outcome == Outcome::ok && r.outcome == Outcome::ok) add_row_start_distance(e, spec, row.point, body, r.error.value);
@@ -428,7 +429,7 @@ std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vect
   const Scene& scene = scenes.front();
   const Advance how = point_advance(spec, method, row.point);
   if (spec.scattering) row = encounter_row(std::move(row), method, scene, how, spec);
-  else row = result_row(std::move(row), integrate_body(scene.bodies.front(), scene.centres, &method, how, sweep_options(spec)));
+  else row = result_row(std::move(row), detail::integrate_checked(scene.bodies.front(), scene.centres, &method, how, sweep_options(spec)));
   return rows;
 }
 
@@ -444,8 +445,12 @@ std::vector<std::vector<std::size_t>> plan_units(const SweepSpec& spec, const st
   for (std::size_t i : todo) {
     const MethodInfo& method = *spec.methods[i % M];
     const std::vector<double> point = grid_point(spec, i / M);
+    if (lanes < 2) {
+      units.push_back({i});
+      continue;
+    }
     const Scene scene = point_scene(spec, point);
-    if (lanes < 2 || !batch::accepts(method, scene.bodies.front(), scene.centres) ||
+    if (!batch::accepts(method, scene.bodies.front(), scene.centres) ||
         (spec.cancel && static_cast<double>(std::get<FixedSteps>(point_advance(spec, method, point)).steps) >
                             kMaxUnpolledBatchSteps)) {
       units.push_back({i});
@@ -466,7 +471,7 @@ std::size_t shard_of(const SweepSpec& spec, std::size_t task, std::size_t shards
 }
 
 void run_sweep_tasks(const SweepSpec& spec, const std::vector<std::size_t>& todo, const SweepRunner& runner) {
-  validate_sweep(spec);
+  if (!runner.validated) validate_sweep(spec);
   const auto units = plan_units(spec, todo, runner.simd);
   std::atomic<std::size_t> next{0};
   std::mutex mutex;  // on_row and the first error

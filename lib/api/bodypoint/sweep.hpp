@@ -161,9 +161,12 @@ struct SweepRunner {
   std::function<void(SweepRow&&)> on_row;
   /// Asked before each unit: true stops the handing out of units (the running ones finish).
   std::function<bool()> stop;
+  /// The caller ran validate_sweep on this spec already (a command checks it before it opens its outputs):
+  /// its points are not built and checked a second time.
+  bool validated = false;
 };
 
-/// Validates the sweep, then runs the tasks of `todo` on runner.threads threads.
+/// Validates the sweep (unless runner.validated), then runs the tasks of `todo` on runner.threads threads.
 void run_sweep_tasks(const SweepSpec& spec, const std::vector<std::size_t>& todo, const SweepRunner& runner);
 
 /// Every task of the sweep, by task index, on `threads` threads.
