@@ -19,7 +19,7 @@ of both signs from scene files) and far-ip under --tol on the far passes, at TOL
 Usage (from the repository, after the build; about a minute on 2 cores):
     /usr/bin/python3 bench/estimate_grid.py [build/bin/bodypoint] [--tols 1e-4,1e-7,1e-10] [--out FILE.csv]
         [--method NAME]   (a named method instead of auto's choice, e.g. far-ip)
-        [--branches]      (auto's other branches and far-ip, --out: branch, scene, tol, status, method, ...)
+        [--branches]      (auto's other branches and far-ip, --out: branch, scene, tol, outcome, method, ...)
 """
 import argparse
 import csv
@@ -57,7 +57,7 @@ def write_rows(path, jobs, results):
     tmp = path + ".tmp"
     with open(tmp, "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["d", "Kz", "B", "Kx", "tol", "status", "method", "err", "err_estimate", "force_evals",
+        w.writerow(["d", "Kz", "B", "Kx", "tol", "outcome", "method", "err", "err_estimate", "force_evals",
                     "search_force_evals", "reason"])
         for (tol, scene), r in zip(jobs, results):
             d, kz, b, kx = scene[1::2]
@@ -150,7 +150,7 @@ def branches(binary, tols, out=None):
         tmp = out + ".tmp"
         with open(tmp, "w", newline="") as f:
             w = csv.writer(f)
-            w.writerow(["branch", "scene", "tol", "status", "method", "err", "err_estimate", "force_evals",
+            w.writerow(["branch", "scene", "tol", "outcome", "method", "err", "err_estimate", "force_evals",
                         "search_force_evals", "reason"])
             for (tol, s), r in zip(jobs, results):
                 if isinstance(r, str):

@@ -156,9 +156,9 @@ std::vector<StressRow> run_stress(bool quick, const std::function<void(const Str
 }
 
 void write_stress(std::ostream& csv, std::ostream& md, const std::vector<StressRow>& rows) {
-  csv << "case,method,status,max_rel_dE,steps,wall_s,reason,err_estimate\n"
+  csv << "case,method,outcome,max_rel_dE,steps,wall_s,reason,err_estimate\n"
       << "# bodypoint study stress, revision " << git_revision() << "\n"
-      << "# status: ok | refused (not run, reason) | failed (started and stopped, reason) | diverged | unresolved | inaccurate | collision (flagged, reason; "
+      << "# outcome: ok | refused (not run, reason) | failed (started and stopped, reason) | diverged | unresolved | inaccurate | collision (flagged, reason; "
          "docs/physics.md, Resolution and accuracy flags); max_rel_dE only for runs; err_estimate = the run's estimated "
          "relative error (a companion run at up to twice or half the step; docs/physics.md, Error estimate of a run by step; NaN: none)\n";
   for (const StressRow& r : rows) {

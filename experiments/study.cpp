@@ -304,7 +304,7 @@ void study_appendix(const StudyContext& c) {
   const long steps = 250000, every = c.quick ? 2500 : 250;
   AtomicFile index((dir / "index.csv").string());
   std::ostream& ix = index.stream();
-  ix << "figure,A,m,B,J,L,d,K1,Kz,Kx,status,file,max_rel_dE,max_rel_dK2sq\n"
+  ix << "figure,A,m,B,J,L,d,K1,Kz,Kx,outcome,file,max_rel_dE,max_rel_dK2sq\n"
      << "# bodypoint study appendix (thesis appendix 1): thesis-euler, h = 1e-4, n = 250000, every "
      << every << "-th step written; revision " << git_revision() << "\n";
   for (const AppendixSet& set : appendix_sets()) {
@@ -338,7 +338,7 @@ void study_appendix(const StudyContext& c) {
     if (br.outcome == Outcome::refused || br.outcome == Outcome::failed) throw Error(br.reason);
     const RunResult& r = br.run;
     f.commit();
-    // The thesis's run as it made it, written whatever its flags; the status says what they are.
+    // The thesis's run as it made it, written whatever its flags; the outcome says what they are.
     ix << row.text(std::string(outcome_name(br.outcome))).text(name).num(r.invariants->max_rel_dE).num(r.invariants->max_rel_dK2sq).str() << '\n';
   }
   index.commit();

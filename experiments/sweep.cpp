@@ -151,12 +151,12 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
               " max_rel_dK2sq = max_i |K2^2_i-K2^2_0|/K2^2_0; max_abs_dK2Q = max_i |K2Q_i-K2Q_0|;"
               " Rx,Ry,Rz = final position; force_evals; wall_s = step-loop time (runs share the cores; a batch of"
               " trajectories run in vector lanes shares its time equally);"
-              " status = ok | diverged (non-finite, or energy error above 1) | unresolved (a step turned the spin by"
+              " outcome = ok | diverged (non-finite, or energy error above 1) | unresolved (a step turned the spin by"
               " more than pi or the direction to a centre by more than pi/2) | incomplete (--scattering: the encounter had"
               " not finished) | inaccurate (energy error above"
               " max_energy_error = " + fmt(spec.max_energy_error) + ", or estimated error above max_error = " +
               fmt(spec.max_error) + ") | collision (diverged after a fall onto an"
-              " attracting centre) | refused (not run); reason = why, when not ok;"
+              " attracting centre) | refused (not run) | failed (started and stopped); reason = why, when not ok;"
               " err_estimate = estimated relative error of the final state, max(|dR|/|R|, |dv|/|v|) (NaN: none),"
               " estimate_force_evals = its companion run's cost, err_basis = how it was estimated or why there is"
               " none; warning = a flag the estimate overruled" +
@@ -169,7 +169,7 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
                                 " asymptotes' model error in the deflection (estimated from half the start distance);"
                                 " start_distance_error, time_delay_error = what the start distance L leaves against L ->"
                                 " infinity (the point again from 2L); deflection_error = the deflection's total;"
-                                " a run that ended before the body left is status incomplete, without them;"
+                                " a run that ended before the body left is outcome incomplete, without them;"
                                 " K1_turn, spin_turn ="
                                 " angles K1 and K2 turned over the run (rad); K1x,K1y,K1z = final K1;"
                                 " asymptotes = kepler | guiding-centre | none: why (docs/physics.md, Scattering)"

@@ -190,7 +190,7 @@ TrackJson body_json(const Body& body, const std::vector<Centre>& centres, RunPla
     std::cerr << "bodypoint: warning: " << who << " is " << outcome_name(br.outcome) << ": " << br.reason
               << "; drawn with that flag\n";
   const std::vector<Frame> f = d.frames(frames);
-  std::string out = "{\"name\": " + json_string(body.name, true) + ", \"status\": " +
+  std::string out = "{\"name\": " + json_string(body.name, true) + ", \"outcome\": " +
                     json_string(std::string(outcome_name(br.outcome)), true) + ", \"reason\": " +
                     json_string(br.reason, true) + ", \"steps\": " + std::to_string(br.run.steps) +
                     ", \"force_evals\": " + std::to_string(br.run.force_evals) + ", \"invariants\": {";

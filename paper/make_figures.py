@@ -245,8 +245,8 @@ def appendix_figure(res, figs, listing):
             ax.plot([0], [0], "k.", markersize=3)
             if len(ok) < len(xs):
                 label += " (leaves)"
-            if row["status"] != "ok":
-                label += f" ({row['status']})"
+            if row["outcome"] != "ok":
+                label += f" ({row['outcome']})"
         ax.set_title(label, fontsize=7, pad=2)
     fig.supxlabel("x", fontsize=8)
     fig.supylabel("y", fontsize=8)
@@ -410,7 +410,7 @@ def map_figure(res, figs, listing):
         grid = [[float("nan")] * len(ds) for _ in Ls]
         for r in groups[m]:
             v = num(r["max_rel_dE"])
-            ok = r["status"] == "ok" and v > 0
+            ok = r["outcome"] == "ok" and v > 0
             grid[Ls.index(num(r["L"]))][ds.index(num(r["d"]))] = math.log10(v) if ok else float("nan")
         image = ax.pcolormesh(ds, Ls, grid, cmap=cmap, vmin=-16, vmax=0, shading="nearest")
         ax.grid(False)

@@ -266,7 +266,7 @@ def java_agreement(M):
     made = re.search(r"bodypoint (\S+) against .*\((\S+) ([0-9a-f]{7})[0-9a-f]*\)", header[0])
     M.add("JavaMadeAt", f"\\texttt{{{made.group(1)}}}" if made else "unknown", math_mode=False)
     M.add("JavaThesisCommit", f"\\texttt{{{made.group(3)}}}" if made else "unknown", math_mode=False)
-    ok = [r for r in rows if r["status"] == "ok"]
+    ok = [r for r in rows if r["outcome"] == "ok"]
     M.add("JavaRuns", count(len(rows)))
     M.add("JavaRunsOk", count(len(ok)))
     for ours, theirs, name in [("max_rel_dE", "java_max_rel_dE", "Energy"), ("max_rel_dK2sq", "java_max_rel_dK2sq", "Ktwo")]:
@@ -514,7 +514,7 @@ def sweeps(res, M):
         sweep_stats(rows, param, "", M, {"Seven": THESIS_SEVEN, "All": fixed})
         pub, _ = read_csv(os.path.join(res, f"published_{param}_sweep.csv"))
         sweep_stats(pub, param, "Pub", M, {"Seven": THESIS_SEVEN})
-        diverged = sum(1 for r in pub if r.get("status") not in ("ok", None))
+        diverged = sum(1 for r in pub if r.get("outcome") not in ("ok", None))
         M.add(f"PubFlagged{camel(param)}", count(diverged))
     # The h sweep: each method's deviation at the smallest step, and the smallest step at which a
     # drift/kick scheme of the thesis is flagged (diverged).
@@ -525,7 +525,7 @@ def sweeps(res, M):
             if num(r["h"]) == hmin:
                 M.add(f"HAtMin{prefix}{camel(r['method'])}", sci(num(r["max_rel_dE"])))
     rows, _ = read_csv(os.path.join(res, "h_sweep.csv"))
-    flagged = [num(r["h"]) for r in rows if r["method"].startswith("thesis-") and r.get("status") != "ok"]
+    flagged = [num(r["h"]) for r in rows if r["method"].startswith("thesis-") and r.get("outcome") != "ok"]
     hmin = min(num(r["h"]) for r in rows)
     M.add("HFlaggedThesis", "at no step of the sweep" if not flagged else "at every step of the sweep"
           if min(flagged) <= hmin else f"from $h = {sci(min(flagged))}$ on", math_mode=False)
@@ -975,7 +975,7 @@ def estimate_grid(res, M):
     path = os.path.join(res, "estimate_grid.csv")
     with open(path) as f:
         rows = list(csv.DictReader(f))
-    ran = [r for r in rows if r["status"] == "ok"]
+    ran = [r for r in rows if r["outcome"] == "ok"]
     M.add("GridRuns", count(len(rows)))
     M.add("GridScenes", count(len({(r["d"], r["Kz"], r["B"], r["Kx"]) for r in rows})))
     for key in ["d", "Kz", "B"]:
@@ -1009,8 +1009,8 @@ def estimate_branches(res, out, M):
     body, totals = [], {"runs": 0, "missed": 0, "under": 0}
     for branch in dict.fromkeys(r["branch"] for r in rows):
         group = [r for r in rows if r["branch"] == branch]
-        ran = [r for r in group if r["status"] == "ok" and r["err"]]
-        unchecked = sum(1 for r in group if r["status"] == "ok" and not r["err"])
+        ran = [r for r in group if r["outcome"] == "ok" and r["err"]]
+        unchecked = sum(1 for r in group if r["outcome"] == "ok" and not r["err"])
         # Below 1e-13 the reference's error and the run's round-off are of the error's size (estimate_grid.py).
         comparable = [r for r in ran if num(r["err"]) > 1e-13 and num(r["err_estimate"]) > 0]
         ratios = [num(r["err"]) / num(r["err_estimate"]) for r in comparable]
@@ -1136,8 +1136,8 @@ def stress(res, out, M):
     rows, _ = read_csv(os.path.join(res, "stress.csv"))
     M.add("StressRuns", count(len(rows)))
     for status, name in [("ok", "StressOk"), ("refused", "StressRefused"), ("failed", "StressFailed")]:
-        M.add(name, count(sum(1 for r in rows if r["status"] == status)))
-    M.add("StressFlagged", count(sum(1 for r in rows if r["status"] in FLAGGED)))
+        M.add(name, count(sum(1 for r in rows if r["outcome"] == status)))
+    M.add("StressFlagged", count(sum(1 for r in rows if r["outcome"] in FLAGGED)))
     cases, methods = [], []
     for r in rows:
         if r["case"] not in cases:
@@ -1154,38 +1154,38 @@ def stress(res, out, M):
                 r = cell.get((c, m))
                 if r is None:
                     cells.append("")
-                elif r["status"] == "ok":
+                elif r["outcome"] == "ok":
                     cells.append(f"${sci(num(r['max_rel_dE']), 1)}$")
                 else:
                     cells.append({"refused": "ref.", "failed": "stop.", "diverged": "\\textbf{div.}",
                                   "unresolved": "\\textbf{unres.}", "inaccurate": "\\textbf{inacc.}",
-                                  "collision": "\\textbf{col.}"}[r["status"]])
+                                  "collision": "\\textbf{col.}"}[r["outcome"]])
             label = c.replace("_", "\\_").replace("|K1|", "$|K_1|$")
             f.write(f"{label} & " + " & ".join(cells) + " \\\\\n")
         f.write("\\midrule\n")
         for title, statuses in [("ended normally", ("ok",)), ("refused with a reason", ("refused",)),
                                 ("stopped with a reason", ("failed",)), ("flagged", FLAGGED)]:
-            n = [sum(1 for c in cases if cell.get((c, m)) and cell[(c, m)]["status"] in statuses) for m in methods]
+            n = [sum(1 for c in cases if cell.get((c, m)) and cell[(c, m)]["outcome"] in statuses) for m in methods]
             f.write(f"\\emph{{{title}}} & " + " & ".join(str(k) for k in n) + " \\\\\n")
     M.add("StressMethodCount", str(len(methods)), math_mode=False)  # a column count, used in the preamble
     M.add("StressCases", count(len(cases)))
     for m in methods:
-        M.add(f"StressFlagged{camel(m)}", count(sum(1 for r in rows if r["method"] == m and r["status"] in FLAGGED)))
-    far_runs = [r for r in rows if r["method"] in ("lp-y4", "logh-y4", "ttl-y4") and r["status"] != "refused"
+        M.add(f"StressFlagged{camel(m)}", count(sum(1 for r in rows if r["method"] == m and r['outcome'] in FLAGGED)))
+    far_runs = [r for r in rows if r["method"] in ("lp-y4", "logh-y4", "ttl-y4") and r["outcome"] != "refused"
                 and (r["case"].startswith("L=") or r["case"].startswith("|K1|"))]
-    far = [num(r["max_rel_dE"]) for r in far_runs if r["status"] == "ok"]
+    far = [num(r["max_rel_dE"]) for r in far_runs if r["outcome"] == "ok"]
     M.add("StressFarWorst", sci(max(far)) if far else "n/a")
     M.add("StressFarRun", count(len(far_runs)))
     M.add("StressFarOk", count(len(far)))
-    not_ok = [f"{tt(r['method'])} at {r['case'].replace('|K1|', '$|K_1|$')} ({r['status']})"
-              for r in far_runs if r["status"] != "ok"]
+    not_ok = [f"{tt(r['method'])} at {r['case'].replace('|K1|', '$|K_1|$')} ({r['outcome']})"
+              for r in far_runs if r["outcome"] != "ok"]
     M.add("StressFarNotOk", "; not: " + ", ".join(not_ok) if not_ok else "", math_mode=False)
     bound = {r["method"]: r for r in rows if r["case"].startswith("bound orbit")}
     for m, r in bound.items():
-        if r["status"] not in ("refused", "failed"):  # a run, ok or flagged: its energy and estimated error
+        if r["outcome"] not in ("refused", "failed"):  # a run, ok or flagged: its energy and estimated error
             M.add(f"StressBound{camel(m)}", sci(num(r["max_rel_dE"])))
             M.add(f"StressBoundErr{camel(m)}", sci(num(r["err_estimate"])))
-            M.add(f"StressBoundStatus{camel(m)}", r["status"], math_mode=False)
+            M.add(f"StressBoundStatus{camel(m)}", r['outcome'], math_mode=False)
 
 
 def appendix(res, M):
@@ -1193,16 +1193,16 @@ def appendix(res, M):
     M.add("AppendixSets", count(len(rows)))
     M.add("AppendixRun", count(sum(1 for r in rows if r["file"])))
     M.add("AppendixSkipped", count(sum(1 for r in rows if not r["file"])))
-    flagged = [r for r in rows if r["file"] and r["status"] != "ok"]
+    flagged = [r for r in rows if r["file"] and r["outcome"] != "ok"]
     M.add("AppendixFlagged", count(len(flagged)))
     # By status: how many, and which sets where they are few.
     parts = []
     for status in FLAGGED:
-        sets = [f"P1.{r['figure']}" for r in flagged if r["status"] == status]
+        sets = [f"P1.{r['figure']}" for r in flagged if r['outcome'] == status]
         if sets:
             parts.append(f"{len(sets)} {status}" + (f" ({', '.join(sets)})" if len(sets) <= 3 else ""))
     if flagged:
-        dE = [num(r["max_rel_dE"]) for r in flagged if r["status"] == "inaccurate"]
+        dE = [num(r["max_rel_dE"]) for r in flagged if r["outcome"] == "inaccurate"]
         if dE:
             parts.append(f"energy deviations of the inaccurate ones from ${sci(min(dE))}$ to ${sci(max(dE))}$")
     M.add("AppendixFlaggedSets", "; ".join(parts) or "none", math_mode=False)
@@ -1241,12 +1241,12 @@ def ensembles(res, M):
     # Share of the map each family keeps below 1e-10 relative energy error (status ok).
     def share(pick, bound=1e-10):
         rs = [r for r in rows if pick(r["method"])]
-        good = sum(1 for r in rs if r["status"] == "ok" and num(r["max_rel_dE"]) < bound)
+        good = sum(1 for r in rs if r["outcome"] == "ok" and num(r["max_rel_dE"]) < bound)
         return 100.0 * good / len(rs)
     M.add("MapShareLp", sci(share(lambda m: m.startswith("lp-")), 3))
     M.add("MapShareThesis", sci(share(lambda m: m.startswith("thesis-")), 3))
     M.add("MapShareRk", sci(share(lambda m: m in ("rk4", "ab4")), 3))
-    M.add("MapNotOk", count(sum(1 for r in rows if r["status"] != "ok")))
+    M.add("MapNotOk", count(sum(1 for r in rows if r["outcome"] != "ok")))
     # bench_batch: items_per_second of the scalar loop and of each width, per method; a speed-up only
     # between two times that count under the timing rule.
     bench = timing_rule.benchmark(os.path.join(res, "bench_batch.csv"), M.rule)

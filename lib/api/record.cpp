@@ -187,9 +187,8 @@ Record sweep_record(const SweepSpec& spec, const SweepRow& r) {
   out.text("method", r.method ? std::string(r.method->name) : std::string());
   out.number("max_rel_dE", s.max_rel_dE).number("max_rel_dK2sq", s.max_rel_dK2sq).number("max_abs_dK2Q", s.max_abs_dK2Q);
   out.number("Rx", f.R.x()).number("Ry", f.R.y()).number("Rz", f.R.z());
-  // A run that stopped reads "refused" as one that was not run: neither has a state.
-  const std::string_view status = r.outcome == Outcome::failed ? "refused" : outcome_name(r.outcome);
-  out.count("force_evals", r.result.force_evals).number("wall_s", r.result.wall_s).text("status", std::string(status));
+  out.count("force_evals", r.result.force_evals).number("wall_s", r.result.wall_s);
+  out.text("outcome", std::string(outcome_name(r.outcome)));
   out.note("reason", r.reason).number("err_estimate", r.error.value).count("estimate_force_evals", r.error.force_evals);
   out.note("err_basis", r.error.basis).note("warning", join(r.warnings, "; "));
   if (spec.scattering) {  // NaN where there is no value (no minimum, no asymptotes, a run that did not finish)

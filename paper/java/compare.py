@@ -45,13 +45,13 @@ def main():
 
     with concurrent.futures.ThreadPoolExecutor(os.cpu_count() or 1) as ex, open(out + ".tmp", "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["sweep", "value", "method", "status", "max_rel_dE", "java_max_rel_dE", "max_rel_dK2sq",
+        w.writerow(["sweep", "value", "method", "outcome", "max_rel_dE", "java_max_rel_dE", "max_rel_dK2sq",
                     "java_max_rel_dK2sq", "rel_diff_R", "java_steps"])
         for (sweep, value, r), j in ex.map(run, jobs):
             R = [float(x) for x in j[3:6]]
             ours = [float(r[k]) for k in ("Rx", "Ry", "Rz")]
             eR = sum((a - b) ** 2 for a, b in zip(ours, R)) ** 0.5 / sum(b * b for b in R) ** 0.5
-            w.writerow([sweep, value, r["method"], r["status"], r["max_rel_dE"], j[1], r["max_rel_dK2sq"], j[2],
+            w.writerow([sweep, value, r["method"], r["outcome"], r["max_rel_dE"], j[1], r["max_rel_dK2sq"], j[2],
                         f"{eR:.3e}", j[6]])
     os.replace(out + ".tmp", out)
 

@@ -123,7 +123,7 @@ def test_grid_is_every_combination_last_axis_fastest():
     cols = bp.sweep({"d": [5, 10], "L": [100, 200, 300]}, "lp-y4", steps=100, threads=2)
     assert list(cols["d"]) == [5, 5, 5, 10, 10, 10]
     assert list(cols["L"]) == [100, 200, 300] * 2
-    assert set(cols["status"]) == {"ok"}
+    assert set(cols["outcome"]) == {"ok"}
 
 
 def test_flags_and_the_energy_bound_equal_the_command_line():
@@ -142,7 +142,7 @@ def test_flags_and_the_energy_bound_equal_the_command_line():
                           "--max-energy-error", "inf", "--max-error", "inf"))
     assert_same_fields(free["bodies"][0], want)
     cols = bp.sweep({"h": [1e-4]}, "thesis-euler", t_end=50, max_energy_error=bp._core.DEFAULT_MAX_ENERGY_ERROR)
-    assert list(cols["status"]) == ["inaccurate"]
+    assert list(cols["outcome"]) == ["inaccurate"]
 
 
 def test_rutherford_deflection_for_a_material_point():
@@ -419,7 +419,7 @@ def test_installs_into_a_fresh_venv_offline_and_runs_the_guides_examples():
 def test_sweep_in_the_accuracy_mode_equals_integrate_per_row():
     tol = 1e-8
     cols = bp.sweep({"d": [5, 10]}, "lp-y4,logh-y4,gsl-rk8pd", t_end=50, accuracy=tol)
-    assert list(cols["status"]) == ["ok"] * 6
+    assert list(cols["outcome"]) == ["ok"] * 6
     for i, (d, method) in enumerate(zip(cols["d"], cols["method"])):
         peer = method == "gsl-rk8pd"  # the peer keeps the sweep's tolerance per step (tol, 1e-10)
         one = bp.integrate(bp.thesis_scene(d=d), method, tol=1e-10 if peer else tol, t_end=50)["bodies"][0]
@@ -444,7 +444,7 @@ def test_fourth_pass_messages_are_one_line_errors_naming_the_quantity():
         bp.sweep({"d": "abc"}, ["lp-y4"], steps=10)
     # A single value is an axis of one value (a right answer is not refused).
     one = bp.sweep({"d": 5}, ["lp-y4"], steps=10)
-    assert list(one["d"]) == [5.0] and one["status"] == ["ok"]
+    assert list(one["d"]) == [5.0] and one["outcome"] == ["ok"]
 
 
 def test_speed_at_infinity_takes_the_root_with_an_encounter():
@@ -484,7 +484,7 @@ def test_sweep_takes_any_scene_and_its_rows_equal_integrate_of_the_scene_with_th
     charges = np.linspace(-2.0, -0.04, 50)
     tol = 1e-8
     cols = bp.sweep({"centre2.A": charges}, ["logh-kl6"], accuracy=tol, t_end=60, scene=path)
-    assert len(cols["status"]) == 100 and set(cols["status"]) == {"ok"}
+    assert len(cols["outcome"]) == 100 and set(cols["outcome"]) == {"ok"}
     assert list(cols["body"][:4]) == [1, 2, 1, 2]
     text = open(path).read()
     edited = bp.parse_scene(text.replace("A = -1.0", f"A = {charges[3]!r}"))

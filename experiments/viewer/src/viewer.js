@@ -59,7 +59,7 @@ data.runs.forEach((run, k) => {
     const hits = b.events || [];
     if (hits.length) s += `; ${hits.length} event hit(s): ` + hits.slice(0, 4).map((h) => `${esc(h.label)} at t=${fmt(h.t)}`).join(', ') +
       (hits.length > 4 ? ', ...' : '');
-    if (b.status && b.status !== 'ok') s += ` <b class="flag">${esc(b.status)}</b>: ${esc(b.reason)}`;
+    if (b.outcome && b.outcome !== 'ok') s += ` <b class="flag">${esc(b.outcome)}</b>: ${esc(b.reason)}`;
     return s;
   });
   headerHtml += `<span class="run"><span class="swatch" style="background:${hex(RUN_COLOURS[k])}"></span>` +

@@ -358,8 +358,8 @@ def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, accuracy=None
     relative error of the final state at ``t_end`` (its step searched per row: columns h_chosen,
     search_force_evals). ``threads``: every core unless
     given (0 too, as on the command line). The columns are those of ``bodypoint sweep``'s CSV (docs/guide.md): one per axis, method,
-    max_rel_dE, max_rel_dK2sq, max_abs_dK2Q, Rx..Rz, force_evals, wall_s, status (an Outcome's name,
-    "refused" for a run that did not start or stopped), reason, err_estimate, estimate_force_evals,
+    max_rel_dE, max_rel_dK2sq, max_abs_dK2Q, Rx..Rz, force_evals, wall_s, outcome (an Outcome's name),
+    reason, err_estimate, estimate_force_evals,
     err_basis, warning; with ``scattering=True`` the encounter's (r_min, t_min, deflection,
     out_of_plane, b_in, v_inf_in, time_delay, asymptote_error, K1_turn, spin_turn, K1x..K1z,
     asymptotes); then steps, t_end, vx..vz, wx..wz. One row per (grid point, method), grid point major.
