@@ -157,7 +157,7 @@ def check(group, name, params, b, phase, tol):
         row["verdict"] = f"no total error ({e['outcome']}: {e.get('reason') or e.get('start_distance_basis')})"
         return row
     try:
-        return compare(row, params, phase, e["deflection"], e["deflection_error"], e["v_inf"])
+        return compare(row, params, phase, e["deflection"], e["deflection_error"], e["v_inf_in"])
     except bp.Error as err:
         raise bp.Error(f"{name} b={b} phase={phase}: {err}") from None
 

@@ -30,7 +30,7 @@ def deflections(B):
         scene = bp.thesis_scene(B=B, b=b)
         e = bp.encounter(scene, tol=1e-10)
         theta.append(e["deflection"])
-        v_inf.append(e["v_inf"])
+        v_inf.append(e["v_inf_in"])
     return np.array(theta), np.array(v_inf)
 
 

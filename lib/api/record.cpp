@@ -165,8 +165,8 @@ Record encounter_record(const Encounter& e) {
   const Scattering& sc = e.scattering;
   Record out;
   out.text("outcome", std::string(outcome_name(e.outcome))).note("reason", e.reason).note("asymptotes", sc.asymptotes);
-  out.number("deflection", sc.deflection).number("out_of_plane", sc.out_of_plane).number("b", sc.b);
-  out.number("v_inf", sc.v_inf).number("time_delay", sc.time_delay).number("asymptote_error", e.asymptote_error);
+  out.number("deflection", sc.deflection).number("out_of_plane", sc.out_of_plane).number("b_in", sc.b);
+  out.number("v_inf_in", sc.v_inf).number("time_delay", sc.time_delay).number("asymptote_error", e.asymptote_error);
   out.note("asymptote_basis", e.asymptote_basis);
   out.number("start_distance_error", e.start_distance_error).number("time_delay_error", e.time_delay_error);
   out.note("start_distance_basis", e.start_distance_basis).number("deflection_error", e.deflection_error);

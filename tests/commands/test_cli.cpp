@@ -375,7 +375,7 @@ TEST(Cli, ScatteringAndEventsAreTheLibrarysToTheLastBit) {
   ASSERT_EQ(lib.outcome, Outcome::ok);
   const Scattering sc = scattering(b.p, s.centres, b.s0, lib.bodies.front().run.final);
   EXPECT_EQ(json_num(r.out, "deflection"), sc.deflection);
-  EXPECT_EQ(json_num(r.out, "b"), sc.b);
+  EXPECT_EQ(json_num(r.out, "b_in"), sc.b);
   EXPECT_EQ(json_num(r.out, "r_min"), lib.bodies.front().events[1].r);
   EXPECT_EQ(json_num(r.out, "t_min"), lib.bodies.front().events[1].t);
   EXPECT_NE(r.out.find("\"asymptotes\": \"kepler\""), std::string::npos);
@@ -412,7 +412,7 @@ TEST(Cli, SweepScatteringColumnsAreThoseOfSingleRuns) {
     ASSERT_EQ(one.code, 0) << one.err;
     for (const char* key : {"deflection", "r_min", "t_min", "time_delay", "spin_turn"})
       EXPECT_EQ(std::stod(row.at(key)), json_num(one.out, key)) << row.at("method") << " b = " << row.at("b") << ": " << key;
-    EXPECT_EQ(std::stod(row.at("b_in")), json_num(one.out, "b"));
+    EXPECT_EQ(std::stod(row.at("b_in")), json_num(one.out, "b_in"));
     EXPECT_EQ(std::stod(row.at("Rx")), json_vec(one.out, "R").x());
     EXPECT_EQ(row.at("asymptotes"), "kepler");
     ++rows;

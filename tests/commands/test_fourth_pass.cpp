@@ -46,7 +46,7 @@ TEST(FourthPass, SpeedAtInfinityTakesTheRootWithAnEncounter) {
     EXPECT_EQ(r.out.find("no closest approach"), std::string::npos) << r.out;
     const auto j = run_cli(std::string("simulate --json --tol 1e-8 --scattering --v-inf ") + v);
     ASSERT_EQ(j.code, 0) << j.err;
-    EXPECT_NEAR(json_number(j.out, "v_inf"), std::stod(v), kSolvedVInf) << j.out;
+    EXPECT_NEAR(json_number(j.out, "v_inf_in"), std::stod(v), kSolvedVInf) << j.out;
   }
   // A start that drifts away has no encounter: no deflection is reported, and no b solves it.
   const auto away = run_cli("simulate --json --tol 1e-8 --scattering --K1 0.8");

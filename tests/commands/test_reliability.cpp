@@ -243,7 +243,7 @@ TEST(Reliability, ThirdPassCasesAreRefusedWithTheirQuantityOrSolved) {
     ASSERT_EQ(r.code, 0) << v << ": " << r.err;
     const std::smatch m = [&r] {
       std::smatch x;
-      std::regex_search(r.out, x, std::regex("\"v_inf\": ([^,]+)"));
+      std::regex_search(r.out, x, std::regex("\"v_inf_in\": ([^,]+)"));
       return x;
     }();
     ASSERT_FALSE(m.empty()) << r.out;

@@ -391,8 +391,9 @@ def encounter(scene, *, t_end=None, method="auto", tol=1e-10, max_seconds=DEFAUL
 
     Without t_end the run stops when the body has left (its guiding centre back at its start distance),
     at the latest after two free passes; with t_end it runs to t_end. Returns outcome ("ok", or
-    "incomplete" when the run ended before the body left: then deflection, out_of_plane, b, v_inf and
-    time_delay are None), reason, deflection, out_of_plane, b, v_inf, time_delay, asymptote_error (the
+    "incomplete" when the run ended before the body left: then deflection, out_of_plane, b_in, v_inf_in and
+    time_delay are None), reason, deflection, out_of_plane, b_in, v_inf_in (the incoming asymptote's
+    impact parameter and speed at infinity, as measured: the sweep's columns of these names), time_delay, asymptote_error (the
     asymptotes' model error in the deflection; 0 for B = 0) and asymptote_basis, start_distance_error and
     time_delay_error (what the finite start distance L leaves against L -> infinity: a scene of
     thesis_scene() is run again from 2L, a material point too; for a scene given by its states 0 for B = 0,
