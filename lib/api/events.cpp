@@ -40,8 +40,11 @@ std::string Event::label() const {
 namespace {
 
 /// The grammar's forms, for the message that refuses a text.
-constexpr const char* kEventForms = "closest, closest:K, local-min, local-min:K, r=RADIUS, r:K=RADIUS, x=X, y=Y, z=Z, "
-                                    "plane=nx,ny,nz,offset, departure, departure=R, arrival=R (K: a centre's index)";
+/// Every form an event takes (K: a centre's index), listed by the message for an unknown one.
+std::vector<std::string> event_forms() {
+  return {"closest", "closest:K", "local-min", "local-min:K", "r=RADIUS", "r:K=RADIUS", "x=X", "y=Y", "z=Z",
+          "plane=nx,ny,nz,offset", "departure", "departure=R", "arrival=R"};
+}
 
 double event_number(std::string_view text, const std::string& value) {
   const std::optional<double> x = read_double(value);
@@ -102,7 +105,7 @@ Event parse_event(std::string_view text_view) {
     return Event{Event::Kind::plane, 0, event_number(text_view, value),
                  key == "x" ? Vec3::UnitX() : key == "y" ? Vec3::UnitY() : Vec3::UnitZ()};
   if (!indexed && valued && key == "plane") return parse_plane(text_view, value);
-  throw Error("unknown event '" + text + "': give " + kEventForms);
+  throw Error(unknown_name("event", text, event_forms()) + " (K: a centre's index)");
 }
 
 std::vector<Event> closest_approaches(std::size_t centres) {

@@ -26,22 +26,11 @@ const MethodInfo* find_method(std::string_view name) {
   return nullptr;
 }
 
-namespace {
-/// A name closer to a typo than this many edits is suggested (lp-y5 -> lp-y4, RK4 -> rk4).
-constexpr std::size_t kSuggestDistance = 2;
-}  // namespace
-
-std::string closest_method(std::string_view name) {
-  std::vector<std::string> names;
-  for (const MethodInfo& m : methods()) names.push_back(m.name);
-  return closest_word(name, names, kSuggestDistance);
-}
-
 const MethodInfo& method_or_throw(std::string_view name) {
   if (const MethodInfo* m = find_method(name)) return *m;
-  const std::string near = closest_method(name);
-  throw Error("unknown method '" + std::string(name) + "'" + (near.empty() ? "" : " (did you mean " + near + "?)") +
-              " (see 'bodypoint methods')");
+  std::vector<std::string> names;
+  for (const MethodInfo& m : methods()) names.push_back(m.name);
+  throw Error(unknown_name("method", name, names));
 }
 
 const MethodInfo* detail::method_of(Family family, std::string_view table, const Body& body,

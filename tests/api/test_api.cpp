@@ -651,16 +651,20 @@ namespace bodypoint {
 namespace {
 
 TEST(ApiCatalogue, AnUnknownMethodSuggestsTheClosestName) {
-  EXPECT_EQ(closest_method("RK4"), "rk4");
-  EXPECT_EQ(closest_method("lp-y5"), "lp-y4");
-  EXPECT_EQ(closest_method("logh-kl7"), "logh-kl6");
-  EXPECT_EQ(closest_method("runge-kutta"), "");
-  try {
-    method_or_throw("lp-pefr");
-    FAIL() << "accepted";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("did you mean lp-pefrl?"), std::string::npos) << e.what();
-  }
+  const auto message = [](std::string_view name) {
+    try {
+      method_or_throw(name);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  for (const auto& [typo, near] : {std::pair{"RK4", "rk4"}, {"lp-y5", "lp-y4"}, {"logh-kl7", "logh-kl6"}, {"lp-pefr", "lp-pefrl"}})
+    EXPECT_EQ(message(typo).rfind("unknown method '" + std::string(typo) + "' (did you mean '" + near + "'?); valid: rk4, ", 0), 0u)
+        << message(typo);
+  const std::string far = message("runge-kutta");
+  EXPECT_EQ(far.find("did you mean"), std::string::npos) << far;
+  for (const MethodInfo& m : methods()) EXPECT_NE(far.find(m.name), std::string::npos) << m.name << " not listed";
 }
 
 }  // namespace

@@ -172,7 +172,7 @@ TEST(Cli, BadInputGivesOneLineErrorNonZeroExitAndNoOutputFile) {
       {"--method rk5", "unknown method 'rk5'"},
       {"--bogus 3", "unrecognised option"},
       {"--metod lp-y4", "unrecognised option '--metod' (did you mean --method?)"},
-      {"--method RK4", "unknown method 'RK4' (did you mean rk4?)"},
+      {"--method RK4", "unknown method 'RK4' (did you mean 'rk4'?); valid: "},
       {"--steps 10 --t-end 5", "not both"},
       {"--steps 0", "the number of steps must be a whole number >= 1"},
       {"--scene " + bad_scene.string(), "bad.toml: line"},
@@ -350,6 +350,8 @@ TEST(Cli, UnknownNamesAreWordedAlike) {
        "unknown observable 'spin_angl' (did you mean 'spin_angle'?); valid: t, Rx, "},
       {"study --name dl-map --quick", "unknown study 'dl-map' (did you mean 'dL-map'?); valid: all, "},
       {"work-precision --scenes thesys", "unknown scene 'thesys' (did you mean 'thesis'?); valid: thesis, close, "},
+      {"simulate --steps 10 --method lp-y5", "unknown method 'lp-y5' (did you mean 'lp-y4'?); valid: rk4, ab4, "},
+      {"simulate --steps 10 --event closes", "unknown event 'closes' (did you mean 'closest'?); valid: closest, "},
   };
   for (const auto& [args, message] : cases) {
     const Result r = run_cli(args);

@@ -254,7 +254,7 @@ def test_an_encounter_has_the_command_lines_scattering_fields():
     (lambda: bp.integrate(bp.thesis_scene(), "lp-y4", h=1e-3, steps=10, t_end=1.0), "not both"),
     (lambda: bp.integrate(bp.thesis_scene(), "lp-y4", h=0.01, steps=10.5), "steps must be a whole number"),
     (lambda: bp.integrate("scene", "lp-y4", h=0.01, t_end=1), "scene must be a bodypoint.Scene"),
-    (lambda: bp.integrate(bp.thesis_scene(), "lp-y5", h=0.01, t_end=1), "did you mean lp-y4?"),
+    (lambda: bp.integrate(bp.thesis_scene(), "lp-y5", h=0.01, t_end=1), "did you mean 'lp-y4'?"),
     (lambda: bp.integrate(bp.thesis_scene(), "lp-y4", h=0.01, t_end=1, events=["r=abc"]), "'abc' is not a finite number"),
     (lambda: bp.integrate(bp.thesis_scene(), "lp-y4", h=0.01, t_end=1, events=["r=5garbage"]), "is not a finite number"),
     (lambda: bp.integrate(bp.thesis_scene(), "lp-y4", h=0.01, t_end=1, events=["closest:99999999999999999999"]),

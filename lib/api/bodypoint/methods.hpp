@@ -25,11 +25,8 @@ const std::vector<MethodInfo>& methods();
 /// The method called `name`, or nullptr.
 const MethodInfo* find_method(std::string_view name);
 
-/// The method whose name is within two edits of `name` (letters compared without case), the closest
-/// first in listing order; empty when none is.
-std::string closest_method(std::string_view name);
-
-/// Throws Error("unknown method ...") for a name not in methods(), suggesting closest_method.
+/// Throws Error("unknown method ...") for a name not in methods(), worded as every unknown name: the
+/// name within two edits of it (letters compared without case), then the valid ones.
 const MethodInfo& method_or_throw(std::string_view name);
 
 /// The methods a list names: "all", "fixed" (every fixed-step method but the Kepler split, whose stage
