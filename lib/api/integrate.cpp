@@ -470,14 +470,35 @@ Advance advance_for(const MethodInfo* m, const StepRequest& r) {
 
 // --- Stepper ---
 
+namespace {
+
+/// A Stepper's segment of `span` (> 0) forwards: the step, fictitious step or tolerance per step it
+/// was built with.
+Advance segment_of(const MethodInfo& method, double step, double span) {
+  if (is_time_transformed(method)) return FictitiousSteps{step, EndTime{span}};
+  if (is_step_controlled(method)) return ControlledSteps{std::min(1e-3, span), span, step};
+  return fixed_steps_to(span, step);
+}
+
+/// A Stepper's request (its scene, its way of advancing time, its options), checked once, when it is
+/// built: a segment (advance_to) is valid by construction and runs unchecked.
+const MethodInfo& checked_request(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
+                                  double step, const Options& options) {
+  require_positive(step, is_time_transformed(method) ? "the fictitious step ds"
+                         : is_step_controlled(method)  ? "the tolerance per step tol"
+                                                       : "the step h");
+  check_request(Scene{centres, {body}}, &method, segment_of(method, step, 1.0), options);
+  return method;
+}
+
+}  // namespace
+
 Stepper::Stepper(const MethodInfo& method, Body body, std::vector<Centre> centres, double step, Options options)
-    : method_(&method), body_(std::move(body)), centres_(std::move(centres)), step_(step), options_(options) {
-  require_positive(step_, is_time_transformed(method) ? "the fictitious step ds"
-                          : is_step_controlled(method)  ? "the tolerance per step tol"
-                                                        : "the step h");
-  // The whole request is checked here, once (its scene, its way of advancing time, its options): a
-  // segment (advance_to) is valid by construction and runs unchecked.
-  check_request(Scene{centres_, {body_}}, method_, segment(1.0), options_);
+    : Stepper(Checked{}, checked_request(method, body, centres, step, options), body, centres, step, options) {}
+
+Stepper::Stepper(Checked, const MethodInfo& method, const Body& body, const std::vector<Centre>& centres, double step,
+                 Options options)
+    : method_(&method), body_(body), centres_(centres), step_(step), options_(std::move(options)) {
   // The time-step constant of a time-transformed method is fixed once, from the starting state, so
   // that every segment integrates the same transformed system.
   if (is_time_transformed(method) && options_.omega_c < 0.0)
@@ -490,11 +511,7 @@ Stepper::Stepper(const MethodInfo& method, Body body, std::vector<Centre> centre
   options_.events = detail::resolved(options_.events, body_.p, centres_, body_.s0);
 }
 
-Advance Stepper::segment(double span) const {
-  if (is_time_transformed(*method_)) return FictitiousSteps{step_, EndTime{span}};
-  if (is_step_controlled(*method_)) return ControlledSteps{std::min(1e-3, span), span, step_};
-  return fixed_steps_to(span, step_);
-}
+Advance Stepper::segment(double span) const { return segment_of(*method_, step_, span); }
 
 Stepper::Stepper(std::string_view method, Body body, std::vector<Centre> centres, double step, Options options)
     : Stepper(method_or_throw(method), std::move(body), std::move(centres), step, options) {}
@@ -505,10 +522,11 @@ namespace {
 /// constant searched over the whole span (no sink, no events: the segments hand those on).
 BodyResult searched(std::string_view method, const Body& body, const std::vector<Centre>& centres, const Accuracy& a,
                     Options options) {
+  const MethodInfo* m = method == "auto" ? nullptr : &method_or_throw(method);
+  check_request(Scene{centres, {body}}, m, Accuracy{a.tol, a.t_end}, options);  // the Stepper's one check
   options.sink = nullptr;
   options.events.clear();
-  const MethodInfo* m = method == "auto" ? nullptr : &method_or_throw(method);
-  BodyResult r = integrate_body(body, centres, m, Accuracy{a.tol, a.t_end}, options);
+  BodyResult r = detail::integrate_checked(body, centres, m, Accuracy{a.tol, a.t_end}, options);
   if (r.outcome != Outcome::ok || !r.accuracy)
     throw Error("the accuracy mode found no step for tol " + fmt(a.tol) + " to t_end = " + fmt(a.t_end) + ": " + r.reason);
   return r;
@@ -526,7 +544,7 @@ Stepper::Stepper(std::string_view method, Body body, std::vector<Centre> centres
 
 Stepper::Stepper(const Body& body, const std::vector<Centre>& centres, const BodyResult& r, const Options& options,
                  double t_end)
-    : Stepper(*r.method, body, centres, r.accuracy->h_chosen, with_constant(options, r)) {
+    : Stepper(Checked{}, *r.method, body, centres, r.accuracy->h_chosen, with_constant(options, r)) {
   accuracy_ = r.accuracy;
   accuracy_t_end_ = t_end;
 }

@@ -426,6 +426,10 @@ class Stepper {
   [[nodiscard]] Advance segment(double span) const;
   Stepper(const Body& body, const std::vector<Centre>& centres, const BodyResult& searched, const Options& options,
           double t_end);
+  /// A request checked already (by the public constructors, once): the segments' settings from it.
+  struct Checked {};
+  Stepper(Checked, const MethodInfo& method, const Body& body, const std::vector<Centre>& centres, double step,
+          Options options);
 
   const MethodInfo* method_;
   Body body_;  // body_.s0 is the current state
