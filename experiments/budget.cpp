@@ -1,6 +1,7 @@
 #include "budget.hpp"
 
 #include "bodypoint/bodypoint.hpp"
+#include "checked.hpp"
 #include "bodypoint/io.hpp"
 
 #include <chrono>
@@ -53,7 +54,7 @@ std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body,
     cal.max_energy_error = std::numeric_limits<double>::infinity();
     cal.estimate_error = false;
     const Advance a = fixed ? Advance(FixedSteps{fixed->h, steps}) : Advance(FictitiousSteps{fictitious->ds, StepCount{steps}});
-    BodyResult r = integrate_body(body, centres, &m, a, cal);
+    BodyResult r = detail::integrate_checked(body, centres, &m, a, cal);
     if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return std::nullopt;
     return std::move(r.run);
   };

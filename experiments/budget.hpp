@@ -24,7 +24,8 @@ struct WorkEstimate {
 /// The estimate for a run that may be long, or nothing when the run is short (or adaptive: those are
 /// bounded by their own step cap).
 /// `options` are the run's (the calibration observes as it will; an error estimate's companion costs
-/// ErrorEstimate::kTypicalCost runs more).
+/// ErrorEstimate::kTypicalCost runs more). The request was checked by the caller (check_request, or the
+/// scene by validate and the rest by check_run): the calibration runs it unchecked.
 std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
                                           const Advance& how, const Options& options);
 

@@ -61,7 +61,9 @@ Scene make_scene(const po::variables_map& vm, SceneOptions& o) {
     return scene;
   }
   o.params = scene_params(vm, o);  // with b, v_inf or the arrival phase: d, K1 or phase as solved
-  return thesis_scene(o.params);
+  Scene scene = thesis_scene(o.params);
+  validate(scene);
+  return scene;
 }
 
 void add_step_options(po::options_description& desc, StepOptions& o) {

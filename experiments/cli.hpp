@@ -38,6 +38,7 @@ void add_scene_options(po::options_description& desc, SceneOptions& o);
 /// The thesis's parameters with --b and --v-inf applied (d and K1 solved for them; scattering.hpp).
 SceneParams scene_params(const po::variables_map& vm, const SceneOptions& o);
 /// The scene from --scene or from the thesis's parameters (never both); o.params becomes the solved ones.
+/// The scene is checked here, once (validate): the command's runs take it as checked (run_body).
 Scene make_scene(const po::variables_map& vm, SceneOptions& o);
 
 /// Step options: --h and --steps or --t-end.
@@ -80,8 +81,8 @@ double planned_step(const RunPlan& plan);
 /// plan.how's end time: t_end, or the end of its steps (fictitious steps: 0, not known in advance).
 double planned_end(const RunPlan& plan);
 
-/// Runs one body as planned through the library (integrate_body with `how`, plan.options, the sink
-/// and the events). A method that refuses the scene or a run that fails throws Error with the
+/// Runs one body of a scene checked by make_scene as planned through the library (integrate_body with
+/// `how`, plan.options, the sink and the events, its scene not checked again). A method that refuses the scene or a run that fails throws Error with the
 /// library's reason; diverged and collision are left to the caller (outcome, reason).
 BodyResult run_body(const RunPlan& plan, const Body& body, const std::vector<Centre>& centres, const Advance& how,
                  const SampleSink* sink, const std::vector<Event>& events = {});

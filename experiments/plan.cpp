@@ -3,6 +3,7 @@
 #include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/methods.hpp"
 #include "cli.hpp"
+#include "checked.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -53,7 +54,8 @@ BodyResult run_body(const RunPlan& plan, const Body& body, const std::vector<Cen
   Options options = plan.options;
   options.events = events;
   options.sink = sink;
-  BodyResult r = integrate_body(body, centres, plan.method, how, options);
+  detail::check_run(centres, plan.method, how, options);  // the scene was checked where it was made (make_scene)
+  BodyResult r = detail::integrate_checked(body, centres, plan.method, how, options);
   if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) throw Error(r.reason);
   return r;
 }

@@ -5,6 +5,7 @@
 #include "stress.hpp"
 
 #include "bodypoint/bodypoint.hpp"
+#include "checked.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
 #include "budget.hpp"
@@ -126,8 +127,9 @@ StressRow run_case(const StressCase& c, const MethodInfo& m, double max_seconds)
     else if (is_time_transformed(m)) how = FictitiousSteps{c.h * 10, EndTime{c.t_end}};
     else how = FixedSteps{c.h, static_cast<long>(std::llround(c.t_end / c.h))};
     const Options options;
+    check_request(Scene{c.scene.centres, {body}}, &m, how, options);  // once: the calibration and the run take it
     if (const auto e = estimate_work(m, body, c.scene.centres, how, options)) check_budget(*e, max_seconds, true);
-    BodyResult r = integrate_body(body, c.scene.centres, &m, how, options);
+    BodyResult r = detail::integrate_checked(body, c.scene.centres, &m, how, options);
     row.outcome = r.outcome;
     row.reason = std::move(r.reason);
     if (r.outcome != Outcome::refused && r.outcome != Outcome::failed) {

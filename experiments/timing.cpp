@@ -23,7 +23,7 @@ namespace bodypoint::cli {
 /// Refuses a study whose calibrated time (every n, method, warm-up and repeat) exceeds the budget, and
 /// announces one longer than kAnnounceSeconds on stderr (a study of 1e10 steps calibrated at 1,110 s
 /// ran without a word).
-void check_timing_budget(const TimingSpec& spec, double max_seconds) {
+void check_timing_budget(const TimingSpec& spec, const Scene& scene, double max_seconds) {
   const double bound = max_seconds > 0.0 ? std::min(max_seconds, kAnnounceSeconds) : kAnnounceSeconds;
   double steps = 0.0;
   for (long n : spec.ns) steps += static_cast<double>(n);
@@ -32,7 +32,6 @@ void check_timing_budget(const TimingSpec& spec, double max_seconds) {
   const double batches = static_cast<double>(spec.repeats) * static_cast<double>(spec.ns.size()) *
                          static_cast<double>(spec.methods.size()) * kMinRepeatSeconds;
   if (steps * runs * static_cast<double>(spec.methods.size()) * kMaxSecondsPerStep + batches <= bound) return;
-  const Scene scene = thesis_scene(spec.base);
   double seconds = batches;
   for (const MethodInfo* m : spec.methods)
     seconds += estimated_seconds(*m, scene.bodies.front(), scene.centres, spec.h, steps, runs);
@@ -50,8 +49,9 @@ std::vector<TimingRow> run_timing(const TimingSpec& spec, bool progress) {
   check_rules(rules);
   for (long n : spec.ns)
     if (n < 1) throw Error("n must be >= 1, got " + std::to_string(n));
-  check_timing_budget(spec, spec.max_seconds);
   const Scene scene = thesis_scene(spec.base);
+  validate(scene);  // once: the calibration and the timed runs take it as checked
+  check_timing_budget(spec, scene, spec.max_seconds);
   std::vector<TimingRow> rows;
   std::size_t done = 0;
   const std::size_t total = spec.ns.size() * spec.methods.size();

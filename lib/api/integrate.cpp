@@ -316,26 +316,6 @@ BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& cen
   return r;
 }
 
-/// Every part of a request checked once, each with one message naming the quantity: the scene, the
-/// way of advancing time and whether the method takes it, the options and the events.
-void check_request(const Scene& scene, const MethodInfo* method, const Advance& how, const Options& options) {
-  validate(scene);
-  if (const auto* f = std::get_if<FictitiousSteps>(&how); f && f->end.index() == 0 && f->ds < 0.0)
-    throw Error("the fictitious step ds must be > 0 (a run backwards has a negative end time), got " + fmt(f->ds));
-  check(forwards(how));  // a run backwards is checked as the forward run it makes (integrate_estimated)
-  if (const auto* accuracy = std::get_if<Accuracy>(&how)) {
-    adaptive::check_tolerance(accuracy->tol);
-    if (method) adaptive::check_searchable(*method);
-  } else if (!method) {
-    throw Error("only the accuracy mode chooses a method by itself; name one");
-  } else {
-    check_takes(*method, how);
-  }
-  check(options);
-  check_energy_bound(options.max_energy_error);
-  check_error_bound(options.max_error);
-  detail::validate_events(options.events, scene.centres);
-}
 
 BodyResult integrate_forwards(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
                               const Advance& how, const Options& options);
@@ -380,6 +360,30 @@ BodyResult integrate_forwards(const Body& body, const std::vector<Centre>& centr
 }
 
 }  // namespace
+
+void check_request(const Scene& scene, const MethodInfo* method, const Advance& how, const Options& options) {
+  validate(scene);
+  detail::check_run(scene.centres, method, how, options);
+}
+
+void detail::check_run(const std::vector<Centre>& centres, const MethodInfo* method, const Advance& how,
+                       const Options& options) {
+  if (const auto* f = std::get_if<FictitiousSteps>(&how); f && f->end.index() == 0 && f->ds < 0.0)
+    throw Error("the fictitious step ds must be > 0 (a run backwards has a negative end time), got " + fmt(f->ds));
+  check(forwards(how));  // a run backwards is checked as the forward run it makes (integrate_estimated)
+  if (const auto* accuracy = std::get_if<Accuracy>(&how)) {
+    adaptive::check_tolerance(accuracy->tol);
+    if (method) adaptive::check_searchable(*method);
+  } else if (!method) {
+    throw Error("only the accuracy mode chooses a method by itself; name one");
+  } else {
+    check_takes(*method, how);
+  }
+  check(options);
+  check_energy_bound(options.max_energy_error);
+  check_error_bound(options.max_error);
+  detail::validate_events(options.events, centres);
+}
 
 bool takes_time_step_constant(const MethodInfo& method) {
   return method.traits.takes_omega_c;

@@ -398,7 +398,7 @@ void validate_sweep(const SweepSpec& spec) {
   for (std::size_t p = 0; p < points; ++p) {
     const std::vector<double> point = grid_point(spec, p);
     try {
-      point_scene(spec, point);
+      validate(point_scene(spec, point));
       for (const MethodInfo* m : spec.methods) check(point_advance(spec, *m, point));
     } catch (const Error& e) {
       throw Error(point_label(spec, point) + ": " + e.what());

@@ -196,7 +196,9 @@ const std::vector<SceneParameter>& scene_parameters();
 /// The field of p named `name`; Error for an unknown name.
 double& scene_field(SceneParams& p, std::string_view name);
 
-/// Scene of one body and one centre at the origin from the thesis's parameters.
+/// Scene of one body and one centre at the origin from the thesis's parameters. Error for a parameter
+/// it cannot compute from (not finite, K1 = 0, m, J or D not positive); the scene as a whole (its start
+/// off the centre, its energy representable) is checked once, by the request that runs it (validate).
 Scene thesis_scene(const SceneParams& sp);
 
 /// Throws Error with a one-line message on the first violated rule: finite numbers, m > 0,

@@ -234,15 +234,18 @@ Scene parse_scene(const std::string& text, const std::string& origin, const std:
       scene.centres.push_back(parse_centre(*(*cs)[k].as_table(), "centre " + std::to_string(k + 1), origin));
   if (const toml::array* bs = array_of_tables(root, "body", origin))
     for (std::size_t i = 0; i < bs->size(); ++i) scene.bodies.push_back(parse_body(*(*bs)[i].as_table(), i, origin));
-  try {
-    validate(scene);
-  } catch (const Error& e) {
-    fail(origin, e.what());
-  }
   return scene;
 }
 
-Scene read_scene_file(const std::string& path) { return parse_scene(read_scene_text(path), path); }
+Scene read_scene_file(const std::string& path) {
+  Scene scene = parse_scene(read_scene_text(path), path);
+  try {
+    validate(scene);
+  } catch (const Error& e) {
+    fail(path, e.what());
+  }
+  return scene;
+}
 
 std::string read_scene_text(const std::string& path) {
   // A scene file is a few lines; a device (/dev/zero) or a huge file would be read forever.

@@ -38,7 +38,8 @@ struct SceneValue {
 };
 
 /// Parses scene text (`origin` names it in messages), with `set` applied to the file's keys first;
-/// Error naming the key for a key the scene does not have.
+/// Error naming the key for a key the scene does not have, or a value that is not a body's parameter.
+/// The scene as a whole is checked once, where it is run (validate; read_scene_file checks it).
 Scene parse_scene(const std::string& text, const std::string& origin, const std::vector<SceneValue>& set = {});
 /// Whether `key` is a key path of SceneValue's form (a scene file's key, not a thesis parameter).
 bool is_scene_key(const std::string& key);

@@ -45,14 +45,12 @@ inline NamedScene named_scene(const std::string& name) {
   if (name == "two-centres") {
     Scene s = thesis_scene(sp);
     s.centres.push_back({Vec3(40.0, 6.0, 0.0), -1.0});
-    validate(s);
     return {name, s, 60.0};
   }
   if (name == "three-centres") {
     Scene s = thesis_scene(sp);
     s.centres.push_back({Vec3(40.0, 6.0, 0.0), -1.0});
     s.centres.push_back({Vec3(80.0, -8.0, 0.0), 1.5});
-    validate(s);
     return {name, s, 60.0};
   }
   throw Error(unknown_name("scene", name, named_scene_names()));
@@ -80,7 +78,6 @@ inline NamedScene convergence_orbit(double B) {
   // K1 = (0, 1.2, 0), K2 = (0.3, 0, 0.5) give the spin a component off the orbit normal.
   const Momenta q{Vec3(1, 0, 0), Vec3(0, 1.2, 0), Vec3(0.3, 0, 0.5)};
   s.bodies.push_back({p, to_state(p, q), "orbit"});
-  validate(s);
   return {"orbit", s, 30.0};
 }
 

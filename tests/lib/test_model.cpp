@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <random>
 #include <type_traits>
@@ -300,9 +302,15 @@ TEST(SceneFile, RejectsMalformedFiles) {
                "exactly one form");
   expect_error([] { parse_scene("[[centre]]\nA = -1\n[[body]]\nm = 1\nB = 1\nJ = 1\nR = [1, 0, 0]\nv = [0, 1, 0]\nw = [0, 0, 0]\n", "f"); },
                "D = m J - B^2");
-  expect_error([] { parse_scene("[[centre]]\nA = -1\n[[body]]\nm = 1\nB = 0\nJ = 1\nR = [0, 0, 0]\nv = [0, 1, 0]\nw = [0, 0, 0]\n", "f"); },
-               "starts on centre");
-  expect_error([] { parse_scene("", "f"); }, "no Coulomb centre");
+  // The scene as a whole is checked once, where it is run (validate); read_scene_file checks it, in the
+  // file's name.
+  const std::string on_centre = "[[centre]]\nA = -1\n[[body]]\nm = 1\nB = 0\nJ = 1\nR = [0, 0, 0]\nv = [0, 1, 0]\nw = [0, 0, 0]\n";
+  expect_error([&] { validate(parse_scene(on_centre, "f")); }, "starts on centre");
+  expect_error([] { validate(parse_scene("", "f")); }, "no Coulomb centre");
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / "bodypoint_test_on_centre.toml";
+  std::ofstream(file) << on_centre;
+  expect_error([&] { read_scene_file(file.string()); }, file.string() + ": body 'body1' starts on centre 1");
+  std::filesystem::remove(file);
   expect_error([] { read_scene_file("/nonexistent/scene.toml"); }, "cannot open");
 }
 
