@@ -13,6 +13,7 @@
 #include "bodypoint/run.hpp"
 #include "bodypoint/scenes.hpp"
 #include "bodypoint/splitting/lie_poisson.hpp"
+#include "sweep_tasks.hpp"
 
 #include <benchmark/benchmark.h>
 

@@ -5,6 +5,7 @@
 #include "bodypoint/threads.hpp"
 #include "bodypoint/io.hpp"
 #include "rows_file.hpp"
+#include "sweep_tasks.hpp"
 
 #include <chrono>
 #include <cstdlib>

@@ -9,6 +9,7 @@
 #pragma once
 
 #include "sweep.hpp"
+#include "sweep_tasks.hpp"
 
 #include <memory>
 #include <string>

@@ -20,6 +20,7 @@
 #include "bodypoint/bodypoint.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/threads.hpp"
+#include "encounter_parts.hpp"
 #include "sweep.hpp"
 
 #include <algorithm>

@@ -10,6 +10,7 @@
 #include "bodypoint/run.hpp"
 #include "budget.hpp"
 #include "cli.hpp"
+#include "encounter_parts.hpp"
 
 #include <algorithm>
 #include <cmath>

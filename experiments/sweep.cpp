@@ -10,6 +10,7 @@
 #include "cli.hpp"
 #include "mpi_sweep.hpp"
 #include "rows_file.hpp"
+#include "sweep_tasks.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -6,6 +6,7 @@
 #include "bodypoint/model.hpp"
 #include "bodypoint/run.hpp"
 #include "bodypoint/sweep.hpp"
+#include "sweep_tasks.hpp"
 
 #include <ostream>
 #include <string>

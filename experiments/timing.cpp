@@ -10,6 +10,7 @@
 #include "cli.hpp"
 #include "stopwatch.hpp"
 #include "sweep.hpp"
+#include "sweep_tasks.hpp"
 
 #include <algorithm>
 #include <cmath>

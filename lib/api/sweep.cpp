@@ -7,7 +7,9 @@
 #include "bodypoint/io.hpp"
 #include "bodypoint/scene_file.hpp"
 #include "checked.hpp"
+#include "encounter_parts.hpp"
 #include "estimate.hpp"
+#include "sweep_tasks.hpp"
 
 #include <algorithm>
 #include <atomic>

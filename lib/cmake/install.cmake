@@ -2,7 +2,8 @@
 # bodypoint (bodypointConfig.cmake with its version file), so that a program outside the tree writes
 #   find_package(bodypoint 0.1 REQUIRED)
 #   target_link_libraries(app PRIVATE bodypoint::bodypoint)
-# The public headers are the API and what it exposes; the rest (kernels, drivers, detail/) stays inside.
+# The public headers are the API and what it exposes; the rest (kernels, drivers, detail/, the commands'
+# helpers: io, scenes, observables, batch, threads, order_fit, the accuracy layer's search) stays inside.
 include(CMakePackageConfigHelpers)
 
 set_target_properties(bodypoint_core PROPERTIES EXPORT_NAME core)
@@ -23,22 +24,12 @@ install(FILES
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/run.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/scattering.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/scene_file.hpp
-          ${PROJECT_SOURCE_DIR}/lib/bodypoint/scenes.hpp
-          ${PROJECT_SOURCE_DIR}/lib/bodypoint/observables.hpp
-          ${PROJECT_SOURCE_DIR}/lib/bodypoint/io.hpp
-          ${PROJECT_SOURCE_DIR}/lib/bodypoint/batch.hpp
-          ${PROJECT_SOURCE_DIR}/lib/bodypoint/threads.hpp
-          ${PROJECT_SOURCE_DIR}/lib/bodypoint/order_fit.hpp
           # The independent references and the equations of motion as an ODE system (Boost.Odeint's
           # headers are needed where a program includes these).
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/reference.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/rhs.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/kepler.hpp
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bodypoint)
-install(FILES
-          ${PROJECT_SOURCE_DIR}/adaptive/bodypoint/adaptive/tolerance.hpp
-          ${PROJECT_SOURCE_DIR}/adaptive/bodypoint/adaptive/methods.hpp
-        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bodypoint/adaptive)
 
 set(BODYPOINT_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/bodypoint)
 install(EXPORT bodypointTargets NAMESPACE bodypoint:: DESTINATION ${BODYPOINT_CMAKE_DIR})

@@ -9,6 +9,7 @@
 #include "bodypoint/record.hpp"
 #include "bodypoint/sweep.hpp"
 #include "bodypoint/threads.hpp"
+#include "encounter_parts.hpp"
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>

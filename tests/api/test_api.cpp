@@ -5,6 +5,7 @@
 #include "bodypoint/bodypoint.hpp"
 #include "bodypoint/reference.hpp"
 #include "bodypoint/sweep.hpp"
+#include "sweep_tasks.hpp"
 
 #include <gtest/gtest.h>
 

@@ -7,6 +7,7 @@
 #include "bodypoint/scene_file.hpp"
 #include "bodypoint/sweep.hpp"
 #include "common.hpp"
+#include "sweep_tasks.hpp"
 
 #include <gtest/gtest.h>
 

@@ -290,13 +290,13 @@ struct Encounter {
   /// Estimated error of the deflection that the asymptotes' model leaves at the run's distances (the
   /// guiding centre is a Kepler particle only far away): the change of the deflection between the
   /// asymptotes taken at the run's ends and at half the start distance, over 2^p - 1 with p =
-  /// kAsymptoteFall. 0 for B = 0 (Kepler's asymptotes are exact); NaN when not known (no
+  /// 2.7, the slowest fall with the distance measured (docs/physics.md, "Scattering"). 0 for B = 0 (Kepler's asymptotes are exact); NaN when not known (no
   /// asymptotes, or the body never came within half its start distance).
   double asymptote_error = Scattering::kNaN;
   std::string asymptote_basis;  ///< how asymptote_error was obtained, or why it is not known
   /// The error of the deflection and of the time delay that the start's finite distance L leaves against
-  /// the limit L -> infinity of the scene as given (thesis_params_twice_as_far; the observables converge as
-  /// 1/L: 3 |x(L) - x(2L)| from the same scene started at 2L, add_start_distance_error; a material point
+  /// the limit L -> infinity of the scene as given (the observables converge as 1/L: 3 |x(L) - x(2L)| from
+  /// the same scene started at 2L, the thesis's parameters with L doubled and b, v_inf solved again; a material point
   /// too where its K1 is given, its v_inf moving with L). 0 for a scene file's material point (its hyperbola
   /// is that of its states); NaN when not known.
   double start_distance_error = Scattering::kNaN, time_delay_error = Scattering::kNaN;
@@ -307,27 +307,6 @@ struct Encounter {
   double deflection_error = Scattering::kNaN;
 };
 
-/// The slowest fall of the asymptotes' model error with the distance L measured (L^-2.7; study
-/// --name scattering, docs/physics.md "Scattering"): halving the distance raises it at least 2^2.7x.
-inline constexpr double kAsymptoteFall = 2.7;
-/// A run with no end time given ends at the departure, or after this many free passes (twice the
-/// start distance over the speed at infinity), then incomplete.
-inline constexpr double kEncounterSpans = 2.0;
-
-/// The events an encounter's run needs, added to `options`: every centre's closest approach; with a
-/// single centre, the guiding centre's arrival at and departure from half its start distance (the
-/// asymptotes' error estimate) and, with `stop_at_departure`, its departure through the start distance
-/// as a stop event. The caller's events stay first, with their indices.
-Options encounter_options(const Body& body, const std::vector<Centre>& centres, Options options, bool stop_at_departure);
-
-/// The encounter of `body` on its run (`run` and the hits of `events`, as encounter_options made them).
-Encounter measure_encounter(const Body& body, const std::vector<Centre>& centres, const RunResult& run,
-                            const std::vector<EventHit>& hits, const std::vector<Event>& events);
-
-/// The end time an encounter of `body` runs to when none is given: kEncounterSpans free passes. Error
-/// when the body has no speed at infinity (a bound orbit, several centres).
-double encounter_span(const Body& body, const std::vector<Centre>& centres);
-
 /// One body's encounter with the accuracy mode (tol; method nullptr: auto): the run stops at the
 /// departure, by t_end (NaN: encounter_span). A run that is not ok keeps its outcome and reason.
 struct EncounterResult {
@@ -337,35 +316,6 @@ struct EncounterResult {
 };
 EncounterResult encounter(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method, double tol,
                           double t_end = Scattering::kNaN, Options options = {});
-
-/// The accuracy of the encounter from twice the start distance, run by auto (the run's own method may not
-/// reach its tol that far out: lp-kl8 at 1e-10 from L = 400): the run's tol where it had one, otherwise
-/// kTwiceAsFarTol (its error must stay well below the 1/L term it measures, 1e-5..1e-3 relative at L = 200).
-inline constexpr double kTwiceAsFarTol = 1e-10;
-inline double twice_as_far_tol(std::optional<double> run_tol) { return run_tol ? *run_tol : kTwiceAsFarTol; }
-/// Sets the start distance's part of `at_L`'s error from the same encounter started twice as far
-/// (`at_2L`: encounter_twice_as_far of the thesis's scene at thesis_params_twice_as_far; its own estimated
-/// error counts in), and the deflection's total error with `numerical` (the run's err_estimate). For
-/// B = 0 (`material`) no second encounter is needed: pass nullptr.
-void add_start_distance_error(Encounter& at_L, const EncounterResult* at_2L, bool material, double numerical);
-/// The encounter of `far` (the thesis's scene from 2L) by auto at `tol` (twice_as_far_tol), looser by
-/// 100x while auto refuses it as out of reach, to 1e-6 at most (the 1/L term it measures is 1e-6..1e-3
-/// at L = 200..1600; auto at 1e-10 is out of reach from L = 3200).
-EncounterResult encounter_twice_as_far(const Scene& far, double tol, const Options& options = {});
-/// The same when the start distance cannot be doubled (a scene given by its states): the part is not
-/// known (`why`), nor is the total, for B != 0.
-void no_start_distance_error(Encounter& e, bool material, double numerical, const std::string& why);
-/// The start distance's part of `e`'s error, one rule for every caller (simulate, sweep, the scattering
-/// study, Python): exact for a material point; not known (`no_far` says why) where the scene has no
-/// thesis start distance to double (`far` empty); otherwise the encounter from `far()` (the thesis's
-/// scene at thesis_params_twice_as_far) run by auto at twice_as_far_tol(tol). Returns the force
-/// evaluations of that second encounter (0 where none ran).
-long add_start_distance(Encounter& e, const Body& body, const std::function<Scene()>& far, std::optional<double> tol,
-                        double numerical, const std::string& no_far, const Options& options = {});
-/// The thesis's parameters `solved` (d, K1, phase solved for the asymptotic data) with the start distance L
-/// doubled and the data b, v_inf (NaN: not given, d, K1 kept) solved for again; the arrival phase as given,
-/// or (NaN) the scene's own at L (a start phase kept has no limit L -> infinity: the extra way in turns it).
-SceneParams thesis_params_twice_as_far(SceneParams solved, double b, double v_inf, double arrival_phase);
 
 /// One body advanced in segments: advance_to(t) integrates from the current time to t and may be
 /// called again to continue. Each segment starts from the state the previous one ended in, as a run

@@ -81,33 +81,12 @@ struct SweepSpec {
 std::size_t task_count(const SweepSpec& spec);
 /// The values of the varied parameters at grid point p (in axis order).
 std::vector<double> grid_point(const SweepSpec& spec, std::size_t p);
-/// The scene parameters at a grid point.
-SceneParams point_params(const SweepSpec& spec, const std::vector<double>& point);
 /// The axis of a scene file's sweep that picks its body (values 1..n), one row per body.
 inline constexpr const char* kBodyAxis = "body";
 /// `spec` over a scene file's text (`origin` names it in messages): checked, and with several bodies
 /// the axis kBodyAxis appended (every body of every point its own row). Error for a scene that does not
 /// parse or a sweep of the thesis's parameters (d, b, ...) that a scene file does not have.
 SweepSpec with_scene_file(SweepSpec spec, std::string text, std::string origin);
-/// The scene at a grid point: the thesis's (point_params), or the scene file's with the axes' keys set
-/// and, with the axis kBodyAxis, only that body.
-Scene point_scene(const SweepSpec& spec, const std::vector<double>& point);
-/// A sweep task's fixed steps: `steps` steps of h, or with t_end > 0 the steps of at most h that land
-/// on t_end (fixed_steps_to); under ForceLaw::thesis_code the code's count instead (thesis_code_steps:
-/// n - 1 steps of exactly h). Error for an h that is not a finite number > 0 or fewer than one step.
-FixedSteps sweep_steps(double h, long steps, double t_end, ForceLaw law = ForceLaw::coulomb);
-/// A task's way of advancing time: to_common_end of its point's sweep_steps, or with SweepSpec::accuracy
-/// (for every method but the step-size-controlled peers) Accuracy{accuracy, t_end}.
-/// Every method to one end time T = f.h f.steps: fixed-step methods take f, time-transformed ones
-/// fictitious steps ds = f.h to T, step-size-controlled ones run to T from a first trial step f.h at
-/// tolerance tol per step (the rule of sweeps, the timing study and the step benchmarks).
-Advance to_common_end(const MethodInfo& method, const FixedSteps& f, double tol);
-/// How `method` advances at a grid point: every method of a sweep ends at the same time T = h n of the
-/// point's sweep_steps (h, n): fixed-step methods take those steps, time-transformed ones fictitious
-/// steps ds = h to T, step-size-controlled ones run to T from a first trial step h at tolerance tol.
-Advance point_advance(const SweepSpec& spec, const MethodInfo& method, const std::vector<double>& point);
-/// "d = 5, L = 100": a grid point for messages.
-std::string point_label(const SweepSpec& spec, const std::vector<double>& point);
 
 /// Throws Error for an empty sweep, or a grid point whose scene or step is invalid (the point named).
 void validate_sweep(const SweepSpec& spec);
@@ -141,33 +120,6 @@ struct SweepRow {
   double start_distance_error = Scattering::kNaN, time_delay_error = Scattering::kNaN, deflection_error = Scattering::kNaN;
   std::optional<AccuracyReport> accuracy;  ///< with SweepSpec::accuracy: what the search chose and cost
 };
-
-/// The tasks of `todo` in units: batches of up to batch::width() tasks of one method and step whose
-/// scenes a batch kernel accepts (with simd), single tasks otherwise.
-std::vector<std::vector<std::size_t>> plan_units(const SweepSpec& spec, const std::vector<std::size_t>& todo, bool simd);
-/// Runs one unit; its rows in the unit's order.
-std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vector<std::size_t>& unit);
-
-/// The shard (0 .. shards-1) that runs task i = point * M + method: (point + method) % shards, so that
-/// every shard gets every method on an equal share of the points.
-std::size_t shard_of(const SweepSpec& spec, std::size_t task, std::size_t shards);
-
-/// How run_sweep_tasks runs.
-struct SweepRunner {
-  unsigned threads = 1;
-  bool simd = true;  ///< batches of vector lanes where a kernel accepts them (false: every task alone)
-  /// Receives each finished row, one call at a time, in completion order. An exception from it stops
-  /// the handing out of units and is rethrown after the running ones finish.
-  std::function<void(SweepRow&&)> on_row;
-  /// Asked before each unit: true stops the handing out of units (the running ones finish).
-  std::function<bool()> stop;
-  /// The caller ran validate_sweep on this spec already (a command checks it before it opens its outputs):
-  /// its points are not built and checked a second time.
-  bool validated = false;
-};
-
-/// Validates the sweep (unless runner.validated), then runs the tasks of `todo` on runner.threads threads.
-void run_sweep_tasks(const SweepSpec& spec, const std::vector<std::size_t>& todo, const SweepRunner& runner);
 
 /// Every task of the sweep, by task index, on `threads` threads.
 /// `progress`, when given, is told (rows done, rows in all) after every row, one call at a time.
