@@ -17,6 +17,7 @@
 #include "bodypoint/adaptive/time_transformed.hpp"
 #include "bodypoint/detail/run_support.hpp"
 #include "bodypoint/splitting/catalogue.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 
 #include <cmath>
 #include <limits>

@@ -15,6 +15,7 @@
 #include "bodypoint/methods.hpp"
 #include "bodypoint/model.hpp"
 #include "bodypoint/run.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 #include "bodypoint/scenes.hpp"
 
 #include <algorithm>

@@ -11,6 +11,7 @@
 #include "budget.hpp"
 #include "cli.hpp"
 #include "encounter_parts.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -9,6 +9,7 @@
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
 #include "budget.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 
 #include <algorithm>
 #include <cmath>

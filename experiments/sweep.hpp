@@ -7,6 +7,7 @@
 #include "bodypoint/run.hpp"
 #include "bodypoint/sweep.hpp"
 #include "sweep_tasks.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 
 #include <ostream>
 #include <string>

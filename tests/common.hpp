@@ -4,6 +4,7 @@
 #include "bodypoint/model.hpp"
 #include "bodypoint/order_fit.hpp"
 #include "bodypoint/run.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 
 #include <gtest/gtest.h>
 

@@ -10,6 +10,7 @@
 
 #include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/detail/run_support.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 
 #include <cstddef>
 #include <limits>

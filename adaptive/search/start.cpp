@@ -3,6 +3,7 @@
 
 #include "bodypoint/adaptive/methods.hpp"
 #include "bodypoint/field.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 
 #include <algorithm>
 #include <cmath>

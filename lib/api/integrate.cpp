@@ -10,6 +10,7 @@
 #include "choice.hpp"
 #include "estimate.hpp"
 #include "events.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 
 #include <algorithm>
 #include <cmath>

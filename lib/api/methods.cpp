@@ -4,6 +4,7 @@
 
 #include "bodypoint/adaptive/methods.hpp"
 #include "bodypoint/io.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 
 #include <algorithm>
 #include <string>

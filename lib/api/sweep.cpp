@@ -10,6 +10,7 @@
 #include "encounter_parts.hpp"
 #include "estimate.hpp"
 #include "sweep_tasks.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 
 #include <algorithm>
 #include <atomic>

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "bodypoint/sweep.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 
 #include <cstddef>
 #include <functional>

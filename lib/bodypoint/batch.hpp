@@ -11,6 +11,7 @@
 
 #include "bodypoint/model.hpp"
 #include "bodypoint/run.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 
 #include <atomic>
 #include <cstddef>

@@ -18,6 +18,7 @@
 #include "bodypoint/splitting/kepler_split.hpp"
 #include "bodypoint/splitting/lie_poisson.hpp"
 #include "bodypoint/splitting/thesis.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -6,6 +6,7 @@
 #include "bodypoint/reference.hpp"
 #include "bodypoint/sweep.hpp"
 #include "sweep_tasks.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 
 #include <gtest/gtest.h>
 

@@ -6,6 +6,7 @@
 #include "bodypoint/io.hpp"
 #include "process.hpp"
 #include "bodypoint/run.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 
 #include <gtest/gtest.h>
 

@@ -4,6 +4,7 @@
 #include "bodypoint/batch.hpp"
 #include "bodypoint/methods.hpp"
 #include "bodypoint/run.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 
 #include <gtest/gtest.h>
 

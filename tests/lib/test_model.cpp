@@ -8,6 +8,7 @@
 #include "bodypoint/sweep.hpp"
 #include "common.hpp"
 #include "sweep_tasks.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 
 #include <gtest/gtest.h>
 

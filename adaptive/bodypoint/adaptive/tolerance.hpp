@@ -15,6 +15,7 @@
 #pragma once
 
 #include "bodypoint/run.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 
 #include <limits>
 #include <string>

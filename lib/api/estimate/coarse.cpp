@@ -5,6 +5,7 @@
 
 #include "bodypoint/adaptive/richardson.hpp"
 #include "bodypoint/batch.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -17,6 +17,7 @@
 #include "bodypoint/run.hpp"
 #include "bodypoint/splitting/catalogue.hpp"
 #include "bodypoint/splitting/lie_poisson.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 
 #include <limits>
 #include <string_view>

@@ -17,7 +17,7 @@ inline constexpr std::size_t kOut = 16;
 /// splitting::drift_functions(x) as {S1, C1, S3}, built for the baseline (batch.cpp).
 void scalar_drift_functions(double x, double* out);
 
-/// A run's cancellation as the units see it: called with `context` every kPollStride steps (run.hpp),
+/// A run's cancellation as the units see it: called with `context` every kPollStride steps (detail/run_parts.hpp),
 /// true ends the run; the units then return kStopped. Built for the baseline (batch.cpp), so the units
 /// load no atomic of their own.
 using Poll = bool (*)(const void* context);

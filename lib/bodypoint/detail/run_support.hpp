@@ -7,6 +7,7 @@
 #include "bodypoint/invariants.hpp"
 #include "bodypoint/run.hpp"
 #include "bodypoint/splitting/composition.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 
 #include <algorithm>
 #include <chrono>
