@@ -23,6 +23,7 @@
 #include "bodypoint/adaptive/landing.hpp"
 #include "bodypoint/adaptive/time_transformed.hpp"
 #include "bodypoint/detail/run_support.hpp"
+#include "bodypoint/detail/model_parts.hpp"
 
 #include <algorithm>
 #include <array>

@@ -18,6 +18,7 @@
 #include "bodypoint/detail/run_support.hpp"
 #include "bodypoint/splitting/catalogue.hpp"
 #include "bodypoint/detail/run_parts.hpp"
+#include "bodypoint/detail/model_parts.hpp"
 
 #include <cmath>
 #include <limits>

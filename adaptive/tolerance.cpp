@@ -6,6 +6,7 @@
 #include "bodypoint/adaptive/methods.hpp"
 #include "bodypoint/field.hpp"
 #include "search/search.hpp"
+#include "bodypoint/detail/model_parts.hpp"
 
 #include <algorithm>
 #include <string>

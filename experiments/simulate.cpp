@@ -12,6 +12,8 @@
 #include "cli.hpp"
 #include "encounter_parts.hpp"
 #include "bodypoint/detail/run_parts.hpp"
+#include "bodypoint/detail/model_parts.hpp"
+#include "checked.hpp"
 
 #include <algorithm>
 #include <cmath>

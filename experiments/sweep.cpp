@@ -11,6 +11,7 @@
 #include "mpi_sweep.hpp"
 #include "rows_file.hpp"
 #include "sweep_tasks.hpp"
+#include "bodypoint/detail/model_parts.hpp"
 
 #include <algorithm>
 #include <cmath>

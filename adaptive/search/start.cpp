@@ -4,6 +4,7 @@
 #include "bodypoint/adaptive/methods.hpp"
 #include "bodypoint/field.hpp"
 #include "bodypoint/detail/run_parts.hpp"
+#include "bodypoint/detail/model_parts.hpp"
 
 #include <algorithm>
 #include <cmath>

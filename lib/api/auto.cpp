@@ -6,6 +6,7 @@
 #include "bodypoint/adaptive/methods.hpp"
 #include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/field.hpp"
+#include "bodypoint/detail/model_parts.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -5,6 +5,7 @@
 
 #include "bodypoint/adaptive/methods.hpp"
 #include "bodypoint/field.hpp"
+#include "bodypoint/detail/model_parts.hpp"
 
 #include <algorithm>
 #include <limits>

@@ -11,6 +11,7 @@
 #include "estimate.hpp"
 #include "sweep_tasks.hpp"
 #include "bodypoint/detail/run_parts.hpp"
+#include "bodypoint/detail/model_parts.hpp"
 
 #include <algorithm>
 #include <atomic>

@@ -2,6 +2,7 @@
 #include "bodypoint/far_field.hpp"
 
 #include "bodypoint/detail/run_support.hpp"
+#include "bodypoint/detail/model_parts.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,7 @@
 #include "bodypoint/model.hpp"
 
 #include "bodypoint/io.hpp"
+#include "bodypoint/detail/model_parts.hpp"
 
 #include <cmath>
 #include <sstream>

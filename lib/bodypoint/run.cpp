@@ -19,6 +19,7 @@
 #include "bodypoint/splitting/lie_poisson.hpp"
 #include "bodypoint/splitting/thesis.hpp"
 #include "bodypoint/detail/run_parts.hpp"
+#include "bodypoint/detail/model_parts.hpp"
 
 #include <algorithm>
 #include <cmath>

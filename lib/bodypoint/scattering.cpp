@@ -5,6 +5,7 @@
 
 #include "bodypoint/field.hpp"
 #include "bodypoint/invariants.hpp"
+#include "bodypoint/detail/model_parts.hpp"
 
 #include <algorithm>
 #include <cmath>

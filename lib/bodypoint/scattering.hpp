@@ -116,10 +116,6 @@ double d_for_impact_parameter(SceneParams params, double b);
 /// (below it, it drifts away: a second root with no encounter). Error when v_inf is not a finite number
 /// > 0 or no K1 on that branch reaches it (a bound orbit on the way).
 double k1_for_speed_at_infinity(SceneParams params, double v_inf);
-/// The least K1 > 0 at which the thesis's guiding centre drifts along K1, towards the centre: its drift
-/// K1 (J K1 - B Kx)/D vanishes at K1 = B Kx/J; 0 where it drifts along K1 at every K1 > 0.
-double least_approaching_k1(const SceneParams& p);
-
 /// The scene given by its asymptotic data: impact parameter b and/or speed at infinity v_inf (NaN:
 /// not given, the scene's own d or K1 kept). Both are solved together (each depends a little on the
 /// other through the start at finite distance L) until neither d nor K1 changes.
@@ -133,10 +129,6 @@ SceneParams with_asymptotic_data(SceneParams params, double b, double v_inf, dou
 struct AsymptoticData {
   std::optional<double> b, v_inf, arrival_phase;
 };
-/// Refuses an asymptotic datum (b, v_inf, arrival_phase) in `data` (given or swept) beside the
-/// parameter it solves (d, K1, phase) in `given` (set explicitly): "give b or d, not both".
-void check_data_beside_solved(const std::vector<std::string>& data, const std::vector<std::string>& given);
-
 /// The thesis scene's parameters with `data` solved in: each datum checked (b and v_inf finite
 /// numbers > 0, the phase finite), refused beside the parameter it solves when that one is in
 /// `given` (the names of the parameters set explicitly), the scene itself validated first. Throws
@@ -153,8 +145,5 @@ double arrival_phase(const SceneParams& params);
 /// The start phase that gives the arrival phase `arrival`. Error when it is not finite or the guiding
 /// centre does not drift.
 double start_phase_for_arrival(const SceneParams& params, double arrival);
-
-/// The angle between two vectors, accurate for small and for near-opposite angles: atan2(|a x b|, a.b).
-double angle_between(const Vec3& a, const Vec3& b);
 
 }  // namespace bodypoint

@@ -11,6 +11,7 @@
 #include "bodypoint/threads.hpp"
 #include "encounter_parts.hpp"
 #include "bodypoint/detail/run_parts.hpp"
+#include "bodypoint/detail/model_parts.hpp"
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>

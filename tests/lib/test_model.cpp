@@ -9,6 +9,7 @@
 #include "common.hpp"
 #include "sweep_tasks.hpp"
 #include "bodypoint/detail/run_parts.hpp"
+#include "bodypoint/detail/model_parts.hpp"
 
 #include <gtest/gtest.h>
 

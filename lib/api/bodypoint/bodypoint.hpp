@@ -114,12 +114,6 @@ const EventHit* nearest_approach(const std::vector<EventHit>& hits, const std::v
 /// the energy's (kDefaultMaxEnergyError).
 inline constexpr double kDefaultMaxError = 1e-2;
 
-/// Throws Error unless max_error is a number > 0 (infinity: no bound).
-void check_error_bound(double max_error);
-
-/// Whether `method` takes a time-step constant c (RunOptions::omega_c): the time-transformed methods
-/// logh-* and ttl-*, not ks (regularised, exact in its fictitious time).
-bool takes_time_step_constant(const MethodInfo& method);
 /// A time-step constant c a caller gives (RunOptions::omega_c; not giving one is -1, automatic),
 /// checked for the run it is given to: a finite number >= 0, for a time-transformed method (logh-*,
 /// ttl-*; ks has none) run by its fictitious step, not in the accuracy mode (which chooses c itself).

@@ -5,6 +5,8 @@
 
 #include "bodypoint/field.hpp"
 #include "bodypoint/invariants.hpp"
+#include "bodypoint/detail/model_parts.hpp"
+#include "checked.hpp"
 
 #include <cmath>
 #include <limits>

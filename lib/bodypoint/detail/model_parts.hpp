@@ -1,0 +1,71 @@
+// bodypoint: the model's and the scattering code's helpers that the library and the commands share but a
+// program outside the tree has no use for: the one wording of a number's range, the resolution of D, the
+// helix of a spinning body far from the centres, the checks of asymptotic data and the least drifting K1.
+// Internal (not installed).
+#pragma once
+
+#include "bodypoint/model.hpp"
+#include "bodypoint/scattering.hpp"
+
+#include <algorithm>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace bodypoint {
+
+/// The one wording of a number's range, shared by every check of the library and the commands: each
+/// throws Error("<what> must be a finite number > 0, got <x>") (>= 0; a whole number >= 1) and
+/// returns x when it is in range.
+double require_positive(double x, std::string_view what);
+double require_non_negative(double x, std::string_view what);
+long require_count(long n, std::string_view what);
+
+/// D = m J - B^2 must exceed this multiple of m J (about 45 rounding errors of m J - B^2): below it
+/// the sign and size of D are not resolved in double precision.
+constexpr double kMinRelativeD = 1e-14;
+
+/// True when some centre does not follow Coulomb's law (a reproduction of the thesis's code).
+inline bool non_coulomb(const std::vector<Centre>& centres) {
+  for (const Centre& k : centres)
+    if (k.law != ForceLaw::coulomb) return true;
+  return false;
+}
+
+/// A spinning body's helix far from the centres (docs/physics.md, "Spinning body"): the kinetic drift
+/// turns the body about an axis along K1 through its guiding centre G = R + K1 x K2/|K1|^2, and G moves
+/// at (J |K1| - B K2.K1/|K1|)/D along K1. A material point (B = 0) has no helix: G = R, moving at v.
+struct Helix {
+  Vec3 centre = Vec3::Zero();    ///< G
+  Vec3 velocity = Vec3::Zero();  ///< dG/dt under the drift (0 at rest)
+  double radius = 0.0;           ///< |G - R| = |K1 x K2|/|K1|^2
+};
+
+inline Helix helix_of(const BodyPoint& p, const Momenta& q) {
+  const double k2 = q.K1.squaredNorm();
+  if (!(k2 > 0.0)) return {q.R, Vec3::Zero(), 0.0};  // at rest: no drift
+  const Vec3 offset = p.B != 0.0 ? Vec3(q.K1.cross(q.K2) / k2) : Vec3::Zero();
+  return {q.R + offset, ((p.J - p.B * q.K1.dot(q.K2) / k2) / p.D()) * q.K1, offset.norm()};
+}
+
+/// The least distance from c of the guiding centre's straight path over the times [0, t_max] (t_max may
+/// be infinite): where a body far from the centres comes closest to c, the force bending the path aside.
+inline double path_distance(const Helix& h, const Vec3& c, double t_max) {
+  const Vec3 d = h.centre - c;
+  const double vv = h.velocity.squaredNorm();
+  const double t = vv > 0.0 ? std::clamp(-d.dot(h.velocity) / vv, 0.0, t_max) : 0.0;
+  return (d + t * h.velocity).norm();
+}
+
+/// The least K1 > 0 at which the thesis's guiding centre drifts along K1, towards the centre: its drift
+/// K1 (J K1 - B Kx)/D vanishes at K1 = B Kx/J; 0 where it drifts along K1 at every K1 > 0.
+double least_approaching_k1(const SceneParams& p);
+
+/// Refuses an asymptotic datum (b, v_inf, arrival_phase) in `data` (given or swept) beside the
+/// parameter it solves (d, K1, phase) in `given` (set explicitly): "give b or d, not both".
+void check_data_beside_solved(const std::vector<std::string>& data, const std::vector<std::string>& given);
+
+/// The angle between two vectors, accurate for small and for near-opposite angles: atan2(|a x b|, a.b).
+double angle_between(const Vec3& a, const Vec3& b);
+
+}  // namespace bodypoint
