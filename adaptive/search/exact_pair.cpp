@@ -30,7 +30,8 @@ Level Search::exact_flow() {
   double best = std::numeric_limits<double>::infinity();
   int stalled = 0;
   for (int k = 0;; ++k) {
-    try {
+    // A pair accepted (its finer-step run's partner delivered), or not yet (none: a finer pair next).
+    Attempt<std::optional<Level>> pair = attempt([&]() -> std::optional<Level> {
       Level a = run_at(h, h, true);
       const Level b = run_at(h / kMinRefinement, h, false, far ? &moved : nullptr);
       estimate_ = std::max(state_distance(a.run.final, b.run.final), std::numeric_limits<double>::epsilon());
@@ -56,13 +57,10 @@ Level Search::exact_flow() {
         throw SearchLimit("tol " + fmt_tol() + " is below what " + std::string(m_.name) + " delivers on this scene: " +
                           (far ? "the estimate from " + pair_text() + " was at least " : "runs differ by ") +
                           short_number(best) + (far ? " at every step it tried" : ""));
-    } catch (const SearchLimit&) {
-      throw;
-    } catch (const StoppedOnRequest&) {
-      throw;
-    } catch (const Error&) {
-      if (!far || k >= kMaxRefinements) throw;
-    }
+      return std::nullopt;
+    });
+    if (pair.value && *pair.value) return std::move(**pair.value);
+    if (!pair.value && (!far || k >= kMaxRefinements)) throw Error(pair.why);
     h *= 0.5;
   }
 }

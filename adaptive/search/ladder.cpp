@@ -63,7 +63,7 @@ constexpr double kRoundOff = 1e-13;
 Level Search::pilot(Level& coarse) {
   double h = initial_step(m_, b_, c_, t_end_);
   for (int k = 0;; ++k) {
-    try {
+    Attempt<Level> pair = attempt([&] {
       coarse = run_at(h, h, false);
       Level fine = run_at(0.5 * coarse.h, h, false);
       // A pair that differs by more than kUnresolvedPair is no trajectory yet: the pair moves down by
@@ -75,14 +75,10 @@ Level Search::pilot(Level& coarse) {
       }
       estimate_ = pair_estimate(coarse, fine);
       return fine;
-    } catch (const SearchLimit&) {
-      throw;
-    } catch (const StoppedOnRequest&) {
-      throw;
-    } catch (const Error&) {
-      if (k >= kMaxRefinements) throw;
-      h *= 0.5;
-    }
+    });
+    if (pair.value) return std::move(*pair.value);
+    if (k >= kMaxRefinements) throw Error(pair.why);
+    h *= 0.5;
   }
 }
 

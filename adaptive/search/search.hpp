@@ -14,6 +14,7 @@
 
 #include <cstddef>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,31 @@ constexpr int kMaxRefinements = 48;
 struct SearchLimit : Error {
   using Error::Error;
 };
+
+/// What a step of the search gave: its value, or (none) why the method broke down at that step (a driver's
+/// Error: a time transformation that stopped advancing, a non-finite state, an iteration that did not
+/// converge), which the search answers with a smaller step. A limit of the search and a stop from outside
+/// are not a step's answer: they end the search (thrown on).
+template <class T>
+struct Attempt {
+  std::optional<T> value;
+  std::string why;  ///< of no value: the method's reason
+};
+
+/// Runs `step` (the runs of one step of the search) and returns what it gave as a value: the one place
+/// where the search turns a method's breakdown into a result.
+template <class F>
+auto attempt(F&& step) -> Attempt<decltype(step())> {
+  try {
+    return {step(), {}};
+  } catch (const SearchLimit&) {
+    throw;
+  } catch (const StoppedOnRequest&) {
+    throw;
+  } catch (const Error& e) {
+    return {std::nullopt, e.what()};
+  }
+}
 
 /// One run of the search, with what it ran and, while it may still be delivered, its samples.
 struct Level {
