@@ -4,7 +4,7 @@
 //
 // For each named scene (thesis, close, material, two-centres), stepper and TOL 1e-4, 1e-7, 1e-10: both
 // sides are called once (their final states and force evaluations compared), then timed under the
-// commands' timing rules (experiments/stopwatch.hpp: warm-up, kRounds repeats interleaved, batches of
+// commands' timing rules (experiments/cli/stopwatch.hpp: warm-up, kRounds repeats interleaved, batches of
 // >= kMinBatchSeconds, wall and CPU time, median, spread, flag). The ratio is bodypoint's median time per
 // force evaluation over the plain program's. Exits 1 when a ratio exceeds 1 + kPeerMargin (the issue's
 // bound: within 10 %).
@@ -107,7 +107,7 @@ int main(int argc, char** argv) {
           std::fflush(stdout);
           rows.push_back(w);
         }
-    std::printf("\nworst ratio %.3f (bound %.2f); %d repeats interleaved (experiments/stopwatch.hpp), batches of >= "
+    std::printf("\nworst ratio %.3f (bound %.2f); %d repeats interleaved (experiments/cli/stopwatch.hpp), batches of >= "
                 "%g ms; times: medians per call; ratio: of the medians per force evaluation\n",
                 worst, 1.0 + kPeerMargin, static_cast<int>(kRounds), kMinBatchSeconds * 1e3);
     if (!csv.empty()) {

@@ -18,7 +18,7 @@ is compared with a deflection measured without any of those models:
   - The integrator is Boost.Odeint's rkf78 at a tolerance per step of 1e-13 (not one of bodypoint's own
     methods); its difference from 1e-14 counts in the oracle's error.
 
-Cases: every series of the scattering study (experiments/scattering_study.cpp: B and spin per series) at a
+Cases: every series of the scattering study (experiments/studies/scattering_study.cpp: B and spin per series) at a
 few impact parameters and arrival phases, and scenes no study or test uses (other A, K1, B, J, m, spin).
 A case passes when |theta - theta_limit| <= deflection_error + the oracle's error. Prints one row per case
 and a summary; exit 1 if any case is outside or the oracle could not be taken.
@@ -51,7 +51,7 @@ ORACLE_TOLS = (1e-13, 1e-14)
 # A generous end time: the stop events end the runs long before (at most a few 8L passes at v_inf >= 1).
 T_FAR = 1e7
 
-# (name, thesis_scene keywords): the study's series (experiments/scattering_study.cpp, series()).
+# (name, thesis_scene keywords): the study's series (experiments/studies/scattering_study.cpp, series()).
 STUDY_SERIES = [("B=0.2", dict(B=0.2, Kx=2.0, Kz=5.0)), ("B=0.5", dict(B=0.5, Kx=2.0, Kz=5.0)),
                 ("B=0.7", dict(B=0.7, Kx=2.0, Kz=5.0)), ("B=0.9", dict(B=0.9, Kx=2.0, Kz=5.0)),
                 ("B=0.7 spin along K1", dict(B=0.7, Kx=5.0, Kz=0.0)),

@@ -13,7 +13,7 @@
 # drives it against a plain C program), bench_steps (cost per step), bench_batch (sweep
 # throughput per core),
 # make_figures.py (vector PDF), make_macros.py (LaTeX macros and tables), latexmk.
-# Every time is taken under the commands' timing rules (experiments/stopwatch.hpp; Google Benchmark:
+# Every time is taken under the commands' timing rules (experiments/cli/stopwatch.hpp; Google Benchmark:
 # 5 repetitions, randomly interleaved, medians): run it on a machine doing nothing else. A time that
 # does not count (contended, spread) is flagged in its CSV and the paper prints no flagged time.
 # BODYPOINT_NO_SETUP=1 skips scripts/setup.sh and BODYPOINT_BUILD_DIR names the build tree (default

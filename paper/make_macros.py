@@ -564,7 +564,7 @@ def timing_ns(res, name="timing.csv"):
 
 
 def flag_word(why):
-    """A timing flag's reason in one word (experiments/stopwatch.cpp: "contended: wall 31 % above
+    """A timing flag's reason in one word (experiments/cli/stopwatch.cpp: "contended: wall 31 % above
     CPU" -> contended, "spread 22 %" -> spread, "3 repeats (< 5)" -> repeats)."""
     return timing_rule.flag_words([why])
 
@@ -707,7 +707,7 @@ def md_table(path):
 
 
 def latex_cell(c):
-    # A time that does not count under the timing rules (experiments/stopwatch.hpp) is not printed.
+    # A time that does not count under the timing rules (experiments/cli/stopwatch.hpp) is not printed.
     if c == "flagged" or c.startswith("flagged ("):
         return "\\emph{flagged}"
     # A configuration chosen by its force evaluations ("gsl-rk8pd tol=1e-09 (1234 evals)"): the count
@@ -803,7 +803,7 @@ def speedup_table(res, out, M):
 def next_rung_reaches(rows, r, target):
     """Whether the next finer configuration of r's ladder (the next row of its method on its scene, as
     work_precision.csv lists a ladder coarse to fine) reaches the target too: a lucky cancellation at one
-    step does not count (experiments/work_precision.cpp, best_at)."""
+    step does not count (experiments/studies/work_precision.cpp, best_at)."""
     i = rows.index(r)
     nxt = rows[i + 1] if i + 1 < len(rows) else None
     return bool(nxt and nxt["scene"] == r["scene"] and nxt["method"] == r["method"] and num(nxt["err_rel"]) <= target)
@@ -1411,7 +1411,7 @@ def platform(res, M):
 
 
 def timing_discipline(res, M):
-    """How many times of this build count under the timing rules (experiments/stopwatch.hpp), the rules'
+    """How many times of this build count under the timing rules (experiments/cli/stopwatch.hpp), the rules'
     margins as the CSVs state them, and GSL as bodypoint drives it against a plain C program."""
     _, header = read_csv(os.path.join(res, "by_tol.csv"))
     rules = next(line for line in header if line.startswith("# flag:"))

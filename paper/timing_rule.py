@@ -1,6 +1,6 @@
 """One timing rule for every time the paper prints (issue #58).
 
-The commands flag a time that does not count (experiments/stopwatch.cpp): fewer repeats than the rule
+The commands flag a time that does not count (experiments/cli/stopwatch.cpp): fewer repeats than the rule
 asks, wall time above CPU time by more than a share (the thread waited for a core: contended), or a
 spread (interquartile range over the median) above a bound. The same limits, read from the CSV header
 the commands write ("# flag: ..."), judge here the times no command flags itself: Google Benchmark's
@@ -21,7 +21,7 @@ _UNIT_SCALE = {"ns": 1e9, "us": 1e6, "ms": 1e3, "s": 1.0}
 
 
 class Rule:
-    """The limits of experiments/stopwatch.cpp, as a command's CSV header states them."""
+    """The limits of experiments/cli/stopwatch.cpp, as a command's CSV header states them."""
 
     def __init__(self, repeats, wait_share, spread):
         self.repeats, self.wait_share, self.spread = repeats, wait_share, spread

@@ -1,7 +1,7 @@
 // bodypoint: the one number format and the text outputs of every driver: numbers written so that a value
 // read back is exactly the value computed (fmt), CSV rows (CsvLine), JSON values, "did you mean" and the
 // revision the binary was built from. Writing files safely (atomic files, locks, signals, a deadline)
-// is the command layer's (experiments/process.hpp).
+// is the command layer's (experiments/cli/process.hpp).
 #pragma once
 
 

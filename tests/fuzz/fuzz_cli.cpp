@@ -3,7 +3,7 @@
 // output limits) and nothing runs or is written. The input is split into arguments at NUL bytes and
 // newlines; the first byte picks the command. Any input must end in exit 0 or in one of the errors
 // that main() turns into one line; a crash or a sanitizer report is a bug.
-#include "../../experiments/cli.hpp"
+#include "../../experiments/cli/cli.hpp"
 
 #include <boost/program_options/errors.hpp>
 

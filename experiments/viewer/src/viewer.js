@@ -2,7 +2,7 @@
 // with three.js by esbuild) and the trajectory as JSON in <script id="bodypoint-data">; the page
 // needs no server and no network.
 //
-// Data (written by experiments/view.cpp):
+// Data (written by experiments/cli/view.cpp):
 //   { title, scene, revision, centres: [{c: [x,y,z], A}],
 //     runs: [{ method, step, bodies: [{ name, steps, force_evals, invariants: {...}, closest: {t, r},
 //              frames: { t: [...], R: [x,y,z,...], v: [...], w: [...], dE: [...], dt: [...] },
