@@ -318,7 +318,6 @@ BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& cen
   return r;
 }
 
-
 BodyResult integrate_forwards(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
                               const Advance& how, const Options& options);
 
