@@ -194,7 +194,7 @@ TimeState run_macro_steps(K& k, TimeState x, const ControlledSteps& spec, Obs& o
   long macro = 0;
   while (x.time() < spec.t_end) {
     if (++macro > detail::kMaxAdaptiveSteps) throw Error("logh-bs: more than 2e8 macro steps before t_end; loosen the tolerance");
-    splitting::poll(obs, macro);  // a cancellation is seen between rejected steps too
+    if (!splitting::poll(obs, macro)) break;  // a cancellation is seen between rejected steps too
     const auto a = ex.step(x, H, std::max(2, target - 1), std::min(kMaxColumns, target + 1));
     if (a.columns == 0) {  // rejected at every column allowed
       if (++rejected > kMaxRejections || !(H > 0.0)) throw Error(stalled(x.time()));

@@ -140,6 +140,7 @@ class FictitiousLoop {
     const double h = spec_.ds, t_end = spec_.t_end();
     StepStats st;
     double t_over = 0.0;  // the time the step that would pass t_end reaches
+    bool goes_on = true;  // false once the observer ended the run (its sink said Flow::stop)
     while (st.steps < cap) {
       const X prev = x;
       const StepAdvance a = s_.step(x, h);
@@ -157,9 +158,9 @@ class FictitiousLoop {
         outputs_until(obs, prev, a.t, st.steps);
         obs.observe(st.steps, a.t, x, !to_time && st.steps == cap);
       }
-      splitting::poll(obs, st.steps);
+      if (!(goes_on = splitting::poll(obs, st.steps))) break;
     }
-    if (to_time) finish(x, t_over, cap, obs, st);
+    if (to_time && goes_on) finish(x, t_over, cap, obs, st);
     st_ = st;
     return x;
   }

@@ -87,9 +87,15 @@ double planned_end(const RunPlan& plan);
 BodyResult run_body(const RunPlan& plan, const Body& body, const std::vector<Centre>& centres, const Advance& how,
                  const SampleSink* sink, const std::vector<Event>& events = {});
 
-/// One run of a study through the public API (integrate_body): its RunResult, whatever its outcome's
-/// flag; a refused or failed run throws Error with the library's reason. A study measures its errors
-/// against references: the run makes no error estimate of its own (Options::estimate_error off).
+/// One run of a study through the public API (integrate_body), as a value: a refused or failed run says
+/// so in its outcome and reason, which the study records. A study measures its errors against
+/// references: the run makes no error estimate of its own (Options::estimate_error off).
+BodyResult run_unestimated(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
+                           const Advance& how, const Options& options);
+/// Whether a run reached its end (it was neither refused nor failed); its outcome's flags aside.
+inline bool ran(const BodyResult& r) { return r.outcome != Outcome::refused && r.outcome != Outcome::failed; }
+/// run_unestimated's RunResult where the run must succeed (a reference, a timed rerun of a run that
+/// did): a refused or failed run throws Error with the library's reason.
 RunResult run_or_throw(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres, const Advance& how,
                        const Options& options);
 /// Options that observe nothing (no invariants, no samples, no error estimate): the fastest run, for

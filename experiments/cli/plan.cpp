@@ -56,16 +56,21 @@ BodyResult run_body(const RunPlan& plan, const Body& body, const std::vector<Cen
   options.sink = sink;
   detail::check_run(centres, plan.method, how, options);  // the scene was checked where it was made (make_scene)
   BodyResult r = detail::integrate_checked(body, centres, plan.method, how, options);
-  if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) throw Error(r.reason);
+  if (!ran(r)) throw Error(r.reason);
   return r;
+}
+
+BodyResult run_unestimated(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
+                           const Advance& how, const Options& options) {
+  Options o = options;
+  o.estimate_error = false;
+  return integrate_body(body, centres, &m, how, o);
 }
 
 RunResult run_or_throw(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres, const Advance& how,
                        const Options& options) {
-  Options o = options;
-  o.estimate_error = false;
-  BodyResult r = integrate_body(body, centres, &m, how, o);
-  if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) throw Error(r.reason);
+  BodyResult r = run_unestimated(m, body, centres, how, options);
+  if (!ran(r)) throw Error(r.reason);
   return std::move(r.run);
 }
 

@@ -46,7 +46,7 @@ struct TolRow {
   long force_evals = 0, delivered_force_evals = 0;
   int runs = 1;
   bool met = false;
-  std::string refusal;  ///< auto refused TOL (out of reach on the scene, over the budget): why; "" otherwise
+  std::string refusal;  ///< auto refused TOL (out of reach on the scene, over the budget), or a peer's run failed: why; "" otherwise
   bool is_auto = false;
   bool is_ladder = false;  ///< a peer's run from its tolerance ladder (oracle view), not at TOL
   bool is_own = false;     ///< a configuration of bodypoint's own methods (own_ladders): a method and a step
@@ -97,6 +97,8 @@ TolRow measure_auto(const NamedScene& ns, const State& ref, double tol) {
   return row;
 }
 
+/// A peer at TOL, driven as its users drive it (first trial step 1e-3); a run that fails is a row with
+/// its reason in `refusal`, for the caller to drop.
 TolRow measure_peer(const NamedScene& ns, const std::string& name, const State& ref, double tol) {
   const Body& body = ns.scene.bodies.front();
   TolRow row;
@@ -105,7 +107,12 @@ TolRow measure_peer(const NamedScene& ns, const std::string& name, const State& 
   row.tol = tol;
   const ControlledSteps how{1e-3, ns.t_end, tol};
   const MethodInfo& m = method_or_throw(name);
-  const RunResult r = run_or_throw(m, body, ns.scene.centres, how, unobserved());
+  const BodyResult x = run_unestimated(m, body, ns.scene.centres, how, unobserved());
+  if (!ran(x)) {
+    row.refusal = x.reason;
+    return row;
+  }
+  const RunResult& r = x.run;
   row.run = [&m, body, centres = ns.scene.centres, how] { run_or_throw(m, body, centres, how, unobserved()); };
   row.err = adaptive::state_distance(r.final, ref);
   if (!std::isfinite(row.err)) row.err = std::numeric_limits<double>::infinity();
@@ -142,11 +149,9 @@ void measure_at_tolerances(const NamedScene& ns, const State& ref, const std::ve
     std::cerr << "  " << ns.name << " tol " << sci(tol, 0) << ": auto " << rows.back().method << " err "
               << sci(rows.back().err) << " (estimate " << sci(rows.back().err_estimate) << ")\n";
     for (const std::string& p : peers) {
-      try {
-        rows.push_back(measure_peer(ns, p, ref, tol));
-      } catch (const Error& e) {
-        std::cerr << "  " << ns.name << " " << p << " tol " << sci(tol, 0) << ": failed (" << e.what() << ")\n";
-      }
+      TolRow r = measure_peer(ns, p, ref, tol);
+      if (r.refusal.empty()) rows.push_back(std::move(r));
+      else std::cerr << "  " << ns.name << " " << p << " tol " << sci(tol, 0) << ": failed (" << r.refusal << ")\n";
     }
   }
 }
@@ -160,17 +165,14 @@ void measure_peer_ladders(const NamedScene& ns, const State& ref, const std::vec
     int stalled = 0;  // rungs in a row that did not halve the best error: the peer's round-off floor
     for (int k = 6; k <= 30; ++k) {
       const double t = std::pow(10.0, -0.5 * k);
-      try {
-        TolRow r = measure_peer(ns, p, ref, t);
-        r.is_ladder = true;
-        rows.push_back(r);
-        if (r.err < kLadderFloor) break;
-        stalled = r.err < 0.5 * best ? 0 : stalled + 1;
-        best = std::min(best, r.err);
-        if (stalled >= kLadderStalls) break;
-      } catch (const Error& e) {
-        break;
-      }
+      TolRow r = measure_peer(ns, p, ref, t);
+      if (!r.refusal.empty()) break;  // the peer's run failed: its ladder ends
+      r.is_ladder = true;
+      rows.push_back(r);
+      if (r.err < kLadderFloor) break;
+      stalled = r.err < 0.5 * best ? 0 : stalled + 1;
+      best = std::min(best, r.err);
+      if (stalled >= kLadderStalls) break;
     }
   }
 }
@@ -224,14 +226,13 @@ void measure_own_ladders(const NamedScene& ns, const State& ref, double smallest
       r.h = h;
       r.is_own = true;
       r.method_is_exact = m.traits.exact_in_fictitious_time;
-      try {
-        const RunResult x = run_or_throw(m, body, ns.scene.centres, how, unobserved());
-        r.err = adaptive::state_distance(x.final, ref);
-        r.force_evals = std::max(x.force_evals, x.steps);  // ks counts its exact steps
-      } catch (const Error&) {
+      const BodyResult x = run_unestimated(m, body, ns.scene.centres, how, unobserved());
+      if (!ran(x)) {
         ++failures;
         continue;
       }
+      r.err = adaptive::state_distance(x.run.final, ref);
+      r.force_evals = std::max(x.run.force_evals, x.run.steps);  // ks counts its exact steps
       if (!std::isfinite(r.err)) r.err = std::numeric_limits<double>::infinity();
       r.run = [&m, body, centres = ns.scene.centres, how] { run_or_throw(m, body, centres, how, unobserved()); };
       rows.push_back(std::move(r));

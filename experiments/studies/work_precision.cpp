@@ -27,6 +27,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 namespace bodypoint::cli {
@@ -59,8 +60,10 @@ struct Options {
 };
 
 /// One configuration run once, untimed: its error, force evaluations and energy error. The time comes
-/// later, from the scene's interleaved timing of every configuration (time_scene).
-Row measure(const NamedScene& ns, const MethodInfo& m, const Body& body, const State& ref, double h, double tol) {
+/// later, from the scene's interleaved timing of every configuration (time_scene). No row where the run
+/// is refused or fails: `why` says why.
+std::optional<Row> measure(const NamedScene& ns, const MethodInfo& m, const Body& body, const State& ref, double h,
+                           double tol, std::string& why) {
   Advance how;
   double step = h;  // the step of the row: h, or the fictitious step ds
   if (is_time_transformed(m)) {
@@ -72,8 +75,13 @@ Row measure(const NamedScene& ns, const MethodInfo& m, const Body& body, const S
     step = ns.t_end / static_cast<double>(steps);
     how = FixedSteps{step, steps};
   }
-  const RunResult r = run_or_throw(m, body, ns.scene.centres, how, unobserved());
-  const RunResult ri = run_or_throw(m, body, ns.scene.centres, how, bodypoint::Options{});
+  const BodyResult plain = run_unestimated(m, body, ns.scene.centres, how, unobserved());
+  if (!ran(plain)) {
+    why = plain.reason;
+    return std::nullopt;
+  }
+  const RunResult& r = plain.run;
+  const RunResult ri = run_or_throw(m, body, ns.scene.centres, how, bodypoint::Options{});  // the same run, monitored
   Row row;
   row.scene = ns.name;
   row.method = std::string(m.name);
@@ -189,14 +197,15 @@ class Ladder {
  private:
   /// Measures m at step h or tolerance tol into `row`; false (with a note) where the run fails.
   bool try_measure(double h, double tol, Row& row) {
-    try {
-      row = measure(ns_, m_, body_, ref_, h, tol);
-      return true;
-    } catch (const Error& e) {
+    std::string why;
+    std::optional<Row> r = measure(ns_, m_, body_, ref_, h, tol, why);
+    if (!r) {
       std::cerr << "  " << ns_.name << " " << m_.name << (tol > 0 ? " tol=" : " h=") << fmt(tol > 0 ? tol : h)
-                << ": skipped (" << e.what() << ")\n";
+                << ": skipped (" << why << ")\n";
       return false;
     }
+    row = std::move(*r);
+    return true;
   }
   /// Keeps the row; true while the ladder goes on (not two rows below the floor, not over the budget).
   bool keep(const Row& r) {
@@ -250,7 +259,10 @@ class Ladder {
         if (!keep(r)) break;
         continue;
       }
-      rows_.push_back(measure(ns_, m_, body_, ref_, h, 0));
+      std::string why;
+      std::optional<Row> row = measure(ns_, m_, body_, ref_, h, 0, why);
+      if (!row) throw Error(ns_.name + " " + m_.name + " h=" + fmt(h) + ": " + why);  // a fixed step the ladder needs
+      rows_.push_back(std::move(*row));
       below_ = rows_.back().err_rel < o_.floor ? below_ + 1 : 0;
       if (below_ >= 2) break;
     }

@@ -38,8 +38,9 @@ bool accepts(const MethodInfo& method, const Body& body, const std::vector<Centr
 
 /// Runs up to width() members (or, given, `lanes` of widths()) for spec.steps fixed steps of spec.h with
 /// invariants tracked; one result per member, as `run` returns it (wall_s: the batch's time shared
-/// equally). Throws Error when the method has no batch kernel or there are too many members, and
-/// StoppedOnRequest when `cancel`, polled every kPollStride steps as the scalar loops poll it, is set.
+/// equally). Throws Error when the method has no batch kernel or there are too many members; returns
+/// no result (an empty vector) when `cancel`, polled every kPollStride steps as the scalar loops poll
+/// it, is set.
 std::vector<RunResult> run(const MethodInfo& method, const std::vector<Member>& members, const FixedSteps& spec,
                            std::size_t lanes = 0, const std::atomic<bool>* cancel = nullptr);
 

@@ -139,7 +139,7 @@ RunResult run_far_field(const Body& body, const std::vector<Centre>& centres, co
       for (long i = 0; i < fixed.steps; ++i) {
         stepper.step(x, fixed.h);
         if constexpr (std::decay_t<decltype(obs)>::active) obs(i + 1, x);
-        sp::poll(obs, i + 1);
+        if (!sp::poll(obs, i + 1)) break;
       }
       return to_state(body.p, x);
     });

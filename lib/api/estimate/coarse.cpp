@@ -70,17 +70,17 @@ std::optional<std::vector<BodyResult>> coarse_lanes(const MethodInfo& m, const B
   for (std::size_t k = 0; k < kDrawLanes; ++k)
     members.push_back({body.p, start_moved_by_rounding(body.s0, rounding_way(static_cast<int>(k))), centres.front().A});
   std::vector<BodyResult> lanes(kDrawLanes);
-  try {
-    std::vector<RunResult> runs = batch::run(m, members, *f, kDrawLanes, oc.cancel);
-    for (std::size_t k = 0; k < kDrawLanes; ++k) {
-      lanes[k].method = &m;
-      lanes[k].run = std::move(runs[k]);
-      Health h = assess(lanes[k].run, checks_for(m, centres, oc.max_energy_error));
-      lanes[k].outcome = h.outcome;
-      lanes[k].reason = std::move(h.why);
-    }
-  } catch (const StoppedOnRequest&) {
+  std::vector<RunResult> runs = batch::run(m, members, *f, kDrawLanes, oc.cancel);
+  if (runs.empty()) {  // stopped on request
     for (BodyResult& lane : lanes) lane.method = &m, lane.outcome = Outcome::failed, lane.reason = kStoppedOnRequest;
+    return lanes;
+  }
+  for (std::size_t k = 0; k < kDrawLanes; ++k) {
+    lanes[k].method = &m;
+    lanes[k].run = std::move(runs[k]);
+    Health h = assess(lanes[k].run, checks_for(m, centres, oc.max_energy_error));
+    lanes[k].outcome = h.outcome;
+    lanes[k].reason = std::move(h.why);
   }
   return lanes;
 }

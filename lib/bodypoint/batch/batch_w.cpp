@@ -125,16 +125,12 @@ class Monitor {
   V3 K2Q0_, prev_R_;
 };
 
-/// What ends a run whose Poll said stop; `run` turns it into abi::kStopped.
-struct Stopped {};
-
 /// The run's cancellation: polled every kPollStride steps (run.hpp), as the scalar loops poll theirs.
+/// True after step i when the run goes on; false when its Poll said stop (the runner returns abi::kStopped).
 struct Canceller {
   abi::Poll poll = nullptr;
   const void* context = nullptr;
-  void operator()(long i) const {
-    if (poll != nullptr && i % kPollStride == 0 && poll(context)) throw Stopped{};
-  }
+  bool operator()(long i) const { return poll == nullptr || i % kPollStride != 0 || !poll(context); }
 };
 
 /// The engine's observer: the physical state of every step, to the monitor; the engine's poll.
@@ -148,7 +144,8 @@ struct Observer {
   void operator()(long, const X& x) {
     monitor.step(kernel.to_physical(x));
   }
-  void poll(long i) const { cancel(i); }
+  bool stopped = false;  ///< the Poll said stop: the loop ended early
+  bool poll(long i) { return cancel(i) || !(stopped = true); }
 };
 
 // --- the Lie-Poisson kernel (splitting::LiePoissonKernel<OriginCentre, true>) ---------------------
@@ -261,7 +258,7 @@ void report(const Physical& f, const Monitor& monitor, std::size_t count, double
   }
 }
 
-/// Runs `Seq` with kernel K on the lanes; returns the force evaluations.
+/// Runs `Seq` with kernel K on the lanes; returns the force evaluations, or abi::kStopped.
 template <const auto& Seq, class K>
 long run_splitting(K kernel, const Physical& s0, double h, long steps, std::size_t count, double* out,
                    Canceller cancel) {
@@ -269,6 +266,7 @@ long run_splitting(K kernel, const Physical& s0, double h, long steps, std::size
   Observer<K> obs{kernel, monitor, cancel};
   typename K::state_type x = kernel.initial_state(s0);
   sp::integrate<Seq>(kernel, x, h, steps, obs);
+  if (obs.stopped) return abi::kStopped;
   report(kernel.to_physical(x), monitor, count, out);
   return kernel.evals;
 }
@@ -320,7 +318,7 @@ long run_rk4(const Params& p, const Physical& s0, double h, long steps, std::siz
     k[3] = &k4;
     x = stage(x, 4, b, k);
     monitor.step({x.R, x.v, x.w});
-    cancel(i + 1);
+    if (!cancel(i + 1)) return abi::kStopped;
   }
   report({x.R, x.v, x.w}, monitor, count, out);
   return 4 * steps;
@@ -366,11 +364,7 @@ long run(int kernel, const double* in, std::size_t count, double h, long steps, 
   Params p{lane_of(in, count, 0), lane_of(in, count, 1), lane_of(in, count, 2), lane_of(in, count, 3), {}};
   p.inv_D = 1.0 / (p.m * p.J - p.B * p.B);
   const Physical s0{v3_of(in, count, 4), v3_of(in, count, 7), v3_of(in, count, 10)};
-  try {
-    return r(p, s0, h, steps, count, out, Canceller{poll, context});
-  } catch (const Stopped&) {
-    return abi::kStopped;
-  }
+  return r(p, s0, h, steps, count, out, Canceller{poll, context});
 }
 
 }  // namespace bodypoint::batch::BODYPOINT_BATCH_NS

@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <string>
 #include <limits>
+#include <optional>
 #include <type_traits>
 #include <vector>
 
@@ -68,6 +69,7 @@ inline Grid grid_of(const FictitiousSteps& f) { return {0.0, f.steps(), f.dt_out
 [[noreturn]] void stop_on_request();
 
 /// The poll of RunOptions::cancel that every step loop makes through its observer (`obs.poll(i)`).
+/// A cancelled run is no result: it leaves by Error(kStoppedOnRequest), which the run's caller reports.
 struct CancelPoll {
   const std::atomic<bool>* cancel = nullptr;
   void poll(long i) const {
@@ -76,15 +78,17 @@ struct CancelPoll {
   }
 };
 
-/// The observer of a run that observes nothing but may be cancelled.
+/// The observer of a run that observes nothing but may be cancelled: it never ends a loop early.
 struct Unobserved : splitting::NullObserver {
   CancelPoll cancel;
-  void poll(long i) const { cancel.poll(i); }
+  bool poll(long i) const {
+    cancel.poll(i);
+    return true;
+  }
 };
 
-/// Unwinds a step loop from its observer when the sink says Flow::stop; observe() catches it, so it
-/// never leaves a run.
-struct SinkStopped {
+/// Where a sink said Flow::stop: the run ends at the state it was handed.
+struct SinkStop {
   long step;
   double t;
   State s;
@@ -100,7 +104,7 @@ class Monitor {
           ToPhysical to_physical)
       : inv_(p, f, s0), grid_(grid), every_(options.every), sink_(options.sink), cancel_{options.cancel},
         to_physical_(std::move(to_physical)) {
-    if (sink_ && (*sink_)(Sample{0, 0.0, s0, 0.0, 0.0, 0.0}) == Flow::stop) throw SinkStopped{0, 0.0, s0};
+    hand(Sample{0, 0.0, s0, 0.0, 0.0, 0.0});
   }
 
   /// Fixed steps: step i ends at time i h and was h long.
@@ -122,7 +126,13 @@ class Monitor {
     hand(Sample{i, t, s, inv_.last_rel_dE(), inv_.last_rel_dK2sq(), inv_.last_abs_dK2Q()});
   }
   [[nodiscard]] bool wants_times() const { return sink_ && grid_.dt_out > 0.0; }
-  void poll(long i) const { cancel_.poll(i); }
+  /// After step i: false once the sink said Flow::stop (the loop then ends).
+  bool poll(long i) const {
+    cancel_.poll(i);
+    return !stop_;
+  }
+  /// Where the sink said Flow::stop, if it did.
+  [[nodiscard]] const std::optional<SinkStop>& stop() const { return stop_; }
 
   [[nodiscard]] const InvariantStats& stats() const { return inv_.stats(); }
 
@@ -134,8 +144,9 @@ class Monitor {
     if (sink_ && grid_.dt_out <= 0.0 && (i % every_ == 0 || last))
       hand(Sample{i, t, s, inv_.last_rel_dE(), inv_.last_rel_dK2sq(), inv_.last_abs_dK2Q()});
   }
-  void hand(const Sample& x) const {
-    if (sink_ && (*sink_)(x) == Flow::stop) throw SinkStopped{x.step, x.t, x.s};
+  /// Hands x to the sink until it says Flow::stop; the states after that are not handed.
+  void hand(const Sample& x) {
+    if (sink_ && !stop_ && (*sink_)(x) == Flow::stop) stop_ = SinkStop{x.step, x.t, x.s};
   }
 
   InvariantMonitor<Field> inv_;
@@ -145,6 +156,7 @@ class Monitor {
   const SampleSink* sink_;
   CancelPoll cancel_;
   ToPhysical to_physical_;
+  std::optional<SinkStop> stop_;
 };
 
 /// Accepted steps of a variable-step run: count, smallest and largest physical step.
@@ -194,7 +206,7 @@ template <class Says, class X, class TryStep, class Observer>
     rejected_in_a_row = 0;
     check_adaptive_rate(st.steps, t, t_end);
     if constexpr (Observer::active) obs.observe(st.steps, t, x, t >= t_end);
-    splitting::poll(obs, st.steps);
+    if (!splitting::poll(obs, st.steps)) break;
     if (!std::isfinite(x[0])) break;
   }
   return x;
@@ -211,12 +223,11 @@ RunResult observe(const BodyPoint& p, const Field& field, const State& s0, const
   if (options.track_invariants || options.sink) {
     Monitor<Field, ToPhysical> mon(p, field, s0, options, grid, to_physical);
     const auto t0 = Clock::now();
-    try {
-      r.final = loop(mon);
-    } catch (const SinkStopped& stop) {
-      r.final = stop.s;
-      r.steps = stop.step;
-      r.t_end = stop.t;
+    if (!mon.stop()) r.final = loop(mon);
+    if (const std::optional<SinkStop>& stop = mon.stop()) {
+      r.final = stop->s;
+      r.steps = stop->step;
+      r.t_end = stop->t;
       r.stopped = true;
     }
     r.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();

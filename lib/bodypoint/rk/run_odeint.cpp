@@ -28,7 +28,7 @@ OdeState<double> fixed_step_body(System& sys, OdeState<double> x, double h, long
   for (long i = 0; i < n; ++i) {
     stepper.do_step(std::ref(sys), x, static_cast<double>(i) * h, h);
     if constexpr (Observer::active) obs(i + 1, x);
-    splitting::poll(obs, i + 1);
+    if (!splitting::poll(obs, i + 1)) break;
   }
   return x;
 }

@@ -189,10 +189,12 @@ struct NullObserver {
   void operator()(long, const X&) const {}
 };
 
-/// Calls obs.poll(i) after step i where the observer has one (a run's cancellation, run_support.hpp).
+/// After step i: whether the run goes on. Calls obs.poll(i) where the observer has one (a run's
+/// cancellation and its sink's Flow::stop, run_support.hpp); the loop ends where it says false.
 template <class Observer>
-inline void poll(const Observer& obs, long i) {
-  if constexpr (requires { obs.poll(i); }) obs.poll(i);
+[[nodiscard]] inline bool poll(Observer& obs, long i) {
+  if constexpr (requires { obs.poll(i); }) return obs.poll(i);
+  else return true;
 }
 
 /// Kernel concept: `state_type`, `drift(x, tau)`, `kick(x, tau)`, `begin_step(x)`, `third(x, tau)` for
@@ -227,24 +229,26 @@ void integrate(Kernel& k, typename Kernel::state_type& x, double h, long n, Obse
       F = k.force(x);
       k.apply_kick(x, Seq.ops[M - 1].c * h, F);
       if constexpr (Observer::active) obs(i + 1, x);
-      poll(obs, i + 1);
+      if (!poll(obs, i + 1)) break;
     }
   } else if constexpr (merge_drift) {
     if (n <= 0) return;
     apply(Seq.ops[0], h);
+    // Only an observer that observes nothing gets here: its poll says false never (a cancellation
+    // leaves the run by an error), so no step ends half merged.
     for (long i = 0; i < n; ++i) {
       for (std::size_t j = 1; j + 1 < M; ++j) apply(Seq.ops[j], h);
       Op last = Seq.ops[M - 1];
       if (i + 1 < n) last.c += Seq.ops[0].c;
       apply(last, h);
-      poll(obs, i + 1);
+      if (!poll(obs, i + 1)) break;
     }
   } else {
     for (long i = 0; i < n; ++i) {
       k.begin_step(x);
       for (std::size_t j = 0; j < M; ++j) apply(Seq.ops[j], h);
       if constexpr (Observer::active) obs(i + 1, x);
-      poll(obs, i + 1);
+      if (!poll(obs, i + 1)) break;
     }
   }
 }
