@@ -8,7 +8,7 @@
 #include "bodypoint/methods.hpp"
 #include "bodypoint/reference.hpp"
 #include "bodypoint/sweep.hpp"
-#include "bodypoint/rhs.hpp"
+#include "bodypoint/detail/equations.hpp"
 #include "bodypoint/rk/odeint.hpp"
 #include "bodypoint/run.hpp"
 #include "bodypoint/scenes.hpp"

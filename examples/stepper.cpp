@@ -12,7 +12,7 @@ int main() {
   p.start.L = 20.0;  // start closer than table 3.1, so that the encounter happens by t = 10
   const bodypoint::Scene scene = bodypoint::thesis_scene(p);
   const bodypoint::Body& body = scene.bodies.front();
-  const double E0 = bodypoint::kinetic_energy(body.p, body.s0) - scene.centres.front().A / body.s0.R.norm();
+  const double E0 = bodypoint::energy(body.p, scene.centres, body.s0);
 
   bodypoint::Stepper stepper("logh-kl6", body, scene.centres, 0.01);
   for (int k = 1; k <= 10; ++k) {
@@ -21,7 +21,7 @@ int main() {
       return 1;
     }
     const bodypoint::State& s = stepper.state();
-    const double E = bodypoint::kinetic_energy(body.p, s) - scene.centres.front().A / s.R.norm();
+    const double E = bodypoint::energy(body.p, scene.centres, s);
     std::printf("t %g r %.12g rel_dE %.2e\n", stepper.time(), s.R.norm(), std::abs(E - E0) / std::abs(E0));
   }
   std::printf("force_evals %ld\n", stepper.force_evals());

@@ -14,7 +14,7 @@
 
 #include "cli.hpp"
 
-#include "bodypoint/invariants.hpp"
+#include "bodypoint/detail/monitor.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
 #include "bodypoint/reference.hpp"

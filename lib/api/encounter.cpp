@@ -2,6 +2,7 @@
 #include "bodypoint/bodypoint.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/scattering.hpp"
+#include "bodypoint/detail/model_parts.hpp"
 #include "encounter_parts.hpp"
 #include "events.hpp"
 

@@ -5,7 +5,7 @@
 #include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/field.hpp"
-#include "bodypoint/invariants.hpp"
+#include "bodypoint/detail/monitor.hpp"
 #include "checked.hpp"
 #include "choice.hpp"
 #include "estimate.hpp"

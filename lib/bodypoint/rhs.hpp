@@ -7,10 +7,11 @@
 // with F = -A (R - c)/|R - c|^3 summed over centres. Erratum 1: the thesis prints the second line
 // with both signs flipped, which breaks dK1/dt = F; tests/lib/test_model.cpp checks the identity.
 //
-// Odeint state layout: x = (R, v, w), nine scalars.
+// Odeint state layout: x = (R, v, w), nine scalars. PreciseEquations is the system a program drives
+// Boost.Odeint with (any scalar type); the production kernels' system over a field
+// (EquationsOfMotion) is internal: detail/equations.hpp.
 #pragma once
 
-#include "bodypoint/field.hpp"
 #include "bodypoint/model.hpp"
 
 #include <array>
@@ -28,54 +29,6 @@ inline OdeState<double> to_ode(const State& s) {
 inline State from_ode(const OdeState<double>& x) {
   return {Vec3(x[0], x[1], x[2]), Vec3(x[3], x[4], x[5]), Vec3(x[6], x[7], x[8])};
 }
-
-/// The system for a given field; `Spin = false` (B = 0) skips the gyroscopic terms entirely,
-/// leaving dw/dt = 0. Counts its own calls (one call = one force evaluation). The coefficients
-/// J/D, B^2/D, B/D and m B/D are computed once: odeint may call this out of line, and a division per
-/// call made an RK4 step 1.8x slower (bench_steps).
-template <class Field, bool Spin>
-struct EquationsOfMotion {
-  BodyPoint p;
-  Field field;
-  long* evals = nullptr;  ///< optional counter of calls
-
-  EquationsOfMotion(const BodyPoint& bp, Field f, long* counter = nullptr)
-      : p(bp), field(std::move(f)), evals(counter), cJ_(bp.J / bp.D()), cBB_(bp.B * bp.B / bp.D()),
-        cB_(bp.B / bp.D()), cmB_(bp.m * bp.B / bp.D()), inv_m_(1.0 / bp.m) {}
-
-  void operator()(const OdeState<double>& x, OdeState<double>& dxdt, double /*t*/) const {
-    eval(x.data(), dxdt.data());
-  }
-
-  /// The same on plain arrays of nine (GSL's right-hand side calls this on its own arrays: copying
-  /// them into OdeState and back made GSL's runs 1.26x slower than a plain C right-hand side).
-  void eval(const double* x, double* dxdt) const {
-    if (evals) ++*evals;
-    const Vec3 R(x[0], x[1], x[2]);
-    const Vec3 F = field.force(R);
-    double dv[3], dw[3];
-    if constexpr (Spin) {
-      const double wxv[3] = {x[7] * x[5] - x[8] * x[4], x[8] * x[3] - x[6] * x[5], x[6] * x[4] - x[7] * x[3]};
-      for (int i = 0; i < 3; ++i) {
-        dv[i] = cJ_ * F[i] - cBB_ * wxv[i];
-        dw[i] = -cB_ * F[i] + cmB_ * wxv[i];
-      }
-    } else {
-      for (int i = 0; i < 3; ++i) {
-        dv[i] = inv_m_ * F[i];
-        dw[i] = 0.0;
-      }
-    }
-    for (int i = 0; i < 3; ++i) {
-      dxdt[i] = x[3 + i];
-      dxdt[3 + i] = dv[i];
-      dxdt[6 + i] = dw[i];
-    }
-  }
-
- private:
-  double cJ_, cBB_, cB_, cmB_, inv_m_;
-};
 
 /// The same equations in any floating type, with a plain loop over centres. It shares no code
 /// with the double-precision kernels so that it can serve as an independent reference

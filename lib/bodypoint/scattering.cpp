@@ -4,7 +4,7 @@
 #include "bodypoint/io.hpp"
 
 #include "bodypoint/field.hpp"
-#include "bodypoint/invariants.hpp"
+#include "bodypoint/detail/monitor.hpp"
 #include "bodypoint/detail/model_parts.hpp"
 
 #include <algorithm>

@@ -44,32 +44,6 @@ struct Asymptote {
   [[nodiscard]] double b() const { return impact.norm(); }
 };
 
-/// The asymptote (outgoing, or incoming) of the Kepler orbit of a particle of mass mu at X relative
-/// to a centre of force kappa X/|X|^3 (kappa = -A > 0 repels) with momentum P. Nothing when the
-/// orbit is bound (E <= 0) or P = 0.
-std::optional<Asymptote> kepler_asymptote(double mu, double kappa, const Vec3& X, const Vec3& P, bool outgoing);
-
-/// The periapsis of that orbit (E > 0): the closest distance and the time from the state at (X, P)
-/// until the body is there (negative once past it), from Kepler's hyperbolic equation.
-struct Periapsis {
-  double r = 0.0, dt = 0.0;
-  double e = 1.0;  ///< the hyperbola's eccentricity (a straight line: 1)
-};
-std::optional<Periapsis> kepler_periapsis(double mu, double kappa, const Vec3& X, const Vec3& P);
-
-/// The Kepler particle a body-point's state is far from a centre at c: (mu, X, P) as above (B = 0:
-/// the body itself; B != 0: its guiding centre). Nothing when the guiding centre does not drift (u = 0).
-struct KeplerParticle {
-  double mu = 0.0;
-  Vec3 X = Vec3::Zero(), P = Vec3::Zero();
-  /// +1; -1 when the guiding centre drifts against K1 (u < 0): then P = -K1, and the centre's force
-  /// acts on the particle as kappa_sign * kappa (a repelling centre attracts it).
-  double kappa_sign = 1.0;
-  /// The force constant the particle feels from a centre of constant A: -A kappa_sign.
-  [[nodiscard]] double kappa(double A) const { return -A * kappa_sign; }
-};
-std::optional<KeplerParticle> kepler_particle(const BodyPoint& p, const State& s, const Vec3& c);
-
 /// The observables of an encounter between two states of one run (start and end).
 struct Scattering {
   Vec3 K1_start = Vec3::Zero(), K1_end = Vec3::Zero(), K2_start = Vec3::Zero(), K2_end = Vec3::Zero();

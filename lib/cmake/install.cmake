@@ -2,8 +2,9 @@
 # bodypoint (bodypointConfig.cmake with its version file), so that a program outside the tree writes
 #   find_package(bodypoint 0.1 REQUIRED)
 #   target_link_libraries(app PRIVATE bodypoint::bodypoint)
-# The public headers are the API and what it exposes; the rest (kernels, drivers, detail/, the commands'
-# helpers: io, scenes, observables, batch, threads, order_fit, the accuracy layer's search) stays inside.
+# The public headers are the API and what it exposes; the rest (kernels, drivers, the force field, the
+# Kepler solver, detail/, the commands' helpers: io, scenes, observables, batch, threads, order_fit, the
+# accuracy layer's search) stays inside.
 include(CMakePackageConfigHelpers)
 
 set_target_properties(bodypoint_core PROPERTIES EXPORT_NAME core)
@@ -17,18 +18,16 @@ install(FILES
           ${PROJECT_SOURCE_DIR}/lib/api/bodypoint/methods.hpp
           ${PROJECT_SOURCE_DIR}/lib/api/bodypoint/record.hpp
           ${PROJECT_SOURCE_DIR}/lib/api/bodypoint/sweep.hpp
-          ${PROJECT_SOURCE_DIR}/lib/bodypoint/field.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/invariant_stats.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/invariants.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/model.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/run.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/scattering.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/scene_file.hpp
-          # The independent references and the equations of motion as an ODE system (Boost.Odeint's
-          # headers are needed where a program includes these).
+          # The independent references and the equations of motion as an ODE system (a program drives
+          # Boost.Odeint with PreciseEquations; neither header includes Boost).
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/reference.hpp
           ${PROJECT_SOURCE_DIR}/lib/bodypoint/rhs.hpp
-          ${PROJECT_SOURCE_DIR}/lib/bodypoint/kepler.hpp
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bodypoint)
 
 set(BODYPOINT_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/bodypoint)

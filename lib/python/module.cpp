@@ -4,7 +4,7 @@
 // library's one-line reason; the GIL is released while integrating. The Python-side docs and the
 // keyword interface are in bodypoint/__init__.py; this file holds only the conversions.
 #include "bodypoint/bodypoint.hpp"
-#include "bodypoint/invariants.hpp"
+#include "bodypoint/detail/monitor.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/record.hpp"
 #include "bodypoint/sweep.hpp"

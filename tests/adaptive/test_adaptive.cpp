@@ -4,7 +4,7 @@
 #include "bodypoint/adaptive/ks.hpp"
 #include "bodypoint/adaptive/methods.hpp"
 #include "bodypoint/adaptive/time_transformed.hpp"
-#include "bodypoint/invariants.hpp"
+#include "bodypoint/detail/monitor.hpp"
 #include "bodypoint/methods.hpp"
 #include "bodypoint/reference.hpp"
 #include "bodypoint/run.hpp"

@@ -4,6 +4,7 @@
 // step search was not tuned on as well as on the named ones: several centres of both signs, near
 // head-on encounters, B = 0 and B != 0, an end time long after the encounter.
 #include "bodypoint/adaptive/methods.hpp"
+#include "bodypoint/detail/model_parts.hpp"
 #include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/methods.hpp"
 #include "bodypoint/reference.hpp"

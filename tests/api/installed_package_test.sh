@@ -31,7 +31,7 @@ ls "$work"/prefix/lib*/cmake/bodypoint/bodypointConfigVersion.cmake >/dev/null
 for h in $(cd "$work/prefix/include" && grep -rho '#include "bodypoint/[^"]*"' bodypoint | sort -u | cut -d'"' -f2); do
   if [ ! -f "$work/prefix/include/$h" ]; then echo "FAIL: an installed header includes $h, which the install leaves out"; exit 1; fi
 done
-for internal in io scenes batch threads order_fit observables adaptive/tolerance adaptive/methods; do
+for internal in io scenes batch threads order_fit observables field kepler adaptive/tolerance adaptive/methods; do
   if [ -e "$work/prefix/include/bodypoint/$internal.hpp" ]; then echo "FAIL: bodypoint/$internal.hpp installed"; exit 1; fi
 done
 

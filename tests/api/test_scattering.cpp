@@ -3,6 +3,7 @@
 // values, the asymptotic deflection against Rutherford's formula, and the guiding-centre asymptotes of a
 // spinning body converging with distance.
 #include "bodypoint/bodypoint.hpp"
+#include "bodypoint/detail/model_parts.hpp"
 #include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/reference.hpp"
 

@@ -3,7 +3,7 @@
 // The Kepler split (kep-*), whose two flows are exact too, shares the helix and invariant tests and is
 // exact for a material point.
 #include "bodypoint/field.hpp"
-#include "bodypoint/invariants.hpp"
+#include "bodypoint/detail/monitor.hpp"
 #include "bodypoint/kepler.hpp"
 #include "bodypoint/methods.hpp"
 #include "bodypoint/reference.hpp"

@@ -1,8 +1,8 @@
 // Model, initial conditions, equations of motion and input validation.
 #include "bodypoint/field.hpp"
-#include "bodypoint/invariants.hpp"
+#include "bodypoint/detail/monitor.hpp"
 #include "bodypoint/methods.hpp"
-#include "bodypoint/rhs.hpp"
+#include "bodypoint/detail/equations.hpp"
 #include "bodypoint/run.hpp"
 #include "bodypoint/scene_file.hpp"
 #include "bodypoint/sweep.hpp"

@@ -4,8 +4,8 @@
 // Each kernel is the scalar kernel's arithmetic on W bodies at once: the Lie-Poisson kernel
 // (splitting/lie_poisson.hpp, spin on), the thesis's kernel (splitting/thesis.hpp, spin on, no code
 // slip) and odeint's classical RK4 (its generic Runge-Kutta stages, zero coefficients included) on
-// rhs.hpp's equations, all in a field of one Coulomb centre at the origin, driven by the same
-// composition engine (splitting/composition.hpp) and observed by the scalar monitor's arithmetic.
+// the equations of motion (rhs.hpp), all in a field of one Coulomb centre at the origin, driven by the
+// same composition engine (splitting/composition.hpp) and observed by the scalar monitor's arithmetic.
 //
 // This unit is compiled with wider instruction sets than the rest of the program, so it calls no
 // inline function of a header (Eigen, the standard library, splitting's scalar code): the linker
@@ -271,7 +271,7 @@ long run_splitting(K kernel, const Physical& s0, double h, long steps, std::size
   return kernel.evals;
 }
 
-// --- odeint's runge_kutta4 on rhs.hpp's EquationsOfMotion<OriginCentre, true> --------------------
+// --- odeint's runge_kutta4 on EquationsOfMotion<OriginCentre, true> (detail/equations.hpp) -------
 
 struct Ode {
   V3 R, v, w;

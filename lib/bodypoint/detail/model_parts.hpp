@@ -1,6 +1,7 @@
 // bodypoint: the model's and the scattering code's helpers that the library and the commands share but a
 // program outside the tree has no use for: the one wording of a number's range, the resolution of D, the
-// helix of a spinning body far from the centres, the checks of asymptotic data and the least drifting K1.
+// helix of a spinning body far from the centres, the checks of asymptotic data and the least drifting K1;
+// the Kepler particle a far body is, with its asymptotes and periapsis (the scattering code's).
 // Internal (not installed).
 #pragma once
 
@@ -8,6 +9,7 @@
 #include "bodypoint/scattering.hpp"
 
 #include <algorithm>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -67,5 +69,33 @@ void check_data_beside_solved(const std::vector<std::string>& data, const std::v
 
 /// The angle between two vectors, accurate for small and for near-opposite angles: atan2(|a x b|, a.b).
 double angle_between(const Vec3& a, const Vec3& b);
+
+// --- the Kepler particle a far body is, its asymptotes and periapsis (scattering.cpp) ----------------
+
+/// The asymptote (outgoing, or incoming) of the Kepler orbit of a particle of mass mu at X relative
+/// to a centre of force kappa X/|X|^3 (kappa = -A > 0 repels) with momentum P. Nothing when the
+/// orbit is bound (E <= 0) or P = 0.
+std::optional<Asymptote> kepler_asymptote(double mu, double kappa, const Vec3& X, const Vec3& P, bool outgoing);
+
+/// The periapsis of that orbit (E > 0): the closest distance and the time from the state at (X, P)
+/// until the body is there (negative once past it), from Kepler's hyperbolic equation.
+struct Periapsis {
+  double r = 0.0, dt = 0.0;
+  double e = 1.0;  ///< the hyperbola's eccentricity (a straight line: 1)
+};
+std::optional<Periapsis> kepler_periapsis(double mu, double kappa, const Vec3& X, const Vec3& P);
+
+/// The Kepler particle a body-point's state is far from a centre at c: (mu, X, P) as above (B = 0:
+/// the body itself; B != 0: its guiding centre). Nothing when the guiding centre does not drift (u = 0).
+struct KeplerParticle {
+  double mu = 0.0;
+  Vec3 X = Vec3::Zero(), P = Vec3::Zero();
+  /// +1; -1 when the guiding centre drifts against K1 (u < 0): then P = -K1, and the centre's force
+  /// acts on the particle as kappa_sign * kappa (a repelling centre attracts it).
+  double kappa_sign = 1.0;
+  /// The force constant the particle feels from a centre of constant A: -A kappa_sign.
+  [[nodiscard]] double kappa(double A) const { return -A * kappa_sign; }
+};
+std::optional<KeplerParticle> kepler_particle(const BodyPoint& p, const State& s, const Vec3& c);
 
 }  // namespace bodypoint

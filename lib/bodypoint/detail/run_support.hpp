@@ -4,7 +4,7 @@
 #pragma once
 
 #include "bodypoint/field.hpp"
-#include "bodypoint/invariants.hpp"
+#include "bodypoint/detail/monitor.hpp"
 #include "bodypoint/run.hpp"
 #include "bodypoint/splitting/composition.hpp"
 #include "bodypoint/detail/run_parts.hpp"

@@ -7,7 +7,7 @@
 // system. gsl_odeiv2_evolve_apply limits the last step to the end time, so t_end is hit exactly.
 #include "bodypoint/rk/run_gsl.hpp"
 
-#include "bodypoint/rhs.hpp"
+#include "bodypoint/detail/equations.hpp"
 #include "bodypoint/detail/run_support.hpp"
 
 #include <gsl/gsl_errno.h>

@@ -1,7 +1,7 @@
 // bodypoint: Boost.Odeint run loops (fixed-step RK4/AB4 and the step-size-controlled steppers).
 #include "bodypoint/rk/run_odeint.hpp"
 
-#include "bodypoint/rhs.hpp"
+#include "bodypoint/detail/equations.hpp"
 #include "bodypoint/rk/odeint.hpp"
 #include "bodypoint/detail/run_support.hpp"
 
