@@ -1,6 +1,7 @@
 #include "process.hpp"
 #include "cli.hpp"
 #include "budget.hpp"
+#include "checked.hpp"
 
 #include "bodypoint/io.hpp"
 #include "bodypoint/scattering.hpp"

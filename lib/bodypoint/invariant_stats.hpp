@@ -26,9 +26,5 @@ struct InvariantStats {
   double min_turn_cos = 1.0;
 };
 
-inline double relative_deviation(double x, double x0) {
-  const double scale = std::abs(x0);
-  return scale > 0.0 ? std::abs(x - x0) / scale : std::abs(x - x0);
-}
 
 }  // namespace bodypoint

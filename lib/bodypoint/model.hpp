@@ -101,17 +101,6 @@ struct ThesisStart {
   double phase = 0.0;
 };
 
-/// K1(0) = K1 i, K2(0) = Kx i - Kz k, R(0) = -L i + (d - Kz/K1) j (eq. 1.11-1.13), so that the
-/// z-component of K2Q = R x K1 + K2 is -d K1; with a phase psi, K2(0) = Kx i + Kz (sin psi j - cos psi k)
-/// and R(0) = -L i + (d - Kz/K1 cos psi) j - (Kz/K1) sin psi k (G and K2Q_z kept).
-inline Momenta thesis_momenta(const ThesisStart& t) {
-  Momenta q;
-  const double c = t.phase == 0.0 ? 1.0 : std::cos(t.phase), s = t.phase == 0.0 ? 0.0 : std::sin(t.phase);
-  q.K1 = Vec3(t.K1, 0.0, 0.0);
-  q.K2 = Vec3(t.Kx, t.Kz * s, -t.Kz * c);
-  q.R = Vec3(-t.L, t.d - t.Kz / t.K1 * c, -t.Kz / t.K1 * s);
-  return q;
-}
 
 /// One body of a scene: parameters, initial state and a label for output.
 struct Body {

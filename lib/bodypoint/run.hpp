@@ -2,8 +2,8 @@
 //
 // A run is one method, one way of advancing time (Advance: fixed steps, fictitious steps, step-size
 // control, or an accuracy that searches one of those) and the observations asked for (RunOptions). The
-// Advance is checked once, where its alternatives are defined (check, check_takes); the method's driver
-// reads the alternative it takes and nothing else. Invariants are tracked only when asked for, and
+// Advance is checked once, where its alternatives are defined (check; check_takes in
+// detail/run_parts.hpp); the method's driver reads the alternative it takes and nothing else. Invariants are tracked only when asked for, and
 // states are handed to a sink only when one is given: with neither, the step loop runs with a null
 // observer and stores nothing. This layer lists its own methods (core_methods); the registry of every
 // method is one layer up (bodypoint/methods.hpp).
@@ -103,23 +103,6 @@ constexpr std::string_view family_name(Family f) {
   return "?";
 }
 
-/// The family as one word, for machine-read tables (`bodypoint methods --csv`, the paper's scripts).
-constexpr std::string_view family_key(Family f) {
-  switch (f) {
-    case Family::Thesis: return "thesis";
-    case Family::LiePoisson: return "lie-poisson";
-    case Family::KeplerSplit: return "kepler-split";
-    case Family::Odeint: return "odeint";
-    case Family::OdeintAdaptive: return "odeint-adaptive";
-    case Family::Gsl: return "gsl";
-    case Family::TimeTransformed: return "time-transformed";
-    case Family::Regularised: return "regularised";
-    case Family::Extrapolated: return "extrapolated";
-    case Family::FarField: return "far-field";
-  }
-  return "?";
-}
-
 /// The three ways of advancing time, one driver each, and the accuracy mode that searches the step of
 /// one of them:
 ///   FixedSteps       `steps` steps of h, time i h (the composition engine and Odeint's fixed-step loop
@@ -194,10 +177,6 @@ struct RunOptions {
 };
 /// The reason of a run that RunOptions::cancel ended.
 inline constexpr const char* kStoppedOnRequest = "stopped on request (an interrupt or the time budget)";
-/// What a loop throws when RunOptions::cancel is set: no search retries it (integrate_body: failed).
-struct StoppedOnRequest : Error {
-  StoppedOnRequest() : Error(kStoppedOnRequest) {}
-};
 /// Throws Error unless every >= 1 (check_every) and omega_c is finite (< 0: automatic).
 void check(const RunOptions& options);
 
@@ -273,13 +252,8 @@ std::string refusal(const MethodInfo& m, const Body& body, const std::vector<Cen
 /// True for methods that choose their own steps from a tolerance per step (ControlledSteps):
 /// Boost.Odeint's and GSL's controlled steppers, and logh-bs.
 inline bool is_step_controlled(const MethodInfo& m) { return m.traits.stepping == Stepping::controlled; }
-/// True for the peers that bodypoint's own methods compete with: the general-purpose ones (Boost.Odeint,
-/// GSL) and the time-transformed one of Mikkola's codes (logh-bs).
-inline bool is_peer(const MethodInfo& m) { return m.traits.peer; }
 /// True for methods with a fixed fictitious step (FictitiousSteps): time-transformed and regularised.
 inline bool is_time_transformed(const MethodInfo& m) { return m.traits.stepping == Stepping::fictitious; }
-/// True for every method whose physical step varies (step-size-controlled or time-transformed).
-inline bool has_variable_step(const MethodInfo& m) { return is_step_controlled(m) || is_time_transformed(m); }
 
 /// How a run ended.
 enum class Outcome {
@@ -304,9 +278,5 @@ constexpr double kDefaultMaxEnergyError = 1e-2;
 /// within 1e-12 of a whole number counts as that number). Throws Error beyond 1e13 steps.
 FixedSteps fixed_steps_to(double t_end, double h_max);
 
-/// Throws Error unless `m` takes this way of advancing time (FixedSteps for fixed-step methods,
-/// FictitiousSteps for time-transformed ones, ControlledSteps for step-size-controlled ones; Accuracy
-/// for none: it searches the step of one of the others).
-void check_takes(const MethodInfo& m, const Advance& how);
 
 }  // namespace bodypoint

@@ -1,4 +1,5 @@
 #include "bodypoint/scene_file.hpp"
+#include "bodypoint/detail/model_parts.hpp"
 
 #include "bodypoint/io.hpp"
 

@@ -41,7 +41,5 @@ struct SceneValue {
 /// Error naming the key for a key the scene does not have, or a value that is not a body's parameter.
 /// The scene as a whole is checked once, where it is run (validate; read_scene_file checks it).
 Scene parse_scene(const std::string& text, const std::string& origin, const std::vector<SceneValue>& set = {});
-/// Whether `key` is a key path of SceneValue's form (a scene file's key, not a thesis parameter).
-bool is_scene_key(const std::string& key);
 
 }  // namespace bodypoint

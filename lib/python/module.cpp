@@ -9,6 +9,7 @@
 #include "bodypoint/record.hpp"
 #include "bodypoint/sweep.hpp"
 #include "bodypoint/threads.hpp"
+#include "checked.hpp"
 #include "encounter_parts.hpp"
 #include "bodypoint/detail/run_parts.hpp"
 #include "bodypoint/detail/model_parts.hpp"

@@ -114,11 +114,6 @@ const EventHit* nearest_approach(const std::vector<EventHit>& hits, const std::v
 /// the energy's (kDefaultMaxEnergyError).
 inline constexpr double kDefaultMaxError = 1e-2;
 
-/// A time-step constant c a caller gives (RunOptions::omega_c; not giving one is -1, automatic),
-/// checked for the run it is given to: a finite number >= 0, for a time-transformed method (logh-*,
-/// ttl-*; ks has none) run by its fictitious step, not in the accuracy mode (which chooses c itself).
-/// Error naming the quantity otherwise.
-void check_time_step_constant(double omega_c, const MethodInfo* method, bool accuracy);
 
 /// What a run asks for besides the way of advancing time and what it observes (RunOptions: invariants,
 /// samples, the time-step constant c): events to locate and the bound of the accuracy flag.
@@ -243,12 +238,6 @@ struct StepRequest {
   /// Backwards in time from t = 0 (to -t_end, or `steps` steps back); a negative t_end says it too.
   bool backward = false;
 };
-/// True when `request` asks the accuracy mode to choose the step of `method` (nullptr: auto).
-bool searches(const MethodInfo* method, const StepRequest& request);
-/// Every front end's default end (the command line's, Python's): a request with neither an end time
-/// nor a count of steps runs the accuracy mode to t_end = kDefaultStep kDefaultSteps (50, the thesis's
-/// h n) and any other way kDefaultSteps steps; a request with one is returned as it is.
-StepRequest with_default_end(StepRequest request, const MethodInfo* method);
 /// The one mapping from a step request to a way of advancing time, by the method's kind:
 ///   accuracy (searches): Accuracy{tol, t_end}; h and steps are refused, t_end is needed;
 ///   fixed-step: t_end given, the steps of at most h that land on it (fixed_steps_to); otherwise

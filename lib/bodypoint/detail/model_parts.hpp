@@ -70,6 +70,23 @@ void check_data_beside_solved(const std::vector<std::string>& data, const std::v
 /// The angle between two vectors, accurate for small and for near-opposite angles: atan2(|a x b|, a.b).
 double angle_between(const Vec3& a, const Vec3& b);
 
+// --- the thesis's start and a scene file's keys -----------------------------------------------
+
+/// K1(0) = K1 i, K2(0) = Kx i - Kz k, R(0) = -L i + (d - Kz/K1) j (eq. 1.11-1.13), so that the
+/// z-component of K2Q = R x K1 + K2 is -d K1; with a phase psi, K2(0) = Kx i + Kz (sin psi j - cos psi k)
+/// and R(0) = -L i + (d - Kz/K1 cos psi) j - (Kz/K1) sin psi k (G and K2Q_z kept).
+inline Momenta thesis_momenta(const ThesisStart& t) {
+  Momenta q;
+  const double c = t.phase == 0.0 ? 1.0 : std::cos(t.phase), s = t.phase == 0.0 ? 0.0 : std::sin(t.phase);
+  q.K1 = Vec3(t.K1, 0.0, 0.0);
+  q.K2 = Vec3(t.Kx, t.Kz * s, -t.Kz * c);
+  q.R = Vec3(-t.L, t.d - t.Kz / t.K1 * c, -t.Kz / t.K1 * s);
+  return q;
+}
+
+/// Whether `key` is a key path of SceneValue's form (a scene file's key, not a thesis parameter).
+bool is_scene_key(const std::string& key);
+
 // --- the Kepler particle a far body is, its asymptotes and periapsis (scattering.cpp) ----------------
 
 /// The asymptote (outgoing, or incoming) of the Kepler orbit of a particle of mass mu at X relative

@@ -40,6 +40,12 @@ inline std::optional<Vec3> angular_momentum_point(const CentreList& f) {
   return std::nullopt;
 }
 
+/// |x - x0| / |x0| (|x - x0| where x0 = 0).
+inline double relative_deviation(double x, double x0) {
+  const double scale = std::abs(x0);
+  return scale > 0.0 ? std::abs(x - x0) / scale : std::abs(x - x0);
+}
+
 /// Tracks the deviations of every integral the field has; one call per observed state, `step` for
 /// the state that ends a step (it also measures the step's resolution), `update` for any other.
 template <class Field>

@@ -90,4 +90,38 @@ FixedSteps thesis_code_steps(double h, long steps, double t_end);
 RunResult run(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres, const Advance& how,
               const RunOptions& options = {});
 
+// --- what the commands, the catalogue and the drivers ask of a method, beyond run.hpp's ----------
+
+/// The family as one word, for machine-read tables (`bodypoint methods --csv`, the paper's scripts).
+constexpr std::string_view family_key(Family f) {
+  switch (f) {
+    case Family::Thesis: return "thesis";
+    case Family::LiePoisson: return "lie-poisson";
+    case Family::KeplerSplit: return "kepler-split";
+    case Family::Odeint: return "odeint";
+    case Family::OdeintAdaptive: return "odeint-adaptive";
+    case Family::Gsl: return "gsl";
+    case Family::TimeTransformed: return "time-transformed";
+    case Family::Regularised: return "regularised";
+    case Family::Extrapolated: return "extrapolated";
+    case Family::FarField: return "far-field";
+  }
+  return "?";
+}
+
+/// True for the peers that bodypoint's own methods compete with: the general-purpose ones (Boost.Odeint,
+/// GSL) and the time-transformed one of Mikkola's codes (logh-bs).
+inline bool is_peer(const MethodInfo& m) { return m.traits.peer; }
+/// True for every method whose physical step varies (step-size-controlled or time-transformed).
+inline bool has_variable_step(const MethodInfo& m) { return is_step_controlled(m) || is_time_transformed(m); }
+/// Throws Error unless `m` takes this way of advancing time (FixedSteps for fixed-step methods,
+/// FictitiousSteps for time-transformed ones, ControlledSteps for step-size-controlled ones; Accuracy
+/// for none: it searches the step of one of the others).
+void check_takes(const MethodInfo& m, const Advance& how);
+
+/// What a loop throws when RunOptions::cancel is set: no search retries it (integrate_body: failed).
+struct StoppedOnRequest : Error {
+  StoppedOnRequest() : Error(kStoppedOnRequest) {}
+};
+
 }  // namespace bodypoint
