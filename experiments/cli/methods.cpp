@@ -17,7 +17,7 @@ namespace {
 void print_markdown_table() {
   std::cout << "| method | family | order | stages | evals/step | description |\n|---|---|---|---|---|---|\n";
   for (const MethodInfo& m : methods())
-    std::cout << "| `" << m.name << "` | " << family_name(m.family) << " | " << (m.order ? std::to_string(m.order) : "var")
+    std::cout << "| `" << m.name << "` | " << m.traits.family_name << " | " << (m.order ? std::to_string(m.order) : "var")
               << " | " << (is_step_controlled(m) || m.traits.cost_set_by_field ? "-" : std::to_string(m.stages)) << " | "
               << (is_step_controlled(m) ? "adaptive"
                   : m.traits.cost_set_by_field ? "points x sweeps"  // far_field.hpp: set by the step and the field
@@ -31,9 +31,9 @@ void print_csv() {
   std::cout << "method,family,order,stages,evals_per_step,advance,family_name\n";
   for (const MethodInfo& m : methods()) {
     CsvLine row;
-    row.text(m.name).text(std::string(family_key(m.family))).count(m.order).count(m.stages).count(m.evals_per_step);
+    row.text(m.name).text(std::string(m.traits.family_key)).count(m.order).count(m.stages).count(m.evals_per_step);
     row.text(is_step_controlled(m) ? "controlled" : is_time_transformed(m) ? "fictitious" : "fixed");
-    row.quoted(std::string(family_name(m.family)));
+    row.quoted(std::string(m.traits.family_name));
     std::cout << row.str() << "\n";
   }
 }

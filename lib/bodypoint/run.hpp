@@ -86,23 +86,6 @@ struct RunResult {
 /// the field's slow scale rather than by the spin (far-ip, far_field.hpp).
 enum class Family { Thesis, LiePoisson, KeplerSplit, Odeint, OdeintAdaptive, Gsl, TimeTransformed, Regularised, Extrapolated, FarField };
 
-/// The family's name as `bodypoint methods --markdown` prints it.
-constexpr std::string_view family_name(Family f) {
-  switch (f) {
-    case Family::Thesis: return "thesis drift/kick";
-    case Family::LiePoisson: return "exact Lie-Poisson";
-    case Family::KeplerSplit: return "Kepler split";
-    case Family::Odeint: return "Boost.Odeint fixed step";
-    case Family::OdeintAdaptive: return "Boost.Odeint adaptive";
-    case Family::Gsl: return "GSL adaptive";
-    case Family::TimeTransformed: return "time-transformed";
-    case Family::Regularised: return "regularised";
-    case Family::Extrapolated: return "logH extrapolated";
-    case Family::FarField: return "far-field collocation";
-  }
-  return "?";
-}
-
 /// The three ways of advancing time, one driver each, and the accuracy mode that searches the step of
 /// one of them:
 ///   FixedSteps       `steps` steps of h, time i h (the composition engine and Odeint's fixed-step loop
@@ -202,6 +185,11 @@ enum class SearchStrategy {
 /// What the code asks of a method besides its name, order and cost: one row of the catalogue
 /// (catalogue_traits, run.cpp, sets it from the family), so no code outside it tests a family's name.
 struct MethodTraits {
+  /// The family's name as `bodypoint methods --markdown` prints it ("exact Lie-Poisson").
+  std::string_view family_name;
+  /// The family as one word, for machine-read tables (`bodypoint methods --csv`, Python's `methods()`,
+  /// the paper's scripts): "lie-poisson".
+  std::string_view family_key;
   Stepping stepping = Stepping::fixed;
   SearchStrategy search = SearchStrategy::ladder;
   /// A general-purpose peer bodypoint's methods compete with (Boost.Odeint, GSL, Mikkola's logh-bs).

@@ -693,7 +693,7 @@ void bind_scenes(py::module_& mod) {
     for (const MethodInfo& m : methods()) {
       py::dict d;
       d["name"] = m.name;
-      d["family"] = std::string(family_key(m.family));
+      d["family"] = std::string(m.traits.family_key);
       d["order"] = m.order;
       d["stages"] = m.stages;
       d["evals_per_step"] = m.evals_per_step;

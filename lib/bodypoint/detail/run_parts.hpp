@@ -92,23 +92,6 @@ RunResult run(const MethodInfo& method, const Body& body, const std::vector<Cent
 
 // --- what the commands, the catalogue and the drivers ask of a method, beyond run.hpp's ----------
 
-/// The family as one word, for machine-read tables (`bodypoint methods --csv`, the paper's scripts).
-constexpr std::string_view family_key(Family f) {
-  switch (f) {
-    case Family::Thesis: return "thesis";
-    case Family::LiePoisson: return "lie-poisson";
-    case Family::KeplerSplit: return "kepler-split";
-    case Family::Odeint: return "odeint";
-    case Family::OdeintAdaptive: return "odeint-adaptive";
-    case Family::Gsl: return "gsl";
-    case Family::TimeTransformed: return "time-transformed";
-    case Family::Regularised: return "regularised";
-    case Family::Extrapolated: return "extrapolated";
-    case Family::FarField: return "far-field";
-  }
-  return "?";
-}
-
 /// True for the peers that bodypoint's own methods compete with: the general-purpose ones (Boost.Odeint,
 /// GSL) and the time-transformed one of Mikkola's codes (logh-bs).
 inline bool is_peer(const MethodInfo& m) { return m.traits.peer; }
