@@ -1,7 +1,6 @@
 // bodypoint: the far-field collocation step (far_field.hpp).
 #include "bodypoint/far_field.hpp"
 
-#include "bodypoint/detail/run_support.hpp"
 #include "bodypoint/detail/model_parts.hpp"
 
 #include <algorithm>

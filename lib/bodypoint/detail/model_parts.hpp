@@ -9,12 +9,22 @@
 #include "bodypoint/scattering.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace bodypoint {
+
+namespace detail {
+/// x with three significant digits, for messages.
+inline std::string short_number(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", x);
+  return buf;
+}
+}  // namespace detail
 
 /// The one wording of a number's range, shared by every check of the library and the commands: each
 /// throws Error("<what> must be a finite number > 0, got <x>") (>= 0; a whole number >= 1) and

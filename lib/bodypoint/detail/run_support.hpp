@@ -8,6 +8,7 @@
 #include "bodypoint/run.hpp"
 #include "bodypoint/splitting/composition.hpp"
 #include "bodypoint/detail/run_parts.hpp"
+#include "bodypoint/detail/model_parts.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -26,13 +27,6 @@ using Clock = std::chrono::steady_clock;
 /// Step-size-controlled runs (Boost.Odeint, GSL): more than kMaxAdaptiveSteps accepted steps (a
 /// minute or more of work) means the tolerance or the end time is out of proportion.
 constexpr long kMaxAdaptiveSteps = 200'000'000L;
-
-/// x with three significant digits, for messages.
-inline std::string short_number(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", x);
-  return buf;
-}
 
 /// Checked every 2^20 accepted steps: throws when the rate so far would need more than
 /// kMaxAdaptiveSteps to reach t_end (odeint-dopri5 to t_end = 1e12 spent 68 s before its cap).
