@@ -59,7 +59,7 @@ w = [0.0, 0.0, 0.0]
 
 
 # Several centres with the thesis's spinning body: two repelling, then one attracting beyond them (the
-# named scenes two-centres and three-centres of lib/bodypoint/scenes.hpp).
+# named scenes two-centres and three-centres of lib/core/model/bodypoint/scenes.hpp).
 SPINNING_BODY = """[[body]]
 name = "spinning"
 m = 1.0

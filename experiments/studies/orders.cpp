@@ -82,7 +82,7 @@ double measured_order(const MethodInfo& m, const Probe& p, std::size_t* used) {
 void write_orders(std::ostream& csv) {
   csv << "method,nominal,encounter,encounter_points,orbit,orbit_points\n"
       << "# bodypoint study orders: slope of the final-position error against the step, fitted above\n"
-      << "# round-off (lib/bodypoint/order_fit.hpp), on the encounter (L = 20, d = 1, t = 3) and the bound\n"
+      << "# round-off (lib/core/model/bodypoint/order_fit.hpp), on the encounter (L = 20, d = 1, t = 3) and the bound\n"
       << "# orbit (A = 1, t = 30) of tests/lib/test_convergence.cpp, B = 0.7 (ks: B = 0); time-transformed\n"
       << "# methods with c = 0; empty: the method does not run there; revision " << git_revision() << "\n";
   const Probe enc_spin = probe(convergence_encounter(0.7)), enc_material = probe(convergence_encounter(0.0));

@@ -1,5 +1,5 @@
 // `bodypoint work-precision`: final-position error against run time for every method, side by side
-// with Boost.Odeint, on named scenes (lib/bodypoint/scenes.hpp).
+// with Boost.Odeint, on named scenes (lib/core/model/bodypoint/scenes.hpp).
 //
 // For each scene the reference is Boost.Odeint rkf78 in long double at tolerance 1e-18; its own error
 // is estimated as the larger of its distance to the same integration at tolerance 1e-15 and to the

@@ -18,16 +18,16 @@ install(FILES
           ${PROJECT_SOURCE_DIR}/lib/api/bodypoint/methods.hpp
           ${PROJECT_SOURCE_DIR}/lib/api/bodypoint/record.hpp
           ${PROJECT_SOURCE_DIR}/lib/api/bodypoint/sweep.hpp
-          ${PROJECT_SOURCE_DIR}/lib/bodypoint/invariant_stats.hpp
-          ${PROJECT_SOURCE_DIR}/lib/bodypoint/invariants.hpp
-          ${PROJECT_SOURCE_DIR}/lib/bodypoint/model.hpp
-          ${PROJECT_SOURCE_DIR}/lib/bodypoint/run.hpp
-          ${PROJECT_SOURCE_DIR}/lib/bodypoint/scattering.hpp
-          ${PROJECT_SOURCE_DIR}/lib/bodypoint/scene_file.hpp
+          ${PROJECT_SOURCE_DIR}/lib/core/model/bodypoint/invariant_stats.hpp
+          ${PROJECT_SOURCE_DIR}/lib/core/model/bodypoint/invariants.hpp
+          ${PROJECT_SOURCE_DIR}/lib/core/model/bodypoint/model.hpp
+          ${PROJECT_SOURCE_DIR}/lib/core/drivers/bodypoint/run.hpp
+          ${PROJECT_SOURCE_DIR}/lib/core/model/bodypoint/scattering.hpp
+          ${PROJECT_SOURCE_DIR}/lib/core/model/bodypoint/scene_file.hpp
           # The independent references and the equations of motion as an ODE system (a program drives
           # Boost.Odeint with PreciseEquations; neither header includes Boost).
-          ${PROJECT_SOURCE_DIR}/lib/bodypoint/reference.hpp
-          ${PROJECT_SOURCE_DIR}/lib/bodypoint/rhs.hpp
+          ${PROJECT_SOURCE_DIR}/lib/core/model/bodypoint/reference.hpp
+          ${PROJECT_SOURCE_DIR}/lib/core/model/bodypoint/rhs.hpp
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bodypoint)
 
 set(BODYPOINT_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/bodypoint)

@@ -1,4 +1,4 @@
-// far-ip, the far-field collocation (lib/bodypoint/far_field.hpp): its quadrature, free flight, the far
+// far-ip, the far-field collocation (lib/core/methods/bodypoint/far_field.hpp): its quadrature, free flight, the far
 // pass at steps of tens of radians of spin against the long-double reference, and its refusals.
 #include "common.hpp"
 #include "bodypoint/far_field.hpp"

@@ -1,7 +1,7 @@
 // bodypoint: the catalogue of every method, part of the public API (bodypoint.hpp).
 //
 // Layers, each a CMake target that depends only on the ones below it:
-//   bodypoint_core      lib/bodypoint/   model, fields, invariants, tables, composition engine,
+//   bodypoint_core      lib/core/        model, fields, invariants, tables, composition engine,
 //                                        kernels, fixed-step and peer drivers (core_methods)
 //   bodypoint_adaptive  adaptive/        time-transformed and regularised methods and their driver
 //                                        (adaptive::methods), the accuracy mode's step search

@@ -1,6 +1,6 @@
 // bodypoint: the pieces every run loop shares: the invariant/sample observer, the timing wrapper
 // that picks a null observer when nothing is asked for, and the once-per-run choice of field type
-// and spin. Used by lib/bodypoint/run.cpp and adaptive/.
+// and spin. Used by lib/core/drivers/bodypoint/run.cpp and adaptive/.
 #pragma once
 
 #include "bodypoint/field.hpp"
