@@ -24,7 +24,9 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <iterator>
 #include <limits>
+#include <string_view>
 #include <type_traits>
 #include <variant>
 
@@ -206,73 +208,79 @@ void check_energy_bound(double max_energy_error) {
                 detail::short_number(max_energy_error));
 }
 
+namespace {
+
+/// Each family's two names (MethodTraits::family_name, family_key), one row per Family in its order.
+struct FamilyNames {
+  Family family;
+  std::string_view name, key;
+};
+constexpr FamilyNames kFamilyNames[] = {
+    {Family::Thesis, "thesis drift/kick", "thesis"},
+    {Family::LiePoisson, "exact Lie-Poisson", "lie-poisson"},
+    {Family::KeplerSplit, "Kepler split", "kepler-split"},
+    {Family::Odeint, "Boost.Odeint fixed step", "odeint"},
+    {Family::OdeintAdaptive, "Boost.Odeint adaptive", "odeint-adaptive"},
+    {Family::Gsl, "GSL adaptive", "gsl"},
+    {Family::TimeTransformed, "time-transformed", "time-transformed"},
+    {Family::Regularised, "regularised", "regularised"},
+    {Family::Extrapolated, "logH extrapolated", "extrapolated"},
+    {Family::FarField, "far-field collocation", "far-field"},
+};
+constexpr bool one_row_per_family_in_order() {
+  for (std::size_t i = 0; i < std::size(kFamilyNames); ++i)
+    if (static_cast<std::size_t>(kFamilyNames[i].family) != i) return false;
+  return std::size(kFamilyNames) == static_cast<std::size_t>(Family::FarField) + 1;
+}
+static_assert(one_row_per_family_in_order(), "kFamilyNames: one row per Family, in the enum's order");
+
+}  // namespace
+
 MethodTraits catalogue_traits(Family f) {
   MethodTraits t;
+  t.family_name = kFamilyNames[static_cast<std::size_t>(f)].name;
+  t.family_key = kFamilyNames[static_cast<std::size_t>(f)].key;
   switch (f) {
     case Family::Thesis:
-      t.family_name = "thesis drift/kick";
-      t.family_key = "thesis";
       t.frozen_gyroscopic_term = true;
       t.in_fixed_set = true;
       break;
     case Family::LiePoisson:
-      t.family_name = "exact Lie-Poisson";
-      t.family_key = "lie-poisson";
       t.free_flight_spin_exact = true;  // the exact drift rotates the spin; without a force nothing else acts on it
       t.in_fixed_set = true;
       break;
     case Family::KeplerSplit:
-      t.family_name = "Kepler split";
-      t.family_key = "kepler-split";
       t.orbit_exact = true;
       t.free_flight_spin_exact = true;
       break;
     case Family::Odeint:
-      t.family_name = "Boost.Odeint fixed step";
-      t.family_key = "odeint";
       t.peer = true;
       t.in_fixed_set = true;
       break;
     case Family::OdeintAdaptive:
-      t.family_name = "Boost.Odeint adaptive";
-      t.family_key = "odeint-adaptive";
-      t.stepping = Stepping::controlled;
-      t.search = SearchStrategy::none;
-      t.peer = true;
-      break;
     case Family::Gsl:
-      t.family_name = "GSL adaptive";
-      t.family_key = "gsl";
       t.stepping = Stepping::controlled;
       t.search = SearchStrategy::none;
       t.peer = true;
       break;
     case Family::TimeTransformed:
-      t.family_name = "time-transformed";
-      t.family_key = "time-transformed";
       t.stepping = Stepping::fictitious;
       t.free_flight_spin_exact = true;
       t.takes_omega_c = true;
       break;
     case Family::Regularised:
-      t.family_name = "regularised";
-      t.family_key = "regularised";
       t.stepping = Stepping::fictitious;
       t.search = SearchStrategy::exact_pair;
       t.orbit_exact = true;
       t.exact_in_fictitious_time = true;
       break;
     case Family::Extrapolated:
-      t.family_name = "logH extrapolated";
-      t.family_key = "extrapolated";
       t.stepping = Stepping::controlled;
       t.search = SearchStrategy::none;
       t.peer = true;
       t.macro_steps = true;
       break;
     case Family::FarField:
-      t.family_name = "far-field collocation";
-      t.family_key = "far-field";
       t.search = SearchStrategy::field_pair;
       t.macro_steps = true;
       t.cost_set_by_field = true;
