@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -161,19 +162,46 @@ namespace {
 constexpr double kImpactRelTol = 1e-14;
 constexpr int kImpactIterations = 60;
 
-/// The incoming asymptote of the thesis's scene with parameters p, and the mass of its Kepler particle.
-std::pair<Asymptote, double> incoming(const SceneParams& p) {
+/// The incoming asymptote of the thesis's scene with parameters p and the mass of its Kepler particle,
+/// or why the scene has none.
+struct Incoming {
+  std::optional<Asymptote> asymptote;
+  double mu = 0.0;
+  std::string why;
+};
+Incoming incoming(const SceneParams& p) {
+  if (p.start.K1 == 0.0) return {std::nullopt, 0.0, "K1 must be non-zero (R(0) contains Kz/K1)"};  // thesis_scene's rule
   const Scene s = thesis_scene(p);
   const Body& body = s.bodies.front();
   const auto k = kepler_particle(body.p, body.s0, s.centres.front().c);
-  if (!k) throw Error("the scene's body does not drift along K1: it has no incoming asymptote");
+  if (!k) return {std::nullopt, 0.0, "the scene's body does not drift along K1: it has no incoming asymptote"};
   // An encounter needs the guiding centre to approach the centre: drifting away from the start (K1 below
   // the drift's zero, B Kx/J, where it drifts against K1), it has no periapsis ahead and no incoming leg.
   if (!(k->X.dot(k->P) < 0.0))
-    throw Error("the scene's guiding centre drifts away from the centre at the start: no encounter happens");
+    return {std::nullopt, 0.0, "the scene's guiding centre drifts away from the centre at the start: no encounter happens"};
   const auto a = kepler_asymptote(k->mu, k->kappa(s.centres.front().A), k->X, k->P, false);
-  if (!a) throw Error("the scene's orbit is bound (energy at infinity <= 0): it has no incoming asymptote");
-  return {*a, k->mu};
+  if (!a) return {std::nullopt, 0.0, "the scene's orbit is bound (energy at infinity <= 0): it has no incoming asymptote"};
+  return {*a, k->mu, ""};
+}
+
+/// A datum of the incoming asymptote at p (b, or the speed at infinity); nothing, with `why`, where the
+/// scene has no incoming asymptote.
+using Datum = std::optional<double> (*)(const SceneParams&, std::string& why);
+std::optional<double> b_of(const SceneParams& p, std::string& why) {
+  const Incoming in = incoming(p);
+  why = in.why;
+  return in.asymptote ? std::optional<double>(in.asymptote->b()) : std::nullopt;
+}
+std::optional<double> v_of(const SceneParams& p, std::string& why) {
+  const Incoming in = incoming(p);
+  why = in.why;
+  return in.asymptote ? std::optional<double>(in.asymptote->p_inf / in.mu) : std::nullopt;
+}
+/// f at p, which must be defined there (where a secant starts): Error with the reason otherwise.
+double defined(Datum f, const SceneParams& p) {
+  std::string why;
+  if (const std::optional<double> x = f(p, why)) return *x;
+  throw Error(why);
 }
 
 /// Secant iterations on one scene parameter x (field) for f(x) = target, from x0 (where f is defined)
@@ -181,21 +209,21 @@ std::pair<Asymptote, double> incoming(const SceneParams& p) {
 /// body does not drift along it) is pulled halfway back to the last point where it was, so that the
 /// secant approaches the edge of the admissible range instead of giving up (v_inf = 0.5 on table 3.1:
 /// the first guess K1 = 0.35 does not drift, the answer K1 = 1.65 does).
-double solve_parameter(SceneParams params, double& (*field)(SceneParams&), double (*f)(const SceneParams&),
-                       double target, double x0, double x1) {
+double solve_parameter(SceneParams params, double& (*field)(SceneParams&), Datum f, double target, double x0,
+                       double x1) {
   field(params) = x0;
-  double f0 = f(params) - target;
+  double f0 = defined(f, params) - target;
+  std::string why;
   for (int i = 0; i < kImpactIterations; ++i) {
     if (!std::isfinite(x1)) return x1;  // the secant left the numbers: the caller says which datum
     field(params) = x1;
-    double f1 = 0.0;
-    try {
-      f1 = f(params) - target;
-    } catch (const Error&) {
-      if (i + 1 == kImpactIterations) throw;
+    const std::optional<double> y = f(params, why);
+    if (!y) {
+      if (i + 1 == kImpactIterations) throw Error(why);
       x1 = 0.5 * (x0 + x1);
       continue;
     }
+    const double f1 = *y - target;
     if (f1 == 0.0 || std::abs(x1 - x0) <= kImpactRelTol * std::max(std::abs(x1), std::abs(target))) return x1;
     const double slope = (f1 - f0) / (x1 - x0);
     x0 = x1;
@@ -207,11 +235,6 @@ double solve_parameter(SceneParams params, double& (*field)(SceneParams&), doubl
 
 double& d_of(SceneParams& p) { return p.start.d; }
 double& k1_of(SceneParams& p) { return p.start.K1; }
-double b_of(const SceneParams& p) { return incoming(p).first.b(); }
-double v_of(const SceneParams& p) {
-  const auto [a, mu] = incoming(p);
-  return a.p_inf / mu;
-}
 
 }  // namespace
 
@@ -312,7 +335,7 @@ double d_for_impact_parameter(SceneParams params, double b) {
   params.start.d = d0;
   double d = 0.0;
   try {
-    d = solve_parameter(params, d_of, b_of, b, d0, d0 - (b_of(params) - b));  // db/dd ~ 1
+    d = solve_parameter(params, d_of, b_of, b, d0, d0 - (defined(b_of, params) - b));  // db/dd ~ 1
   } catch (const Error& e) {  // the scene at the first guess has no incoming asymptote, or cannot be built
     throw Error("no start distance d gives the impact parameter b = " + fmt(b) + ": " + e.what());
   }
@@ -336,7 +359,7 @@ double k1_for_speed_at_infinity(SceneParams params, double v_inf) {
   const double k_min = least_approaching_k1(params);
   if (!(params.start.K1 > k_min)) params.start.K1 = k_min > 0.0 ? kApproachingStart * k_min : 1.0;
   const double k0 = params.start.K1;
-  const double k1 = k0 * v_inf / v_of(params);  // v_inf ~ K1 / mass
+  const double k1 = k0 * v_inf / defined(v_of, params);  // v_inf ~ K1 / mass
   const double k = solve_parameter(params, k1_of, v_of, v_inf, k0, k1);
   if (!(std::isfinite(k) && k > k_min))
     throw Error("no momentum K1 above " + fmt(k_min) + " (where the guiding centre approaches the centre) gives the speed at infinity v_inf = " + fmt(v_inf));
