@@ -30,6 +30,7 @@
 #include <iostream>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -185,35 +186,39 @@ struct Rainbow {
   long runs = 0;
 };
 
-/// The extremum of theta(b) at phase psi inside [lo, hi] (log b), by golden-section search.
+/// The extremum of theta(b) at phase psi inside [lo, hi] (log b), by golden-section search; none (NaN b
+/// and theta, no runs counted) where a point on the way fails.
 Rainbow locate_rainbow(const Series& s, std::size_t series, double psi, double lo, double hi, bool maximum) {
-  Rainbow r{series, psi, kNaN, kNaN, maximum, 0};
+  const Rainbow none{series, psi, kNaN, kNaN, maximum, 0};
+  Rainbow r = none;
   const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-  auto f = [&](double x) {
+  auto f = [&](double x) -> std::optional<double> {
     ++r.runs;
     const Point p = run_point(s, std::exp(x), psi);
-    if (!p.ok()) throw Error(p.failure);
+    if (!p.ok()) return std::nullopt;
     return maximum ? p.sc.deflection : -p.sc.deflection;
   };
   double a = std::log(lo), c = std::log(hi);
-  double x1 = c - g * (c - a), x2 = a + g * (c - a), f1 = f(x1), f2 = f(x2);
-  for (int i = 0; i < kGoldenSteps; ++i) {
-    if (f1 > f2) {
+  double x1 = c - g * (c - a), x2 = a + g * (c - a);
+  std::optional<double> y1 = f(x1), y2 = y1 ? f(x2) : std::nullopt;
+  for (int i = 0; i < kGoldenSteps && y1 && y2; ++i) {
+    if (*y1 > *y2) {
       c = x2;
       x2 = x1;
-      f2 = f1;
+      y2 = y1;
       x1 = c - g * (c - a);
-      f1 = f(x1);
+      y1 = f(x1);
     } else {
       a = x1;
       x1 = x2;
-      f1 = f2;
+      y1 = y2;
       x2 = a + g * (c - a);
-      f2 = f(x2);
+      y2 = f(x2);
     }
   }
-  r.b = std::exp(f1 > f2 ? x1 : x2);
-  r.theta = maximum ? std::max(f1, f2) : -std::max(f1, f2);
+  if (!y1 || !y2) return none;
+  r.b = std::exp(*y1 > *y2 ? x1 : x2);
+  r.theta = maximum ? std::max(*y1, *y2) : -std::max(*y1, *y2);
   return r;
 }
 
@@ -235,12 +240,8 @@ std::vector<Rainbow> find_rainbows(const Grid& g, unsigned threads) {
   std::vector<Rainbow> out(brackets.size());
   parallel_for(brackets.size(), threads, [&](std::size_t n) {
     const Bracket& br = brackets[n];
-    try {
-      out[n] = locate_rainbow(g.all[br.series], br.series, g.phases_of(g.all[br.series]) > 1 ? g.phases[br.phase] : 0.0,
-                              g.bs[br.i - 1], g.bs[br.i + 1], br.maximum);
-    } catch (const Error&) {
-      out[n] = Rainbow{br.series, g.phases[br.phase], kNaN, kNaN, br.maximum, 0};
-    }
+    out[n] = locate_rainbow(g.all[br.series], br.series, g.phases_of(g.all[br.series]) > 1 ? g.phases[br.phase] : 0.0,
+                            g.bs[br.i - 1], g.bs[br.i + 1], br.maximum);
   });
   return out;
 }
