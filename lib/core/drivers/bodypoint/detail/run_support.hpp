@@ -116,6 +116,7 @@ class Monitor {
 
   /// With grid.dt_out > 0: a state at a requested output time t (made by a side step).
   void emit(long i, double t, const State& s) {
+    if (stop_) return;  // the run ended where the sink said stop: nothing after it is observed
     inv_.update(s);
     hand(Sample{i, t, s, inv_.last_rel_dE(), inv_.last_rel_dK2sq(), inv_.last_abs_dK2Q()});
   }
@@ -133,6 +134,7 @@ class Monitor {
  private:
   template <class X>
   void stepped(long i, double t, double dt, const X& x, bool last) {
+    if (stop_) return;
     const State s = to_physical_(x);
     inv_.step(s, dt);
     if (sink_ && grid_.dt_out <= 0.0 && (i % every_ == 0 || last))
