@@ -55,7 +55,7 @@ std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body,
     cal.estimate_error = false;
     const Advance a = fixed ? Advance(FixedSteps{fixed->h, steps}) : Advance(FictitiousSteps{fictitious->ds, StepCount{steps}});
     BodyResult r = detail::integrate_checked(body, centres, &m, a, cal);
-    if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return std::nullopt;
+    if (!ran(r.outcome)) return std::nullopt;
     return std::move(r.run);
   };
   const double t_end = fictitious ? fictitious->t_end() : 0.0;

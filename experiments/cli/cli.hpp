@@ -92,8 +92,6 @@ BodyResult run_body(const RunPlan& plan, const Body& body, const std::vector<Cen
 /// references: the run makes no error estimate of its own (Options::estimate_error off).
 BodyResult run_unestimated(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
                            const Advance& how, const Options& options);
-/// Whether a run reached its end (it was neither refused nor failed); its outcome's flags aside.
-inline bool ran(const BodyResult& r) { return r.outcome != Outcome::refused && r.outcome != Outcome::failed; }
 /// run_unestimated's RunResult where the run must succeed (a reference, a timed rerun of a run that
 /// did): a refused or failed run throws Error with the library's reason.
 RunResult run_or_throw(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres, const Advance& how,

@@ -56,7 +56,7 @@ BodyResult run_body(const RunPlan& plan, const Body& body, const std::vector<Cen
   options.sink = sink;
   detail::check_run(centres, plan.method, how, options);  // the scene was checked where it was made (make_scene)
   BodyResult r = detail::integrate_checked(body, centres, plan.method, how, options);
-  if (!ran(r)) throw Error(r.reason);
+  if (!ran(r.outcome)) throw Error(r.reason);
   return r;
 }
 
@@ -70,7 +70,7 @@ BodyResult run_unestimated(const MethodInfo& m, const Body& body, const std::vec
 RunResult run_or_throw(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres, const Advance& how,
                        const Options& options) {
   BodyResult r = run_unestimated(m, body, centres, how, options);
-  if (!ran(r)) throw Error(r.reason);
+  if (!ran(r.outcome)) throw Error(r.reason);
   return std::move(r.run);
 }
 

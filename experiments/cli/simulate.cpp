@@ -293,7 +293,7 @@ Reversal run_back(const RunPlan& plan, const BodyResult& fwd, const Body& body, 
     if (constant && options.omega_c < 0.0) options.omega_c = adaptive::automatic_omega_c(body, centres, planned_step(plan));
   }
   const BodyResult back = integrate_body(there, centres, &m, how, options);
-  if (back.outcome == Outcome::refused || back.outcome == Outcome::failed)
+  if (!ran(back.outcome))
     throw Error("body '" + body.name + "': the way back failed: " + back.reason);
   return {adaptive::state_distance(back.run.final, body.s0), back.error.value, back.total_force_evals()};
 }

@@ -81,7 +81,7 @@ TolRow measure_auto(const NamedScene& ns, const State& ref, double tol) {
   row.is_auto = true;
   const Accuracy accuracy{tol, ns.t_end};
   const BodyResult r = integrate_body(body, ns.scene.centres, nullptr, accuracy, unobserved());
-  if (!ran(r)) {
+  if (!ran(r.outcome)) {
     row.method = "refused";
     row.err = row.err_estimate = std::numeric_limits<double>::quiet_NaN();
     row.refusal = r.reason;
@@ -115,7 +115,7 @@ TolRow measure_peer(const NamedScene& ns, const std::string& name, const State& 
   const ControlledSteps how{1e-3, ns.t_end, tol};
   const MethodInfo& m = method_or_throw(name);
   const BodyResult x = run_unestimated(m, body, ns.scene.centres, how, unobserved());
-  if (!ran(x)) {
+  if (!ran(x.outcome)) {
     row.refusal = x.reason;
     return row;
   }
@@ -225,7 +225,7 @@ void measure_own_ladders(const NamedScene& ns, const State& ref, double smallest
       r.is_own = true;
       r.method_is_exact = m.traits.exact_in_fictitious_time;
       const BodyResult x = run_unestimated(m, body, ns.scene.centres, how, unobserved());
-      if (!ran(x)) {
+      if (!ran(x.outcome)) {
         ++failures;
         continue;
       }

@@ -58,7 +58,7 @@ double error_at(const MethodInfo& m, const Probe& p, double h) {
     how = FixedSteps{p.t_end / static_cast<double>(steps), steps};
   }
   const BodyResult r = run_unestimated(m, p.scene.bodies.front(), p.scene.centres, how, o);
-  if (!ran(r)) return std::numeric_limits<double>::infinity();  // a step too large for this encounter (logH's E - T + c <= 0)
+  if (!ran(r.outcome)) return std::numeric_limits<double>::infinity();  // a step too large for this encounter (logH's E - T + c <= 0)
   return (r.run.final.R - p.ref.R).norm() / p.ref.R.norm();
 }
 

@@ -133,7 +133,7 @@ StressRow run_case(const StressCase& c, const MethodInfo& m, double max_seconds)
     BodyResult r = detail::integrate_checked(body, c.scene.centres, &m, how, options);
     row.outcome = r.outcome;
     row.reason = std::move(r.reason);
-    if (r.outcome != Outcome::refused && r.outcome != Outcome::failed) {
+    if (ran(r.outcome)) {
       row.max_rel_dE = r.run.invariants ? r.run.invariants->max_rel_dE : std::nan("");
       row.err_estimate = r.error.value;
       row.steps = r.run.steps;

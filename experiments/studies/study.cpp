@@ -335,7 +335,7 @@ void study_appendix(const StudyContext& c) {
     o.sink = &sink;
     const BodyResult br = integrate_body(scene.bodies.front(), scene.centres, &method_or_throw("thesis-euler"),
                                          FixedSteps{1e-4, steps}, o);
-    if (br.outcome == Outcome::refused || br.outcome == Outcome::failed) throw Error(br.reason);
+    if (!ran(br.outcome)) throw Error(br.reason);
     const RunResult& r = br.run;
     f.commit();
     // The thesis's run as it made it, written whatever its flags; the outcome says what they are.

@@ -76,7 +76,7 @@ std::optional<Row> measure(const NamedScene& ns, const MethodInfo& m, const Body
     how = FixedSteps{step, steps};
   }
   const BodyResult plain = run_unestimated(m, body, ns.scene.centres, how, unobserved());
-  if (!ran(plain)) {
+  if (!ran(plain.outcome)) {
     why = plain.reason;
     return std::nullopt;
   }

@@ -62,7 +62,7 @@ bool stopped_by_event(const BodyResult& r, const Options& options) {
 
 /// Whether a companion ended as the run did (finite, at the same stop event).
 bool ended_alike(const BodyResult& run, const Options& run_options, const BodyResult& x, const Options& o) {
-  return x.outcome != Outcome::refused && x.outcome != Outcome::failed && x.run.final.R.allFinite() &&
+  return ran(x.outcome) && x.run.final.R.allFinite() &&
          x.run.final.v.allFinite() && stopped_by_event(run, run_options) == stopped_by_event(x, o);
 }
 

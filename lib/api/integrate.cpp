@@ -151,7 +151,7 @@ detail::Advancer advancer(const BodyResult& r, const Body& body, const std::vect
     else a = fixed_steps_to(tau, step);  // one step of tau inside a step; steps <= h across output times
     const BodyResult x = integrate_valid_body(from, centres, &m, a, sub);
     evals += x.run.force_evals;
-    if (x.outcome == Outcome::refused || x.outcome == Outcome::failed) {
+    if (!ran(x.outcome)) {
       constexpr double nan = std::numeric_limits<double>::quiet_NaN();
       return State{Vec3::Constant(nan), Vec3::Constant(nan), Vec3::Constant(nan)};
     }
@@ -227,7 +227,7 @@ BodyResult run_with_events(const Body& body, const std::vector<Centre>& centres,
   inner.sink = &sink;
   inner.every = 1;
   BodyResult r = integrate_valid_body(body, centres, method, how, inner);
-  if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return r;
+  if (!ran(r.outcome)) return r;
   r.events = detail::locate(watch, events, body.p, centres, advancer(r, body, centres, how, options), r.event_force_evals);
   detail::keep_closest(r.events, events);
   const auto stop = std::find_if(r.events.begin(), r.events.end(),
@@ -258,7 +258,7 @@ BodyResult run_with_output_times(const Body& body, const std::vector<Centre>& ce
   Advance plain = how;
   std::visit([](auto& a) { a.dt_out = 0.0; }, plain);
   BodyResult r = integrate_valid_body(body, centres, &method, plain, inner);
-  if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return r;
+  if (!ran(r.outcome)) return r;
   outputs.finish();
   r.event_force_evals += outputs.evals();
   return r;
@@ -594,7 +594,7 @@ Outcome Stepper::advance_to(double t) {
     opt.sink = &shifted;
   }
   const BodyResult r = integrate_estimated(body_, centres_, method_, how, opt);  // checked in the constructor
-  if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) {
+  if (!ran(r.outcome)) {
     reason_ = r.reason;
     return r.outcome;
   }

@@ -54,7 +54,7 @@ Options sweep_options(const SweepSpec& spec) {
 
 /// The row of a finished run of the public API.
 SweepRow result_row(SweepRow row, BodyResult r) {
-  if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return unrun_row(std::move(row), r.outcome, r.reason);
+  if (!ran(r.outcome)) return unrun_row(std::move(row), r.outcome, r.reason);
   row.result = std::move(r.run);
   row.outcome = r.outcome;
   row.reason = std::move(r.reason);
@@ -253,7 +253,7 @@ SweepRow encounter_row(SweepRow row, const MethodInfo& method, const Scene& scen
   const Body& body = scene.bodies.front();
   const Options options = encounter_options(body, scene.centres, sweep_options(spec), true);
   BodyResult r = detail::integrate_checked(body, scene.centres, &method, how, options);  // checked by validate_sweep
-  if (r.outcome == Outcome::refused || r.outcome == Outcome::failed) return result_row(std::move(row), std::move(r));
+  if (!ran(r.outcome)) return result_row(std::move(row), std::move(r));
   Encounter e = measure_encounter(body, scene.centres, r.run, r.events, options.events);
   if (e.outcome == Outcome::ok && r.outcome == Outcome::ok) add_row_start_distance(e, spec, row.point, body, r.error.value);
   row.r_min = e.r_min;

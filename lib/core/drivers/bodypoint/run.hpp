@@ -257,6 +257,8 @@ enum class Outcome {
 /// The outcome as one word, for outputs (ok, diverged, collision, refused, failed, unresolved, inaccurate,
 /// incomplete).
 std::string_view outcome_name(Outcome o);
+/// Whether a run with this outcome reached a final state: neither refused nor failed (its flags aside).
+constexpr bool ran(Outcome o) { return o != Outcome::refused && o != Outcome::failed; }
 
 /// The default bound on the relative energy error of a run called ok: a run whose energy is 1% off
 /// has lost its trajectory long before (lp-y4 at h = 50 on table 3.1: 4e-2 in energy, 77% in R).
