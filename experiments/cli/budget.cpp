@@ -90,15 +90,26 @@ double estimated_seconds(const MethodInfo& m, const Body& body, const std::vecto
   return e->seconds / e->steps * steps * runs;
 }
 
-void check_budget(const WorkEstimate& e, double max_seconds, bool quiet) {
+namespace {
+
+std::string work_text(const WorkEstimate& e) {
   char steps[32];
   std::snprintf(steps, sizeof steps, "%.3g", e.steps);
-  const std::string what = std::string(steps) + " steps, about " + duration(e.seconds) + " (calibrated on " +
-                           std::to_string(kCalibrationSteps) + " steps)";
-  if (e.seconds > max_seconds)
-    throw Error("the run would take " + what + ", above --max-seconds " + fmt(max_seconds) +
-                ": shorten it, take a larger step, or raise --max-seconds");
-  if (!quiet && e.seconds > kAnnounceSeconds) std::cerr << "bodypoint: " << what << "\n";
+  return std::string(steps) + " steps, about " + duration(e.seconds) + " (calibrated on " +
+         std::to_string(kCalibrationSteps) + " steps)";
+}
+
+}  // namespace
+
+std::string over_budget(const WorkEstimate& e, double max_seconds) {
+  if (!(e.seconds > max_seconds)) return {};
+  return "the run would take " + work_text(e) + ", above --max-seconds " + fmt(max_seconds) +
+         ": shorten it, take a larger step, or raise --max-seconds";
+}
+
+void check_budget(const WorkEstimate& e, double max_seconds, bool quiet) {
+  if (std::string why = over_budget(e, max_seconds); !why.empty()) throw Error(why);
+  if (!quiet && e.seconds > kAnnounceSeconds) std::cerr << "bodypoint: " << work_text(e) << "\n";
 }
 
 bool progress_wanted(bool quiet) { return !quiet && ::isatty(2) == 1 && std::getenv("CI") == nullptr; }

@@ -46,7 +46,9 @@ inline constexpr double kMaxSecondsPerStep = 1e-4;
 double estimated_seconds(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres, double step,
                          double steps, double runs);
 
-/// Throws Error when the estimate exceeds max_seconds; prints it on stderr when it exceeds
+/// Why a run of this estimate is refused (it exceeds max_seconds: the message names both), or "".
+std::string over_budget(const WorkEstimate& e, double max_seconds);
+/// Throws over_budget's Error when the estimate exceeds max_seconds; prints it on stderr when it exceeds
 /// kAnnounceSeconds and `quiet` is false.
 void check_budget(const WorkEstimate& e, double max_seconds, bool quiet);
 

@@ -247,9 +247,8 @@ class TrajectoryFile {
 /// data, run to its departure by auto (twice_as_far_tol); not known for a scene file's states.
 void add_start_distance_of(Encounter& e, const po::variables_map& vm, const SceneOptions& so, const RunPlan& plan,
                            const Body& body, double numerical) {
-  std::function<Scene()> far;
-  if (!vm.count("scene"))
-    far = [&] { return thesis_scene(thesis_params_twice_as_far(so.params, so.b, so.v_inf, so.arrival_phase)); };
+  std::function<Expected<Scene>()> far;
+  if (!vm.count("scene")) far = [&] { return thesis_scene_twice_as_far(so.params, so.b, so.v_inf, so.arrival_phase); };
   add_start_distance(e, body, far, plan.search ? std::optional<double>(plan.tol) : std::nullopt, numerical,
                      "the scene file gives states, not the thesis's start distance L");
 }

@@ -471,7 +471,8 @@ void run_job_mpi(const SweepJob& job) {
 }
 
 /// The steps of a row on average: those of the step h, or, when h is swept, their mean over its values
-/// (h the smallest of them, for the calibration). Throws Error for a step sweep_steps refuses.
+/// (h the smallest of them, for the calibration). The steps were checked (validate_sweep_rules, and the
+/// first point's by validate_sweep_points).
 FixedSteps mean_row_steps(const SweepSpec& spec) {
   for (const Axis& a : spec.axes)
     if (a.param == "h" && !a.values.empty()) {
@@ -487,18 +488,13 @@ FixedSteps mean_row_steps(const SweepSpec& spec) {
 
 /// Runs the job and writes its CSV (or, for a shard, its rows file), through a journal when it has a file.
 /// Refuses a sweep whose calibrated time (every row of this shard, on its threads) exceeds the budget:
-/// each method's time per step on the first grid point, times the steps of every row.
+/// each method's time per step on the first grid point, times the steps of every row. The sweep's rules
+/// and its first point were checked.
 void check_sweep_budget(const SweepJob& job) {
   if (!(job.max_seconds > 0.0) || job.spec.accuracy) return;  // a search's cost is not known beforehand
   const std::size_t tasks = task_count(job.spec), methods = job.spec.methods.size();
-  FixedSteps steps{};
-  Scene scene;
-  try {
-    steps = mean_row_steps(job.spec);
-    scene = point_scene(job.spec, grid_point(job.spec, 0));
-  } catch (const Error&) {
-    return;  // validate_sweep names the step or the point
-  }
+  const FixedSteps steps = mean_row_steps(job.spec);
+  const Scene scene = point_scene(job.spec, grid_point(job.spec, 0));
   const double runs_per_task = job.spec.estimate_error ? 1.0 + ErrorEstimate::kTypicalCost : 1.0;  // and the companion
   if (static_cast<double>(tasks) * static_cast<double>(steps.steps) * runs_per_task * kMaxSecondsPerStep <= job.max_seconds)
     return;
@@ -517,8 +513,12 @@ void check_sweep_budget(const SweepJob& job) {
 
 void run_job(const SweepJob& job) {
   if (launched_by_mpi()) return run_job_mpi(job);
-  check_sweep_budget(job);   // before validating every point, which a sweep of 1e9 points would spend long on
-  validate_sweep(job.spec);  // before a journal exists
+  // Checked before a journal exists; the budget before every point is, which a sweep of 1e9 points would
+  // spend long on, and after the first, on which it calibrates.
+  validate_sweep_rules(job.spec);
+  validate_sweep_points(job.spec, 0, 1);
+  check_sweep_budget(job);
+  validate_sweep_points(job.spec, 1, sweep_points(job.spec));
   std::unique_ptr<AtomicFile> file;
   if (!job.out.empty()) file = std::make_unique<AtomicFile>(job.out);
   const std::unique_ptr<RowJournal> journal = open_journal(job, file.get());

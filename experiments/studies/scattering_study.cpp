@@ -99,38 +99,47 @@ Point run_point(const Series& s, double b, double psi) {
   Point p;
   p.b_target = b;
   p.psi = psi;
-  try {
-    const SceneParams params = with_asymptotic_data(series_params(s, b), b, kNaN, phased(s) ? psi : kNaN);
-    p.d = params.start.d;
-    const Scene scene = thesis_scene(params);
-    const Body& body = scene.bodies.front();
-    Options o;
-    o.track_invariants = false;
-    const MethodInfo* method = std::string_view(s.method) == "auto" ? nullptr : &method_or_throw(s.method);
-    EncounterResult r = encounter(body, scene.centres, method, p.tol, kNaN, o);
-    for (int k = 0; k < kRetries && r.run.outcome == Outcome::failed && r.run.reason.find("out of reach") != std::string::npos; ++k) {
-      p.tol *= kRetryLooser;
-      r = encounter(body, scene.centres, method, p.tol, kNaN, o);
-    }
-    p.force_evals = r.run.total_force_evals();
-    p.t_end = r.run.run.t_end;
-    if (r.run.method) p.method = r.run.method->name;
-    if (r.encounter.outcome != Outcome::ok) {
-      p.failure = r.encounter.reason;
-      return p;
-    }
-    p.force_evals += add_start_distance(
-        r.encounter, body, [&] { return thesis_scene(thesis_params_twice_as_far(params, b, kNaN, phased(s) ? psi : kNaN)); },
-        p.tol, r.run.error.value, "", o);
-    p.sc = r.encounter.scattering;
-    p.asymptote_error = r.encounter.asymptote_error;
-    p.start_distance_error = r.encounter.start_distance_error;
-    p.deflection_error = r.encounter.deflection_error;
-    p.r_min = r.encounter.r_min;
-    p.t_min = r.encounter.t_min;
-  } catch (const Error& e) {
-    p.failure = e.what();
+  const double arrival = phased(s) ? psi : kNaN;
+  const Expected<SceneParams> solved = solve_asymptotic_data(series_params(s, b), b, kNaN, arrival);
+  if (!solved) {  // no start distance gives b (the row says why)
+    p.failure = solved.error();
+    return p;
   }
+  const SceneParams& params = *solved;
+  p.d = params.start.d;
+  if (std::string why = why_invalid(params); !why.empty()) {
+    p.failure = why;
+    return p;
+  }
+  const Scene scene = thesis_scene(params);
+  if (std::string why = why_invalid(scene); !why.empty()) {
+    p.failure = why;
+    return p;
+  }
+  const Body& body = scene.bodies.front();
+  Options o;
+  o.track_invariants = false;
+  const MethodInfo* method = std::string_view(s.method) == "auto" ? nullptr : &method_or_throw(s.method);
+  EncounterResult r = encounter(body, scene.centres, method, p.tol, kNaN, o);
+  for (int k = 0; k < kRetries && r.run.outcome == Outcome::failed && r.run.reason.find("out of reach") != std::string::npos; ++k) {
+    p.tol *= kRetryLooser;
+    r = encounter(body, scene.centres, method, p.tol, kNaN, o);
+  }
+  p.force_evals = r.run.total_force_evals();
+  p.t_end = r.run.run.t_end;
+  if (r.run.method) p.method = r.run.method->name;
+  if (r.encounter.outcome != Outcome::ok) {
+    p.failure = r.encounter.reason;
+    return p;
+  }
+  p.force_evals += add_start_distance(
+      r.encounter, body, [&] { return thesis_scene_twice_as_far(params, b, kNaN, arrival); }, p.tol, r.run.error.value, "", o);
+  p.sc = r.encounter.scattering;
+  p.asymptote_error = r.encounter.asymptote_error;
+  p.start_distance_error = r.encounter.start_distance_error;
+  p.deflection_error = r.encounter.deflection_error;
+  p.r_min = r.encounter.r_min;
+  p.t_min = r.encounter.t_min;
   return p;
 }
 

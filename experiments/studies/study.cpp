@@ -315,13 +315,11 @@ void study_appendix(const StudyContext& c) {
     CsvLine row;
     row.count(set.figure);
     for (const char* k : {"A", "m", "B", "J", "L", "d", "K1", "Kz", "Kx"}) row.num(scene_field(p, k));
-    Scene scene;
-    try {
-      scene = thesis_scene(p);
-    } catch (const Error& e) {
-      ix << row.quoted(std::string("skipped: ") + e.what()).str() << ",,,\n";
+    if (std::string why = why_invalid(p); !why.empty()) {
+      ix << row.quoted("skipped: " + why).str() << ",,,\n";
       continue;
     }
+    const Scene scene = thesis_scene(p);
     const std::string name = "P1." + std::to_string(set.figure) + ".csv";
     AtomicFile f((dir / name).string());
     std::ostream& os = f.stream();

@@ -178,8 +178,8 @@ void no_start_distance_error(Encounter& e, bool material, double numerical, cons
   if (!material) e.start_distance_basis = "not known: " + why;
 }
 
-long add_start_distance(Encounter& e, const Body& body, const std::function<Scene()>& far, std::optional<double> tol,
-                        double numerical, const std::string& no_far, const Options& options) {
+long add_start_distance(Encounter& e, const Body& body, const std::function<Expected<Scene>()>& far,
+                        std::optional<double> tol, double numerical, const std::string& no_far, const Options& options) {
   // A thesis scene's material point is run from 2L too: at the scene's K1 its speed at infinity moves
   // with L (the potential at L is part of the start's energy), and with it the deflection (B = 0, b = 10:
   // 0.0159869 from L = 200, 0.0159981 from 1600); a scene file's states are its own asymptotic data.
@@ -187,18 +187,30 @@ long add_start_distance(Encounter& e, const Body& body, const std::function<Scen
     no_start_distance_error(e, body.p.B == 0.0, numerical, no_far);
     return 0;
   }
-  const EncounterResult r = encounter_twice_as_far(far(), twice_as_far_tol(tol), options);
+  const Expected<Scene> scene = far();
+  if (!scene) {  // no scene from 2L has the data: the part is not known, and why
+    no_start_distance_error(e, false, numerical, "the scene from twice the start distance has no such data (" + scene.error() + ")");
+    return 0;
+  }
+  const EncounterResult r = encounter_twice_as_far(*scene, twice_as_far_tol(tol), options);
   add_start_distance_error(e, &r, false, numerical);
   return r.run.total_force_evals();
 }
 
-SceneParams thesis_params_twice_as_far(SceneParams solved, double b, double v_inf, double arrival_phase) {
+Expected<Scene> thesis_scene_twice_as_far(SceneParams solved, double b, double v_inf, double arrival_phase) {
   // The limit L -> infinity is of the scene as given: its K1 or v_inf, its d or b, kept. Its start phase
   // has no limit (the helix turns on the longer way in: doubling L moves the arrival phase by whatever
   // the extra turn is), so where no arrival phase is given the scene's own at L is kept instead.
-  if (std::isnan(arrival_phase) && solved.B != 0.0) arrival_phase = bodypoint::arrival_phase(solved);
+  if (std::isnan(arrival_phase) && solved.B != 0.0) {
+    const Expected<double> own = solve_arrival_phase(solved);
+    if (!own) return Expected<Scene>::failure(own.error());
+    arrival_phase = *own;
+  }
   solved.start.L *= 2.0;
-  return with_asymptotic_data(solved, b, v_inf, arrival_phase);
+  const Expected<SceneParams> far = solve_asymptotic_data(solved, b, v_inf, arrival_phase);
+  if (!far) return Expected<Scene>::failure(far.error());
+  if (std::string why = why_invalid(*far); !why.empty()) return Expected<Scene>::failure(why);
+  return thesis_scene(*far);
 }
 
 EncounterResult encounter(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method, double tol,

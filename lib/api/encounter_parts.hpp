@@ -40,7 +40,7 @@ double encounter_span(const Body& body, const std::vector<Centre>& centres);
 inline constexpr double kTwiceAsFarTol = 1e-10;
 inline double twice_as_far_tol(std::optional<double> run_tol) { return run_tol ? *run_tol : kTwiceAsFarTol; }
 /// Sets the start distance's part of `at_L`'s error from the same encounter started twice as far
-/// (`at_2L`: encounter_twice_as_far of the thesis's scene at thesis_params_twice_as_far; its own estimated
+/// (`at_2L`: encounter_twice_as_far of thesis_scene_twice_as_far; its own estimated
 /// error counts in), and the deflection's total error with `numerical` (the run's err_estimate). For
 /// B = 0 (`material`) no second encounter is needed: pass nullptr.
 void add_start_distance_error(Encounter& at_L, const EncounterResult* at_2L, bool material, double numerical);
@@ -53,14 +53,15 @@ EncounterResult encounter_twice_as_far(const Scene& far, double tol, const Optio
 void no_start_distance_error(Encounter& e, bool material, double numerical, const std::string& why);
 /// The start distance's part of `e`'s error, one rule for every caller (simulate, sweep, the scattering
 /// study, Python): exact for a material point; not known (`no_far` says why) where the scene has no
-/// thesis start distance to double (`far` empty); otherwise the encounter from `far()` (the thesis's
-/// scene at thesis_params_twice_as_far) run by auto at twice_as_far_tol(tol). Returns the force
-/// evaluations of that second encounter (0 where none ran).
-long add_start_distance(Encounter& e, const Body& body, const std::function<Scene()>& far, std::optional<double> tol,
-                        double numerical, const std::string& no_far, const Options& options = {});
-/// The thesis's parameters `solved` (d, K1, phase solved for the asymptotic data) with the start distance L
-/// doubled and the data b, v_inf (NaN: not given, d, K1 kept) solved for again; the arrival phase as given,
-/// or (NaN) the scene's own at L (a start phase kept has no limit L -> infinity: the extra way in turns it).
-SceneParams thesis_params_twice_as_far(SceneParams solved, double b, double v_inf, double arrival_phase);
+/// thesis start distance to double (`far` empty), or (its reason) where `far()` finds no scene there;
+/// otherwise the encounter from `far()` (thesis_scene_twice_as_far) run by auto at twice_as_far_tol(tol).
+/// Returns the force evaluations of that second encounter (0 where none ran).
+long add_start_distance(Encounter& e, const Body& body, const std::function<Expected<Scene>()>& far,
+                        std::optional<double> tol, double numerical, const std::string& no_far, const Options& options = {});
+/// The thesis's scene of the parameters `solved` (d, K1, phase solved for the asymptotic data) with the start
+/// distance L doubled and the data b, v_inf (NaN: not given, d, K1 kept) solved for again; the arrival phase
+/// as given, or (NaN) the scene's own at L (a start phase kept has no limit L -> infinity: the extra way in
+/// turns it). Or why no scene from 2L has the data.
+Expected<Scene> thesis_scene_twice_as_far(SceneParams solved, double b, double v_inf, double arrival_phase);
 
 }  // namespace bodypoint

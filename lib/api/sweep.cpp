@@ -229,15 +229,15 @@ PointData point_data(const SweepSpec& spec, const std::vector<double>& point) {
 }
 
 /// The start distance's part of a row's encounter error: the grid point's scene from twice its start
-/// distance (thesis_params_twice_as_far: the point's data b, v_inf, arrival phase solved for again, the
+/// distance (thesis_scene_twice_as_far: the point's data b, v_inf, arrival phase solved for again, the
 /// rest kept), run to its departure by auto (twice_as_far_tol).
 void add_row_start_distance(Encounter& e, const SweepSpec& spec, const std::vector<double>& point, const Body& body,
                             double numerical) {
-  std::function<Scene()> far;
+  std::function<Expected<Scene>()> far;
   if (spec.scene_text.empty())
     far = [&] {
       const PointData d = point_data(spec, point);
-      return thesis_scene(thesis_params_twice_as_far(d.params, d.b, d.v_inf, d.arrival));
+      return thesis_scene_twice_as_far(d.params, d.b, d.v_inf, d.arrival);
     };
   Options o;
   o.track_invariants = false;
@@ -363,7 +363,7 @@ void fix_asymptotic_datum(SweepSpec& spec, const std::string& datum, double valu
   spec.axes.push_back(Axis{datum, {value}});
 }
 
-void validate_sweep(const SweepSpec& spec) {
+void validate_sweep_rules(const SweepSpec& spec) {
   if (spec.methods.empty()) throw Error("the method list is empty");
   check_energy_bound(spec.max_energy_error);
   check_error_bound(spec.max_error);
@@ -397,9 +397,17 @@ void validate_sweep(const SweepSpec& spec) {
       if ((a.param == "b" && other.param == "d") || (a.param == "v_inf" && other.param == "K1") ||
           (a.param == "arrival_phase" && other.param == "phase"))
         throw Error("the sweep varies " + a.param + " and " + other.param + ", which it solves for " + a.param);
+  // Every step of the axis h makes a run (at most 1e13 steps): a calibration averages over them all.
+  for (const Axis& a : spec.axes)
+    if (a.param == "h")
+      for (double h : a.values) sweep_steps(h, spec.steps, spec.t_end, spec.base.law);
+}
+
+std::size_t sweep_points(const SweepSpec& spec) { return task_count(spec) / spec.methods.size(); }
+
+void validate_sweep_points(const SweepSpec& spec, std::size_t from, std::size_t to) {
   // Every point's scene and every method's way of advancing there, checked once for the sweep.
-  const std::size_t points = task_count(spec) / spec.methods.size();
-  for (std::size_t p = 0; p < points; ++p) {
+  for (std::size_t p = from; p < to; ++p) {
     const std::vector<double> point = grid_point(spec, p);
     try {
       validate(point_scene(spec, point));
@@ -408,6 +416,11 @@ void validate_sweep(const SweepSpec& spec) {
       throw Error(point_label(spec, point) + ": " + e.what());
     }
   }
+}
+
+void validate_sweep(const SweepSpec& spec) {
+  validate_sweep_rules(spec);
+  validate_sweep_points(spec, 0, sweep_points(spec));
 }
 
 std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vector<std::size_t>& unit) {

@@ -37,6 +37,14 @@ std::string point_label(const SweepSpec& spec, const std::vector<double>& point)
 /// The tasks of `todo` in units: batches of up to batch::width() tasks of one method and step whose
 /// scenes a batch kernel accepts (with simd), single tasks otherwise.
 std::vector<std::vector<std::size_t>> plan_units(const SweepSpec& spec, const std::vector<std::size_t>& todo, bool simd);
+/// validate_sweep in parts: the rules of the sweep as a whole (its methods, bounds, axes and their values,
+/// the steps of an axis h), then the grid points [from, to) of sweep_points(spec) (each one's scene and
+/// every method's way of advancing there, the point named in the message). A command checks the first
+/// point before it calibrates its budget on it, the rest after.
+void validate_sweep_rules(const SweepSpec& spec);
+std::size_t sweep_points(const SweepSpec& spec);
+void validate_sweep_points(const SweepSpec& spec, std::size_t from, std::size_t to);
+
 /// Runs one unit; its rows in the unit's order.
 std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vector<std::size_t>& unit);
 

@@ -527,13 +527,14 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
   return sweep_columns(s, rows);
 }
 
-/// The scene of thesis_scene()'s keywords `kw` from twice its start distance (thesis_params_twice_as_far:
-/// the data given solved for again, the rest kept, the arrival phase the scene's own where none is given).
-Scene twice_as_far(const py::dict& kw) {
+/// The scene of thesis_scene()'s keywords `kw` from twice its start distance (thesis_scene_twice_as_far:
+/// the data given solved for again, the rest kept, the arrival phase the scene's own where none is given),
+/// or why there is none.
+Expected<Scene> twice_as_far(const py::dict& kw) {
   const ThesisParams t = thesis_params_from(kw);
   constexpr double kNotGiven = std::numeric_limits<double>::quiet_NaN();
-  return thesis_scene(thesis_params_twice_as_far(t.solved, t.data.b.value_or(kNotGiven), t.data.v_inf.value_or(kNotGiven),
-                                                 t.data.arrival_phase.value_or(kNotGiven)));
+  return thesis_scene_twice_as_far(t.solved, t.data.b.value_or(kNotGiven), t.data.v_inf.value_or(kNotGiven),
+                                   t.data.arrival_phase.value_or(kNotGiven));
 }
 
 /// The encounter's record with its run's (`run`: method, steps, t_end, err_estimate, force_evals, ...).
@@ -556,9 +557,9 @@ py::dict encounter_py(const Scene& scene, const std::string& method, double tol,
   const Body& body = scene.bodies.front();
   if (r.encounter.outcome == Outcome::ok) {
     // The far scene is made here, under the GIL (from the thesis's parameters, a Python dict).
-    std::optional<Scene> far_scene;
+    std::optional<Expected<Scene>> far_scene;
     if (thesis) far_scene = twice_as_far(*thesis);
-    std::function<Scene()> far;
+    std::function<Expected<Scene>()> far;
     if (far_scene) far = [&far_scene] { return *far_scene; };
     {
       py::gil_scoped_release free;

@@ -6,6 +6,7 @@
 #include "bodypoint/detail/model_parts.hpp"
 #include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/reference.hpp"
+#include "encounter_parts.hpp"
 
 #include <gtest/gtest.h>
 
@@ -14,6 +15,7 @@
 #include <limits>
 #include <numbers>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace bodypoint {
@@ -315,6 +317,57 @@ TEST(Encounter, AnUnfinishedEncounterHasNoDeflection) {
   EXPECT_TRUE(done.run.run.stopped);
   EXPECT_LT(done.encounter.asymptote_error, 1e-6);
   EXPECT_GT(done.encounter.asymptote_error, 0.0);
+}
+
+/// with_asymptotic_data's message, or "" where it solves the data.
+std::string thrown_by_solving(const SceneParams& p, double b, double v_inf) {
+  try {
+    (void)with_asymptotic_data(p, b, v_inf, Scattering::kNaN);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return {};
+}
+
+TEST(Encounter, AsymptoticDataAreSolvedAsAValueWithTheThrowingFormsAnswer) {
+  SceneParams bound;  // an attracting centre slow enough to hold the body: no incoming asymptote
+  bound.A = 2.0;
+  bound.start.K1 = 0.1;
+  bound.start.L = 5.0;
+  for (const auto& [p, b, v] : {std::tuple{SceneParams{}, 1.0, Scattering::kNaN}, {SceneParams{}, Scattering::kNaN, 1.0},
+                                {SceneParams{}, 2.0, 1.5}, {bound, 1.0, Scattering::kNaN}, {SceneParams{}, -1.0, Scattering::kNaN}}) {
+    const Expected<SceneParams> solved = solve_asymptotic_data(p, b, v, Scattering::kNaN);
+    const std::string thrown = thrown_by_solving(p, b, v);
+    EXPECT_EQ(solved.error(), thrown) << "b = " << b << ", v_inf = " << v;
+    if (solved) {
+      const SceneParams again = with_asymptotic_data(p, b, v, Scattering::kNaN);
+      EXPECT_EQ(solved->start.d, again.start.d);
+      EXPECT_EQ(solved->start.K1, again.start.K1);
+    }
+  }
+  EXPECT_FALSE(solve_asymptotic_data(bound, 1.0, Scattering::kNaN, Scattering::kNaN).has_value());
+  EXPECT_NE(thrown_by_solving(bound, 1.0, Scattering::kNaN).find("no start distance d gives the impact parameter b = 1"),
+            std::string::npos);
+}
+
+TEST(Encounter, NoSceneFromTwiceTheStartDistanceLeavesThatPartNotKnownAndSaysWhy) {
+  const SceneParams p = with_asymptotic_data(SceneParams{}, 1.0, Scattering::kNaN);
+  const Scene s = thesis_scene(p);
+  const Body& body = s.bodies.front();
+  EncounterResult r = encounter(body, s.centres, nullptr, 1e-8);
+  ASSERT_EQ(r.encounter.outcome, Outcome::ok) << r.encounter.reason;
+  const long evals = add_start_distance(
+      r.encounter, body, [] { return Expected<Scene>::failure("no scene there"); }, 1e-8, r.run.error.value, "");
+  EXPECT_EQ(evals, 0);
+  EXPECT_TRUE(std::isnan(r.encounter.start_distance_error));
+  EXPECT_TRUE(std::isnan(r.encounter.deflection_error));  // its total is not known either
+  EXPECT_NE(r.encounter.start_distance_basis.find("not known"), std::string::npos);
+  EXPECT_NE(r.encounter.start_distance_basis.find("no scene there"), std::string::npos);
+  // The same scene from 2L exists: the part is known.
+  EncounterResult known = encounter(body, s.centres, nullptr, 1e-8);
+  add_start_distance(known.encounter, body, [&p] { return thesis_scene_twice_as_far(p, 1.0, Scattering::kNaN, Scattering::kNaN); },
+                     1e-8, known.run.error.value, "");
+  EXPECT_TRUE(std::isfinite(known.encounter.start_distance_error)) << known.encounter.start_distance_basis;
 }
 
 TEST(Encounter, TheClosestApproachIsTheGlobalMinimumNotAHelixWiggle) {

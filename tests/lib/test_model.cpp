@@ -233,6 +233,45 @@ TEST(Validation, RejectsBodyOnCentreAndEmptyScenes) {
   expect_error([&] { validate(s); }, "no Coulomb centre");
 }
 
+/// validate's message of `s`, or "" where it accepts it.
+std::string thrown_by_validate(const Scene& s) {
+  try {
+    validate(s);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return {};
+}
+
+TEST(Validation, WhyInvalidIsValidatesMessageAsAValue) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<Scene> scenes = {scene_with({1.0, 0.0, 1.0}), scene_with({0.0, 0.0, 1.0}), scene_with({1.0, 2.0, 1.0}),
+                               scene_with({1.0, 0.0, 1.0}, Vec3(nan, 0, 0)), scene_with({1.0, 0.0, 1.0}, Vec3::Zero()),
+                               scene_with({1.0, 0.0, 1.0}, Vec3(1e200, 0, 0))};
+  scenes.push_back(scene_with({1.0, 0.0, 1.0}));
+  scenes.back().bodies.clear();
+  int refused = 0;
+  for (const Scene& s : scenes) {
+    EXPECT_EQ(why_invalid(s), thrown_by_validate(s));
+    refused += why_invalid(s).empty() ? 0 : 1;
+  }
+  EXPECT_EQ(refused, static_cast<int>(scenes.size()) - 1);  // all but the first
+  SceneParams sp;
+  EXPECT_EQ(why_invalid(sp), "");
+  EXPECT_EQ(why_invalid(thesis_scene(sp)), "");
+  for (double& (*field)(SceneParams&) : {+[](SceneParams& q) -> double& { return q.start.d; },
+                                         +[](SceneParams& q) -> double& { return q.start.K1; },
+                                         +[](SceneParams& q) -> double& { return q.J; }}) {
+    SceneParams bad;
+    field(bad) = nan;
+    const std::string why = why_invalid(bad);
+    EXPECT_NE(why.find("must be a finite number"), std::string::npos) << why;
+    expect_error([&] { thesis_scene(bad); }, why);
+  }
+  sp.start.K1 = 0.0;
+  EXPECT_EQ(why_invalid(sp), "K1 must be non-zero (R(0) contains Kz/K1)");
+}
+
 TEST(Validation, RejectsBadStepsAndUnknownMethod) {
   const Scene s = test::table31();
   FlatRun spec;

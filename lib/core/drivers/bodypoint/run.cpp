@@ -446,11 +446,23 @@ double steps_landing_on(double t_end, double h_max) { return std::max(1.0, std::
 
 void detail::stop_on_request() { throw StoppedOnRequest(); }
 
+namespace {
+
+/// A run by step asks for at most this many steps (1e13 steps of the cheapest method take days).
+constexpr double kMostSteps = 1e13;
+
+Error too_many_steps(double t_end, double h) {
+  return Error("the end time / the step h (" + detail::short_number(t_end) + " / " + detail::short_number(h) +
+               ") asks for more than 1e13 steps");
+}
+
+}  // namespace
+
 FixedSteps fixed_steps_to(double t_end, double h_max) {
   require_positive(h_max, "the step h");
   require_positive(t_end, "the end time t_end");
   const double n = steps_landing_on(t_end, h_max);
-  if (!(n <= 1e13)) throw Error("end time / step size asks for more than 1e13 steps");
+  if (!(n <= kMostSteps)) throw too_many_steps(t_end, h_max);
   const auto steps = static_cast<long>(n);
   return {t_end / n, steps};
 }
@@ -462,7 +474,8 @@ FixedSteps thesis_code_steps(double h, long steps, double t_end) {
     require_positive(t_end, "the end time t_end");
     n = std::trunc(t_end / h);
   }
-  if (!(n <= 1e13)) throw Error("end time / step size asks for more than 1e13 steps");
+  if (!(n <= kMostSteps))
+    throw t_end > 0.0 ? too_many_steps(t_end, h) : Error("the number of steps " + detail::short_number(n) + " is above 1e13");
   if (n < 2.0)
     throw Error("the thesis's code takes n - 1 steps of n asked (n = " + detail::short_number(n) + "): no step; ask for n >= 2");
   return {h, static_cast<long>(n) - 1};

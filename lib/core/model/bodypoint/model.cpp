@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 namespace bodypoint {
 namespace {
@@ -16,12 +17,82 @@ std::string num(double x) {
   return os.str();
 }
 
-void require_finite(double x, const std::string& what) {
-  if (!std::isfinite(x)) throw Error(what + " must be a finite number, got " + num(x));
+/// Each rule below as a value: its message, or "" where it holds (why_invalid); validate throws it.
+std::string not_finite(double x, const std::string& what) {
+  return std::isfinite(x) ? std::string() : what + " must be a finite number, got " + num(x);
 }
 
-void require_finite(const Vec3& x, const std::string& what) {
-  for (int i = 0; i < 3; ++i) require_finite(x[i], what);
+std::string not_finite(const Vec3& x, const std::string& what) {
+  for (int i = 0; i < 3; ++i)
+    if (std::string why = not_finite(x[i], what); !why.empty()) return why;
+  return {};
+}
+
+void require(const std::string& why) {
+  if (!why.empty()) throw Error(why);
+}
+
+std::string why_invalid(const BodyPoint& p, const std::string& who) {
+  for (const auto& [x, name] : {std::pair{p.m, ": m"}, {p.B, ": B"}, {p.J, ": J"}})
+    if (std::string why = not_finite(x, who + name); !why.empty()) return why;
+  if (p.m <= 0.0) return who + ": mass m must be > 0, got " + num(p.m);
+  if (p.J <= 0.0) return who + ": inertia J must be > 0, got " + num(p.J);
+  if (!std::isfinite(p.D())) return who + ": D = m J - B^2 overflows (m J = " + num(p.m * p.J) + "); rescale the units";
+  if (!(p.D() > 0.0)) return who + ": D = m J - B^2 must be > 0 (kinetic energy positive definite), got " + num(p.D());
+  // D is computed with a rounding error of about eps m J; a D within a few dozen of those is not
+  // resolved (m = 0.49, J = 1, B = 0.7 gives D = 5.6e-17 for an exact 0) and every velocity built
+  // from 1/D would be noise.
+  if (p.D() <= kMinRelativeD * p.m * p.J)
+    return who + ": D = m J - B^2 = " + num(p.D()) + " is zero within rounding (it must exceed " + num(kMinRelativeD) +
+           " m J)";
+  return {};
+}
+
+std::string why_invalid(const ThesisStart& t, const std::string& who) {
+  for (const auto& [x, name] : {std::pair{t.d, "d"}, {t.L, "L"}, {t.K1, "K1"}, {t.Kx, "Kx"}, {t.Kz, "Kz"}, {t.phase, "phase"}})
+    if (std::string why = not_finite(x, who + name); !why.empty()) return why;
+  if (t.K1 == 0.0) return who + "K1 must be non-zero (R(0) contains Kz/K1)";
+  return {};
+}
+
+/// A body's start against the centres: off each, at a distance whose square, potential and force are
+/// doubles, with representable integrals.
+std::string why_invalid_start(const Body& b, const std::vector<Centre>& centres, const std::string& who) {
+  for (const auto& [x, name] : {std::pair{&b.s0.R, ": R"}, {&b.s0.v, ": v"}, {&b.s0.w, ": w"}})
+    if (std::string why = not_finite(*x, who + name); !why.empty()) return why;
+  for (std::size_t k = 0; k < centres.size(); ++k) {
+    // A body on a centre has infinite potential energy and an undefined force; one so close that A/r
+    // overflows (R = 1e-300: |R|^2 underflows to 0) has them too, in double precision.
+    const Vec3 d = b.s0.R - centres[k].c;
+    const std::string centre = "centre " + std::to_string(k + 1);
+    if (d == Vec3::Zero()) return who + " starts on " + centre + " (R = c); move it off the centre";
+    const double r = d.stableNorm();
+    // The force and the potential take |R - c|^2 (a centre at 1e308 read "an invariant became
+    // non-finite; reduce --h").
+    if (!std::isfinite(d.squaredNorm()))
+      return who + " starts " + num(r) + " from " + centre + ": the square of that distance overflows a double; rescale the units";
+    if (!(r > 0.0) || !std::isfinite(centres[k].A / r) || !std::isfinite(centres[k].A / (r * r)))
+      return who + " starts " + num(r) + " from " + centre + ": its potential or force there (A/r, A/r^2 with A = " +
+             num(centres[k].A) + ") overflows a double; start it farther or rescale the units";
+  }
+  // The integrals at the start must be representable: |R| |K1| and the energies of a scene of
+  // scale 1e308 overflow, and every deviation after that is NaN.
+  const Momenta k = to_momenta(b.p, b.s0);
+  double potential = 0.0;
+  for (const Centre& c : centres) potential -= c.A / (b.s0.R - c.c).norm();
+  const double kinetic = 0.5 * (b.p.m * b.s0.v.squaredNorm() + 2.0 * b.p.B * b.s0.v.dot(b.s0.w) +
+                                b.p.J * b.s0.w.squaredNorm());
+  if (!(k.K1.allFinite() && k.K2.allFinite() && (k.R.cross(k.K1) + k.K2).allFinite() && std::isfinite(kinetic) &&
+        std::isfinite(potential) && std::isfinite(kinetic + potential)))
+    return who + ": the energy or angular momentum at the start overflows a double (|R| = " + num(b.s0.R.norm()) +
+           ", |v| = " + num(b.s0.v.norm()) + "); rescale the units";
+  // The angular momentum about each centre is an integral the runs track (a centre at 1e308 read
+  // "an invariant became non-finite; reduce --h").
+  for (std::size_t c = 0; c < centres.size(); ++c)
+    if (!((k.R - centres[c].c).cross(k.K1) + k.K2).allFinite())
+      return who + ": the angular momentum about centre " + std::to_string(c + 1) + " overflows a double (|R - c| = " +
+             num((b.s0.R - centres[c].c).norm()) + "); rescale the units";
+  return {};
 }
 
 }  // namespace
@@ -41,91 +112,38 @@ long require_count(long n, std::string_view what) {
   return n;
 }
 
-void validate(const BodyPoint& p, const std::string& who) {
-  require_finite(p.m, who + ": m");
-  require_finite(p.B, who + ": B");
-  require_finite(p.J, who + ": J");
-  if (p.m <= 0.0) throw Error(who + ": mass m must be > 0, got " + num(p.m));
-  if (p.J <= 0.0) throw Error(who + ": inertia J must be > 0, got " + num(p.J));
-  if (!std::isfinite(p.D()))
-    throw Error(who + ": D = m J - B^2 overflows (m J = " + num(p.m * p.J) + "); rescale the units");
-  if (!(p.D() > 0.0))
-    throw Error(who + ": D = m J - B^2 must be > 0 (kinetic energy positive definite), got " +
-                num(p.D()));
-  // D is computed with a rounding error of about eps m J; a D within a few dozen of those is not
-  // resolved (m = 0.49, J = 1, B = 0.7 gives D = 5.6e-17 for an exact 0) and every velocity built
-  // from 1/D would be noise.
-  if (p.D() <= kMinRelativeD * p.m * p.J)
-    throw Error(who + ": D = m J - B^2 = " + num(p.D()) + " is zero within rounding (it must exceed " +
-                num(kMinRelativeD) + " m J)");
-}
+void validate(const BodyPoint& p, const std::string& who) { require(why_invalid(p, who)); }
 
-void validate(const Scene& scene) {
-  if (scene.centres.empty()) throw Error("the scene has no Coulomb centre");
-  if (scene.bodies.empty()) throw Error("the scene has no body-point");
+std::string why_invalid(const Scene& scene) {
+  if (scene.centres.empty()) return "the scene has no Coulomb centre";
+  if (scene.bodies.empty()) return "the scene has no body-point";
   for (std::size_t k = 0; k < scene.centres.size(); ++k) {
     const std::string who = "centre " + std::to_string(k + 1);
-    require_finite(scene.centres[k].c, who + ": position");
-    require_finite(scene.centres[k].A, who + ": A");
+    if (std::string why = not_finite(scene.centres[k].c, who + ": position"); !why.empty()) return why;
+    if (std::string why = not_finite(scene.centres[k].A, who + ": A"); !why.empty()) return why;
   }
   for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
     const Body& b = scene.bodies[i];
     const std::string who = b.name.empty() ? "body " + std::to_string(i + 1) : "body '" + b.name + "'";
-    validate(b.p, who);
-    require_finite(b.s0.R, who + ": R");
-    require_finite(b.s0.v, who + ": v");
-    require_finite(b.s0.w, who + ": w");
-    for (std::size_t k = 0; k < scene.centres.size(); ++k) {
-      // A body on a centre has infinite potential energy and an undefined force; one so close that A/r
-      // overflows (R = 1e-300: |R|^2 underflows to 0) has them too, in double precision.
-      const Vec3 d = b.s0.R - scene.centres[k].c;
-      const std::string centre = "centre " + std::to_string(k + 1);
-      if (d == Vec3::Zero()) throw Error(who + " starts on " + centre + " (R = c); move it off the centre");
-      const double r = d.stableNorm();
-      // The force and the potential take |R - c|^2 (a centre at 1e308 read "an invariant became
-      // non-finite; reduce --h").
-      if (!std::isfinite(d.squaredNorm()))
-        throw Error(who + " starts " + num(r) + " from " + centre + ": the square of that distance overflows a double; "
-                    "rescale the units");
-      if (!(r > 0.0) || !std::isfinite(scene.centres[k].A / r) || !std::isfinite(scene.centres[k].A / (r * r)))
-        throw Error(who + " starts " + num(r) + " from " + centre + ": its potential or force there (A/r, A/r^2 with A = " +
-                    num(scene.centres[k].A) + ") overflows a double; start it farther or rescale the units");
-    }
-    // The integrals at the start must be representable: |R| |K1| and the energies of a scene of
-    // scale 1e308 overflow, and every deviation after that is NaN.
-    const Momenta k = to_momenta(b.p, b.s0);
-    double potential = 0.0;
-    for (const Centre& c : scene.centres) potential -= c.A / (b.s0.R - c.c).norm();
-    const double kinetic = 0.5 * (b.p.m * b.s0.v.squaredNorm() + 2.0 * b.p.B * b.s0.v.dot(b.s0.w) +
-                                  b.p.J * b.s0.w.squaredNorm());
-    if (!(k.K1.allFinite() && k.K2.allFinite() && (k.R.cross(k.K1) + k.K2).allFinite() && std::isfinite(kinetic) &&
-          std::isfinite(potential) && std::isfinite(kinetic + potential)))
-      throw Error(who + ": the energy or angular momentum at the start overflows a double (|R| = " + num(b.s0.R.norm()) +
-                  ", |v| = " + num(b.s0.v.norm()) + "); rescale the units");
-    // The angular momentum about each centre is an integral the runs track (a centre at 1e308 read
-    // "an invariant became non-finite; reduce --h").
-    for (std::size_t c = 0; c < scene.centres.size(); ++c)
-      if (!((k.R - scene.centres[c].c).cross(k.K1) + k.K2).allFinite())
-        throw Error(who + ": the angular momentum about centre " + std::to_string(c + 1) + " overflows a double (|R - c| = " +
-                    num((b.s0.R - scene.centres[c].c).norm()) + "); rescale the units");
+    if (std::string why = why_invalid(b.p, who); !why.empty()) return why;
+    if (std::string why = why_invalid_start(b, scene.centres, who); !why.empty()) return why;
   }
+  return {};
 }
 
-void validate(const ThesisStart& t, const std::string& who) {
-  require_finite(t.d, who + "d");
-  require_finite(t.L, who + "L");
-  require_finite(t.K1, who + "K1");
-  require_finite(t.Kx, who + "Kx");
-  require_finite(t.Kz, who + "Kz");
-  require_finite(t.phase, who + "phase");
-  if (t.K1 == 0.0) throw Error(who + "K1 must be non-zero (R(0) contains Kz/K1)");
+void validate(const Scene& scene) { require(why_invalid(scene)); }
+
+void validate(const ThesisStart& t, const std::string& who) { require(why_invalid(t, who)); }
+
+std::string why_invalid(const SceneParams& sp) {
+  if (std::string why = not_finite(sp.A, "A"); !why.empty()) return why;
+  if (std::string why = why_invalid(sp.start, ""); !why.empty()) return why;
+  return why_invalid(BodyPoint{sp.m, sp.B, sp.J}, "body");
 }
 
 Scene thesis_scene(const SceneParams& sp) {
-  require_finite(sp.A, "A");
-  validate(sp.start, "");
-  BodyPoint p{sp.m, sp.B, sp.J};
-  validate(p, "body");
+  require(why_invalid(sp));
+  const BodyPoint p{sp.m, sp.B, sp.J};
   Body body{p, to_state(p, thesis_momenta(sp.start)), "body"};
   Scene s;
   s.centres.push_back(Centre{Vec3::Zero(), sp.A, sp.law});

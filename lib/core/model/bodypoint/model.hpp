@@ -13,10 +13,12 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace bodypoint {
@@ -26,6 +28,32 @@ using Vec3 = Eigen::Vector3d;
 /// Every invalid input is reported by throwing this; drivers print what() on one line.
 struct Error : std::runtime_error {
   using std::runtime_error::runtime_error;
+};
+
+/// A value, or why there is none (one line, in Error's words): what a check or a solver returns where
+/// its caller decides what a failure means (a study records it beside its point, a run reports "not
+/// known"); value() throws the reason as Error for a caller that stops on it. The part of C++23's
+/// std::expected<T, std::string> this code needs.
+template <class T>
+class Expected {
+ public:
+  Expected(T value) : value_(std::move(value)) {}  // NOLINT(google-explicit-constructor): a value is an answer
+  /// No value, because of `why` (non-empty).
+  static Expected failure(std::string why) { return Expected(std::move(why), 0); }
+  [[nodiscard]] bool has_value() const { return value_.has_value(); }
+  explicit operator bool() const { return has_value(); }
+  [[nodiscard]] const std::string& error() const { return why_; }
+  [[nodiscard]] const T& value() const& {
+    if (!value_) throw Error(why_);
+    return *value_;
+  }
+  [[nodiscard]] const T& operator*() const& { return *value_; }
+  [[nodiscard]] const T* operator->() const { return &*value_; }
+
+ private:
+  Expected(std::string why, int) : why_(std::move(why)) {}
+  std::optional<T> value_;
+  std::string why_;
 };
 
 /// Inertial parameters of one body-point.
@@ -150,6 +178,11 @@ Scene thesis_scene(const SceneParams& sp);
 /// Throws Error with a one-line message on the first violated rule: finite numbers, m > 0,
 /// J > 0, D = mJ - B^2 > 0, at least one centre and one body, no body starting on a centre.
 void validate(const Scene& scene);
+/// The same rules as a value: the message validate would throw, or "" for a valid scene. For a caller
+/// that records the reason and goes on (a study's skipped point, a sweep's calibration).
+std::string why_invalid(const Scene& scene);
+/// Why thesis_scene refuses these parameters (its message), or "" when it builds a scene from them.
+std::string why_invalid(const SceneParams& sp);
 void validate(const BodyPoint& p, const std::string& who);
 /// The thesis's start parameters (d, L, K1, Kx, Kz, phase) finite and K1 non-zero; `who` prefixes the
 /// message ("" for the thesis's scene, "body 2: " in a scene file).

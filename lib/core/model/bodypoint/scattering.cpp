@@ -170,7 +170,7 @@ struct Incoming {
   std::string why;
 };
 Incoming incoming(const SceneParams& p) {
-  if (p.start.K1 == 0.0) return {std::nullopt, 0.0, "K1 must be non-zero (R(0) contains Kz/K1)"};  // thesis_scene's rule
+  if (std::string why = why_invalid(p); !why.empty()) return {std::nullopt, 0.0, std::move(why)};  // a secant's trial
   const Scene s = thesis_scene(p);
   const Body& body = s.bodies.front();
   const auto k = kepler_particle(body.p, body.s0, s.centres.front().c);
@@ -197,11 +197,11 @@ std::optional<double> v_of(const SceneParams& p, std::string& why) {
   why = in.why;
   return in.asymptote ? std::optional<double>(in.asymptote->p_inf / in.mu) : std::nullopt;
 }
-/// f at p, which must be defined there (where a secant starts): Error with the reason otherwise.
-double defined(Datum f, const SceneParams& p) {
+/// f at p, or why it is not defined there.
+Expected<double> defined(Datum f, const SceneParams& p) {
   std::string why;
   if (const std::optional<double> x = f(p, why)) return *x;
-  throw Error(why);
+  return Expected<double>::failure(why);
 }
 
 /// Secant iterations on one scene parameter x (field) for f(x) = target, from x0 (where f is defined)
@@ -209,17 +209,20 @@ double defined(Datum f, const SceneParams& p) {
 /// body does not drift along it) is pulled halfway back to the last point where it was, so that the
 /// secant approaches the edge of the admissible range instead of giving up (v_inf = 0.5 on table 3.1:
 /// the first guess K1 = 0.35 does not drift, the answer K1 = 1.65 does).
-double solve_parameter(SceneParams params, double& (*field)(SceneParams&), Datum f, double target, double x0,
-                       double x1) {
+/// f must be defined at x0: the answer is why not otherwise (as where no trial was).
+Expected<double> solve_parameter(SceneParams params, double& (*field)(SceneParams&), Datum f, double target, double x0,
+                                 double x1) {
   field(params) = x0;
-  double f0 = defined(f, params) - target;
+  const Expected<double> at_x0 = defined(f, params);
+  if (!at_x0) return at_x0;
+  double f0 = *at_x0 - target;
   std::string why;
   for (int i = 0; i < kImpactIterations; ++i) {
     if (!std::isfinite(x1)) return x1;  // the secant left the numbers: the caller says which datum
     field(params) = x1;
     const std::optional<double> y = f(params, why);
     if (!y) {
-      if (i + 1 == kImpactIterations) throw Error(why);
+      if (i + 1 == kImpactIterations) return Expected<double>::failure(why);
       x1 = 0.5 * (x0 + x1);
       continue;
     }
@@ -286,13 +289,13 @@ struct GuidingModel {
 /// Number of halvings that locate the periapsis inside its last step (ds 2e-3 / 2^40: to round-off).
 constexpr int kPhaseBisections = 40;
 
-double helix_turn_to_periapsis(const SceneParams& p) {
+Expected<double> helix_turn_to_periapsis(const SceneParams& p) {
   const Momenta q = thesis_momenta(p.start);
   const double D = p.m * p.J - p.B * p.B;
   GuidingModel model{p.A, p.B, p.J, D, q.K2.dot(q.K1) / q.K1.norm()};
   GuidingModel::Y y{q.R + q.K1.cross(q.K2) / q.K1.squaredNorm(), q.K1, 0.0};
   const double u_floor = 1e-3 * std::abs(model.u(y));
-  if (!(u_floor > 0.0)) throw Error("the guiding centre does not drift (u = 0): it has no arrival phase");
+  if (!(u_floor > 0.0)) return Expected<double>::failure("the guiding centre does not drift (u = 0): it has no arrival phase");
   if (!(model.radial(y) < 0.0)) return 0.0;  // not approaching: the start is its arrival
   for (long i = 0; i < kPhaseMaxSteps; ++i) {
     const double ds = model.ds(y, u_floor);
@@ -307,7 +310,7 @@ double helix_turn_to_periapsis(const SceneParams& p) {
     }
     y = next;
   }
-  throw Error("the guiding centre reaches no periapsis: the scene has no arrival phase");
+  return Expected<double>::failure("the guiding centre reaches no periapsis: the scene has no arrival phase");
 }
 
 double wrapped(double angle) {
@@ -318,72 +321,105 @@ double wrapped(double angle) {
 
 }  // namespace
 
-double arrival_phase(const SceneParams& params) {
-  return wrapped(params.start.phase + helix_turn_to_periapsis(params));
+Expected<double> solve_arrival_phase(const SceneParams& params) {
+  const Expected<double> turn = helix_turn_to_periapsis(params);
+  if (!turn) return turn;
+  return wrapped(params.start.phase + *turn);
 }
 
-double start_phase_for_arrival(const SceneParams& params, double arrival) {
-  if (!std::isfinite(arrival)) throw Error("the arrival phase must be a finite number (rad)");
+double arrival_phase(const SceneParams& params) { return solve_arrival_phase(params).value(); }
+
+namespace {
+
+Expected<double> solve_start_phase(const SceneParams& params, double arrival) {
+  if (!std::isfinite(arrival)) return Expected<double>::failure("the arrival phase must be a finite number (rad)");
   SceneParams at_zero = params;
   at_zero.start.phase = 0.0;
-  return wrapped(arrival - helix_turn_to_periapsis(at_zero));
+  const Expected<double> turn = helix_turn_to_periapsis(at_zero);
+  if (!turn) return turn;
+  return wrapped(arrival - *turn);
 }
 
-double d_for_impact_parameter(SceneParams params, double b) {
-  if (!(std::isfinite(b) && b > 0.0)) throw Error("the impact parameter b must be a finite number > 0");
+Expected<double> solve_d(SceneParams params, double b) {
+  if (!(std::isfinite(b) && b > 0.0)) return Expected<double>::failure("the impact parameter b must be a finite number > 0");
+  const std::string none = "no start distance d gives the impact parameter b = " + fmt(b);
   const double d0 = params.B == 0.0 ? params.start.Kz / params.start.K1 + b : b;
   params.start.d = d0;
-  double d = 0.0;
-  try {
-    d = solve_parameter(params, d_of, b_of, b, d0, d0 - (defined(b_of, params) - b));  // db/dd ~ 1
-  } catch (const Error& e) {  // the scene at the first guess has no incoming asymptote, or cannot be built
-    throw Error("no start distance d gives the impact parameter b = " + fmt(b) + ": " + e.what());
-  }
-  if (!std::isfinite(d))
-    throw Error("no start distance d gives the impact parameter b = " + fmt(b) +
-                " (the scene's numbers overflow on the way; give a smaller b)");
+  const Expected<double> b0 = defined(b_of, params);
+  const Expected<double> d = b0 ? solve_parameter(params, d_of, b_of, b, d0, d0 - (*b0 - b)) : b0;  // db/dd ~ 1
+  // The scene at the first guess has no incoming asymptote, or cannot be built; or the secant overflowed.
+  if (!d) return Expected<double>::failure(none + ": " + d.error());
+  if (!std::isfinite(*d)) return Expected<double>::failure(none + " (the scene's numbers overflow on the way; give a smaller b)");
   return d;
 }
-
-double least_approaching_k1(const SceneParams& p) { return std::max(0.0, p.B * p.start.Kx / p.J); }
 
 /// The first K1 the search for v_inf starts from: the scene's own where it approaches the centre,
 /// otherwise twice the drift's zero (v is 0 at the zero and grows with K1: one root on the branch).
 constexpr double kApproachingStart = 2.0;
 
-double k1_for_speed_at_infinity(SceneParams params, double v_inf) {
-  if (!(std::isfinite(v_inf) && v_inf > 0.0)) throw Error("the speed at infinity v_inf must be a finite number > 0");
+Expected<double> solve_k1(SceneParams params, double v_inf) {
+  if (!(std::isfinite(v_inf) && v_inf > 0.0))
+    return Expected<double>::failure("the speed at infinity v_inf must be a finite number > 0");
   // Only the branch on which the guiding centre drifts towards the centre has an encounter: below the
   // drift's zero it drifts away, its "incoming" asymptote a leg it never travels (v_inf = 1 on table 3.1
   // solved K1 = 0.884 there). incoming() refuses that branch, so a secant trial on it is pulled back.
   const double k_min = least_approaching_k1(params);
   if (!(params.start.K1 > k_min)) params.start.K1 = k_min > 0.0 ? kApproachingStart * k_min : 1.0;
   const double k0 = params.start.K1;
-  const double k1 = k0 * v_inf / defined(v_of, params);  // v_inf ~ K1 / mass
-  const double k = solve_parameter(params, k1_of, v_of, v_inf, k0, k1);
-  if (!(std::isfinite(k) && k > k_min))
-    throw Error("no momentum K1 above " + fmt(k_min) + " (where the guiding centre approaches the centre) gives the speed at infinity v_inf = " + fmt(v_inf));
+  const Expected<double> v0 = defined(v_of, params);
+  if (!v0) return v0;
+  const Expected<double> k = solve_parameter(params, k1_of, v_of, v_inf, k0, k0 * v_inf / *v0);  // v_inf ~ K1 / mass
+  if (!k) return k;
+  if (!(std::isfinite(*k) && *k > k_min))
+    return Expected<double>::failure("no momentum K1 above " + fmt(k_min) +
+                                     " (where the guiding centre approaches the centre) gives the speed at infinity v_inf = " +
+                                     fmt(v_inf));
   return k;
 }
 
-SceneParams with_asymptotic_data(SceneParams params, double b, double v_inf, double arrival) {
-  params = with_asymptotic_data(params, b, v_inf);
-  if (!std::isnan(arrival)) params.start.phase = start_phase_for_arrival(params, arrival);
-  return params;
-}
+}  // namespace
 
-SceneParams with_asymptotic_data(SceneParams params, double b, double v_inf) {
+double least_approaching_k1(const SceneParams& p) { return std::max(0.0, p.B * p.start.Kx / p.J); }
+
+double start_phase_for_arrival(const SceneParams& params, double arrival) { return solve_start_phase(params, arrival).value(); }
+
+double d_for_impact_parameter(SceneParams params, double b) { return solve_d(std::move(params), b).value(); }
+
+double k1_for_speed_at_infinity(SceneParams params, double v_inf) { return solve_k1(std::move(params), v_inf).value(); }
+
+Expected<SceneParams> solve_asymptotic_data(SceneParams params, double b, double v_inf, double arrival) {
   for (int i = 0; i < kImpactIterations; ++i) {
     const SceneParams before = params;
-    if (!std::isnan(v_inf)) params.start.K1 = k1_for_speed_at_infinity(params, v_inf);
-    if (!std::isnan(b)) params.start.d = d_for_impact_parameter(params, b);
+    if (!std::isnan(v_inf)) {
+      const Expected<double> k = solve_k1(params, v_inf);
+      if (!k) return Expected<SceneParams>::failure(k.error());
+      params.start.K1 = *k;
+    }
+    if (!std::isnan(b)) {
+      const Expected<double> d = solve_d(params, b);
+      if (!d) return Expected<SceneParams>::failure(d.error());
+      params.start.d = *d;
+    }
     // One datum given: one solve is exact. Both: until neither moves (each depends a little on the other).
     if (std::isnan(b) || std::isnan(v_inf) ||
         (std::abs(params.start.K1 - before.start.K1) <= kImpactRelTol * params.start.K1 &&
          std::abs(params.start.d - before.start.d) <= kImpactRelTol * std::max(params.start.d, b)))
-      return params;
+      break;
+  }
+  if (!std::isnan(arrival)) {
+    const Expected<double> phase = solve_start_phase(params, arrival);
+    if (!phase) return Expected<SceneParams>::failure(phase.error());
+    params.start.phase = *phase;
   }
   return params;
+}
+
+SceneParams with_asymptotic_data(SceneParams params, double b, double v_inf, double arrival) {
+  return solve_asymptotic_data(std::move(params), b, v_inf, arrival).value();
+}
+
+SceneParams with_asymptotic_data(SceneParams params, double b, double v_inf) {
+  return with_asymptotic_data(std::move(params), b, v_inf, std::numeric_limits<double>::quiet_NaN());
 }
 
 void check_data_beside_solved(const std::vector<std::string>& data, const std::vector<std::string>& given) {

@@ -97,6 +97,9 @@ SceneParams with_asymptotic_data(SceneParams params, double b, double v_inf);
 /// The same with the helix's phase at arrival (NaN: the scene's own start phase kept), set after b and
 /// v_inf (which do not depend on it): start_phase_for_arrival.
 SceneParams with_asymptotic_data(SceneParams params, double b, double v_inf, double arrival);
+/// The same as a value: the solved parameters, or why no scene has these data (the message the
+/// throwing form gives), for a caller that records the reason beside its point.
+Expected<SceneParams> solve_asymptotic_data(SceneParams params, double b, double v_inf, double arrival);
 
 /// Asymptotic data a thesis scene is given by (absent: not given), each in place of the start
 /// parameter it solves: b for d, v_inf for K1, arrival_phase for phase.

@@ -73,6 +73,9 @@ inline double path_distance(const Helix& h, const Vec3& c, double t_max) {
 /// K1 (J K1 - B Kx)/D vanishes at K1 = B Kx/J; 0 where it drifts along K1 at every K1 > 0.
 double least_approaching_k1(const SceneParams& p);
 
+/// arrival_phase (scattering.hpp) as a value: the phase, or why the scene has none.
+Expected<double> solve_arrival_phase(const SceneParams& params);
+
 /// Refuses an asymptotic datum (b, v_inf, arrival_phase) in `data` (given or swept) beside the
 /// parameter it solves (d, K1, phase) in `given` (set explicitly): "give b or d, not both".
 void check_data_beside_solved(const std::vector<std::string>& data, const std::vector<std::string>& given);
