@@ -107,6 +107,11 @@ const Example kIssueExamples[] = {
     {"timing --values 1e10", "the timing study would take about"},
     {"timing --values 1000 --warmup 9223372036854775807", "the timing study would take about"},
     {"sweep --param d --values 5,6 --methods lp-y4 --steps 10000000000 --max-seconds 10", "the sweep would take about"},
+    // Issue #54: the budget calibrates on a checked first point; a bad point or step is named, never skipped.
+    {"sweep --param B --values 2,0.5 --methods lp-y4 --steps 100000000 --max-seconds 5", "B = 2: body: D = m J - B^2 must be > 0"},
+    {"sweep --param B --values 0.5,2 --methods lp-y4 --steps 10 --max-seconds 5", "B = 2: body: D = m J - B^2 must be > 0"},
+    {"sweep --param h --values 1e-3,1e-20 --methods lp-y4 --t-end 10 --max-seconds 1",
+     "the end time / the step h (10 / 1e-20) asks for more than 1e13 steps"},
     // Issue #43: the sweep's accuracy mode needs an end and chooses the step itself.
     {"sweep --param h --values 0.1 --methods lp-y4 --t-end 5 --accuracy 1e-8", "the accuracy mode chooses the step"},
     {"sweep --param d --values 5 --methods lp-y4 --steps 10 --accuracy 1e-8", "give t_end"},
