@@ -168,6 +168,22 @@ TEST(Estimates, TheCoarseCompanionCostsHalfARunAndFallsBackWhereItCannotBeTruste
   EXPECT_GT(json_num(lost.out, "err_estimate"), json_num(lost.out, "err_rel") / kHonestFactor) << lost.out;
 }
 
+TEST(Estimates, AFinePairTheCoarseSideDisagreesWithIsCheckedByTheNextLevel) {
+  // Where the error's terms of two orders cancel near one step, a Richardson pair there agrees by chance:
+  // attracting lp-euler at h = 0.02 read 2.0e-6 for 1.0e-5 from its h/2 pair (1.0e-6 apart, where the
+  // next pair is 3.6e-6 apart and the coarse side read 2.4e-5). A second fine companion shows it.
+  const auto r = run_cli("simulate --json --reference --A 2 --d 3 --t-end 80 --method lp-euler --h 0.02");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_GE(json_num(r.out, "err_estimate"), json_num(r.out, "err_rel") / kHonestFactor) << r.out;
+  EXPECT_NE(r.out.find("the pair differs less than the order predicts from the next"), std::string::npos) << r.out;
+  // A pair in its regime whose coarse run is not (lp-pefrl at h = 0.05 on the same scene: the coarse side
+  // read 7.2e-5 for an error of 1.5e-8) keeps the fine pair's estimate.
+  const auto kept = run_cli("simulate --json --reference --A 2 --d 3 --t-end 80 --method lp-pefrl --h 0.05");
+  ASSERT_EQ(kept.code, 0) << kept.err;
+  EXPECT_LT(json_num(kept.out, "err_estimate"), kHonestFactor * json_num(kept.out, "err_rel")) << kept.out;
+  EXPECT_GE(json_num(kept.out, "err_estimate"), json_num(kept.out, "err_rel") / kHonestFactor) << kept.out;
+}
+
 TEST(Estimates, ARunAliasingTheSpinIsKeptWhereAThirdCompanionBoundsIt) {
   // Two repelling centres and the thesis's spinning body: lp-bm4 at h = 1 turns the spin by 6.86 rad per
   // step and is 8.1e-4 off (right by aliasing), its companion at h/2 aliases too (2.7e-3 off), so the

@@ -66,12 +66,25 @@ struct FineCompanion {
 /// The finer companion of the run r (fine.cpp); nullopt, r.error.basis saying why, where there is none.
 std::optional<FineCompanion> finer_companion(BodyResult& r, const Body& body, const Advance& how, const Options& options,
                                              const Options& o, const Rerun& rerun);
-/// A flagged run, or one of fewer than kFewSteps: a second companion one level finer than f (fine.cpp).
+/// A flagged run, one of fewer than kFewSteps, or one whose fine pair the coarse side disagrees with
+/// (`check_pair`): a second companion one level finer than f (fine.cpp).
 void second_companion(BodyResult& r, const Body& body, const Advance& how, const Options& options, const Options& o,
-                      const Rerun& rerun, const FineCompanion& f);
-/// The estimate of the coarse companion where the run has one and it is trusted (true; coarse.cpp).
+                      const Rerun& rerun, const FineCompanion& f, bool check_pair);
+/// What the coarse side says where it does not give the estimate.
+struct CoarseSide {
+  /// Where the coarse run ended as the run did: the pair's Richardson at the method's order, to compare with
+  /// the fine pair's.
+  std::optional<double> at_order;
+};
+/// The estimate of the coarse companion where the run has one and it is trusted (true; coarse.cpp); where
+/// not, `side` says what the coarse side saw.
 bool estimated_by_coarse(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Advance& how,
-                         const Options& options, const Options& o, const Rerun& rerun);
+                         const Options& options, const Options& o, const Rerun& rerun, CoarseSide& side);
+/// Asymptotically a pair differs ratio^p times what the next finer pair does, and the coarse side's
+/// Richardson at the method's order reads what the fine side's does; beyond this factor either the coarse
+/// run is outside its regime or the fine pair agrees by chance, and a second fine companion tells which
+/// (second_companion's check).
+inline constexpr double kAsymptoticSpread = 4.0;
 /// Adds kRoundingDraws - 1 draws of the rounding to e where it is at the rounding level (rounding.cpp).
 void add_rounding_draws(ErrorEstimate& e, const BodyResult& r, const Options& options, const Options& o,
                         const std::function<BodyResult(int)>& draw, const std::string& what);
