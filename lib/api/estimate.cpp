@@ -80,8 +80,8 @@ void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& 
     return;
   }
   const Options o = companion_options(body, centres, how, options);
-  CoarseSide side;
-  if (estimated_by_coarse(r, body, centres, how, options, o, rerun, side)) return;
+  std::optional<double> coarse_side;
+  if (estimated_by_coarse(r, body, centres, how, options, o, rerun, coarse_side)) return;
   const std::optional<FineCompanion> f = finer_companion(r, body, how, options, o, rerun);
   if (!f) return;
   e.value = f->c.factor * adaptive::state_distance(r.run.final, f->x.run.final);
@@ -93,7 +93,7 @@ void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& 
   add_rounding_draws(e, r, options, o, rerun_draws(body, [&how](int k) { return off_grid(how, k); }, o, rerun),
                      kRepeatRoundingDraw);
   // A fine pair the coarse side disagrees with is checked by the next finer one.
-  const bool check_pair = side.at_order && *side.at_order > kAsymptoticSpread * e.value;
+  const bool check_pair = coarse_side && *coarse_side > kAsymptoticSpread * e.value;
   if (r.outcome == Outcome::unresolved || r.run.steps < kFewSteps || check_pair)
     second_companion(r, body, how, options, o, rerun, *f, check_pair);
 }

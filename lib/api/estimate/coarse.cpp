@@ -92,7 +92,7 @@ std::optional<std::vector<BodyResult>> coarse_lanes(const MethodInfo& m, const B
 /// run does not refine says nothing of the run; a flagged run is left to the fine pair, which can
 /// confirm it.
 bool estimated_by_coarse(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Advance& how,
-                         const Options& options, const Options& o, const Rerun& rerun, CoarseSide& side) {
+                         const Options& options, const Options& o, const Rerun& rerun, std::optional<double>& coarse_side) {
   if (r.outcome == Outcome::unresolved) return false;
   const std::optional<CoarseCompanion> c =
       coarse_companion(*r.method, how, r.run.steps, coarse_ratio_limit(*r.method, centres, r.run));
@@ -118,8 +118,8 @@ bool estimated_by_coarse(BodyResult& r, const Body& body, const std::vector<Cent
   std::optional<ErrorEstimate> coarse;
   if (x.outcome == Outcome::ok && ended_alike(r, options, x, oc) && coarser(*c, x.run.steps, r.run.steps)) {
     coarse = coarse_estimate(*r.method, body, centres, *c, r.run.final, x.run.final);
-    side.at_order = adaptive::finer_run_error(adaptive::state_distance(r.run.final, x.run.final), c->ratio,
-                                              fixed_order(*r.method, body));
+    coarse_side = adaptive::finer_run_error(adaptive::state_distance(r.run.final, x.run.final), c->ratio,
+                                            fixed_order(*r.method, body));
   }
   if (!coarse || !at_rounding_level(*coarse)) lane_cost(coarse ? *coarse : e);
   if (!coarse) return false;

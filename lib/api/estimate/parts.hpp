@@ -70,16 +70,11 @@ std::optional<FineCompanion> finer_companion(BodyResult& r, const Body& body, co
 /// (`check_pair`): a second companion one level finer than f (fine.cpp).
 void second_companion(BodyResult& r, const Body& body, const Advance& how, const Options& options, const Options& o,
                       const Rerun& rerun, const FineCompanion& f, bool check_pair);
-/// What the coarse side says where it does not give the estimate.
-struct CoarseSide {
-  /// Where the coarse run ended as the run did: the pair's Richardson at the method's order, to compare with
-  /// the fine pair's.
-  std::optional<double> at_order;
-};
-/// The estimate of the coarse companion where the run has one and it is trusted (true; coarse.cpp); where
-/// not, `side` says what the coarse side saw.
+/// The estimate of the coarse companion where the run has one and it is trusted (true; coarse.cpp). Where it
+/// is not, but the coarse run ended as the run did, `coarse_side` is that pair's Richardson at the method's
+/// order, to compare with the fine pair's.
 bool estimated_by_coarse(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Advance& how,
-                         const Options& options, const Options& o, const Rerun& rerun, CoarseSide& side);
+                         const Options& options, const Options& o, const Rerun& rerun, std::optional<double>& coarse_side);
 /// Asymptotically a pair differs ratio^p times what the next finer pair does, and the coarse side's
 /// Richardson at the method's order reads what the fine side's does; beyond this factor either the coarse
 /// run is outside its regime or the fine pair agrees by chance, and a second fine companion tells which
