@@ -136,8 +136,9 @@ std::optional<FineCompanion> finer_companion(BodyResult& r, const Body& body, co
   }
 }
 
-/// A flagged run, or one of fewer than kFewSteps: a second companion one level finer than `f` tells whether
-/// the pair is in the asymptotic regime (confirm), and bounds a run of a few steps.
+/// A flagged run, one of fewer than kFewSteps, or one whose pair the coarse side disagrees with (`check_pair`):
+/// a second companion one level finer than `f` tells whether the pair is in the asymptotic regime (confirm),
+/// and bounds a run of a few steps, or a pair that agrees by chance.
 void second_companion(BodyResult& r, const Body& body, const Advance& how, const Options& options, const Options& o,
                       const Rerun& rerun, const FineCompanion& f, bool check_pair) {
   ErrorEstimate& e = r.error;
@@ -148,32 +149,25 @@ void second_companion(BodyResult& r, const Body& body, const Advance& how, const
   e.force_evals += y.total_force_evals();
   e.wall_s += y.run.wall_s;
   const bool alike = ended_alike(r, options, y, o);
-  if (alike && r.run.steps < kFewSteps) {
-    // A run of a few steps (a time-transformed run whose landing step spans the whole end time) is not in
-    // any asymptotic regime: its estimate is at least what it differs by from the finer companion, plus
-    // what that one may still be off by (ttl-verlet at ds = 1 on the material pass: 1 step, 2.1e-5 off,
-    // estimated 4.0e-6 from a companion of 2 steps; a second of 3 steps is 1.7e-5 from the run).
-    const double bound = adaptive::state_distance(r.run.final, y.run.final) + adaptive::state_distance(f.x.run.final, y.run.final);
-    if (bound > e.value) {
-      e.value = bound;
-      e.basis += "; a run of " + std::to_string(r.run.steps) + " steps: raised to what a second companion one level "
-                 "finer differs by from it and from the first";
-    }
-  }
-  if (alike && check_pair) {
-    // A pair can agree by chance where the error's terms of two orders cancel near its step: asymptotically
-    // it differs ratio^p times what the next pair does; where it differs less than 1/kAsymptoticSpread of
-    // that, the estimate is at least the few-steps bound above (attracting lp-euler at h = 0.02: 1.0e-5 off,
-    // estimated 2.0e-6 from its h/2 pair, which differs 1.0e-6 where the next differs 3.6e-6). Where it
-    // falls as the order says, the coarse side was outside its regime.
-    const double near = adaptive::state_distance(r.run.final, f.x.run.final);
-    const double further = adaptive::state_distance(f.x.run.final, y.run.final);
-    const double bound = adaptive::state_distance(r.run.final, y.run.final) + further;
-    if (kAsymptoticSpread * near < std::pow(kStepRatio, fixed_order(*r.method, body)) * further && bound > e.value) {
-      e.value = bound;
-      e.basis += "; the pair differs less than the order predicts from the next "
-                 "(not asymptotic): raised to what a second companion one level finer differs by from it and from the first";
-    }
+  // What the run differs by from the second companion, plus what the first may still be off by.
+  const double near = adaptive::state_distance(r.run.final, f.x.run.final);
+  const double further = adaptive::state_distance(f.x.run.final, y.run.final);
+  const double bound = adaptive::state_distance(r.run.final, y.run.final) + further;
+  // A run of a few steps (a time-transformed run whose landing step spans the whole end time) is not in any
+  // asymptotic regime (ttl-verlet at ds = 1 on the material pass: 1 step, 2.1e-5 off, estimated 4.0e-6 from a
+  // companion of 2 steps; a second of 3 steps is 1.7e-5 from the run). Nor is a pair that agrees by chance
+  // where the error's terms of two orders cancel near its step: asymptotically it differs ratio^p times what
+  // the next pair does, and it differs less than 1/kAsymptoticSpread of that (attracting lp-euler at h = 0.02:
+  // 1.0e-5 off, estimated 2.0e-6 from its h/2 pair, 1.0e-6 apart where the next is 3.6e-6). Where it falls as
+  // the order says, the coarse side was outside its regime.
+  const bool few = r.run.steps < kFewSteps;
+  const bool by_chance = check_pair && kAsymptoticSpread * near < std::pow(kStepRatio, fixed_order(*r.method, body)) * further;
+  if (alike && (few || by_chance) && bound > e.value) {
+    e.value = bound;
+    e.basis += few ? "; a run of " + std::to_string(r.run.steps) + " steps: raised to what a second companion one level "
+                     "finer differs by from it and from the first"
+                   : "; the pair differs less than the order predicts from the next (not asymptotic): raised to what a "
+                     "second companion one level finer differs by from it and from the first";
   }
   if (r.outcome != Outcome::unresolved) return;
   if (!alike) {
