@@ -19,6 +19,7 @@
 
 #include "bodypoint/bodypoint.hpp"
 #include "bodypoint/io.hpp"
+#include "bodypoint/detail/model_parts.hpp"
 #include "bodypoint/threads.hpp"
 #include "encounter_parts.hpp"
 #include "sweep.hpp"
@@ -107,23 +108,19 @@ Point run_point(const Series& s, double b, double psi) {
   }
   const SceneParams& params = *solved;
   p.d = params.start.d;
-  if (std::string why = why_invalid(params); !why.empty()) {
-    p.failure = why;
+  const Expected<Scene> scene = valid_thesis_scene(params);
+  if (!scene) {
+    p.failure = scene.error();
     return p;
   }
-  const Scene scene = thesis_scene(params);
-  if (std::string why = why_invalid(scene); !why.empty()) {
-    p.failure = why;
-    return p;
-  }
-  const Body& body = scene.bodies.front();
+  const Body& body = scene->bodies.front();
   Options o;
   o.track_invariants = false;
   const MethodInfo* method = std::string_view(s.method) == "auto" ? nullptr : &method_or_throw(s.method);
-  EncounterResult r = encounter(body, scene.centres, method, p.tol, kNaN, o);
+  EncounterResult r = encounter(body, scene->centres, method, p.tol, kNaN, o);
   for (int k = 0; k < kRetries && r.run.outcome == Outcome::failed && r.run.reason.find("out of reach") != std::string::npos; ++k) {
     p.tol *= kRetryLooser;
-    r = encounter(body, scene.centres, method, p.tol, kNaN, o);
+    r = encounter(body, scene->centres, method, p.tol, kNaN, o);
   }
   p.force_evals = r.run.total_force_evals();
   p.t_end = r.run.run.t_end;

@@ -209,8 +209,7 @@ Expected<Scene> thesis_scene_twice_as_far(SceneParams solved, double b, double v
   solved.start.L *= 2.0;
   const Expected<SceneParams> far = solve_asymptotic_data(solved, b, v_inf, arrival_phase);
   if (!far) return Expected<Scene>::failure(far.error());
-  if (std::string why = why_invalid(*far); !why.empty()) return Expected<Scene>::failure(why);
-  return thesis_scene(*far);
+  return valid_thesis_scene(*far);
 }
 
 EncounterResult encounter(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method, double tol,

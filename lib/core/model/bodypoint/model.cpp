@@ -151,6 +151,16 @@ Scene thesis_scene(const SceneParams& sp) {
   return s;  // the scene as a whole is checked by the request that runs it (model.hpp)
 }
 
+Expected<Scene> valid_scene(Scene scene) {
+  if (std::string why = why_invalid(scene); !why.empty()) return Expected<Scene>::failure(std::move(why));
+  return scene;
+}
+
+Expected<Scene> valid_thesis_scene(const SceneParams& sp) {
+  if (std::string why = why_invalid(sp); !why.empty()) return Expected<Scene>::failure(std::move(why));
+  return valid_scene(thesis_scene(sp));
+}
+
 const std::vector<SceneParameter>& scene_parameters() {
   using Of = SceneParameter::Of;
   static const std::vector<SceneParameter> list = {

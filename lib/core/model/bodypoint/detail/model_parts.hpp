@@ -73,6 +73,12 @@ inline double path_distance(const Helix& h, const Vec3& c, double t_max) {
 /// K1 (J K1 - B Kx)/D vanishes at K1 = B Kx/J; 0 where it drifts along K1 at every K1 > 0.
 double least_approaching_k1(const SceneParams& p);
 
+/// A scene as a value, checked whole once (why_invalid, model.hpp): `scene`, or why it is not valid.
+Expected<Scene> valid_scene(Scene scene);
+/// The thesis's scene of sp as a value: thesis_scene(sp) where sp builds one and the scene is valid as a
+/// whole, or the first reason why not (a study's point, the encounter from twice the start distance).
+Expected<Scene> valid_thesis_scene(const SceneParams& sp);
+
 /// arrival_phase (scattering.hpp) as a value: the phase, or why the scene has none.
 Expected<double> solve_arrival_phase(const SceneParams& params);
 
