@@ -869,6 +869,14 @@ def trust_prices(rows, body, M):
     prices = [num(r["estimate_force_evals"]) / num(r["force_evals"]) for r in rows
               if r["kind"] == "own" and r.get("estimate_force_evals") and num(r["estimate_force_evals"]) > 0
               and num(r["force_evals"]) > 0]
+    # The price a user pays who picks a configuration by hand and must trust it without knowing the error: the
+    # cheapest own configuration that delivers TOL and whose default estimate says so, its run and estimate
+    # (by_tol.csv's auto rows, trusted_force_evals), and auto's whole call over it (ks, exact, left out).
+    trusted = [num(r["force_evals"]) / num(r["trusted_force_evals"]) for r in rows
+               if r["kind"] == "auto" and r.get("trusted_force_evals") and num(r["trusted_force_evals"]) > 0
+               and num(r["force_evals"]) > 0 and r["met"] == "yes"]
+    M.add("AutoOverTrusted", f"a median ${sci(statistics.median(trusted))}$ times (${sci(min(trusted))}$ to "
+          f"${sci(max(trusted))}$, {count(len(trusted))} cases)" if trusted else "not measured", math_mode=False)
     M.add("OwnEstimatePrice", f"a median ${sci(statistics.median(prices))}$ times their run's force evaluations "
           f"(${sci(min(prices))}$ to ${sci(max(prices))}$, {count(len(prices))} configurations)" if prices else
           "not measured (no own configuration of this copy's by-tol table has an estimate)", math_mode=False)

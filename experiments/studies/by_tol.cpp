@@ -55,6 +55,10 @@ struct TolRow {
   /// estimate made): what its estimate cost in force evaluations, and the estimate; -1 / NaN where it has none
   long estimate_force_evals = -1;
   double own_estimate = std::numeric_limits<double>::quiet_NaN();
+  /// auto: bodypoint's cheapest own configuration whose default estimate shows TOL and that delivers it
+  /// (mark_trusted_best): "method h=..." or "" where none does, and its price, the run and its estimate
+  std::string trusted;
+  long trusted_evals = 0;
 };
 
 /// A peer's ladder stops once its delivered error is below this (the smallest TOL of the grid is 1e-12).
@@ -258,7 +262,7 @@ TolRow* own_best_for(std::vector<TolRow>& rows, const TolRow& a) {
 
 void write_tol_rows(std::ostream& csv, const std::vector<TolRow>& rows, const TimingRules& rules) {
   csv << "scene,method,kind,tol,h,err_estimate,err,met,runs,force_evals,wall_s,cpu_s,spread,repeats,flag,"
-         "delivered_force_evals,delivered_wall_s,estimate_force_evals,own_estimate\n"
+         "delivered_force_evals,delivered_wall_s,estimate_force_evals,own_estimate,trusted_config,trusted_force_evals\n"
       << "# bodypoint work-precision --by-tol, revision " << git_revision() << "\n"
       << "# err = max(|dR|/|R_ref|, |dv|/|v_ref|) against odeint rkf78 in long double at tol 1e-18; met = err <= tol\n"
       << "# met: refused where auto refused TOL with a reason (the summary gives it); a call is the whole request "
@@ -269,7 +273,9 @@ void write_tol_rows(std::ostream& csv, const std::vector<TolRow>& rows, const Ti
       << "# delivered_* (auto only): the delivered run alone (delivered_wall_s: median of its step loop in the timed "
          "calls), the cost if the search were free\n"
       << "# estimate_force_evals, own_estimate (own only): the same configuration run as simulate --h runs it by default "
-         "(invariants, error estimate): the force evaluations its estimate took beyond the run, and the estimate\n";
+         "(invariants, error estimate): the force evaluations its estimate took beyond the run, and the estimate\n"
+      << "# trusted_config, trusted_force_evals (auto only): bodypoint's cheapest own configuration (the same ladders) "
+         "that delivers TOL and whose default estimate says so, and its run's and estimate's force evaluations\n";
   for (const TolRow& r : rows)
     csv << CsvLine().text(r.scene).text(r.method).text(r.is_auto ? "auto" : r.is_ladder ? "ladder" : r.is_own ? "own" : "at-tol")
                .num(r.tol).num_if(r.is_auto || r.is_own, r.h).num_if(r.is_auto, r.err_estimate).num(r.err)
@@ -277,7 +283,8 @@ void write_tol_rows(std::ostream& csv, const std::vector<TolRow>& rows, const Ti
                .num(r.time.cpu_s).num(r.time.spread()).count(r.time.repeats).quoted(r.time.flag())
                .num_if(r.is_auto, static_cast<double>(r.delivered_force_evals)).num_if(r.is_auto, r.delivered_wall_s)
                .num_if(r.is_own && r.estimate_force_evals >= 0, static_cast<double>(r.estimate_force_evals))
-               .num_if(r.is_own && r.estimate_force_evals >= 0, r.own_estimate).str()
+               .num_if(r.is_own && r.estimate_force_evals >= 0, r.own_estimate).text(r.trusted)
+               .num_if(!r.trusted.empty(), static_cast<double>(r.trusted_evals)).str()
         << '\n';
 }
 
@@ -357,9 +364,26 @@ void write_own_cells(std::ostream& summary, const std::vector<TolRow>& rows, con
   if (own && own->estimate_force_evals >= 0 && own->force_evals > 0)
     summary << std::setprecision(3)
             << static_cast<double>(own->estimate_force_evals) / static_cast<double>(own->force_evals) << "x ("
-            << sci(own->own_estimate) << " for " << sci(own->err) << ") |\n";
+            << sci(own->own_estimate) << " for " << sci(own->err) << ") | ";
   else
-    summary << "- |\n";
+    summary << "- | ";
+}
+
+/// The last cells of auto's summary row: bodypoint's cheapest own configuration that delivers TOL with a
+/// default estimate that says so (its run and estimate in force evaluations), and auto's whole call over it.
+void write_trusted_cells(std::ostream& summary, const TolRow& a, std::vector<double>& ratios) {
+  if (a.trusted.empty() || !a.refusal.empty()) {
+    summary << (a.trusted.empty() ? "none" : a.trusted) << " | - |\n";
+    return;
+  }
+  summary << a.trusted << " (" << a.trusted_evals << " evals) | ";
+  if (a.force_evals > 0 && a.trusted_evals > 0) {
+    const double r = static_cast<double>(a.force_evals) / static_cast<double>(a.trusted_evals);
+    ratios.push_back(r);
+    summary << std::setprecision(3) << r << "x |\n";
+  } else {
+    summary << "- (no force evaluations) |\n";
+  }
 }
 
 /// The two prices under the table: auto over bodypoint's own fastest configuration (`own_ratios`, force
@@ -389,10 +413,12 @@ void write_tol_summary(std::ostream& summary, const std::vector<TolRow>& rows, s
              "| time [ms] | speed-up | peers meeting TOL | cheapest peer config delivering TOL | time [ms] | speed-up "
              "| delivered run [ms] | speed-up if the search were free | bodypoint's fastest config delivering TOL "
              "| time [ms] | auto / it, evals | auto / it, time | auto's search / its delivered run, evals "
-             "| its estimate / it, evals (estimate for error) |\n"
-          << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+             "| its estimate / it, evals (estimate for error) | bodypoint's cheapest config whose estimate shows TOL "
+             "(run + estimate) | auto / it, evals |\n"
+          << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   int met = 0, refused = 0, total = 0, faster3 = 0, compared = 0, oracle3 = 0, oracle_n = 0;
   std::vector<double> own_ratios;  // auto over bodypoint's fastest configuration, force evaluations
+  std::vector<double> trusted_ratios;  // auto over the cheapest configuration whose estimate shows TOL
   std::ostringstream refusals;
   for (const TolRow& a : rows) {
     if (!a.is_auto) continue;
@@ -429,6 +455,7 @@ void write_tol_summary(std::ostream& summary, const std::vector<TolRow>& rows, s
       summary << "none | - | - | " << delivered_cell(a) << " | - | ";
     }
     write_own_cells(summary, rows, a, own_ratios);
+    write_trusted_cells(summary, a, trusted_ratios);
   }
   summary << "\nauto met TOL in " << met << " of " << total << " cases";
   if (refused > 0) summary << " and refused " << refused << " with its reason (below)";
@@ -437,20 +464,38 @@ void write_tol_summary(std::ostream& summary, const std::vector<TolRow>& rows, s
           << "delivers TOL (its tolerance chosen afterwards), >= 3x in " << oracle3 << " of " << oracle_n
           << " (a comparison with a flagged time counts as not >= 3x).\n";
   write_price_medians(summary, rows, std::move(own_ratios));
+  if (!trusted_ratios.empty()) {
+    std::sort(trusted_ratios.begin(), trusted_ratios.end());
+    summary << "\nauto against bodypoint's cheapest configuration that delivers TOL with a default estimate saying so "
+            << "(its run and estimate), force evaluations: median " << std::setprecision(3) << median(trusted_ratios)
+            << "x, from " << trusted_ratios.front() << "x to " << trusted_ratios.back() << "x (" << trusted_ratios.size()
+            << " cases).\n";
+  }
   if (refused > 0) summary << "\nauto refused:\n\n" << refusals.str();
 }
 
 }  // namespace
 
-/// The price of the default error estimate on each own row from `first` (mark_own_bests' rows): the row's
-/// configuration made again as `simulate --method M --h h` makes it (Options' defaults: invariants tracked, the
-/// estimate on), untimed; its estimate's force evaluations beside the run's. A run that does not end ok leaves
-/// the row without them.
+/// An own row's configuration made again as `simulate --method M --h h` makes it (Options' defaults: invariants
+/// tracked, the estimate on), untimed: its estimate's force evaluations and value (none where the run does not
+/// end ok: own_estimate is then +inf, so that it is not made again).
+void estimate_own(const NamedScene& ns, TolRow& r) {
+  const MethodInfo& m = method_or_throw(r.method);
+  const BodyResult x = integrate_body(ns.scene.bodies.front(), ns.scene.centres, &m, own_advance(m, r.h, ns.t_end), Options{});
+  if (x.outcome != Outcome::ok || !x.error.known()) {
+    r.own_estimate = std::numeric_limits<double>::infinity();
+    return;
+  }
+  r.estimate_force_evals = x.error.force_evals;
+  r.own_estimate = x.error.value;
+}
+
+/// The price of the default error estimate on each own row from `first` (mark_own_bests' rows; estimate_own),
+/// where mark_trusted_bests did not make it already.
 void measure_own_estimates(const NamedScene& ns, std::vector<TolRow>& rows, std::size_t first) {
-  const Body& body = ns.scene.bodies.front();
   for (std::size_t i = first; i < rows.size(); ++i) {
     TolRow& r = rows[i];
-    if (!r.is_own) continue;
+    if (!r.is_own || r.estimate_force_evals >= 0 || std::isinf(r.own_estimate)) continue;
     // One configuration fastest at several TOLs has a row per TOL: made once, its numbers copied.
     const auto same = std::find_if(rows.begin() + static_cast<std::ptrdiff_t>(first), rows.begin() + static_cast<std::ptrdiff_t>(i),
                                    [&](const TolRow& o) { return o.is_own && o.method == r.method && o.h == r.h; });
@@ -459,11 +504,35 @@ void measure_own_estimates(const NamedScene& ns, std::vector<TolRow>& rows, std:
       r.own_estimate = same->own_estimate;
       continue;
     }
-    const MethodInfo& m = method_or_throw(r.method);
-    const BodyResult x = integrate_body(body, ns.scene.centres, &m, own_advance(m, r.h, ns.t_end), Options{});
-    if (x.outcome != Outcome::ok || !x.error.known()) continue;
-    r.estimate_force_evals = x.error.force_evals;
-    r.own_estimate = x.error.value;
+    estimate_own(ns, r);
+  }
+}
+
+/// For each auto row of the scene (rows [first, own_first)), bodypoint's cheapest own configuration (rows from
+/// own_first, every rung of the own ladders) that delivers its TOL and whose default estimate says so: what a
+/// user who cannot know the error pays to trust a configuration chosen by hand, the run and its estimate.
+/// Rungs are tried by their run's evaluations, each estimated once, until a run alone costs more than the
+/// best price found.
+void mark_trusted_bests(const NamedScene& ns, std::vector<TolRow>& rows, std::size_t first, std::size_t own_first) {
+  std::vector<std::size_t> order;
+  for (std::size_t i = own_first; i < rows.size(); ++i) order.push_back(i);
+  std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return rows[x].force_evals < rows[y].force_evals; });
+  for (std::size_t i = first; i < own_first; ++i) {
+    TolRow& a = rows[i];
+    if (!a.is_auto) continue;
+    long best = std::numeric_limits<long>::max();
+    for (std::size_t k : order) {
+      TolRow& r = rows[k];
+      if (r.force_evals >= best) break;
+      if (!(r.err <= a.tol)) continue;
+      if (r.estimate_force_evals < 0 && std::isnan(r.own_estimate)) estimate_own(ns, r);
+      if (!(r.own_estimate <= a.tol) || r.estimate_force_evals < 0) continue;
+      if (r.force_evals + r.estimate_force_evals < best) {
+        best = r.force_evals + r.estimate_force_evals;
+        a.trusted = r.method + " h=" + sci(r.h);
+        a.trusted_evals = best;
+      }
+    }
   }
 }
 
@@ -514,6 +583,7 @@ void run_by_tolerance(const std::vector<NamedScene>& scenes, const std::vector<d
       if (rows[i].is_auto) auto_evals = std::max(auto_evals, static_cast<double>(rows[i].force_evals));
     const double own_cap = auto_evals > 0.0 ? std::min(max_evals, kOwnOverAuto * auto_evals) : max_evals;
     measure_own_ladders(ns, ref, *std::min_element(tols.begin(), tols.end()), own_cap, rows);
+    mark_trusted_bests(ns, rows, first, own_first);
     mark_own_bests(rows, first, own_first);
     measure_own_estimates(ns, rows, own_first);
     std::cerr << "  " << ns.name << ": timing " << rows.size() - first << " configurations, interleaved\n";

@@ -120,8 +120,9 @@ void add_work_precision_options(po::options_description& desc, WorkPrecisionArgs
       ("max-evals", defaulted(&a.o.max_evals), "largest run of a ladder, in force evaluations")
       ("by-tol", po::bool_switch(&a.by_tol), "second view: auto and every step-size-controlled peer with the same "
        "requested tolerance; delivered error, whether it met TOL, and time; auto against bodypoint's own fastest "
-       "configuration delivering TOL (a method at a step; evaluations and time) and what that configuration's default "
-       "error estimate costs (evaluations)")
+       "configuration delivering TOL (a method at a step; evaluations and time), what that configuration's default "
+       "error estimate costs (evaluations), and against the cheapest own configuration that delivers TOL with a "
+       "default estimate saying so (its run and estimate, evaluations)")
       ("tols", defaulted(&a.tols), "with --by-tol: the tolerances")
       ("list-scenes", po::bool_switch(&a.list_scenes), "print the named scenes that 'all' means, one per line, and exit")
       ("quick", po::bool_switch(&a.quick), "coarse: scenes thesis and material, every ladder (the peers' too) up to 1e6 force evaluations")

@@ -274,6 +274,24 @@ TEST(Cli, ByTolComparesAutoWithBodypointsOwnFastestConfiguration) {
   EXPECT_EQ(own, 2) << "one per TOL";
   EXPECT_NE(r.out.find("The default error estimate of bodypoint's fastest configuration (simulate --h), force "
                        "evaluations beyond the run: median"), std::string::npos) << r.out;
+  // The price of choosing by hand with trust: the cheapest own configuration that delivers TOL and whose
+  // default estimate says so, its run and estimate together; never cheaper than the fastest one alone.
+  EXPECT_NE(r.out.find("| bodypoint's cheapest config whose estimate shows TOL (run + estimate) | auto / it, evals |"),
+            std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("auto against bodypoint's cheapest configuration that delivers TOL with a default estimate "
+                       "saying so (its run and estimate), force evaluations: median"), std::string::npos) << r.out;
+  in.clear();
+  in.seekg(0);
+  std::map<std::string, long> fastest, trusted;  // per TOL: the fastest run alone, the trusted run and estimate
+  while (std::getline(in, line)) {
+    std::vector<std::string> c;
+    std::stringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) c.push_back(cell);
+    if (c.size() >= 10 && c[2] == "own") fastest[c[3]] = std::stol(c[9]);
+    if (c.size() >= 21 && c[2] == "auto" && !c[20].empty()) trusted[c[3]] = std::stol(c[20]);
+  }
+  ASSERT_EQ(trusted.size(), 2u) << "one per TOL";
+  for (const auto& [tol, evals] : trusted) EXPECT_GE(evals, fastest.at(tol)) << "TOL " << tol;
   fs::remove(out);
 }
 
