@@ -56,7 +56,7 @@ struct TolRow {
   long estimate_force_evals = -1;
   double own_estimate = std::numeric_limits<double>::quiet_NaN();
   /// auto: bodypoint's cheapest own configuration whose default estimate shows TOL and that delivers it
-  /// (mark_trusted_best): "method h=..." or "" where none does, and its price, the run and its estimate
+  /// (mark_trusted_bests): "method h=..." or "" where none does, and its price, the run and its estimate
   std::string trusted;
   long trusted_evals = 0;
 };
@@ -386,26 +386,33 @@ void write_trusted_cells(std::ostream& summary, const TolRow& a, std::vector<dou
   }
 }
 
-/// The two prices under the table: auto over bodypoint's own fastest configuration (`own_ratios`, force
-/// evaluations of the whole call) and that configuration's default error estimate over its run.
-void write_price_medians(std::ostream& summary, const std::vector<TolRow>& rows, std::vector<double> own_ratios) {
-  if (!own_ratios.empty()) {
-    std::sort(own_ratios.begin(), own_ratios.end());
+/// "median Mx, from Ax to Bx (N <what>).\n" of `values`, a sentence's end under the table.
+std::string median_range(std::vector<double> values, const char* what) {
+  std::sort(values.begin(), values.end());
+  std::ostringstream os;
+  os << "median " << std::setprecision(3) << median(values) << "x, from " << values.front() << "x to " << values.back()
+     << "x (" << values.size() << " " << what << ").\n";
+  return os.str();
+}
+
+/// The prices under the table: auto over bodypoint's own fastest configuration (`own_ratios`, force
+/// evaluations of the whole call), that configuration's default error estimate over its run, and auto over
+/// the cheapest configuration whose default estimate shows TOL (`trusted_ratios`, its run and estimate).
+void write_price_medians(std::ostream& summary, const std::vector<TolRow>& rows, const std::vector<double>& own_ratios,
+                         const std::vector<double>& trusted_ratios) {
+  if (!own_ratios.empty())
     summary << "\nauto against bodypoint's own fastest configuration delivering TOL, force evaluations of the whole call: "
-            << "median " << std::setprecision(3) << median(own_ratios) << "x, from " << own_ratios.front() << "x to "
-            << own_ratios.back() << "x (" << own_ratios.size() << " cases).\n";
-  }
+            << median_range(own_ratios, "cases");
   std::vector<double> estimate_prices;  // the fastest configurations' default estimate over their run, evaluations
   for (const TolRow& r : rows)
     if (r.is_own && r.estimate_force_evals >= 0 && r.force_evals > 0 && !r.method_is_exact)
       estimate_prices.push_back(static_cast<double>(r.estimate_force_evals) / static_cast<double>(r.force_evals));
-  if (!estimate_prices.empty()) {
-    std::sort(estimate_prices.begin(), estimate_prices.end());
+  if (!estimate_prices.empty())
     summary << "\nThe default error estimate of bodypoint's fastest configuration (simulate --h), force evaluations "
-            << "beyond the run: median " << std::setprecision(3) << median(estimate_prices) << "x, from "
-            << estimate_prices.front() << "x to " << estimate_prices.back() << "x (" << estimate_prices.size()
-            << " configurations).\n";
-  }
+            << "beyond the run: " << median_range(estimate_prices, "configurations");
+  if (!trusted_ratios.empty())
+    summary << "\nauto against bodypoint's cheapest configuration that delivers TOL with a default estimate saying so "
+            << "(its run and estimate), force evaluations: " << median_range(trusted_ratios, "cases");
 }
 
 void write_tol_summary(std::ostream& summary, const std::vector<TolRow>& rows, std::size_t peer_count) {
@@ -463,14 +470,7 @@ void write_tol_summary(std::ostream& summary, const std::vector<TolRow>& rows, s
           << "faster in " << faster3 << " of " << compared << "; against the cheapest peer configuration that "
           << "delivers TOL (its tolerance chosen afterwards), >= 3x in " << oracle3 << " of " << oracle_n
           << " (a comparison with a flagged time counts as not >= 3x).\n";
-  write_price_medians(summary, rows, std::move(own_ratios));
-  if (!trusted_ratios.empty()) {
-    std::sort(trusted_ratios.begin(), trusted_ratios.end());
-    summary << "\nauto against bodypoint's cheapest configuration that delivers TOL with a default estimate saying so "
-            << "(its run and estimate), force evaluations: median " << std::setprecision(3) << median(trusted_ratios)
-            << "x, from " << trusted_ratios.front() << "x to " << trusted_ratios.back() << "x (" << trusted_ratios.size()
-            << " cases).\n";
-  }
+  write_price_medians(summary, rows, own_ratios, trusted_ratios);
   if (refused > 0) summary << "\nauto refused:\n\n" << refusals.str();
 }
 
