@@ -9,6 +9,7 @@ scene). A run refused by a flag is made again with the bounds lifted, to know it
   - exit 0 with a true error above 10 % and no estimate showing it (the estimate below 10 %);
   - right answers refused: a flag refused a run whose true error is below the flag's bound (1e-2);
   - the estimate's ratio to the true error (runs whose error is above the round-off level);
+  - what the estimate costs: its force evaluations over the delivered run's;
   - runs with no estimate, and the methods' refusals of scenes they do not take (not flags).
 
 Usage (from the repository, after the build; a few minutes on 2 cores):
@@ -150,6 +151,8 @@ def one(binary, job):
     base += ["--tol", step] if method["advance"] == "controlled" else ["--h", step]
     code, out, err = simulate(binary, base)
     row = {"scene": scene, "method": method["method"], "step": step, "exit": code, "reason": err}
+    if out is not None:  # what the delivered run and its estimate cost
+        row["force_evals"], row["estimate_force_evals"] = out["force_evals"], out["estimate_force_evals"]
     # Without invariants no flag is raised: the state and its estimate come out whatever the flags said.
     lifted = out if code == 0 else simulate(binary, base + ["--no-invariants", "--max-error", "inf",
                                                            "--max-energy-error", "inf"])[1]
@@ -205,6 +208,7 @@ def main():
         print(f"   {r['scene']} {r['method']} {r['step']}: error {r['error']:.3g}, estimate {r['estimate']}: {r['reason'][:150]}")
     for label, pairs in ratios.items():
         print_ratios(label, pairs)
+    print_cost(rows)
     if a.csv:
         write_rows(a.csv, rows)
 
@@ -224,13 +228,24 @@ def print_ratios(label, pairs):
         print(f"   {r['scene']} {r['method']} {r['step']}: error {r['error']:.3g}, estimate {r['estimate']:.3g}")
 
 
+def print_cost(rows):
+    """The estimate's price on the delivered runs: its force evaluations over the run's, in total and per run."""
+    paid = [(r["estimate_force_evals"], r["force_evals"]) for r in rows
+            if r["exit"] == 0 and r.get("force_evals") and r.get("estimate_force_evals") is not None]
+    if not paid:
+        return
+    total = sum(e for e, _ in paid) / sum(n for _, n in paid)
+    per_run = statistics.median(e / n for e, n in paid)
+    print(f"estimate's force evaluations over the run's, {len(paid)} delivered runs: {total:.3f} in total, median {per_run:.3f}")
+
+
 def write_rows(path, rows):
     with open(path, "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["scene", "method", "step", "exit", "error", "estimate", "reason"])
+        w.writerow(["scene", "method", "step", "exit", "error", "estimate", "force_evals", "estimate_force_evals", "reason"])
         for r in rows:
             w.writerow([r["scene"], r["method"], r["step"], r["exit"], r.get("error", ""), r.get("estimate", ""),
-                        r["reason"]])
+                        r.get("force_evals", ""), r.get("estimate_force_evals", ""), r["reason"]])
 
 
 if __name__ == "__main__":

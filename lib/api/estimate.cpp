@@ -93,7 +93,7 @@ void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& 
   add_rounding_draws(e, r, options, o, rerun_draws(body, [&how](int k) { return off_grid(how, k); }, o, rerun),
                      kRepeatRoundingDraw);
   // A fine pair the coarse side disagrees with is checked by the next finer one.
-  const bool check_pair = coarse_side && *coarse_side > kAsymptoticSpread * e.value;
+  const bool check_pair = checks_fine_pair(coarse_side, e.value);
   if (r.outcome == Outcome::unresolved || r.run.steps < kFewSteps || check_pair)
     second_companion(r, body, how, options, o, rerun, *f, check_pair);
 }

@@ -61,6 +61,29 @@ double coarse_ratio_limit(const MethodInfo& m, const std::vector<Centre>& centre
 /// (a coarse state not finite, an estimate above kCoarseTrusted, estimate/coarse.cpp): the fine companion decides.
 std::optional<ErrorEstimate> coarse_estimate(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
                                              const CoarseCompanion& c, const State& run, const State& coarse);
+/// Whether a coarse pair whose estimate e would be trusted asks a second coarse companion: above the rounding
+/// level (below, the rounding draws decide), where the method's flow is not exact (estimate/coarse.cpp).
+bool asks_second_coarse(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres, const ErrorEstimate& e);
+/// Whether a second coarse companion c2 (the coarse run's own, c2.ratio times its step) shows the pair (run,
+/// coarse) in its asymptotic regime: the order the three final states observe lies within one of the orders
+/// the estimate assumes (estimate/coarse.cpp, kObservedOrderSlack); where it does, e's basis says so.
+bool observed_order_agrees(const MethodInfo& m, const Body& body, const CoarseCompanion& c, const CoarseCompanion& c2,
+                           const State& run, const State& coarse, const State& coarser, ErrorEstimate& e);
+
+/// What the coarse side reads of the run (Richardson on the pair at the method's order) where the coarse run
+/// ended ok: compared with the fine pair's estimate (checks_fine_pair).
+double coarse_side_of(const MethodInfo& m, const Body& body, const CoarseCompanion& c, const State& run, const State& coarse);
+/// Whether a fine pair whose estimate is `fine` is checked by a second companion one level finer
+/// (bound_by_second): the coarse side reads more than kAsymptoticSpread times it (estimate/fine.cpp).
+bool checks_fine_pair(const std::optional<double>& coarse_side, double fine);
+/// A run of fewer than kFewSteps steps, or a fine pair checks_fine_pair asks about (check_pair), given a second
+/// companion one level finer: e is raised to what the run differs by from the second plus what the first
+/// differs by from it, where the run is a few steps or its pair differs less than the order p predicts from
+/// the next, p the method's order (estimate/fine.cpp).
+void bound_by_second(ErrorEstimate& e, const MethodInfo& m, const Body& body, long steps, bool check_pair, const State& run,
+                     const State& first, const State& second);
+/// A run of fewer steps than this has no asymptotic regime of its own: a second companion bounds it too.
+inline constexpr long kFewSteps = 4;
 
 /// A fixed-step run's companion `level` levels finer (h/2^level, 2^level times the steps), the estimate
 /// from the final states of the run and its first companion, and whether the second companion confirms

@@ -88,6 +88,39 @@ void lane_rounding_draws(const MethodInfo& method, const std::vector<batch::Memb
     if (e != nullptr) detail::bound_from_draws(*e);
 }
 
+/// As integrate() (estimate/coarse.cpp): the lanes whose coarse estimate would be trusted above the rounding level
+/// ask a second coarse batch, the coarse batch's own coarse companion from the same moved starts; a lane whose
+/// three runs do not observe the order the estimate assumes is left to the fine companions, the batch's cost
+/// counted in `cost` as the coarse batch's is.
+void second_coarse_batch(const MethodInfo& method, const detail::CoarseCompanion& c, const std::vector<batch::Member>& moved,
+                         const std::vector<Scene>& scenes, const std::vector<RunResult>& results,
+                         const std::vector<RunResult>& coarse, std::vector<std::optional<ErrorEstimate>>& out,
+                         std::vector<ErrorEstimate>& cost) {
+  const auto asks = [&](std::size_t k) {
+    return out[k] && detail::asks_second_coarse(method, scenes[k].bodies.front(), scenes[k].centres, *out[k]);
+  };
+  double max_ratio = ErrorEstimate::kStepRatio;
+  bool any = false;
+  for (std::size_t k = 0; k < out.size(); ++k)
+    if (asks(k)) any = true, max_ratio = std::min(max_ratio, detail::coarse_ratio_limit(method, scenes[k].centres, coarse[k]));
+  if (!any) return;
+  const auto c2 = detail::coarse_companion(method, c.how, std::get<FixedSteps>(c.how).steps, max_ratio);
+  if (!c2) return;
+  const auto y = batch::run(method, moved, std::get<FixedSteps>(c2->how));
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    if (!asks(k)) continue;
+    out[k]->force_evals += y[k].force_evals;
+    out[k]->wall_s += y[k].wall_s;
+    const bool ok = assess(y[k], checks_for(method, scenes[k].centres, detail::kCoarseEnergyBound)).outcome == Outcome::ok;
+    if (ok && detail::observed_order_agrees(method, scenes[k].bodies.front(), c, *c2, results[k].final, coarse[k].final,
+                                            y[k].final, *out[k]))
+      continue;
+    cost[k].force_evals += y[k].force_evals;
+    cost[k].wall_s += y[k].wall_s;
+    out[k].reset();
+  }
+}
+
 /// The lanes' estimates from the coarse companion batch (estimate.hpp, CoarseCompanion), as integrate()
 /// makes them: nullopt for a lane the fine companions decide (flagged, or its coarse estimate not trusted),
 /// whose estimate then counts the coarse lane's cost in `cost` as integrate() does.
@@ -96,7 +129,8 @@ std::vector<std::optional<ErrorEstimate>> coarse_estimates(const MethodInfo& met
                                                            const std::vector<Scene>& scenes,
                                                            const std::vector<RunResult>& results,
                                                            const std::vector<Health>& health,
-                                                           std::vector<ErrorEstimate>& cost) {
+                                                           std::vector<ErrorEstimate>& cost,
+                                                           std::vector<std::optional<double>>& coarse_side) {
   std::vector<std::optional<ErrorEstimate>> out(members.size());
   double max_ratio = ErrorEstimate::kStepRatio;  // one coarse batch: the ratio every lane's steps allow
   for (std::size_t k = 0; k < members.size(); ++k)
@@ -111,10 +145,13 @@ std::vector<std::optional<ErrorEstimate>> coarse_estimates(const MethodInfo& met
     cost[k].wall_s = coarse[k].wall_s;
     if (health[k].outcome != Outcome::ok && health[k].outcome != Outcome::inaccurate) continue;
     if (assess(coarse[k], checks_for(method, scenes[k].centres, detail::kCoarseEnergyBound)).outcome != Outcome::ok) continue;
+    if (!(coarse[k].final.R.allFinite() && coarse[k].final.v.allFinite())) continue;
+    coarse_side[k] = detail::coarse_side_of(method, scenes[k].bodies.front(), *c, results[k].final, coarse[k].final);
     out[k] = detail::coarse_estimate(method, scenes[k].bodies.front(), scenes[k].centres, *c, results[k].final,
                                      coarse[k].final);
     if (out[k]) out[k]->force_evals = coarse[k].force_evals, out[k]->wall_s = coarse[k].wall_s;
   }
+  second_coarse_batch(method, *c, moved, scenes, results, coarse, out, cost);
   // As integrate(): lanes whose coarse estimate is at the rounding level add more draws of it, coarse
   // batches off the run's grid.
   std::vector<const State*> finals(members.size());
@@ -162,13 +199,24 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
     health.push_back(assess(results[k], checks_for(method, scenes[k].centres, spec.max_energy_error)));
   std::vector<std::optional<ErrorEstimate>> by_coarse(rows.size());
   std::vector<ErrorEstimate> coarse_cost(rows.size());
-  if (spec.estimate_error) by_coarse = coarse_estimates(method, how, members, scenes, results, health, coarse_cost);
+  std::vector<std::optional<double>> coarse_side(rows.size());
+  if (spec.estimate_error) by_coarse = coarse_estimates(method, how, members, scenes, results, health, coarse_cost, coarse_side);
   bool fine = false;
   for (std::size_t k = 0; k < rows.size(); ++k) fine = fine || (estimable(health[k].outcome) && !by_coarse[k]);
   std::vector<RunResult> companions, second;
   if (spec.estimate_error && fine) companions = batch::run(method, members, detail::fixed_companion(how));
-  if (spec.estimate_error && std::any_of(health.begin(), health.end(), [](const Health& h) { return h.outcome == Outcome::unresolved; }))
-    second = batch::run(method, members, detail::fixed_companion(how, 2));  // to confirm the flagged lanes' estimates
+  // As integrate(): a second companion batch confirms the flagged lanes' estimates, bounds a run of a few steps and
+  // checks the fine pairs the coarse side disagrees with (checks_fine_pair; the rounding draws only raise the
+  // estimate it is compared with, so a lane that asks after them asks before).
+  bool any_second = false;
+  for (std::size_t k = 0; spec.estimate_error && k < rows.size(); ++k) {
+    if (by_coarse[k] || !estimable(health[k].outcome)) continue;
+    const ErrorEstimate fine_estimate =
+        detail::fixed_step_estimate(method, scenes[k].bodies.front(), scenes[k].centres, results[k].final, companions[k].final);
+    any_second = any_second || health[k].outcome == Outcome::unresolved || how.steps < detail::kFewSteps ||
+                 detail::checks_fine_pair(coarse_side[k], fine_estimate.value);
+  }
+  if (any_second) second = batch::run(method, members, detail::fixed_companion(how, 2));
   for (std::size_t k = 0; k < rows.size(); ++k) {
     SweepRow& row = rows[k];
     Health& h = health[k];
@@ -204,6 +252,19 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
   }
   lane_rounding_draws(method, members, [&how](int k) { return detail::off_grid(how, k); }, finals, drawn,
                       detail::kRepeatRoundingDraw);
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    if (!spec.estimate_error || by_coarse[k] || !estimable(rows[k].outcome) || second.empty()) continue;
+    ErrorEstimate& e = rows[k].error;
+    const bool check = detail::checks_fine_pair(coarse_side[k], e.value);
+    if (rows[k].outcome != Outcome::unresolved) {  // a flagged lane counted its second companion above
+      if (!check && how.steps >= detail::kFewSteps) continue;
+      e.force_evals += second[k].force_evals;
+      e.wall_s += second[k].wall_s;
+    }
+    if (second[k].final.R.allFinite() && second[k].final.v.allFinite())
+      detail::bound_by_second(e, method, scenes[k].bodies.front(), how.steps, check, rows[k].result.final,
+                              companions[k].final, second[k].final);
+  }
   for (std::size_t k = 0; k < rows.size(); ++k)
     detail::settle(rows[k].outcome, rows[k].reason, rows[k].warnings, rows[k].error, spec.max_error, spec.max_energy_error,
                    detail::final_energy_error(scenes[k].bodies.front(), scenes[k].centres, rows[k].result.final));

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <fstream>
 #include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -182,6 +183,53 @@ TEST(Estimates, AFinePairTheCoarseSideDisagreesWithIsCheckedByTheNextLevel) {
   ASSERT_EQ(kept.code, 0) << kept.err;
   EXPECT_LT(json_num(kept.out, "err_estimate"), kHonestFactor * json_num(kept.out, "err_rel")) << kept.out;
   EXPECT_GE(json_num(kept.out, "err_estimate"), json_num(kept.out, "err_rel") / kHonestFactor) << kept.out;
+}
+
+/// The sweep's value of `column` in its first data row (a CSV on standard output, comment lines skipped).
+std::string sweep_column(const std::string& csv, const std::string& column) {
+  std::istringstream in(csv);
+  std::string line;
+  std::vector<std::string> names;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    if (names.empty()) {
+      names = test::csv_fields(line);
+      continue;
+    }
+    const std::vector<std::string> f = test::csv_fields(line);
+    for (std::size_t i = 0; i < names.size() && i < f.size(); ++i)
+      if (names[i] == column) return f[i];
+  }
+  return "";
+}
+
+TEST(Estimates, ACoarsePairIsTrustedWhereASecondCoarseRunObservesItsOrder) {
+  // Two orders' terms cancel near twice the step, and the coarse pair reads a fraction of the error: attracting
+  // lp-euler at h = 0.01 (9.3e-6 off, its coarse run at 0.02 1.0e-5 off the same way: read 1.0e-6) and the
+  // bound orbit's lp-rkn4 at h = 0.1 (9.6e-7 off, read 1.2e-7). With a coarse run at 4h the three observe
+  // order 4.5 for 1 and 8.7 for 4: the pair is passed over, and the fine companion decides.
+  const std::string euler = "--A 2 --d 3 --t-end 80 --method lp-euler --h 0.01";
+  for (const std::string& c : {euler, bound_orbit() + " --t-end 300 --method lp-rkn4 --h 0.1"}) {
+    const auto r = run_cli("simulate --json --reference " + c);
+    ASSERT_EQ(r.code, 0) << c << ": " << r.err;
+    EXPECT_NE(r.out.find("companion run at h/2"), std::string::npos) << c << ": " << r.out;
+    EXPECT_GE(json_num(r.out, "err_estimate"), json_num(r.out, "err_rel") / kHonestFactor) << c << ": " << r.out;
+  }
+  // A sweep's lanes make integrate()'s estimate, bit for bit.
+  const auto alone = run_cli("simulate --json " + euler);
+  const auto swept = run_cli("sweep --param d --values 3 --methods lp-euler --A 2 --h 0.01 --t-end 80");
+  ASSERT_EQ(swept.code, 0) << swept.err;
+  EXPECT_EQ(std::stod(sweep_column(swept.out, "err_estimate")), json_num(alone.out, "err_estimate")) << swept.out;
+  EXPECT_EQ(std::stod(sweep_column(swept.out, "estimate_force_evals")), json_num(alone.out, "estimate_force_evals"))
+      << swept.out;
+  // Where the three observe the order, the coarse pair's estimate stands and says what was checked
+  // (lp-verlet at h = 0.01 on the same scene: 4.2e-6 off).
+  const auto kept = run_cli("simulate --json --reference --A 2 --d 3 --t-end 80 --method lp-verlet --h 0.01");
+  ASSERT_EQ(kept.code, 0) << kept.err;
+  EXPECT_NE(kept.out.find("a second coarse run at 4 times the step: the three observe order"), std::string::npos)
+      << kept.out;
+  EXPECT_GE(json_num(kept.out, "err_estimate"), json_num(kept.out, "err_rel") / kHonestFactor) << kept.out;
+  EXPECT_LT(json_num(kept.out, "err_estimate"), kHonestFactor * json_num(kept.out, "err_rel")) << kept.out;
 }
 
 TEST(Estimates, ARunAliasingTheSpinIsKeptWhereAThirdCompanionBoundsIt) {

@@ -44,6 +44,19 @@ constexpr double kCoarseAngleMargin = 0.45;
 /// rounding): the fine companion decides.
 constexpr double kMinCoarseRatio = 1.25;
 
+/// A coarse pair in its asymptotic regime differs ratio^p - 1 times the run's error; two orders whose terms
+/// cancel near twice the step make it differ by much less (attracting lp-euler at h = 0.01: 9.3e-6 off, its
+/// coarse run at 0.02 1.0e-5 off the same way, read 1.0e-6; bound-orbit lp-rkn4 at h = 0.1: 9.6e-7 off,
+/// read 1.2e-7). A second coarse run, the coarse run's own coarse companion, tells: the order the three
+/// runs observe (adaptive::observed_order) must lie within kObservedOrderSlack of the orders the estimate
+/// assumes (below: the coarse side's order, capped; above: the method's own, which high orders may
+/// show at coarse steps). There it observed 4.5 (order 1) and 8.7 (order 4).
+constexpr double kObservedOrderSlack = 1.0;
+
+/// The second coarse run is asked for where the pair's estimate is at least this: within a hundred times the
+/// rounding level the pair's difference is partly rounding, and the order three runs observe says nothing.
+constexpr double kSecondCoarseFrom = 100.0 * kRoundingLevel;
+
 /// Whether a coarse companion that took `coarse_steps` is coarser than the run of `run_steps`: a
 /// time-transformed pair whose steps were not cut by the ratio (the landing step, steps bound by
 /// something else) is no Richardson pair; it must take at most 1 / (1 + (ratio - 1) / 2) of the steps,
@@ -85,7 +98,47 @@ std::optional<std::vector<BodyResult>> coarse_lanes(const MethodInfo& m, const B
   return lanes;
 }
 
+/// The second coarse companion of a pair whose estimate would be trusted: the coarse run's own coarse
+/// companion (within the angles the coarse run's steps allow), from the same moved start; the order the three
+/// runs observe decides (kObservedOrderSlack). True where the pair is kept: the three agree with the order, or
+/// there is no second coarse run to ask (the coarse run too short, its steps at the angles' limit). A second
+/// coarse run that breaks down or ends otherwise says the pair is near the end of its regime: not kept.
+bool coarse_pair_asymptotic(ErrorEstimate& e, const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
+                            const CoarseCompanion& c, const BodyResult& x, const BodyResult& r, const Options& options,
+                            const Options& oc, const Rerun& rerun) {
+  const std::optional<CoarseCompanion> c2 =
+      coarse_companion(m, c.how, x.run.steps, coarse_ratio_limit(m, centres, x.run));
+  if (!c2) return true;
+  const BodyResult y = rerun_draws(body, [&c2](int) { return c2->how; }, oc, rerun)(0);
+  e.force_evals += y.total_force_evals();
+  e.wall_s += y.run.wall_s;
+  if (!(y.outcome == Outcome::ok && ended_alike(r, options, y, oc))) return false;
+  if (!coarser(*c2, y.run.steps, x.run.steps)) return true;
+  return observed_order_agrees(m, body, c, *c2, r.run.final, x.run.final, y.run.final, e);
+}
+
 }  // namespace
+
+double coarse_side_of(const MethodInfo& m, const Body& body, const CoarseCompanion& c, const State& run, const State& coarse) {
+  return adaptive::finer_run_error(adaptive::state_distance(run, coarse), c.ratio, fixed_order(m, body));
+}
+
+bool asks_second_coarse(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres, const ErrorEstimate& e) {
+  return e.value >= kSecondCoarseFrom && !flow_is_exact(m, body, centres);
+}
+
+bool observed_order_agrees(const MethodInfo& m, const Body& body, const CoarseCompanion& c, const CoarseCompanion& c2,
+                           const State& run, const State& coarse, const State& coarser, ErrorEstimate& e) {
+  if (!(coarser.R.allFinite() && coarser.v.allFinite())) return false;
+  const double q = adaptive::observed_order(adaptive::state_distance(coarse, coarser), adaptive::state_distance(run, coarse),
+                                            c.ratio * c2.ratio, c.ratio);
+  const int p = fixed_order(m, body);
+  const int assumed = std::min(c.asked < kStepRatio ? kCoarseMaxOrderBelow2 : kCoarseMaxOrder, p);
+  if (!(q >= assumed - kObservedOrderSlack && q <= p + kObservedOrderSlack)) return false;
+  e.basis += "; a second coarse run at " + short_number(c.ratio * c2.ratio) + " times the step: the three observe order " +
+             short_number(q);
+  return true;
+}
 
 /// The estimate of the coarse companion where the run has one and it is trusted (true); otherwise its
 /// cost is counted and the fine companion decides (false). A coarse run that breaks down or that the
@@ -118,8 +171,13 @@ bool estimated_by_coarse(BodyResult& r, const Body& body, const std::vector<Cent
   std::optional<ErrorEstimate> coarse;
   if (x.outcome == Outcome::ok && ended_alike(r, options, x, oc) && coarser(*c, x.run.steps, r.run.steps)) {
     coarse = coarse_estimate(*r.method, body, centres, *c, r.run.final, x.run.final);
-    coarse_side = adaptive::finer_run_error(adaptive::state_distance(r.run.final, x.run.final), c->ratio,
-                                            fixed_order(*r.method, body));
+    coarse_side = coarse_side_of(*r.method, body, *c, r.run.final, x.run.final);
+    if (coarse && asks_second_coarse(*r.method, body, centres, *coarse) &&
+        !coarse_pair_asymptotic(*coarse, *r.method, body, centres, *c, x, r, options, oc, rerun)) {
+      e.force_evals += coarse->force_evals;
+      e.wall_s += coarse->wall_s;
+      coarse.reset();
+    }
   }
   if (!coarse || !at_rounding_level(*coarse)) lane_cost(coarse ? *coarse : e);
   if (!coarse) return false;

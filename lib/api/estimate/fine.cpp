@@ -149,26 +149,7 @@ void second_companion(BodyResult& r, const Body& body, const Advance& how, const
   e.force_evals += y.total_force_evals();
   e.wall_s += y.run.wall_s;
   const bool alike = ended_alike(r, options, y, o);
-  // What the run differs by from the second companion, plus what the first may still be off by.
-  const double near = adaptive::state_distance(r.run.final, f.x.run.final);
-  const double further = adaptive::state_distance(f.x.run.final, y.run.final);
-  const double bound = adaptive::state_distance(r.run.final, y.run.final) + further;
-  // A run of a few steps (a time-transformed run whose landing step spans the whole end time) is not in any
-  // asymptotic regime (ttl-verlet at ds = 1 on the material pass: 1 step, 2.1e-5 off, estimated 4.0e-6 from a
-  // companion of 2 steps; a second of 3 steps is 1.7e-5 from the run). Nor is a pair that agrees by chance
-  // where the error's terms of two orders cancel near its step: asymptotically it differs ratio^p times what
-  // the next pair does, and it differs less than 1/kAsymptoticSpread of that (attracting lp-euler at h = 0.02:
-  // 1.0e-5 off, estimated 2.0e-6 from its h/2 pair, 1.0e-6 apart where the next is 3.6e-6). Where it falls as
-  // the order says, the coarse side was outside its regime.
-  const bool few = r.run.steps < kFewSteps;
-  const bool by_chance = check_pair && kAsymptoticSpread * near < std::pow(kStepRatio, fixed_order(*r.method, body)) * further;
-  if (alike && (few || by_chance) && bound > e.value) {
-    e.value = bound;
-    e.basis += few ? "; a run of " + std::to_string(r.run.steps) + " steps: raised to what a second companion one level "
-                     "finer differs by from it and from the first"
-                   : "; the pair differs less than the order predicts from the next (not asymptotic): raised to what a "
-                     "second companion one level finer differs by from it and from the first";
-  }
+  if (alike) bound_by_second(e, *r.method, body, r.run.steps, check_pair, r.run.final, f.x.run.final, y.run.final);
   if (r.outcome != Outcome::unresolved) return;
   if (!alike) {
     e.basis += "; a second companion one level finer did not end as the run did";
@@ -183,6 +164,34 @@ void second_companion(BodyResult& r, const Body& body, const Advance& how, const
   e.wall_s += z.run.wall_s;
   if (ended_alike(r, options, z, o)) confirm_deeper(e, r.run.final, f.x.run.final, y.run.final, z.run.final);
   else e.basis += "; a third companion did not end as the run did";
+}
+
+bool checks_fine_pair(const std::optional<double>& coarse_side, double fine) {
+  return coarse_side && *coarse_side > kAsymptoticSpread * fine;
+}
+
+void bound_by_second(ErrorEstimate& e, const MethodInfo& m, const Body& body, long steps, bool check_pair, const State& run,
+                     const State& first, const State& second) {
+  const int p = fixed_order(m, body);
+  // What the run differs by from the second companion, plus what the first may still be off by.
+  const double near = adaptive::state_distance(run, first);
+  const double further = adaptive::state_distance(first, second);
+  const double bound = adaptive::state_distance(run, second) + further;
+  // A run of a few steps (a time-transformed run whose landing step spans the whole end time) is not in any
+  // asymptotic regime (ttl-verlet at ds = 1 on the material pass: 1 step, 2.1e-5 off, estimated 4.0e-6 from a
+  // companion of 2 steps; a second of 3 steps is 1.7e-5 from the run). Nor is a pair that agrees by chance
+  // where the error's terms of two orders cancel near its step: asymptotically it differs ratio^p times what
+  // the next pair does, and it differs less than 1/kAsymptoticSpread of that (attracting lp-euler at h = 0.02:
+  // 1.0e-5 off, estimated 2.0e-6 from its h/2 pair, 1.0e-6 apart where the next is 3.6e-6). Where it falls as
+  // the order says, the coarse side was outside its regime.
+  const bool few = steps < kFewSteps;
+  const bool by_chance = check_pair && kAsymptoticSpread * near < std::pow(kStepRatio, p) * further;
+  if (!(few || by_chance) || !(bound > e.value)) return;
+  e.value = bound;
+  e.basis += few ? "; a run of " + std::to_string(steps) + " steps: raised to what a second companion one level "
+                   "finer differs by from it and from the first"
+                 : "; the pair differs less than the order predicts from the next (not asymptotic): raised to what a "
+                   "second companion one level finer differs by from it and from the first";
 }
 
 FixedSteps fixed_companion(const FixedSteps& run, int level) {

@@ -22,8 +22,6 @@ namespace bodypoint::detail {
 /// The companion of a fixed or fictitious step h runs at h / kStepRatio: it costs kStepRatio runs, and
 /// its error is kStepRatio^-p of the run's, so what the two differ by is the run's error to within that fraction.
 inline constexpr double kStepRatio = ErrorEstimate::kStepRatio;
-/// A run of fewer steps than this has no asymptotic regime of its own: a second companion bounds it too.
-inline constexpr long kFewSteps = 4;
 /// A companion difference below kRoundingLevel is at the scene's rounding level, where the pair can agree
 /// by chance (one draw of the rounding each). There the estimate adds what kRoundingDraws - 1 more runs
 /// differ from the run by, off the run's grid (off_grid) from its start moved by adaptive::kStartShift,
