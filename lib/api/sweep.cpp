@@ -208,13 +208,14 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
   // As integrate(): a second companion batch confirms the flagged lanes' estimates, bounds a run of a few steps and
   // checks the fine pairs the coarse side disagrees with (checks_fine_pair; the rounding draws only raise the
   // estimate it is compared with, so a lane that asks after them asks before).
+  std::vector<ErrorEstimate> by_fine(rows.size());
   bool any_second = false;
   for (std::size_t k = 0; spec.estimate_error && k < rows.size(); ++k) {
     if (by_coarse[k] || !estimable(health[k].outcome)) continue;
-    const ErrorEstimate fine_estimate =
+    by_fine[k] =
         detail::fixed_step_estimate(method, scenes[k].bodies.front(), scenes[k].centres, results[k].final, companions[k].final);
     any_second = any_second || health[k].outcome == Outcome::unresolved || how.steps < detail::kFewSteps ||
-                 detail::checks_fine_pair(coarse_side[k], fine_estimate.value);
+                 detail::checks_fine_pair(coarse_side[k], by_fine[k].value);
   }
   if (any_second) second = batch::run(method, members, detail::fixed_companion(how, 2));
   for (std::size_t k = 0; k < rows.size(); ++k) {
@@ -228,8 +229,7 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
     } else if (by_coarse[k]) {
       row.error = std::move(*by_coarse[k]);
     } else if (estimable(row.outcome)) {
-      row.error = detail::fixed_step_estimate(method, scenes[k].bodies.front(), scenes[k].centres, row.result.final,
-                                              companions[k].final);
+      row.error = std::move(by_fine[k]);
       row.error.force_evals = coarse_cost[k].force_evals + companions[k].force_evals;
       row.error.wall_s = coarse_cost[k].wall_s + companions[k].wall_s;
       if (row.outcome == Outcome::unresolved) {
