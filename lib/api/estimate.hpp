@@ -61,8 +61,9 @@ double coarse_ratio_limit(const MethodInfo& m, const std::vector<Centre>& centre
 /// (a coarse state not finite, an estimate above kCoarseTrusted, estimate/coarse.cpp): the fine companion decides.
 std::optional<ErrorEstimate> coarse_estimate(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
                                              const CoarseCompanion& c, const State& run, const State& coarse);
-/// Whether a coarse pair whose estimate e would be trusted asks a second coarse companion: above the rounding
-/// level (below, the rounding draws decide), where the method's flow is not exact (estimate/coarse.cpp).
+/// Whether a coarse pair whose estimate e would be trusted asks a second coarse companion: at 1e-8 or above
+/// (kSecondCoarseFrom; nearer the rounding level the pair's difference is partly rounding), where the method's
+/// flow is not exact (estimate/coarse.cpp).
 bool asks_second_coarse(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres, const ErrorEstimate& e);
 /// Whether a second coarse companion c2 (the coarse run's own, c2.ratio times its step) shows the pair (run,
 /// coarse) in its asymptotic regime: the order the three final states observe lies within one of the orders

@@ -88,8 +88,8 @@ void lane_rounding_draws(const MethodInfo& method, const std::vector<batch::Memb
     if (e != nullptr) detail::bound_from_draws(*e);
 }
 
-/// As integrate() (estimate/coarse.cpp): the lanes whose coarse estimate would be trusted above the rounding level
-/// ask a second coarse batch, the coarse batch's own coarse companion from the same moved starts; a lane whose
+/// As integrate() (estimate/coarse.cpp): the lanes whose trusted coarse estimate asks (asks_second_coarse)
+/// get a second coarse batch, the coarse batch's own coarse companion from the same moved starts; a lane whose
 /// three runs do not observe the order the estimate assumes is left to the fine companions, the batch's cost
 /// counted in `cost` as the coarse batch's is.
 void second_coarse_batch(const MethodInfo& method, const detail::CoarseCompanion& c, const std::vector<batch::Member>& moved,
