@@ -99,7 +99,7 @@ TolRow measure_auto(const NamedScene& ns, const State& ref, double tol) {
   row.met = row.err <= tol;
   row.delivered_samples = std::make_shared<std::vector<double>>();
   row.run = [&m, body, centres = ns.scene.centres, accuracy, samples = row.delivered_samples] {
-    const adaptive::ToleranceResult x = adaptive::run_to_tolerance(m, body, centres, accuracy, unobserved(), false);
+    const adaptive::ToleranceResult x = adaptive::run_to_tolerance(m, body, centres, accuracy, unobserved(), auto_verifies(centres));
     samples->push_back(x.result.wall_s);
   };
   row.force_evals = r.accuracy->force_evals;

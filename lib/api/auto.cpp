@@ -7,25 +7,65 @@
 #include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/field.hpp"
 #include "bodypoint/detail/model_parts.hpp"
+#include "bodypoint/detail/run_support.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <string_view>
 
 namespace bodypoint {
 namespace {
 
-/// auto's table: Yoshida 4 from this tolerance up, Kahan-Li 6 from kTightTolerance, Kahan-Li 8 below. Each
-/// constant's measurement: docs/developers.md, "Tuned constants".
-constexpr double kLooseTolerance = 1e-5;
+/// What auto's whole search costs with each composition table it may choose, measured: per decade of tol
+/// from 1e-4 to 1e-8, the geometric mean over the named scenes thesis, close, long, two-centres and
+/// three-centres of the search's force evaluations over the cheapest table's on that scene (bench/auto_costs:
+/// the searches as auto runs them, verified about several centres; docs/developers.md, "Tuned constants").
+/// auto takes the table of least cost at tol, interpolated in log10(tol) between decades, held above 1e-4.
+struct MeasuredCost {
+  std::string_view table;
+  std::array<double, 5> by_decade;  ///< tol = 1e-4, 1e-5, ..., 1e-8
+};
+constexpr std::array<MeasuredCost, 5> kMeasuredCost = {{
+    {"y4", {1.00, 1.12, 1.15, 1.43, 1.51}},
+    {"pefrl", {1.30, 1.35, 1.09, 1.10, 1.13}},
+    {"bm4", {2.13, 1.63, 1.64, 1.71, 1.25}},
+    {"kl6", {3.52, 2.97, 2.64, 2.20, 1.93}},
+    {"kl8", {5.40, 4.50, 3.69, 3.85, 2.69}},
+}};
+constexpr double kFirstDecade = 4.0;  ///< by_decade[0] is tol = 1e-4
+/// Below kMeasuredDown auto keeps the tables it had: Kahan-Li 6 down to kTightTolerance, Kahan-Li 8 below.
+/// The five scenes measured others cheapest there (Blanes-Moan 4 at 1e-9, Kahan-Li 6 at 1e-11, McLachlan
+/// 8 at 1e-12), but with them the scattering study's encounters (`study --quick --name scattering`, which
+/// asks 1e-12 and retries 10x looser down to 1e-9) refined for minutes: over 400 s in all against 19.6 s.
+constexpr double kMeasuredDown = 1e-8;
 constexpr double kTightTolerance = 1e-10;
+
+/// A table's measured cost at tol >= kMeasuredDown (kMeasuredCost).
+double measured_cost(const MeasuredCost& c, double tol) {
+  const double x = std::clamp(-std::log10(tol) - kFirstDecade, 0.0, static_cast<double>(c.by_decade.size() - 1));
+  const auto i = std::min(static_cast<std::size_t>(x), c.by_decade.size() - 2);
+  const double f = x - static_cast<double>(i);
+  return c.by_decade[i] * std::pow(c.by_decade[i + 1] / c.by_decade[i], f);
+}
+
+/// The table of least measured cost at tol; below kMeasuredDown, Kahan-Li 6 or 8.
+std::string_view table_for(double tol) {
+  if (tol < kMeasuredDown) return tol >= kTightTolerance ? "kl6" : "kl8";
+  return std::min_element(kMeasuredCost.begin(), kMeasuredCost.end(), [tol](const MeasuredCost& a, const MeasuredCost& b) {
+           return measured_cost(a, tol) < measured_cost(b, tol);
+         })->table;
+}
 
 /// auto takes a fixed step when the potential at the estimated closest approach is below this
 /// fraction of the time-step constant c: the time transformation would then change the step by < 10%.
 constexpr double kFarFraction = 0.1;
 
 }  // namespace
+
+bool auto_verifies(const std::vector<Centre>& centres) { return centres.size() > 1; }
 
 const MethodInfo& choose_method(const Body& body, const std::vector<Centre>& centres, double tol, std::string* why) {
   adaptive::check_tolerance(tol);
@@ -34,9 +74,8 @@ const MethodInfo& choose_method(const Body& body, const std::vector<Centre>& cen
 
 const MethodInfo& detail::choose_method_for(const Body& body, const std::vector<Centre>& centres, double tol,
                                             std::string* why) {
-  // The table by tolerance (docs/developers.md, "Tuned constants"): Yoshida 4 (3 stages) down to 1e-5,
-  // Kahan-Li 6 down to 1e-10, Kahan-Li 8 below.
-  const std::string_view table = tol >= kLooseTolerance ? "y4" : tol >= kTightTolerance ? "kl6" : "kl8";
+  // The table whose whole search was measured cheapest at this tol (kMeasuredCost), or Kahan-Li 6 or 8.
+  const std::string_view table = table_for(tol);
   std::ostringstream os;
   double potential_at_closest = 0.0;  // at the guiding centre's closest approach to each centre
   const Helix helix = helix_of(body.p, to_momenta(body.p, body.s0));
@@ -58,9 +97,12 @@ const MethodInfo& detail::choose_method_for(const Body& body, const std::vector<
     os << m->name << (all_repulsive(centres) ? ": every centre repels (logarithmic Hamiltonian, step ~ distance to the centres)"
                                              : ": an attracting centre (time-transformed leapfrog, step ~ distance to the centres)");
   }
-  if (m->table == table)
-    os << "; " << (tol >= kLooseTolerance ? "Yoshida 4 for tol >= 1e-5"
-                   : tol >= kTightTolerance ? "Kahan-Li 6 for 1e-10 <= tol < 1e-5" : "Kahan-Li 8 for tol < 1e-10");
+  if (m->table == table && tol < kMeasuredDown)
+    os << (tol >= kTightTolerance ? "; Kahan-Li 6 for 1e-10 <= tol < 1e-8" : "; Kahan-Li 8 for tol < 1e-10");
+  else if (m->table == table)
+    os << "; its table's search was measured the cheapest at this tol (" << detail::short_number(measured_cost(*std::find_if(
+              kMeasuredCost.begin(), kMeasuredCost.end(), [&](const MeasuredCost& k) { return k.table == table; }), tol))
+       << "x the cheapest table on each scene, geometric mean)";
   if (why) *why = os.str();
   return *m;
 }

@@ -44,11 +44,11 @@ void judge(BodyResult& r, const std::vector<Centre>& centres, const Options& opt
 void run_accurately(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Accuracy& a,
                     const Options& options) {
   // One search rule whoever named the method: the method auto chooses for this scene and tol is not
-  // verified (its estimates there were measured honest: bench/estimate_ladder.py), any other is,
-  // against a companion at half the delivered step. logh-kl6 named at tol 1e-9 on an encounter was
-  // refused where auto delivered it.
-  const bool autos = r.method == &detail::choose_method_for(body, centres, a.tol, nullptr);
-  adaptive::ToleranceResult t = adaptive::search_step(*r.method, body, centres, a, options, !autos);
+  // verified about one centre (its estimates there were measured honest: bench/estimate_grid.py), any
+  // other is, against a companion at half the delivered step (auto_verifies, methods.hpp). logh-kl6
+  // named at tol 1e-9 on an encounter was refused where auto delivered it.
+  const bool unverified = r.method == &detail::choose_method_for(body, centres, a.tol, nullptr) && !auto_verifies(centres);
+  adaptive::ToleranceResult t = adaptive::search_step(*r.method, body, centres, a, options, !unverified);
   r.accuracy = AccuracyReport{a.tol, t.err_estimate, t.h, t.omega_c, t.runs, t.total_force_evals, t.total_wall_s,
                               std::move(t.basis)};
   r.run = std::move(t.result);

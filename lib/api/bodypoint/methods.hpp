@@ -37,11 +37,16 @@ std::vector<const MethodInfo*> methods_named(std::string_view list);
 
 /// `--method auto`: a one-centre material point: ks; a body far from every centre for the whole run
 /// (straight-line estimate of the closest approach, potential there below the time-step constant c):
-/// Lie-Poisson; only repelling centres: logH; any attracting centre: TTL. The table by measured cost:
-/// Yoshida 4 for tol >= 1e-5, Kahan-Li 6 for 1e-10 <= tol < 1e-5, Kahan-Li 8 below (Blanes-Moan S6,
-/// tried for the loose tolerances, has an error that is rough in ds near the bounded step's spin
-/// angle, and its Richardson estimates were off by up to 60x on the two-centres scene).
+/// Lie-Poisson; only repelling centres: logH; any attracting centre: TTL. The composition table, from tol
+/// 1e-4 to 1e-8, is the one whose whole search was measured cheapest (bench/auto_costs: Yoshida 4 to about
+/// 1e-5, PEFRL from about 1e-6 to 1e-8); Kahan-Li 6 down to 1e-10, Kahan-Li 8 below.
 /// `why` receives one line saying what was chosen and why.
 const MethodInfo& choose_method(const Body& body, const std::vector<Centre>& centres, double tol, std::string* why);
+
+/// Whether the accuracy mode checks auto's answer against a companion at half its step, as it checks a
+/// method the user named: about several centres. Unverified there, every table auto may choose missed
+/// TOL on some scene (bench/estimate_grid.py --branches, TOL 1e-5 to 1e-9: ttl-kl6 at 1e-8 delivered
+/// 5.7e-8 with an estimate of 6.6e-10); verified, none did.
+bool auto_verifies(const std::vector<Centre>& centres);
 
 }  // namespace bodypoint
