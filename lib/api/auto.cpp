@@ -51,12 +51,12 @@ double measured_cost(const MeasuredCost& c, double tol) {
   return c.by_decade[i] * std::pow(c.by_decade[i + 1] / c.by_decade[i], f);
 }
 
-/// The table of least measured cost at tol; below kMeasuredDown, Kahan-Li 6 or 8.
-std::string_view table_for(double tol) {
-  if (tol < kMeasuredDown) return tol >= kTightTolerance ? "kl6" : "kl8";
-  return std::min_element(kMeasuredCost.begin(), kMeasuredCost.end(), [tol](const MeasuredCost& a, const MeasuredCost& b) {
-           return measured_cost(a, tol) < measured_cost(b, tol);
-         })->table;
+/// The table of least measured cost at tol; nullptr below kMeasuredDown.
+const MeasuredCost* cheapest_measured(double tol) {
+  if (tol < kMeasuredDown) return nullptr;
+  return &*std::min_element(kMeasuredCost.begin(), kMeasuredCost.end(), [tol](const MeasuredCost& a, const MeasuredCost& b) {
+    return measured_cost(a, tol) < measured_cost(b, tol);
+  });
 }
 
 /// auto takes a fixed step when the potential at the estimated closest approach is below this
@@ -75,7 +75,8 @@ const MethodInfo& choose_method(const Body& body, const std::vector<Centre>& cen
 const MethodInfo& detail::choose_method_for(const Body& body, const std::vector<Centre>& centres, double tol,
                                             std::string* why) {
   // The table whose whole search was measured cheapest at this tol (kMeasuredCost), or Kahan-Li 6 or 8.
-  const std::string_view table = table_for(tol);
+  const MeasuredCost* measured = cheapest_measured(tol);
+  const std::string_view table = measured ? measured->table : tol >= kTightTolerance ? "kl6" : "kl8";
   std::ostringstream os;
   double potential_at_closest = 0.0;  // at the guiding centre's closest approach to each centre
   const Helix helix = helix_of(body.p, to_momenta(body.p, body.s0));
@@ -97,12 +98,11 @@ const MethodInfo& detail::choose_method_for(const Body& body, const std::vector<
     os << m->name << (all_repulsive(centres) ? ": every centre repels (logarithmic Hamiltonian, step ~ distance to the centres)"
                                              : ": an attracting centre (time-transformed leapfrog, step ~ distance to the centres)");
   }
-  if (m->table == table && tol < kMeasuredDown)
-    os << (tol >= kTightTolerance ? "; Kahan-Li 6 for 1e-10 <= tol < 1e-8" : "; Kahan-Li 8 for tol < 1e-10");
-  else if (m->table == table)
-    os << "; its table's search was measured the cheapest at this tol (" << detail::short_number(measured_cost(*std::find_if(
-              kMeasuredCost.begin(), kMeasuredCost.end(), [&](const MeasuredCost& k) { return k.table == table; }), tol))
+  if (m->table == table && measured)
+    os << "; its table's search was measured the cheapest at this tol (" << detail::short_number(measured_cost(*measured, tol))
        << "x the cheapest table on each scene, geometric mean)";
+  else if (m->table == table)
+    os << (tol >= kTightTolerance ? "; Kahan-Li 6 for 1e-10 <= tol < 1e-8" : "; Kahan-Li 8 for tol < 1e-10");
   if (why) *why = os.str();
   return *m;
 }
