@@ -9,7 +9,7 @@
 // floor, budget) has no mean at that TOL. Honesty: runs whose delivered error exceeds TOL, and estimates more
 // than 3x below an error above 1e-12. Deterministic (force evaluations, not times): any machine, any load.
 //
-//     build/bin/auto_costs [--scenes thesis,close,two-centres,three-centres] [--tols 1e-4,...,1e-12]
+//     build/bin/auto_costs [--scenes thesis,close,long,two-centres,three-centres] [--tols 1e-4,...,1e-12]
 #include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/methods.hpp"
 #include "bodypoint/reference.hpp"
@@ -45,7 +45,7 @@ std::vector<std::string> split(const std::string& s) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string scenes = "thesis,close,two-centres,three-centres", tols = "1e-4,1e-5,1e-6,1e-7,1e-8,1e-9,1e-10,1e-11,1e-12";
+  std::string scenes = "thesis,close,long,two-centres,three-centres", tols = "1e-4,1e-5,1e-6,1e-7,1e-8,1e-9,1e-10,1e-11,1e-12";
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--scenes")) scenes = argv[i + 1];
     else if (!std::strcmp(argv[i], "--tols")) tols = argv[i + 1];
