@@ -10,9 +10,11 @@
 // 2. The latest estimate predicts the step h* that gives kTarget tol. When h*'s own c is well below the
 //    ladder's (far from the centres a run costs ~c/ds steps per unit time), a new ladder starts: the answer
 //    at h* and its companion at kCompanionRatio h* (half the cost of the answer). Otherwise the answer at
-//    h* joins the ladder, whose finest run is its companion: one run.
+//    h* joins the ladder, whose finest run is its companion: one run. After the first such run the pilot's
+//    coarse run is delivered where the two finer runs bound its error within TOL (pilot_answer).
 // 3. A trusted estimate at most kAccept tol delivers the answer (below kProbeBelowTol with the round-off
-//    probe's floor added, rounding.cpp); otherwise back to 2.
+//    probe's floor added, rounding.cpp), verified where asked by a companion at h*/kVerifyRatio; otherwise
+//    back to 2.
 // Differences that stop shrinking far below 1 are round-off: the search reports the floor it met (what the
 // finest runs still differ by). Each constant's measurement: docs/developers.md, "Tuned constants".
 #include "search.hpp"
@@ -55,6 +57,9 @@ constexpr double kMinAimShare = 0.1;
 constexpr double kUnresolvedPair = 1.0;
 /// Differences at or below this relative size are at the round-off level of a run of 1e3..1e6 steps.
 constexpr double kRoundOff = 1e-13;
+/// A run about to be delivered is verified by a companion at its step over this ratio, which costs this many
+/// of its runs.
+constexpr double kVerifyRatio = 1.25;
 
 }  // namespace
 
@@ -64,13 +69,14 @@ Level Search::pilot(Level& coarse) {
   double h = initial_step(m_, b_, c_, t_end_);
   for (int k = 0;; ++k) {
     Attempt<Level> pair = attempt([&] {
-      coarse = run_at(h, h, false);
+      coarse = run_at(h, h, true);
       Level fine = run_at(0.5 * coarse.h, h, false);
       // A pair that differs by more than kUnresolvedPair is no trajectory yet: the pair moves down by
       // halvings, each run one more at half the step (their sum at most the last pair's cost), with the same
       // constant c, until it differs by less.
       for (int d = 0; state_distance(coarse.run.final, fine.run.final) > kUnresolvedPair && d < kMaxRefinements; ++d) {
         coarse = std::move(fine);
+        coarse.samples_dropped = true;  // it ran without the caller's observers: delivered, it runs again
         fine = run_at(0.5 * coarse.h, h, false);
       }
       estimate_ = pair_estimate(coarse, fine);
@@ -80,6 +86,21 @@ Level Search::pilot(Level& coarse) {
     if (k >= kMaxRefinements) throw Error(pair.why);
     h *= 0.5;
   }
+}
+
+/// The pilot's coarse run itself, where the ladder's first refinement leaves it the best-checked answer:
+/// the finest run bounds its error within TOL (their difference over 1 - r^-q, q the lower of p and the
+/// order the three runs observe) and the three show at least order p - kOrderSlack (a higher order only
+/// means the finer runs err less: the bound stands). It is checked by finer runs, as a verified answer is.
+/// Above kProbeBelowTol only.
+std::optional<Level> Search::pilot_answer(std::vector<Level>& rungs) {
+  if (tol_ < kProbeBelowTol || rungs.size() != 3 || rungs[0].samples_dropped) return std::nullopt;
+  const double q = observed_order(rungs[0], rungs[1], rungs[2]);
+  const double d = state_distance(rungs[0].run.final, rungs[2].run.final);
+  const double e = coarser_run_error(d, rungs[0].h / rungs[2].h, static_cast<int>(std::floor(std::min<double>(p_, q))));
+  if (!(q >= p_ - kOrderSlack && e <= kAccept * tol_ && d > kRoundOff)) return std::nullopt;
+  estimate_ = last_estimate_ = e;
+  return std::move(rungs[0]);
 }
 
 /// Runs that share one time-step constant c form a ladder; each new run is estimated from the run before it
@@ -95,8 +116,13 @@ Level Search::ladder() {
   int stalled = 0;
   bool verified_finer = false;  // the newest rung is a verification's companion: estimate it first
   for (int k = 0; k < kMaxRefinements; ++k) {
-    const double expected = verified_finer ? estimate_ * std::pow(0.5, p_) : refine(rungs, h_c);
+    const double expected = verified_finer ? estimate_ * std::pow(rungs.back().h / rungs[rungs.size() - 2].h, p_)
+                                           : refine(rungs, h_c);
     verified_finer = false;
+    if (k == 0) {
+      if (std::optional<Level> answer = pilot_answer(rungs)) return std::move(*answer);
+      rungs.front().samples = {};
+    }
     Level& a = rungs[rungs.size() - 2];
     a.samples = {};  // only the newest run can still be delivered: its predecessors' samples go
     estimate_ = pair_estimate(a, rungs.back());
@@ -195,22 +221,22 @@ bool Search::deliverable(const Level& l, double h_c, bool trusted) {
   return true;
 }
 
-/// Whether the ladder's newest run may be delivered as it is: without verification (auto: its choices'
-/// estimates were measured honest), or when its companion at half its step, run now, agrees within TOL (its
-/// difference over 1 - 2^-p: the error of the run at h). A companion that does not agree joins the ladder as
-/// its newest run (false): the search goes on from there.
+/// Whether the ladder's newest run may be delivered as it is: without verification (auto about one centre:
+/// its choices' estimates were measured honest), or when its companion at h/kVerifyRatio, run now, agrees
+/// within TOL (their difference over 1 - r^-p: the error of the run at h). A companion that does not agree
+/// joins the ladder as its newest run (false): the search goes on from there.
 bool Search::verified(std::vector<Level>& rungs, double h_c) { return !verify_ || verified_at(rungs, h_c, estimate_); }
 
 /// The same with the delivered run's estimate `current`, which the companion's can only raise.
 bool Search::verified_at(std::vector<Level>& rungs, double h_c, double current) {
-  Level half = run_at(0.5 * rungs.back().h, h_c, true);
-  const double e = coarser_run_error(state_distance(rungs.back().run.final, half.run.final), 2.0, p_);
+  Level finer = run_at(rungs.back().h / kVerifyRatio, h_c, true);
+  const double e = coarser_run_error(state_distance(rungs.back().run.final, finer.run.final), rungs.back().h / finer.h, p_);
   if (e + std::max(floor_, 0.0) <= kAccept * tol_) {
     estimate_ = last_estimate_ = std::max(current, e + std::max(floor_, 0.0));
     return true;
   }
   rungs.back().samples = {};
-  rungs.push_back(std::move(half));
+  rungs.push_back(std::move(finer));
   return false;
 }
 

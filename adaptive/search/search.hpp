@@ -103,6 +103,7 @@ class Search {
 
   // ladder.cpp
   Level pilot(Level& coarse);
+  std::optional<Level> pilot_answer(std::vector<Level>& rungs);
   Level ladder();
   double refine(std::vector<Level>& rungs, double& h_c);
   [[nodiscard]] bool smooth(const std::vector<Level>& rungs, double expected) const;
@@ -128,7 +129,7 @@ class Search {
   double tol_, t_end_, dt_out_;
   int p_;
   RunOptions delivery_;
-  bool verify_;  ///< a run about to be delivered is checked against a companion at half its step
+  bool verify_;  ///< a run about to be delivered is checked against a companion at a finer step (ladder.cpp)
   double estimate_ = 0.0, last_estimate_ = std::numeric_limits<double>::quiet_NaN();
   double floor_ = -1.0;  ///< the round-off floor last measured (below kProbeBelowTol), -1 before
   double spent_evals_ = 0.0, total_wall_ = 0.0;
