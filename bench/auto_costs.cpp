@@ -28,7 +28,7 @@ using namespace bodypoint;
 namespace {
 
 /// The tables auto may choose (lib/api/auto.cpp), in its order.
-const std::vector<std::string> kTables = {"y4", "pefrl", "bm4", "kl6", "mcl8", "kl8"};
+const std::vector<std::string> kTables = {"verlet", "y4", "pefrl", "bm4", "kl6", "mcl8", "kl8"};
 /// An estimate this many times below a delivered error above kRoundingLevel is not honest (the estimate
 /// ladder's criterion, issue #56: below 1e-12 an error is the run's rounding).
 constexpr double kLowEstimate = 3.0;

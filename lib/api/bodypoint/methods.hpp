@@ -38,8 +38,8 @@ std::vector<const MethodInfo*> methods_named(std::string_view list);
 /// `--method auto`: a one-centre material point: ks; a body far from every centre for the whole run
 /// (straight-line estimate of the closest approach, potential there below the time-step constant c):
 /// Lie-Poisson; only repelling centres: logH; any attracting centre: TTL. The composition table, from tol
-/// 1e-4 to 1e-8, is the one whose whole search was measured cheapest (bench/auto_costs: Yoshida 4 to about
-/// 1e-5, PEFRL from about 1e-6 to 1e-8); Kahan-Li 6 down to 1e-10, Kahan-Li 8 below.
+/// 1e-4 to 1e-8, is the one whose whole search was measured cheapest (bench/auto_costs: Verlet to about
+/// 2e-5, Yoshida 4 near 1e-5, PEFRL from about 1e-6 to 1e-8); Kahan-Li 6 down to 1e-10, Kahan-Li 8 below.
 /// `why` receives one line saying what was chosen and why.
 const MethodInfo& choose_method(const Body& body, const std::vector<Centre>& centres, double tol, std::string* why);
 
