@@ -64,12 +64,13 @@ constexpr double kVerifyRatio = 1.25;
 }  // namespace
 
 /// The pilot pair at h0 and h0/2 (a refused step halves h0); sets the first estimate and returns the finer
-/// run, never delivered (docs/developers.md, "Limits, measured": a pilot pair's estimate alone was 25x low).
+/// run, never delivered (docs/developers.md, "Limits, measured": a pilot pair's estimate alone was 25x low;
+/// the coarser may be, bounded by finer runs: pilot_answer).
 Level Search::pilot(Level& coarse) {
   double h = initial_step(m_, b_, c_, t_end_);
   for (int k = 0;; ++k) {
     Attempt<Level> pair = attempt([&] {
-      coarse = run_at(h, h, true);
+      coarse = run_at(h, h, tol_ >= kProbeBelowTol);  // it may be the answer (pilot_answer)
       Level fine = run_at(0.5 * coarse.h, h, false);
       // A pair that differs by more than kUnresolvedPair is no trajectory yet: the pair moves down by
       // halvings, each run one more at half the step (their sum at most the last pair's cost), with the same
@@ -97,8 +98,9 @@ std::optional<Level> Search::pilot_answer(std::vector<Level>& rungs) {
   if (tol_ < kProbeBelowTol || rungs.size() != 3 || rungs[0].samples_dropped) return std::nullopt;
   const double q = observed_order(rungs[0], rungs[1], rungs[2]);
   const double d = state_distance(rungs[0].run.final, rungs[2].run.final);
+  if (!(q >= p_ - kOrderSlack && q >= 1.0 && d > kRoundOff)) return std::nullopt;
   const double e = coarser_run_error(d, rungs[0].h / rungs[2].h, static_cast<int>(std::floor(std::min<double>(p_, q))));
-  if (!(q >= p_ - kOrderSlack && e <= kAccept * tol_ && d > kRoundOff)) return std::nullopt;
+  if (!(e <= kAccept * tol_)) return std::nullopt;
   estimate_ = last_estimate_ = e;
   return std::move(rungs[0]);
 }

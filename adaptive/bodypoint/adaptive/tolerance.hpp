@@ -72,9 +72,10 @@ ToleranceResult run_to_tolerance(const MethodInfo& method, const Body& body, con
                                  const Accuracy& accuracy, const RunOptions& delivery = {}, bool verify = true);
 /// The search alone, for a request whose every part was checked already (integrate() checks each once).
 /// With `verify` (a method the user named) the run about to be delivered is checked against a companion
-/// at 1/1.25 of its step (kVerifyRatio, search/ladder.cpp), and the search goes on from that companion when they disagree by more than tol:
-/// the ladder's own estimate can be fooled where the error is not smooth in h (lp-kl8 at tol 1e-4 on a
-/// two-centre pass delivered 46x tol). `auto`'s choices were measured honest without it.
+/// at 1/1.25 of its step (kVerifyRatio, search/ladder.cpp), and the search goes on from that companion
+/// when they disagree by more than tol: the ladder's own estimate can be fooled where the error is not
+/// smooth in h (lp-kl8 at tol 1e-4 on a two-centre pass delivered 46x tol). `auto`'s choices about one
+/// centre were measured honest without it.
 ToleranceResult search_step(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
                             const Accuracy& accuracy, const RunOptions& delivery, bool verify = true);
 /// Throws Error unless the accuracy mode can search `method`'s step: a fixed-step or time-transformed

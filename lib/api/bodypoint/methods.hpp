@@ -43,8 +43,8 @@ std::vector<const MethodInfo*> methods_named(std::string_view list);
 /// `why` receives one line saying what was chosen and why.
 const MethodInfo& choose_method(const Body& body, const std::vector<Centre>& centres, double tol, std::string* why);
 
-/// Whether the accuracy mode checks auto's answer against a companion at a finer step (1/1.25 of it), as it checks a
-/// method the user named: about several centres. Unverified there, every table auto may choose missed
+/// Whether the accuracy mode checks auto's answer against a companion at a finer step (1/1.25 of it), as
+/// it checks a method the user named: about several centres. Unverified there, every table auto may choose missed
 /// TOL on some scene (bench/estimate_grid.py --branches, TOL 1e-5 to 1e-9: ttl-kl6 at 1e-8 delivered
 /// 5.7e-8 with an estimate of 6.6e-10); verified, none did.
 bool auto_verifies(const std::vector<Centre>& centres);
