@@ -254,20 +254,16 @@ TEST(Tolerance, ThePilotsCoarseRunIsDeliveredWhereFinerRunsBoundIt) {
 }
 
 // A verifying companion at h/2 lands on every point of the answer's grid and shares its rounding there
-// (search/ladder.cpp, kVerifyRatio). On a pass at d = 2 from L = 6400 (t = 2133) runs at fixed ds from 0.017
-// to 0.043 are 0.8e-9 to 6.3e-9 off, and logh-kl8 at 1e-10 was delivered 1.2e-10 off with 7.9e-11
-// estimated. Verified off the grid, the answer is within TOL or the search says TOL is out of reach.
-/// Above the pass's rounding (runs 6.3e-9 off at most): a TOL the search must deliver.
-constexpr double kAboveThePassRounding = 1e-8;
+// (search/ladder.cpp, kVerifyRatio). On the rounded pass (common.hpp) logh-kl8 at 1e-10 was delivered
+// 1.2e-10 off with 7.9e-11 estimated. Verified off the grid, the answer is within TOL or the search says TOL
+// is out of reach.
 TEST(Tolerance, AVerifiedAnswerOnARoundedPassIsWithinTolOrRefused) {
-  SceneParams sp;
-  sp.start.d = 2.0;
-  sp.start.L = 6400.0;
+  const SceneParams sp = rounded_pass();
   const Scene s = thesis_scene(sp);
   const Body& b = s.bodies.front();
-  const double t_end = 2.0 * sp.start.L / 6.0;
+  const double t_end = rounded_pass_end(sp);
   const State ref = reference_state(b, s.centres, t_end);
-  for (double tol : {1e-10, kAboveThePassRounding}) {
+  for (double tol : {1e-10, kRoundedPassTol}) {
     try {
       const adaptive::ToleranceResult r =
           adaptive::run_to_tolerance(method_or_throw("logh-kl8"), b, s.centres, Accuracy{tol, t_end}, kUnobserved);
@@ -276,7 +272,7 @@ TEST(Tolerance, AVerifiedAnswerOnARoundedPassIsWithinTolOrRefused) {
       EXPECT_GE(r.err_estimate, err / kEstimateFactor);
     } catch (const Error& e) {
       EXPECT_NE(std::string(e.what()).find("out of reach"), std::string::npos) << e.what();
-      EXPECT_LT(tol, kAboveThePassRounding) << e.what();
+      EXPECT_LT(tol, kRoundedPassTol) << e.what();
     }
   }
 }

@@ -6,6 +6,7 @@
 #include "bodypoint/detail/model_parts.hpp"
 #include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/reference.hpp"
+#include "common.hpp"
 #include "encounter_parts.hpp"
 
 #include <gtest/gtest.h>
@@ -246,27 +247,20 @@ TEST(Scattering, MaterialPointTimeDelayIsKeplersAtEveryDistance) {
   }
 }
 
-/// The accuracy asked of the long pass below: above its rounding floor (about 6e-9).
-constexpr double kRoundedPassTol = 1e-8;
-
 TEST(Scattering, GuidingCentreAsymptotesConvergeWithDistance) {
   // One spinning body's pass (thesis table 3.1 with d = 2) seen from the states where it crosses
   // r = 25, 100, 400 and 3200 on the way in and out: the deflection between the guiding-centre
   // asymptotes of each pair approaches the farthest pair's, faster than K1's own turn does.
-  SceneParams p;
-  p.start.d = 2.0;
-  p.start.L = 6400.0;
+  const SceneParams p = rounded_pass();
   const Scene s = thesis_scene(p);
   const Body& body = s.bodies.front();
   const std::vector<double> radii = {25.0, 100.0, 400.0, 3200.0};
   Options o;
   o.track_invariants = false;
   for (double r : radii) o.events.push_back(Event{Event::Kind::radius, 0, r, Vec3::UnitX()});
-  // The pass at d = 2 amplifies rounding: over t = 2133 runs at fixed ds from 0.017 to 0.043 are 0.8e-9 to
-  // 6.3e-9 off the reference, not falling with ds, so TOL 1e-8 (below it the search says "out of reach").
-  // 1e-10 was delivered once by a companion at ds/2 sharing the answer's grid (1.2e-10 off, estimated
-  // 7.9e-11).
-  const Result res = integrate(s, "logh-kl8", Accuracy{kRoundedPassTol, 2.0 * p.start.L / 6.0}, o);
+  // The pass amplifies rounding (common.hpp, rounded_pass): TOL above it. 1e-10 was delivered once by a
+  // companion at ds/2 sharing the answer's grid (1.2e-10 off, estimated 7.9e-11).
+  const Result res = integrate(s, "logh-kl8", Accuracy{kRoundedPassTol, rounded_pass_end(p)}, o);
   ASSERT_EQ(res.outcome, Outcome::ok) << res.reason;
   std::vector<double> theta, turn;
   for (std::size_t k = 0; k < radii.size(); ++k) {
