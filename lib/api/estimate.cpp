@@ -92,8 +92,9 @@ void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& 
   }
   add_rounding_draws(e, r, options, o, rerun_draws(body, [&how](int k) { return off_grid(how, k); }, o, rerun),
                      kRepeatRoundingDraw);
-  // A fine pair the coarse side disagrees with is checked by the next finer one.
-  const bool check_pair = checks_fine_pair(coarse_side, e.value);
+  // A fine pair the coarse side disagrees with, or whose run steps past the coarse margin, is checked by the
+  // next finer one.
+  const bool check_pair = checks_fine_pair(*r.method, centres, r.run, coarse_side, e.value);
   if (r.outcome == Outcome::unresolved || r.run.steps < kFewSteps || check_pair)
     second_companion(r, body, how, options, o, rerun, *f, check_pair);
 }

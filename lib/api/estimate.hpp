@@ -75,8 +75,15 @@ bool observed_order_agrees(const MethodInfo& m, const Body& body, const CoarseCo
 /// ended ok: compared with the fine pair's estimate (checks_fine_pair).
 double coarse_side_of(const MethodInfo& m, const Body& body, const CoarseCompanion& c, const State& run, const State& coarse);
 /// Whether a fine pair whose estimate is `fine` is checked by a second companion one level finer
-/// (bound_by_second): the coarse side reads more than kAsymptoticSpread times it (estimate/fine.cpp).
-bool checks_fine_pair(const std::optional<double>& coarse_side, double fine);
+/// (bound_by_second): the coarse side reads more than kAsymptoticSpread times it, or the run's own steps
+/// turn past the angles a coarse companion's steps are held to (run_past_coarse_margin), so that the
+/// pair's coarser run is where coarse pairs were measured outside their regime (estimate/fine.cpp).
+bool checks_fine_pair(const MethodInfo& m, const std::vector<Centre>& centres, const RunResult& run,
+                      const std::optional<double>& coarse_side, double fine);
+/// Whether the run's own steps turn the spin, or the direction to a centre, past kCoarseAngleMargin of the
+/// flags' angles (coarse_ratio_limit below 1): where a coarse companion's steps would not be trusted
+/// (estimate/coarse.cpp).
+bool run_past_coarse_margin(const MethodInfo& m, const std::vector<Centre>& centres, const RunResult& run);
 /// A run of fewer than kFewSteps steps, or a fine pair checks_fine_pair asks about (check_pair), given a second
 /// companion one level finer: e is raised to what the run differs by from the second plus what the first
 /// differs by from it, where the run is a few steps or its pair differs less than the order p predicts from

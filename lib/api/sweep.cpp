@@ -215,7 +215,7 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
     by_fine[k] =
         detail::fixed_step_estimate(method, scenes[k].bodies.front(), scenes[k].centres, results[k].final, companions[k].final);
     any_second = any_second || health[k].outcome == Outcome::unresolved || how.steps < detail::kFewSteps ||
-                 detail::checks_fine_pair(coarse_side[k], by_fine[k].value);
+                 detail::checks_fine_pair(method, scenes[k].centres, results[k], coarse_side[k], by_fine[k].value);
   }
   if (any_second) second = batch::run(method, members, detail::fixed_companion(how, 2));
   for (std::size_t k = 0; k < rows.size(); ++k) {
@@ -255,7 +255,7 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
   for (std::size_t k = 0; k < rows.size(); ++k) {
     if (!spec.estimate_error || by_coarse[k] || !estimable(rows[k].outcome) || second.empty()) continue;
     ErrorEstimate& e = rows[k].error;
-    const bool check = detail::checks_fine_pair(coarse_side[k], e.value);
+    const bool check = detail::checks_fine_pair(method, scenes[k].centres, rows[k].result, coarse_side[k], e.value);
     if (rows[k].outcome != Outcome::unresolved) {  // a flagged lane counted its second companion above
       if (!check && how.steps >= detail::kFewSteps) continue;
       e.force_evals += second[k].force_evals;

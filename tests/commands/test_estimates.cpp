@@ -232,6 +232,32 @@ TEST(Estimates, ACoarsePairIsTrustedWhereASecondCoarseRunObservesItsOrder) {
   EXPECT_LT(json_num(kept.out, "err_estimate"), kHonestFactor * json_num(kept.out, "err_rel")) << kept.out;
 }
 
+TEST(Estimates, AFinePairWhoseRunStepsPastTheCoarseMarginIsCheckedByTheNextLevel) {
+  // Three centres and the thesis's spinning body: ttl-verlet at ds = 0.2 turns the spin by 2 rad a step
+  // (its automatic time-step constant's cap), past the angles a coarse companion is held to, so it has no
+  // coarse side. It is 1.7e-4 off, its companion at ds/2 1.7e-4 too, the next at ds/4 4.3e-5: the pair
+  // read 4.3e-5. As the coarser run of its pair it is checked by the next level.
+  const auto path = test::temp_path("three-centres.toml");
+  std::ofstream(path) << "[[centre]]\nposition = [0.0, 0.0, 0.0]\nA = -2.0\n[[centre]]\nposition = [40.0, 6.0, 0.0]\n"
+                         "A = -1.0\n[[centre]]\nposition = [80.0, -8.0, 0.0]\nA = 1.5\n[[body]]\nname = \"spinning\"\n"
+                         "m = 1.0\nB = 0.7\nJ = 1.0\nd = 10.0\nL = 200.0\nK1 = 5.0\nKx = 2.0\nKz = 5.0\n";
+  const auto r = run_cli("simulate --json --reference --scene " + path.string() + " --t-end 60 --method ttl-verlet --h 0.2");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_GE(json_num(r.out, "err_estimate"), json_num(r.out, "err_rel") / kHonestFactor) << r.out;
+  EXPECT_NE(r.out.find("the pair differs less than the order predicts from the next"), std::string::npos) << r.out;
+  // A fixed-step run whose steps turn the direction to the centre past that margin is checked so too, and a
+  // sweep's lanes check it as integrate() does (attracting material point, lp-y4 at h = 1: 6.1e-3 off).
+  const std::string material = "--A 2 --B 0 --d 3 --t-end 80 --method lp-y4 --h 1";
+  const auto alone = run_cli("simulate --json --reference " + material);
+  ASSERT_EQ(alone.code, 0) << alone.err;
+  EXPECT_GE(json_num(alone.out, "err_estimate"), json_num(alone.out, "err_rel") / kHonestFactor) << alone.out;
+  const auto swept = run_cli("sweep --param d --values 3 --methods lp-y4 --A 2 --B 0 --h 1 --t-end 80");
+  ASSERT_EQ(swept.code, 0) << swept.err;
+  EXPECT_EQ(std::stod(sweep_column(swept.out, "err_estimate")), json_num(alone.out, "err_estimate")) << swept.out;
+  EXPECT_EQ(std::stod(sweep_column(swept.out, "estimate_force_evals")), json_num(alone.out, "estimate_force_evals"))
+      << swept.out;
+}
+
 TEST(Estimates, ARunAliasingTheSpinIsKeptWhereAThirdCompanionBoundsIt) {
   // Two repelling centres and the thesis's spinning body: lp-bm4 at h = 1 turns the spin by 6.86 rad per
   // step and is 8.1e-4 off (right by aliasing), its companion at h/2 aliases too (2.7e-3 off), so the

@@ -201,6 +201,14 @@ double coarse_ratio_limit(const MethodInfo& m, const std::vector<Centre>& centre
   return limit;
 }
 
+/// A run whose steps turn past the coarse margin is, as the coarser run of its fine pair, where a coarse pair
+/// was measured outside its regime (kCoarseAngleMargin): three-centres ttl-verlet at ds = 0.2, its steps
+/// turning the spin by 2 rad, is 1.7e-4 off where its pair at ds/2 read 4.3e-5 (the companion at ds/2 is
+/// 1.7e-4 off too, the next at ds/4 4.3e-5).
+bool run_past_coarse_margin(const MethodInfo& m, const std::vector<Centre>& centres, const RunResult& run) {
+  return coarse_ratio_limit(m, centres, run) < 1.0;
+}
+
 std::optional<CoarseCompanion> coarse_companion(const MethodInfo& m, const Advance& how, long run_steps, double max_ratio) {
   const double r = std::min(kStepRatio, max_ratio);
   if (run_steps < kCoarseMinSteps || !(r >= kMinCoarseRatio)) return std::nullopt;

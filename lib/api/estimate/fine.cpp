@@ -166,8 +166,9 @@ void second_companion(BodyResult& r, const Body& body, const Advance& how, const
   else e.basis += "; a third companion did not end as the run did";
 }
 
-bool checks_fine_pair(const std::optional<double>& coarse_side, double fine) {
-  return coarse_side && *coarse_side > kAsymptoticSpread * fine;
+bool checks_fine_pair(const MethodInfo& m, const std::vector<Centre>& centres, const RunResult& run,
+                      const std::optional<double>& coarse_side, double fine) {
+  return (coarse_side && *coarse_side > kAsymptoticSpread * fine) || run_past_coarse_margin(m, centres, run);
 }
 
 void bound_by_second(ErrorEstimate& e, const MethodInfo& m, const Body& body, long steps, bool check_pair, const State& run,
