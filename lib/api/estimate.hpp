@@ -81,8 +81,8 @@ double coarse_side_of(const MethodInfo& m, const Body& body, const CoarseCompani
 bool checks_fine_pair(const MethodInfo& m, const std::vector<Centre>& centres, const RunResult& run,
                       const std::optional<double>& coarse_side, double fine);
 /// Whether the run's own steps turn the spin, or the direction to a centre, past kCoarseAngleMargin of the
-/// flags' angles (coarse_ratio_limit below 1): where a coarse companion's steps would not be trusted
-/// (estimate/coarse.cpp).
+/// flags' angles between two of its force evaluations (coarse_ratio_limit times the evaluations a step below
+/// 1): where a coarse companion's steps would not be trusted (estimate/coarse.cpp).
 bool run_past_coarse_margin(const MethodInfo& m, const std::vector<Centre>& centres, const RunResult& run);
 /// A run of fewer than kFewSteps steps, or a fine pair checks_fine_pair asks about (check_pair), given a second
 /// companion one level finer: e is raised to what the run differs by from the second plus what the first
