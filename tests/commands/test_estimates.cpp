@@ -42,6 +42,18 @@ std::string bound_orbit() {
   return "--scene " + path.string();
 }
 
+/// The thesis's spinning body between the two repelling centres of scenes/two-centres.toml, with a third,
+/// attracting centre beyond them where `three` (bench/estimate_ladder.py's two-centres-spin and three-centres):
+/// the scene file's path.
+std::string spinning_between_centres(bool three = false) {
+  const auto path = test::temp_path(three ? "three-centres.toml" : "two-centres-spin.toml");
+  std::ofstream(path) << "[[centre]]\nposition = [0.0, 0.0, 0.0]\nA = -2.0\n[[centre]]\nposition = [40.0, 6.0, 0.0]\n"
+                         "A = -1.0\n" << (three ? "[[centre]]\nposition = [80.0, -8.0, 0.0]\nA = 1.5\n" : "")
+                      << "[[body]]\nname = \"spinning\"\nm = 1.0\nB = 0.7\nJ = 1.0\nd = 10.0\nL = 200.0\n"
+                         "K1 = 5.0\nKx = 2.0\nKz = 5.0\n";
+  return path.string();
+}
+
 TEST(Estimates, RunsFarOffAreFlaggedByTheirEstimate) {
   // Each exited 0 before, 26 % to 303 % off with energy errors down to 1.6e-14 (phase, not energy).
   const std::vector<std::string> cases = {
@@ -161,12 +173,8 @@ TEST(Estimates, TheCoarseCompanionCostsHalfARunAndFallsBackWhereItCannotBeTruste
   // A coarse step that loses the energy agrees with the run by chance (rk4 at h = 0.2 and 0.4 on the
   // two-centre spinning scene, 70 % off, 1.5e-5 apart): held to the default flags even where the run
   // tracks nothing, it is passed over and the fine companion shows the error.
-  const auto path = test::temp_path("two-centres-spin.toml");
-  std::ofstream(path) << "[[centre]]\nposition = [0.0, 0.0, 0.0]\nA = -2.0\n[[centre]]\nposition = [40.0, 6.0, 0.0]\n"
-                         "A = -1.0\n[[body]]\nname = \"spinning\"\nm = 1.0\nB = 0.7\nJ = 1.0\nd = 10.0\nL = 200.0\n"
-                         "K1 = 5.0\nKx = 2.0\nKz = 5.0\n";
   const auto lost = run_cli("simulate --json --reference --no-invariants --max-error inf --max-energy-error inf --scene " +
-                            path.string() + " --t-end 60 --method rk4 --h 0.2");
+                            spinning_between_centres() + " --t-end 60 --method rk4 --h 0.2");
   ASSERT_EQ(lost.code, 0) << lost.err;
   EXPECT_GT(json_num(lost.out, "err_rel"), 0.1);
   EXPECT_GT(json_num(lost.out, "err_estimate"), json_num(lost.out, "err_rel") / kHonestFactor) << lost.out;
@@ -240,18 +248,15 @@ TEST(Estimates, AFinePairWhoseRunStepsPastTheCoarseMarginIsCheckedByTheNextLevel
   // (its automatic time-step constant's cap) with one force evaluation a step, past the angles a coarse
   // companion is held to, so it has no coarse side. It is 1.7e-4 off, its companion at ds/2 1.7e-4 too, the
   // next at ds/4 4.3e-5: the pair read 4.3e-5. As the coarser run of its pair it is checked by the next level.
-  const auto path = test::temp_path("three-centres.toml");
-  std::ofstream(path) << "[[centre]]\nposition = [0.0, 0.0, 0.0]\nA = -2.0\n[[centre]]\nposition = [40.0, 6.0, 0.0]\n"
-                         "A = -1.0\n[[centre]]\nposition = [80.0, -8.0, 0.0]\nA = 1.5\n[[body]]\nname = \"spinning\"\n"
-                         "m = 1.0\nB = 0.7\nJ = 1.0\nd = 10.0\nL = 200.0\nK1 = 5.0\nKx = 2.0\nKz = 5.0\n";
-  const auto r = run_cli("simulate --json --reference --scene " + path.string() + " --t-end 60 --method ttl-verlet --h 0.2");
+  const std::string three = spinning_between_centres(true);
+  const auto r = run_cli("simulate --json --reference --scene " + three + " --t-end 60 --method ttl-verlet --h 0.2");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_GE(json_num(r.out, "err_estimate"), json_num(r.out, "err_rel") / kHonestFactor) << r.out;
   EXPECT_NE(r.out.find("the pair differs less than the order predicts from the next"), std::string::npos) << r.out;
   // A composition whose steps turn the spin as far, but by less than the margin between two force
   // evaluations, is in its regime at that step and keeps its pair's estimate at two runs (ttl-pefrl, four
   // evaluations a step: 2.4e-4 off, estimated 2.6e-4).
-  const auto pefrl = run_cli("simulate --json --reference --scene " + path.string() + " --t-end 60 --method ttl-pefrl --h 0.2");
+  const auto pefrl = run_cli("simulate --json --reference --scene " + three + " --t-end 60 --method ttl-pefrl --h 0.2");
   ASSERT_EQ(pefrl.code, 0) << pefrl.err;
   EXPECT_GE(json_num(pefrl.out, "err_estimate"), json_num(pefrl.out, "err_rel") / kHonestFactor) << pefrl.out;
   EXPECT_EQ(pefrl.out.find("a second companion"), std::string::npos) << pefrl.out;
@@ -263,11 +268,7 @@ TEST(Estimates, ARunAliasingTheSpinIsKeptWhereAThirdCompanionBoundsIt) {
   // step and is 8.1e-4 off (right by aliasing), its companion at h/2 aliases too (2.7e-3 off), so the
   // first two differences do not fall (1.1x) and the run was refused though right. A third companion (h/8)
   // resolves the spin: the run is bounded through it and kept, by integrate() and by a sweep's lanes alike.
-  const auto scene = test::temp_path("two-centres-spin.toml");
-  std::ofstream(scene) << "[[centre]]\nposition = [0.0, 0.0, 0.0]\nA = -2.0\n[[centre]]\nposition = [40.0, 6.0, 0.0]\n"
-                          "A = -1.0\n[[body]]\nname = \"spinning\"\nm = 1.0\nB = 0.7\nJ = 1.0\nd = 10.0\nL = 200.0\n"
-                          "K1 = 5.0\nKx = 2.0\nKz = 5.0\n";
-  const std::string run = "--scene " + scene.string() + " --t-end 60 --h 1";
+  const std::string run = "--scene " + spinning_between_centres() + " --t-end 60 --h 1";
   const auto r = run_cli("simulate --json --reference --method lp-bm4 " + run);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("turned the spin by 6.86 rad"), std::string::npos) << r.err;
