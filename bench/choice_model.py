@@ -10,6 +10,10 @@ picks the m with the fewest predicted evaluations s / ds_m. Printed: the picked 
 coarsest rung meeting TOL with the next finer rung meeting it too) over the family's cheapest by the same rule.
 
     bench/choice_model.py paper/results-quick [--family logh] [--cap 0.2] [--reference close]
+
+With --ratios it prints instead each method's error constant over the family's Verlet, k_m / k_verlet, on every
+scene and their geometric mean: the search's pilot pair (adaptive/search/start.cpp, kVerletErrorRatio) runs the
+family's Verlet and predicts the step of the method searched from it with that mean.
 """
 import argparse
 import csv
@@ -35,6 +39,7 @@ def main():
     ap.add_argument("--family", default="logh", help="logh or ttl (three-centres attracts: ttl only)")
     ap.add_argument("--cap", type=float, default=0.2, help="the largest fictitious step the model predicts")
     ap.add_argument("--reference", default="close", help="the scene the error constants are fitted on")
+    ap.add_argument("--ratios", action="store_true", help="print k_m / k_verlet per scene and their geometric mean")
     a = ap.parse_args()
     meth = {r["method"]: r for r in rows(os.path.join(a.results, "methods.csv"))}
     ladders = defaultdict(list)
@@ -62,8 +67,17 @@ def main():
                 return n
         return None
 
-    k_ref = {m: constant(a.reference, m) for m in cands}
     verlet = a.family + "-verlet"
+    if a.ratios:
+        print(f"{'method':12s} " + " ".join(f"{s:>13s}" for s in SCENES) + "  geometric mean")
+        for m in sorted(cands):
+            r = [(k, v) for s in SCENES if (k := constant(s, m)) and (v := constant(s, verlet))]
+            per = [f"{constant(s, m) / constant(s, verlet):13.3g}" if constant(s, m) and constant(s, verlet)
+                   else f"{'-':>13s}" for s in SCENES]
+            mean = math.exp(statistics.fmean(math.log(k / v) for k, v in r)) if r else float("nan")
+            print(f"{m:12s} " + " ".join(per) + f"  {mean:.3g}")
+        return
+    k_ref = {m: constant(a.reference, m) for m in cands}
     ratios = []
     for scene in SCENES:
         k_v = constant(scene, verlet)
