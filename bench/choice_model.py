@@ -12,8 +12,8 @@ coarsest rung meeting TOL with the next finer rung meeting it too) over the fami
     bench/choice_model.py paper/results-quick [--family logh] [--cap 0.2] [--reference close]
 
 With --ratios it prints instead each method's error constant over the family's Verlet, k_m / k_verlet, on every
-scene and their geometric mean: the search's pilot pair (adaptive/search/start.cpp, kVerletErrorRatio) runs the
-family's Verlet and predicts the step of the method searched from it with that mean.
+scene and their geometric mean: how far a step predicted from a Verlet pilot pair by that mean may be off
+(docs/developers.md, "Limits, measured": the pilot pair run by the family's Verlet, measured and not kept).
 """
 import argparse
 import csv
@@ -71,11 +71,9 @@ def main():
     if a.ratios:
         print(f"{'method':12s} " + " ".join(f"{s:>13s}" for s in SCENES) + "  geometric mean")
         for m in sorted(cands):
-            r = [(k, v) for s in SCENES if (k := constant(s, m)) and (v := constant(s, verlet))]
-            per = [f"{constant(s, m) / constant(s, verlet):13.3g}" if constant(s, m) and constant(s, verlet)
-                   else f"{'-':>13s}" for s in SCENES]
-            mean = math.exp(statistics.fmean(math.log(k / v) for k, v in r)) if r else float("nan")
-            print(f"{m:12s} " + " ".join(per) + f"  {mean:.3g}")
+            per = {s: k / v for s in SCENES if (k := constant(s, m)) and (v := constant(s, verlet))}
+            mean = math.exp(statistics.fmean(math.log(x) for x in per.values())) if per else float("nan")
+            print(f"{m:12s} " + " ".join(f"{per[s]:13.3g}" if s in per else f"{'-':>13s}" for s in SCENES) + f"  {mean:.3g}")
         return
     k_ref = {m: constant(a.reference, m) for m in cands}
     ratios = []
