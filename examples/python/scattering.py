@@ -28,7 +28,7 @@ def deflections(B):
     theta, v_inf = [], []
     for b in bs:
         scene = bp.thesis_scene(B=B, b=b)
-        e = bp.encounter(scene, tol=1e-10)
+        e = bp.encounter(scene, tol=1e-9)  # at 1e-10, B = 0.7 and b = 1 are out of auto's reach (1.8e-10)
         theta.append(e["deflection"])
         v_inf.append(e["v_inf_in"])
     return np.array(theta), np.array(v_inf)

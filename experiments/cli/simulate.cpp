@@ -245,11 +245,11 @@ class TrajectoryFile {
 
 /// The start distance's part of an encounter's error: the thesis's scene at 2L with the same asymptotic
 /// data, run to its departure by auto (twice_as_far_tol); not known for a scene file's states.
-void add_start_distance_of(Encounter& e, const po::variables_map& vm, const SceneOptions& so, const RunPlan& plan,
+long add_start_distance_of(Encounter& e, const po::variables_map& vm, const SceneOptions& so, const RunPlan& plan,
                            const Body& body, double numerical) {
   std::function<Expected<Scene>()> far;
   if (!vm.count("scene")) far = [&] { return thesis_scene_twice_as_far(so.params, so.b, so.v_inf, so.arrival_phase); };
-  add_start_distance(e, body, far, plan.search ? std::optional<double>(plan.tol) : std::nullopt, numerical,
+  return add_start_distance(e, body, far, plan.search ? std::optional<double>(plan.tol) : std::nullopt, numerical,
                      "the scene file gives states, not the thesis's start distance L");
 }
 
@@ -494,7 +494,7 @@ int cmd_simulate(int argc, char** argv) {
       enc[b] = measure_encounter(scene.bodies[b], scene.centres, runs[b].run.run, runs[b].run.events, o.body_events[b]);
       if (enc[b]->outcome != Outcome::ok)
         throw Error("body '" + scene.bodies[b].name + "': " + enc[b]->reason + "; no output written");
-      add_start_distance_of(*enc[b], vm, o.so, plan, scene.bodies[b], runs[b].run.error.value);
+      runs[b].run.encounter_force_evals = add_start_distance_of(*enc[b], vm, o.so, plan, scene.bodies[b], runs[b].run.error.value);
     }
   if (file) file->commit();
   if (o.json) {

@@ -170,7 +170,7 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
                                 " time_delay = against free motion, Coulomb logarithm removed; asymptote_error = the"
                                 " asymptotes' model error in the deflection (estimated from half the start distance);"
                                 " start_distance_error, time_delay_error = what the start distance L leaves against L ->"
-                                " infinity (the point again from 2L); deflection_error = the deflection's total;"
+                                " infinity (the point again from 2L); deflection_error = the deflection's total; start_distance_force_evals = what that run from 2L cost;"
                                 " a run that ended before the body left is outcome incomplete, without them;"
                                 " K1_turn, spin_turn ="
                                 " angles K1 and K2 turned over the run (rad); K1x,K1y,K1z = final K1;"

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -60,15 +61,23 @@ const EventHit* marker(const std::vector<EventHit>& hits, const std::vector<Even
   return found;
 }
 
-void estimate_asymptote_error(Encounter& e, const Body& body, const std::vector<Centre>& centres,
+/// A material point's asymptotes are exact but for their formula's rounding: Lv = X x P at the distance r
+/// carries eps r |P| against its size b |P|, and the direction with it (B = 0, b = 1: the deflections from
+/// L = 200 and 1600 differ by 5.0e-13, 4 eps (r0 + r1)/b = 3.2e-12 for the two).
+constexpr double kKeplerRounding = 4.0;
+
+void estimate_asymptote_error(Encounter& e, const Body& body, const std::vector<Centre>& centres, const State& end,
                               const std::vector<EventHit>& hits, const std::vector<Event>& events) {
   if (!std::isfinite(e.scattering.deflection)) {
     e.asymptote_basis = "not known: no asymptotes";
     return;
   }
   if (body.p.B == 0.0) {
-    e.asymptote_error = 0.0;
-    e.asymptote_basis = "exact: a material point's asymptotes are its Kepler orbit's";
+    const Vec3& c = centres.front().c;
+    const double b = e.scattering.b, r = (body.s0.R - c).norm() + (end.R - c).norm();
+    e.asymptote_error = b > 0.0 ? kKeplerRounding * std::numeric_limits<double>::epsilon() * r / b : 0.0;
+    e.asymptote_basis = "exact: a material point's asymptotes are its Kepler orbit's (the rounding of their formula at "
+                        "the run's distances: 4 eps (r0 + r1)/b)";
     return;
   }
   const double half = 0.5 * start_distance(body, centres.front());
@@ -129,7 +138,7 @@ Encounter measure_encounter(const Body& body, const std::vector<Centre>& centres
     e.asymptote_basis = "not known: " + none;
     return e;
   }
-  estimate_asymptote_error(e, body, centres, hits, events);
+  estimate_asymptote_error(e, body, centres, run.final, hits, events);
   return e;
 }
 
@@ -180,10 +189,10 @@ void no_start_distance_error(Encounter& e, bool material, double numerical, cons
 
 long add_start_distance(Encounter& e, const Body& body, const std::function<Expected<Scene>()>& far,
                         std::optional<double> tol, double numerical, const std::string& no_far, const Options& options) {
-  // A thesis scene's material point is run from 2L too: at the scene's K1 its speed at infinity moves
-  // with L (the potential at L is part of the start's energy), and with it the deflection (B = 0, b = 10:
-  // 0.0159869 from L = 200, 0.0159981 from 1600); a scene file's states are its own asymptotic data.
-  if (!far) {
+  // A material point's Kepler hyperbola is that of its states, wherever they are: a scene given by its
+  // start state has the observables of that trajectory, and one given by asymptotic data keeps K1 as its
+  // momentum at infinity (speed_at_infinity_of), so no start distance changes them.
+  if (!far || body.p.B == 0.0) {
     no_start_distance_error(e, body.p.B == 0.0, numerical, no_far);
     return 0;
   }
@@ -194,7 +203,8 @@ long add_start_distance(Encounter& e, const Body& body, const std::function<Expe
   }
   const EncounterResult r = encounter_twice_as_far(*scene, twice_as_far_tol(tol), options);
   add_start_distance_error(e, &r, false, numerical);
-  return r.run.total_force_evals();
+  e.start_distance_force_evals = r.run.total_force_evals();
+  return e.start_distance_force_evals;
 }
 
 Expected<Scene> thesis_scene_twice_as_far(SceneParams solved, double b, double v_inf, double arrival_phase) {
@@ -205,6 +215,13 @@ Expected<Scene> thesis_scene_twice_as_far(SceneParams solved, double b, double v
     const Expected<double> own = solve_arrival_phase(solved);
     if (!own) return Expected<Scene>::failure(own.error());
     arrival_phase = *own;
+  }
+  // The speed at infinity is the scene's own at L where none was given (solve_asymptotic_data reads K1 as the
+  // momentum at infinity, and `solved` has the K1 solved at L for it).
+  if (std::isnan(v_inf) && !(std::isnan(b) && std::isnan(arrival_phase))) {
+    const Expected<double> own = incoming_speed(solved);
+    if (!own) return Expected<Scene>::failure(own.error());
+    v_inf = *own;
   }
   solved.start.L *= 2.0;
   const Expected<SceneParams> far = solve_asymptotic_data(solved, b, v_inf, arrival_phase);

@@ -24,7 +24,7 @@
 namespace bodypoint {
 
 long BodyResult::total_force_evals() const {
-  return (accuracy ? accuracy->force_evals : run.force_evals) + error.force_evals + event_force_evals;
+  return (accuracy ? accuracy->force_evals : run.force_evals) + error.force_evals + event_force_evals + encounter_force_evals;
 }
 
 namespace {

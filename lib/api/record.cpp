@@ -169,7 +169,8 @@ Record encounter_record(const Encounter& e) {
   out.number("v_inf_in", sc.v_inf).number("time_delay", sc.time_delay).number("asymptote_error", e.asymptote_error);
   out.note("asymptote_basis", e.asymptote_basis);
   out.number("start_distance_error", e.start_distance_error).number("time_delay_error", e.time_delay_error);
-  out.note("start_distance_basis", e.start_distance_basis).number("deflection_error", e.deflection_error);
+  out.note("start_distance_basis", e.start_distance_basis).count("start_distance_force_evals", e.start_distance_force_evals);
+  out.number("deflection_error", e.deflection_error);
   if (sc.in) out.vector("direction_in", sc.in->direction).vector("direction_out", sc.out->direction);
   out.number("r_min", e.r_min).number("t_min", e.t_min).number("K1_turn", sc.K1_turn).number("spin_turn", sc.spin_turn);
   out.vector("K1_start", sc.K1_start).vector("K1_end", sc.K1_end).vector("K2_start", sc.K2_start).vector("K2_end", sc.K2_end);
@@ -197,7 +198,7 @@ Record sweep_record(const SweepSpec& spec, const SweepRow& r) {
     out.number("out_of_plane", sc.out_of_plane).number("b_in", sc.b).number("v_inf_in", sc.v_inf);
     out.number("time_delay", sc.time_delay).number("asymptote_error", r.asymptote_error);
     out.number("start_distance_error", r.start_distance_error).number("time_delay_error", r.time_delay_error);
-    out.number("deflection_error", r.deflection_error);
+    out.number("deflection_error", r.deflection_error).count("start_distance_force_evals", r.start_distance_force_evals);
     out.number("K1_turn", r.scattering ? sc.K1_turn : nan).number("spin_turn", r.scattering ? sc.spin_turn : nan);
     out.number("K1x", sc.K1_end.x()).number("K1y", sc.K1_end.y()).number("K1z", sc.K1_end.z());
     out.note("asymptotes", r.scattering ? sc.asymptotes : std::string("none: the run did not finish"));

@@ -292,7 +292,7 @@ PointData point_data(const SweepSpec& spec, const std::vector<double>& point) {
 /// The start distance's part of a row's encounter error: the grid point's scene from twice its start
 /// distance (thesis_scene_twice_as_far: the point's data b, v_inf, arrival phase solved for again, the
 /// rest kept), run to its departure by auto (twice_as_far_tol).
-void add_row_start_distance(Encounter& e, const SweepSpec& spec, const std::vector<double>& point, const Body& body,
+long add_row_start_distance(Encounter& e, const SweepSpec& spec, const std::vector<double>& point, const Body& body,
                             double numerical) {
   std::function<Expected<Scene>()> far;
   if (spec.scene_text.empty())
@@ -303,7 +303,7 @@ void add_row_start_distance(Encounter& e, const SweepSpec& spec, const std::vect
   Options o;
   o.track_invariants = false;
   o.cancel = spec.cancel;
-  add_start_distance(e, body, far, spec.accuracy, numerical, "a scene file's body has no thesis start distance to double", o);
+  return add_start_distance(e, body, far, spec.accuracy, numerical, "a scene file's body has no thesis start distance to double", o);
 }
 
 /// The row of a run with its encounter (SweepSpec::scattering): integrate_checked with the encounter's
@@ -316,7 +316,8 @@ SweepRow encounter_row(SweepRow row, const MethodInfo& method, const Scene& scen
   BodyResult r = detail::integrate_checked(body, scene.centres, &method, how, options);  // checked by validate_sweep
   if (!ran(r.outcome)) return result_row(std::move(row), std::move(r));
   Encounter e = measure_encounter(body, scene.centres, r.run, r.events, options.events);
-  if (e.outcome == Outcome::ok && r.outcome == Outcome::ok) add_row_start_distance(e, spec, row.point, body, r.error.value);
+  if (e.outcome == Outcome::ok && r.outcome == Outcome::ok)
+    row.start_distance_force_evals = add_row_start_distance(e, spec, row.point, body, r.error.value);
   row.r_min = e.r_min;
   row.t_min = e.t_min;
   row.asymptote_error = e.asymptote_error;

@@ -293,8 +293,13 @@ TEST(Scattering, SeveralCentresHaveNoAsymptotes) {
 
 // --- Issue #42: only finished encounters, the phase, back-scatter, the closest approach ---
 
-/// The issue's numbers are quoted to 4 digits: B = 0.7, b = 1 finished deflection 0.2876.
+/// The issue's numbers are quoted to 4 digits: B = 0.7, b = 1 finished deflection 0.2876 with K1 = 5 at the
+/// start; 0.3101 since K1 is the momentum at infinity of a scene given by b (speed_at_infinity_of: v_inf 7.06,
+/// was 7.00 at L = 200).
 constexpr double kQuotedDigits = 1e-4;
+/// The accuracy of the finished encounter there: auto reaches 1e-9 on it (1e-10 is out of its reach, 1.8e-10
+/// between its finest runs).
+constexpr double kFinishedTol = 1e-9;
 /// At a fixed arrival phase the deflection converges as the start moves away (the phase's model error
 /// falls as 1/L): from L = 400 to 800 it changes by ~6e-6 (measured), where one helix pitch of L moved
 /// it by up to 0.24 before the phase was a parameter.
@@ -312,9 +317,9 @@ TEST(Encounter, AnUnfinishedEncounterHasNoDeflection) {
   EXPECT_NE(cut.encounter.reason.find("did not finish"), std::string::npos);
   EXPECT_TRUE(std::isnan(cut.encounter.scattering.deflection));
   EXPECT_TRUE(std::isnan(cut.encounter.scattering.time_delay));
-  const EncounterResult done = encounter(body, s.centres, nullptr, 1e-10);  // to the departure
+  const EncounterResult done = encounter(body, s.centres, nullptr, kFinishedTol);  // to the departure
   ASSERT_EQ(done.encounter.outcome, Outcome::ok) << done.encounter.reason;
-  EXPECT_NEAR(done.encounter.scattering.deflection, 0.2876, kQuotedDigits);
+  EXPECT_NEAR(done.encounter.scattering.deflection, 0.3101, kQuotedDigits);
   EXPECT_TRUE(done.run.run.stopped);
   EXPECT_LT(done.encounter.asymptote_error, 1e-6);
   EXPECT_GT(done.encounter.asymptote_error, 0.0);
@@ -406,7 +411,8 @@ TEST(Encounter, ABodyThatBackScattersHasItsAsymptote) {
   const EncounterResult e = encounter(s.bodies.front(), s.centres, nullptr, 1e-10);
   ASSERT_EQ(e.encounter.outcome, Outcome::ok) << e.encounter.reason;
   EXPECT_EQ(e.encounter.scattering.asymptotes, "guiding-centre");
-  EXPECT_NEAR(e.encounter.scattering.deflection, std::numbers::pi - 0.128, 1e-3);
+  // pi - 0.128 with K1 = 5 at the start; pi - 0.1268 with K1 = 5 the momentum at infinity (speed_at_infinity_of).
+  EXPECT_NEAR(e.encounter.scattering.deflection, std::numbers::pi - 0.1268, 1e-3);
 }
 
 /// The runs' tolerance where the deflection's convergence in L is measured: far below the changes it
@@ -436,11 +442,12 @@ TEST(Encounter, AtAFixedArrivalPhaseTheDeflectionConvergesWithTheStartDistance) 
   EXPECT_GT(hi - lo, 0.1);
 }
 
-/// Differences that fall as 1/L halve when L doubles; this band around 2 is far from what the flawed
-/// arrival phase gave below (-0.16: the two differences of opposite signs).
-constexpr double kOneOverLMin = 1.5, kOneOverLMax = 2.5;
+/// Differences that fall as 1/L halve when L doubles, faster ones more (4.2 here since the asymptotes take
+/// the speed at infinity from the energy and b from K2Q); at least 1.5 is far from what the flawed arrival
+/// phase gave below (-0.16: the two differences of opposite signs).
+constexpr double kOneOverLMin = 1.5;
 
-TEST(Encounter, NearHeadOnTheArrivalPhaseIsSolvedAndTheDeflectionFallsAs1OverL) {
+TEST(Encounter, NearHeadOnTheArrivalPhaseIsSolvedAndTheDeflectionConvergesInL) {
   // b = 0.0316 at B = 0.5: the guiding centre's model turns K1 about in a time over which G barely moves,
   // where fixed steps of its RK4 put the arrival phase at L = 400 6.2e-3 rad off, and the deflections from
   // L = 200, 400, 800 read 0.1152532, 0.1152485, 0.1152783 (the study's stated error 1.4e-5 missed it).
@@ -457,7 +464,6 @@ TEST(Encounter, NearHeadOnTheArrivalPhaseIsSolvedAndTheDeflectionFallsAs1OverL) 
   const double t200 = theta(200.0), t400 = theta(400.0), t800 = theta(800.0);
   const double fall = (t400 - t200) / (t800 - t400);
   EXPECT_GT(fall, kOneOverLMin) << t200 << " " << t400 << " " << t800;
-  EXPECT_LT(fall, kOneOverLMax) << t200 << " " << t400 << " " << t800;
 }
 
 // Below that floor the accuracy mode refuses, or delivers within TOL: at 1e-10 a ladder whose middle run sat
@@ -501,6 +507,46 @@ TEST(Events, TheLibrarysGrammarParsesEveryFormAndNamesWhatIsWrong) {
   EXPECT_EQ(parse_event("y=3").label(), "y=3");
   for (const char* bad : {"r=abc", "r=5garbage", "r=1e400", "closest:99999999999999999999", "x:1=2", "arrival", "nearest"})
     EXPECT_THROW((void)parse_event(bad), Error) << bad;
+}
+
+// --- Issue #79: observables at their L -> infinity limit ---
+
+/// At a fixed (b, v_inf, arrival phase) the deflection from L = 200 and 400 differed by 1.4e-5 while the
+/// asymptotes took the speed at infinity from the guiding centre's hyperbola (its mass mu = |K1|/u at the
+/// state) and b from G x K1; from the energy and K2Q they differ by 3.6e-9 (B = 0.7, b = 3, v_inf = 7,
+/// psi = 1). This bound sits 30x above the new difference and 40x below the old one.
+constexpr double kLimitDifference = 1e-7;
+/// The solved scene's own asymptote states the data it was solved for, to the secant's 1e-14 and round-off.
+constexpr double kDataSolved = 1e-12;
+
+TEST(Encounter, AtFixedAsymptoticDataTheDeflectionHardlyMovesWithTheStartDistance) {
+  auto at = [](double L) {
+    SceneParams p;
+    p.start.L = L;
+    p = with_asymptotic_data(p, 3.0, 7.0, 1.0);
+    const Scene s = thesis_scene(p);
+    const EncounterResult e = encounter(s.bodies.front(), s.centres, nullptr, kEncounterTol);
+    EXPECT_EQ(e.encounter.outcome, Outcome::ok) << e.encounter.reason;
+    EXPECT_NEAR(e.encounter.scattering.b, 3.0, kDataSolved * 3.0);
+    EXPECT_NEAR(e.encounter.scattering.v_inf, 7.0, kDataSolved * 7.0);
+    return e.encounter.scattering.deflection;
+  };
+  EXPECT_LT(std::abs(at(200.0) - at(400.0)), kLimitDifference);
+}
+
+TEST(Encounter, AnEncounterGivenByBTakesK1AsItsMomentumAtInfinity) {
+  // K1 = 5, Kx = 2, B = 0.7, J = 1, D = 0.51: the guiding centre's speed at momentum 5 is (5 - 1.4)/0.51.
+  SceneParams p;
+  const double v = speed_at_infinity_of(p);
+  EXPECT_DOUBLE_EQ(v, (5.0 - 0.7 * 2.0) / 0.51);
+  const Scene s = thesis_scene(with_asymptotic_data(p, 3.0, Scattering::kNaN));
+  const Scattering sc = scattering(s.bodies.front().p, s.centres, s.bodies.front().s0, s.bodies.front().s0);
+  EXPECT_NEAR(sc.v_inf, v, kDataSolved * v);
+  EXPECT_NEAR(sc.in->p_inf, 5.0, kDataSolved * 5.0);
+  // A material point's speed at infinity is K1/m; a scene given by d and K1 is a start state and keeps K1.
+  p.B = 0.0;
+  EXPECT_DOUBLE_EQ(speed_at_infinity_of(p), 5.0);
+  EXPECT_EQ(with_asymptotic_data(SceneParams{}, Scattering::kNaN, Scattering::kNaN, 1.0).start.K1, 5.0);
 }
 
 }  // namespace

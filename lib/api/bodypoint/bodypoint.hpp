@@ -204,8 +204,10 @@ struct BodyResult {
   std::vector<std::string> warnings;
   std::vector<EventHit> events;  ///< Options::events located, in time order
   long event_force_evals = 0;    ///< spent locating them
+  /// Spent on its encounter's start distance (Encounter::start_distance_force_evals), where it was measured.
+  long encounter_force_evals = 0;
   /// The force evaluations this body cost in all: the run, the search of the accuracy mode or the error
-  /// estimate's companion, the events.
+  /// estimate's companion, the events, the encounter's start distance.
   [[nodiscard]] long total_force_evals() const;
 };
 
@@ -284,6 +286,7 @@ struct Encounter {
   /// is that of its states); NaN when not known.
   double start_distance_error = Scattering::kNaN, time_delay_error = Scattering::kNaN;
   std::string start_distance_basis = "not known: not measured";
+  long start_distance_force_evals = 0;  ///< the encounter from twice the start distance cost these (its search included)
   /// The deflection's total error: the run's estimated error (a relative error of the final state, which
   /// bounds the angle of its velocity), the asymptotes' model error and the start distance's; NaN when
   /// any part is not known.

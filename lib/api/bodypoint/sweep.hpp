@@ -118,6 +118,7 @@ struct SweepRow {
   /// The start distance's part of the deflection's and the time delay's error, and the deflection's total
   /// error (Encounter's fields of the same names).
   double start_distance_error = Scattering::kNaN, time_delay_error = Scattering::kNaN, deflection_error = Scattering::kNaN;
+  long start_distance_force_evals = 0;  ///< the row's encounter from twice its start distance cost these
   std::optional<AccuracyReport> accuracy;  ///< with SweepSpec::accuracy: what the search chose and cost
 };
 

@@ -6,6 +6,7 @@
 #include "bodypoint/field.hpp"
 #include "bodypoint/detail/monitor.hpp"
 #include "bodypoint/detail/model_parts.hpp"
+#include "bodypoint/invariants.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -32,6 +33,7 @@ std::optional<Asymptote> kepler_asymptote(double mu, double kappa, const Vec3& X
   a.direction = u.normalized();
   a.impact = a.direction.cross(Lv) / p_inf;
   a.p_inf = p_inf;
+  a.v_inf = p_inf / mu;
   return a;
 }
 
@@ -85,6 +87,35 @@ std::optional<KeplerParticle> kepler_particle(const BodyPoint& p, const State& s
 
 namespace {
 
+/// The asymptote of a body about the centre at c (constant A). B = 0: its Kepler hyperbola's, exact. B != 0:
+/// the direction from the guiding centre's hyperbola (mass mu = |K1|/u at the state), and the two numbers
+/// that hyperbola would get wrong by O(1/r) from exact first integrals instead (docs/physics.md,
+/// "Scattering"): the guiding centre's kinetic energy J P^2/(2D) - B k P/D + m|K2|^2/(2D) (k = K2.K1/|K1|,
+/// an adiabatic invariant far away) is not P^2/(2 mu) with one mu, so the momentum at infinity P solves it
+/// at the body's energy and the speed there is |J P - B k|/D; and G x K1 = K2Q - k K1/|K1| turns with K1,
+/// so the impact is taken from the total angular momentum K2Q, which does not: direction x K2Q/P.
+std::optional<Asymptote> body_asymptote(const BodyPoint& p, const State& s, const Centre& c, const KeplerParticle& k,
+                                        bool outgoing) {
+  std::optional<Asymptote> a = kepler_asymptote(k.mu, k.kappa(c.A), k.X, k.P, outgoing);
+  if (!a || p.B == 0.0) return a;
+  const Momenta q = to_momenta(p, s);
+  const double K1 = q.K1.norm(), kpar = q.K2.dot(q.K1) / K1, D = p.D();
+  const double E = energy(p, CentreList{{c}}, s);
+  const double disc = p.B * p.B * kpar * kpar + p.J * (2.0 * D * E - p.m * q.K2.squaredNorm());
+  // The root on the guiding centre's branch: drifting along K1 (J P > B k) the larger, against it the smaller.
+  const double P = disc >= 0.0 ? (p.B * kpar + k.kappa_sign * std::sqrt(disc)) / p.J : std::numeric_limits<double>::quiet_NaN();
+  if (!(P > 0.0) || !std::isfinite(P) || (p.J * P - p.B * kpar) * k.kappa_sign <= 0.0) return a;  // the hyperbola's, then
+  const Vec3 K2Q = total_angular_momentum(p, s, c.c);
+  a->p_inf = P;
+  a->v_inf = std::abs(p.J * P - p.B * kpar) / D;
+  a->impact = k.kappa_sign * a->direction.cross(K2Q) / P;
+  return a;
+}
+
+}  // namespace
+
+namespace {
+
 /// One leg's Coulomb time delay, -kappa/(mu v_inf^3) (1 + ln e) (scattering.hpp, time_delay), and for
 /// a spinning body the term that makes the delay converge: the guiding centre's kinetic energy
 /// (J P^2 - 2 B K2.K1/|K1| P)/(2D) is not P^2/(2 mu), so its time along a leg grows as
@@ -132,8 +163,8 @@ Scattering scattering(const BodyPoint& p, const std::vector<Centre>& centres, co
     return out;
   }
   const double kappa_in = in->kappa(k.A), kappa_out = fin->kappa(k.A);
-  out.in = kepler_asymptote(in->mu, kappa_in, in->X, in->P, false);
-  out.out = kepler_asymptote(fin->mu, kappa_out, fin->X, fin->P, true);
+  out.in = body_asymptote(p, start, k, *in, false);
+  out.out = body_asymptote(p, end, k, *fin, true);
   if (!out.in || !out.out) {
     out.asymptotes = "none: the orbit is bound (energy at infinity <= 0)";
     out.in.reset();
@@ -143,7 +174,7 @@ Scattering scattering(const BodyPoint& p, const std::vector<Centre>& centres, co
   out.asymptotes = p.B == 0.0 ? "kepler" : "guiding-centre";
   out.deflection = angle_between(out.in->direction, out.out->direction);
   out.b = out.in->b();
-  out.v_inf = out.in->p_inf / in->mu;
+  out.v_inf = out.in->v_inf;
   const Vec3 normal = out.in->direction.cross(out.in->impact);
   out.out_of_plane = normal.squaredNorm() > 0.0 ? std::asin(std::clamp(out.out->direction.dot(normal.normalized()), -1.0, 1.0))
                                                 : 0.0;
@@ -179,7 +210,7 @@ Incoming incoming(const SceneParams& p) {
   // the drift's zero, B Kx/J, where it drifts against K1), it has no periapsis ahead and no incoming leg.
   if (!(k->X.dot(k->P) < 0.0))
     return {std::nullopt, 0.0, "the scene's guiding centre drifts away from the centre at the start: no encounter happens"};
-  const auto a = kepler_asymptote(k->mu, k->kappa(s.centres.front().A), k->X, k->P, false);
+  const auto a = body_asymptote(body.p, body.s0, s.centres.front(), *k, false);
   if (!a) return {std::nullopt, 0.0, "the scene's orbit is bound (energy at infinity <= 0): it has no incoming asymptote"};
   return {*a, k->mu, ""};
 }
@@ -195,7 +226,7 @@ std::optional<double> b_of(const SceneParams& p, std::string& why) {
 std::optional<double> v_of(const SceneParams& p, std::string& why) {
   const Incoming in = incoming(p);
   why = in.why;
-  return in.asymptote ? std::optional<double>(in.asymptote->p_inf / in.mu) : std::nullopt;
+  return in.asymptote ? std::optional<double>(in.asymptote->v_inf) : std::nullopt;
 }
 /// f at p, or why it is not defined there.
 Expected<double> defined(Datum f, const SceneParams& p) {
@@ -379,6 +410,14 @@ Expected<double> solve_k1(SceneParams params, double v_inf) {
 
 }  // namespace
 
+Expected<double> incoming_speed(const SceneParams& p) { return defined(v_of, p); }
+
+double speed_at_infinity_of(const SceneParams& p) {
+  // K2.K1/|K1| = Kx at the start (the phase turns K2 about K1 = K1 i): the guiding centre's speed at momentum K1.
+  const double v = p.B == 0.0 ? p.start.K1 / p.m : (p.J * p.start.K1 - p.B * p.start.Kx) / (p.m * p.J - p.B * p.B);
+  return v > 0.0 ? v : std::numeric_limits<double>::quiet_NaN();
+}
+
 double least_approaching_k1(const SceneParams& p) { return std::max(0.0, p.B * p.start.Kx / p.J); }
 
 double start_phase_for_arrival(const SceneParams& params, double arrival) { return solve_start_phase(params, arrival).value(); }
@@ -388,6 +427,14 @@ double d_for_impact_parameter(SceneParams params, double b) { return solve_d(std
 double k1_for_speed_at_infinity(SceneParams params, double v_inf) { return solve_k1(std::move(params), v_inf).value(); }
 
 Expected<SceneParams> solve_asymptotic_data(SceneParams params, double b, double v_inf, double arrival) {
+  // Each datum depends a little on the others' parameters through the start at finite distance L: b and
+  // v_inf on the start phase too (the body's place on its helix sets its potential energy and K2Q). So
+  // all are solved in turn until none moves; one datum given is one solve.
+  // An encounter given by its impact parameter has its L -> infinity limit at a fixed momentum at infinity:
+  // the scene's K1 is read as that momentum (its speed there, speed_at_infinity_of), not as K1 at the start,
+  // which moves the speed at infinity by O(1/L) (the potential at L is part of the start's energy).
+  if (std::isnan(v_inf) && !std::isnan(b)) v_inf = speed_at_infinity_of(params);
+  const int given = !std::isnan(b) + !std::isnan(v_inf) + !std::isnan(arrival);
   for (int i = 0; i < kImpactIterations; ++i) {
     const SceneParams before = params;
     if (!std::isnan(v_inf)) {
@@ -400,16 +447,16 @@ Expected<SceneParams> solve_asymptotic_data(SceneParams params, double b, double
       if (!d) return Expected<SceneParams>::failure(d.error());
       params.start.d = *d;
     }
-    // One datum given: one solve is exact. Both: until neither moves (each depends a little on the other).
-    if (std::isnan(b) || std::isnan(v_inf) ||
-        (std::abs(params.start.K1 - before.start.K1) <= kImpactRelTol * params.start.K1 &&
-         std::abs(params.start.d - before.start.d) <= kImpactRelTol * std::max(params.start.d, b)))
+    if (!std::isnan(arrival)) {
+      const Expected<double> phase = solve_start_phase(params, arrival);
+      if (!phase) return Expected<SceneParams>::failure(phase.error());
+      params.start.phase = *phase;
+    }
+    const auto still = [](double x, double y, double scale) { return std::abs(x - y) <= kImpactRelTol * scale; };
+    if (given <= 1 || (still(params.start.K1, before.start.K1, params.start.K1) &&
+                       still(params.start.d, before.start.d, std::max(params.start.d, std::isnan(b) ? 0.0 : b)) &&
+                       still(params.start.phase, before.start.phase, 2.0 * std::numbers::pi)))
       break;
-  }
-  if (!std::isnan(arrival)) {
-    const Expected<double> phase = solve_start_phase(params, arrival);
-    if (!phase) return Expected<SceneParams>::failure(phase.error());
-    params.start.phase = *phase;
   }
   return params;
 }

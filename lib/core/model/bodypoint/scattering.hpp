@@ -22,7 +22,9 @@
 // For B != 0 the body travels on a helix about its guiding centre G = R + K1 x K2/|K1|^2, which the
 // kinetic drift moves exactly along K1 at the speed u = (J |K1| - B K2.K1/|K1|)/D (docs/physics.md,
 // "Exact Lie-Poisson splitting"): far from the centre G is a Kepler particle of momentum K1 and mass
-// mu = |K1|/u. Its asymptotes are those of that hyperbola ("guiding-centre"); the model neglects
+// mu = |K1|/u. Its asymptotes' directions are those of that hyperbola ("guiding-centre"); the momentum and
+// speed at infinity come from the energy with the guiding centre's own kinetic energy, and the impact from
+// the total angular momentum K2Q (both exact first integrals; the hyperbola's are O(1/r) off). The model neglects
 // the helix's radius against the distance and the slow change of K2.K1, an error that falls as
 // L^-2.7 .. L^-3.9 with the distance L it is applied at (Encounter::asymptote_error estimates it).
 #pragma once
@@ -41,6 +43,7 @@ struct Asymptote {
   Vec3 direction = Vec3::Zero();  ///< unit vector of the motion along the line
   Vec3 impact = Vec3::Zero();     ///< from the centre to the line's closest point; its length is b
   double p_inf = 0.0;             ///< momentum at infinity
+  double v_inf = 0.0;             ///< speed at infinity (B != 0: the guiding centre's)
   [[nodiscard]] double b() const { return impact.norm(); }
 };
 
@@ -90,6 +93,11 @@ double d_for_impact_parameter(SceneParams params, double b);
 /// (below it, it drifts away: a second root with no encounter). Error when v_inf is not a finite number
 /// > 0 or no K1 on that branch reaches it (a bound orbit on the way).
 double k1_for_speed_at_infinity(SceneParams params, double v_inf);
+/// The speed at infinity of the thesis's scene whose momentum at infinity is its K1 (B = 0: K1/m; B != 0: the
+/// guiding centre's, (J K1 - B Kx)/D); NaN where the guiding centre would drift away (no encounter). A scene
+/// given by b and not by v_inf takes this speed (solve_asymptotic_data): its L -> infinity limit keeps K1 as
+/// the momentum at infinity.
+double speed_at_infinity_of(const SceneParams& p);
 /// The scene given by its asymptotic data: impact parameter b and/or speed at infinity v_inf (NaN:
 /// not given, the scene's own d or K1 kept). Both are solved together (each depends a little on the
 /// other through the start at finite distance L) until neither d nor K1 changes.

@@ -72,6 +72,8 @@ inline double path_distance(const Helix& h, const Vec3& c, double t_max) {
 /// The least K1 > 0 at which the thesis's guiding centre drifts along K1, towards the centre: its drift
 /// K1 (J K1 - B Kx)/D vanishes at K1 = B Kx/J; 0 where it drifts along K1 at every K1 > 0.
 double least_approaching_k1(const SceneParams& p);
+/// The speed at infinity of the thesis's scene p (its incoming asymptote's, from its start state), or why it has none.
+Expected<double> incoming_speed(const SceneParams& p);
 
 /// A scene as a value, checked whole once (why_invalid, model.hpp): `scene`, or why it is not valid.
 Expected<Scene> valid_scene(Scene scene);
