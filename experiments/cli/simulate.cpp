@@ -70,7 +70,9 @@ void print_encounter(const std::vector<Event>& events, const BodyResult& run, co
   std::cout << "  scattering (asymptotes: " << sc.asymptotes << ")\n";
   if (sc.in)
     std::cout << "    deflection = " << fmt(sc.deflection) << " rad (out of the incoming plane: " << fmt(sc.out_of_plane)
-              << "), impact parameter b = " << fmt(sc.b) << ", v_inf = " << fmt(sc.v_inf)
+              << ", error " << (std::isfinite(e->out_of_plane_error) ? fmt(e->out_of_plane_error) : "not known")
+              << "), impact parameter b = " << fmt(sc.b) << " (model error " << fmt(e->b_error) << "), v_inf = " << fmt(sc.v_inf)
+              << " (" << fmt(e->v_inf_error) << ")"
               << ", time delay = " << fmt(sc.time_delay) << "\n"
               << "    the asymptotes' model error in the deflection: "
               << (std::isfinite(e->asymptote_error) ? fmt(e->asymptote_error) + " (" : "") << e->asymptote_basis
@@ -250,7 +252,8 @@ long add_start_distance_of(Encounter& e, const po::variables_map& vm, const Scen
   std::function<Expected<Scene>()> far;
   if (!vm.count("scene")) far = [&] { return thesis_scene_twice_as_far(so.params, so.b, so.v_inf, so.arrival_phase); };
   return add_start_distance(e, body, far, plan.search ? std::optional<double>(plan.tol) : std::nullopt, numerical,
-                     "the scene file gives states, not the thesis's start distance L");
+                            "the scene file gives states, not the thesis's start distance L", {},
+                            !vm.count("scene") && (vm.count("b") || vm.count("v-inf")));
 }
 
 /// One body's run and, with --reference, the reference state at its end.

@@ -26,8 +26,20 @@ constexpr double kLeftSlack = 1e-9;
 /// margin of 1.5 for the next one (the differences fall by 2.0x and 1.94x there: 2 |x(200) - x(400)| is
 /// 0.3 % below the limit's 2.42e-5).
 constexpr double kStartDistanceFactor = 2.0 * 1.5;
+/// An encounter given by asymptotic data answers at the limit L -> infinity: Richardson's 2 x(2L) - x(L)
+/// removes a 1/L term, and for a single term c/L^p with p >= 0.5 it is within 1.41 |x(L) - x(2L)| of the
+/// limit (0 at p = 1, 2/3 at p = 2, 1 as p grows); a margin of 1.5 on that. Table 3.1, b = 3, arrival
+/// phase 1: 0.0410657139 from L = 200 and 400, 0.0410657134 from 400 and 800, where x(200) is 1.1e-8 away.
+constexpr double kLimitFactor = 1.5;
 
 double start_distance(const Body& body, const Centre& c) { return (detail::guiding_centre(body.p, body.s0) - c.c).norm(); }
+
+/// The centres an encounter is measured about: the one centre, or several centres' far-field centre
+/// (far_field_centre: their total charge), or each of them where there is none (a law other than Coulomb's).
+std::vector<Centre> measured_about(const std::vector<Centre>& centres) {
+  const std::optional<Centre> far = centres.size() > 1 ? far_field_centre(centres) : std::nullopt;
+  return far ? std::vector<Centre>{*far} : centres;
+}
 
 bool has_event(const std::vector<Event>& events, Event::Kind kind, std::size_t centre, bool stop) {
   return std::any_of(events.begin(), events.end(),
@@ -35,7 +47,8 @@ bool has_event(const std::vector<Event>& events, Event::Kind kind, std::size_t c
 }
 
 /// Why the run ended before the body left, or empty when it had left.
-std::string unfinished(const Body& body, const std::vector<Centre>& centres, const RunResult& run) {
+std::string unfinished(const Body& body, const std::vector<Centre>& all, const RunResult& run) {
+  const std::vector<Centre> centres = measured_about(all);
   for (std::size_t k = 0; k < centres.size(); ++k) {
     const double r0 = start_distance(body, centres[k]);
     const Vec3 G = detail::guiding_centre(body.p, run.final) - centres[k].c;
@@ -72,23 +85,32 @@ void estimate_asymptote_error(Encounter& e, const Body& body, const std::vector<
     e.asymptote_basis = "not known: no asymptotes";
     return;
   }
-  if (body.p.B == 0.0) {
+  if (body.p.B == 0.0 && centres.size() == 1) {
     const Vec3& c = centres.front().c;
     const double b = e.scattering.b, r = (body.s0.R - c).norm() + (end.R - c).norm();
     e.asymptote_error = b > 0.0 ? kKeplerRounding * std::numeric_limits<double>::epsilon() * r / b : 0.0;
+    e.b_error = e.asymptote_error * b;  // the same rounding, relative
+    e.v_inf_error = kKeplerRounding * std::numeric_limits<double>::epsilon() * e.scattering.v_inf;
+    e.out_of_plane_model_error = e.asymptote_error;
     e.asymptote_basis = "exact: a material point's asymptotes are its Kepler orbit's (the rounding of their formula at "
                         "the run's distances: 4 eps (r0 + r1)/b)";
     return;
   }
-  const double half = 0.5 * start_distance(body, centres.front());
+  const double half = 0.5 * start_distance(body, measured_about(centres).front());
   const EventHit* in = marker(hits, events, Event::Kind::arrival, half, false);
   const EventHit* out = marker(hits, events, Event::Kind::departure, half, true);
   if (!in || !out || out->t <= in->t) {
     e.asymptote_basis = "not known: the guiding centre did not pass half its start distance (" + fmt(half) + ") both ways";
     return;
   }
-  const double theta_half = scattering(body.p, centres, in->s, out->s).deflection;
-  e.asymptote_error = std::abs(e.scattering.deflection - theta_half) / (std::pow(2.0, kAsymptoteFall) - 1.0);
+  const Scattering at_half = scattering(body.p, centres, in->s, out->s);
+  const double fall = std::pow(2.0, kAsymptoteFall) - 1.0;
+  e.asymptote_error = std::abs(e.scattering.deflection - at_half.deflection) / fall;
+  // The incoming asymptote's b and v_inf the same way (b from K2Q, v_inf from the energy: their model error
+  // falls faster still, 11x a doubling from L = 200 on table 3.1, b = 3).
+  e.b_error = std::abs(e.scattering.b - at_half.b) / fall;
+  e.v_inf_error = std::abs(e.scattering.v_inf - at_half.v_inf) / fall;
+  e.out_of_plane_model_error = std::abs(e.scattering.out_of_plane - at_half.out_of_plane) / fall;
   e.asymptote_basis = "deflection at the run's ends against at half the start distance (" + fmt(half) + "), over 2^" +
                       fmt(kAsymptoteFall) + " - 1";
 }
@@ -99,13 +121,19 @@ Options encounter_options(const Body& body, const std::vector<Centre>& centres, 
   using K = Event::Kind;
   for (std::size_t k = 0; k < centres.size(); ++k)
     if (!has_event(options.events, K::closest_approach, k, false)) options.events.push_back(Event{K::closest_approach, k});
-  if (centres.size() != 1) return options;
-  const double half = 0.5 * start_distance(body, centres.front());
-  options.events.push_back(Event{K::arrival, 0, half});
-  options.events.push_back(Event{K::departure, 0, half});
+  const std::vector<Centre> about = measured_about(centres);
+  if (about.size() != 1) return options;
+  // Several centres: the distances from their far-field centre (Event::about).
+  const std::optional<Vec3> point = centres.size() > 1 ? std::optional<Vec3>(about.front().c) : std::nullopt;
+  const double half = 0.5 * start_distance(body, about.front());
+  Event in{K::arrival, 0, half}, out{K::departure, 0, half};
+  in.about = out.about = point;
+  options.events.push_back(in);
+  options.events.push_back(out);
   if (stop_at_departure && !has_event(options.events, K::departure, 0, true)) {
     Event leave{K::departure, 0, 0.0};
     leave.stop = true;
+    leave.about = point;
     options.events.push_back(leave);
   }
   return options;
@@ -143,33 +171,52 @@ Encounter measure_encounter(const Body& body, const std::vector<Centre>& centres
 }
 
 double encounter_span(const Body& body, const std::vector<Centre>& centres) {
-  if (centres.size() != 1) throw Error("an encounter without an end time t_end needs a single centre (give t_end)");
-  const auto k = kepler_particle(body.p, body.s0, centres.front().c);
-  const auto a = k ? kepler_asymptote(k->mu, k->kappa(centres.front().A), k->X, k->P, false) : std::nullopt;
+  const std::optional<Centre> far = far_field_centre(centres);
+  if (!far) throw Error("an encounter without an end time t_end needs Coulomb centres (give t_end)");
+  const auto k = kepler_particle(body.p, body.s0, far->c);
+  const auto a = k ? kepler_asymptote(k->mu, k->kappa(far->A), k->X, k->P, false) : std::nullopt;
   if (!a) throw Error("the body has no speed at infinity (a bound orbit, or a guiding centre at rest): give t_end");
   return kEncounterSpans * 2.0 * k->X.norm() / (a->p_inf / k->mu);
 }
 
-void add_start_distance_error(Encounter& at_L, const EncounterResult* at_2L, bool material, double numerical) {
+void add_start_distance_error(Encounter& at_L, const EncounterResult* at_2L, bool material, double numerical, bool at_limit) {
   if (material) {
-    at_L.start_distance_error = at_L.time_delay_error = 0.0;
+    at_L.start_distance_error = at_L.time_delay_error = at_L.out_of_plane_start_error = 0.0;
     at_L.start_distance_basis = "exact: a material point's Kepler hyperbola is that of its states, wherever they are";
   } else if (!at_2L || at_2L->run.outcome != Outcome::ok || at_2L->encounter.outcome != Outcome::ok ||
              !std::isfinite(at_2L->encounter.scattering.deflection)) {
     const std::string why = !at_2L ? "" : at_2L->run.outcome != Outcome::ok ? at_2L->run.reason : at_2L->encounter.reason;
     at_L.start_distance_basis = "not known: the encounter from twice the start distance did not finish" +
                                 (why.empty() ? std::string() : " (" + why + ")");
+  } else if (at_limit) {
+    // The value at the limit, 2 x(2L) - x(L); the far run's errors count twice in it.
+    const Encounter& far = at_2L->encounter;
+    Scattering& sc = at_L.scattering;
+    const double far_error = (std::isfinite(at_2L->run.error.value) ? at_2L->run.error.value : 0.0) +
+                             (std::isfinite(far.asymptote_error) ? far.asymptote_error : 0.0);
+    const double d_theta = sc.deflection - far.scattering.deflection, d_delay = sc.time_delay - far.scattering.time_delay;
+    sc.deflection = far.scattering.deflection - d_theta;
+    at_L.out_of_plane_start_error = kLimitFactor * std::abs(sc.out_of_plane - far.scattering.out_of_plane) + 2.0 * far_error;
+    sc.out_of_plane = 2.0 * far.scattering.out_of_plane - sc.out_of_plane;
+    sc.time_delay = far.scattering.time_delay - d_delay;
+    at_L.start_distance_error = kLimitFactor * std::abs(d_theta) + 2.0 * far_error;
+    at_L.time_delay_error = kLimitFactor * std::abs(d_delay);
+    at_L.start_distance_basis = "at the limit L -> infinity: 2 x(2L) - x(L) from the encounter started at twice the distance (" +
+                                fmt(far.scattering.deflection) + " rad there, estimated error " + fmt(far_error) +
+                                "), within 1.5 |x(L) - x(2L)| and twice that run's error";
   } else {
     // x(L) = x_inf + c/L: x(L) - x_inf = 2 (x(L) - x(2L)), with a margin; the far run's own error counts.
     const Scattering& far = at_2L->encounter.scattering;
     const double far_error = std::isfinite(at_2L->run.error.value) ? at_2L->run.error.value : 0.0;
     at_L.start_distance_error = kStartDistanceFactor * (std::abs(at_L.scattering.deflection - far.deflection) + far_error);
     at_L.time_delay_error = kStartDistanceFactor * std::abs(at_L.scattering.time_delay - far.time_delay);
+    at_L.out_of_plane_start_error = kStartDistanceFactor * (std::abs(at_L.scattering.out_of_plane - far.out_of_plane) + far_error);
     at_L.start_distance_basis = "3 |x(L) - x(2L)| from the encounter started at twice the distance (" + fmt(far.deflection) +
                                 " rad there, estimated error " + fmt(far_error) +
                                 "): the observables converge as 1/L, a margin of 1.5 for the next order";
   }
   at_L.deflection_error = numerical + at_L.asymptote_error + at_L.start_distance_error;  // NaN if any is
+  at_L.out_of_plane_error = numerical + at_L.out_of_plane_model_error + at_L.out_of_plane_start_error;
 }
 
 EncounterResult encounter_twice_as_far(const Scene& far, double tol, const Options& options) {
@@ -183,17 +230,21 @@ EncounterResult encounter_twice_as_far(const Scene& far, double tol, const Optio
 }
 
 void no_start_distance_error(Encounter& e, bool material, double numerical, const std::string& why) {
-  add_start_distance_error(e, nullptr, material, numerical);
+  add_start_distance_error(e, nullptr, material, numerical, false);
   if (!material) e.start_distance_basis = "not known: " + why;
 }
 
 long add_start_distance(Encounter& e, const Body& body, const std::function<Expected<Scene>()>& far,
-                        std::optional<double> tol, double numerical, const std::string& no_far, const Options& options) {
+                        std::optional<double> tol, double numerical, const std::string& no_far, const Options& options,
+                        bool at_limit) {
   // A material point's Kepler hyperbola is that of its states, wherever they are: a scene given by its
   // start state has the observables of that trajectory, and one given by asymptotic data keeps K1 as its
-  // momentum at infinity (speed_at_infinity_of), so no start distance changes them.
+  // momentum at infinity (speed_at_infinity_of), so no start distance changes them. A scene that gives
+  // states (a scene file) has no start distance to double: its observables are its trajectory's, their
+  // error the run's and the asymptotes' (issue #79: a spinning body's was "not known").
   if (!far || body.p.B == 0.0) {
-    no_start_distance_error(e, body.p.B == 0.0, numerical, no_far);
+    add_start_distance_error(e, nullptr, true, numerical);
+    if (!far && body.p.B != 0.0) e.start_distance_basis = "none: " + no_far + "; its observables are its trajectory's";
     return 0;
   }
   const Expected<Scene> scene = far();
@@ -202,7 +253,7 @@ long add_start_distance(Encounter& e, const Body& body, const std::function<Expe
     return 0;
   }
   const EncounterResult r = encounter_twice_as_far(*scene, twice_as_far_tol(tol), options);
-  add_start_distance_error(e, &r, false, numerical);
+  add_start_distance_error(e, &r, false, numerical, at_limit);
   e.start_distance_force_evals = r.run.total_force_evals();
   return e.start_distance_force_evals;
 }

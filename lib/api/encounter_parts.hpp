@@ -43,7 +43,10 @@ inline double twice_as_far_tol(std::optional<double> run_tol) { return run_tol ?
 /// (`at_2L`: encounter_twice_as_far of thesis_scene_twice_as_far; its own estimated
 /// error counts in), and the deflection's total error with `numerical` (the run's err_estimate). For
 /// B = 0 (`material`) no second encounter is needed: pass nullptr.
-void add_start_distance_error(Encounter& at_L, const EncounterResult* at_2L, bool material, double numerical);
+/// With `at_limit` (a scene given by asymptotic data: b or v_inf) the deflection, out-of-plane angle and
+/// time delay become their values at the limit, 2 x(2L) - x(L), and the errors those values' (kLimitFactor).
+void add_start_distance_error(Encounter& at_L, const EncounterResult* at_2L, bool material, double numerical,
+                              bool at_limit = false);
 /// The encounter of `far` (the thesis's scene from 2L) by auto at `tol` (twice_as_far_tol), looser by
 /// 100x while auto refuses it as out of reach, to 1e-6 at most (the 1/L term it measures is 1e-6..1e-3
 /// at L = 200..1600; auto at 1e-10 is out of reach from L = 3200).
@@ -52,12 +55,15 @@ EncounterResult encounter_twice_as_far(const Scene& far, double tol, const Optio
 /// known (`why`), nor is the total, for B != 0.
 void no_start_distance_error(Encounter& e, bool material, double numerical, const std::string& why);
 /// The start distance's part of `e`'s error, one rule for every caller (simulate, sweep, the scattering
-/// study, Python): exact for a material point; not known (`no_far` says why) where the scene has no
-/// thesis start distance to double (`far` empty), or (its reason) where `far()` finds no scene there;
-/// otherwise the encounter from `far()` (thesis_scene_twice_as_far) run by auto at twice_as_far_tol(tol).
-/// Returns the force evaluations of that second encounter (0 where none ran).
+/// study, Python): exact (0) for a material point, and 0 where the scene gives states (`far` empty, `no_far`
+/// saying so: its observables are its trajectory's); not known (its reason) where `far()` finds no scene
+/// there; otherwise the encounter from `far()` (thesis_scene_twice_as_far) run by auto at
+/// twice_as_far_tol(tol), and with `at_limit` (a scene given by b or v_inf) the observables taken to the limit
+/// L -> infinity (add_start_distance_error). Returns the force evaluations of that second encounter (0 where
+/// none ran), also in Encounter::start_distance_force_evals.
 long add_start_distance(Encounter& e, const Body& body, const std::function<Expected<Scene>()>& far,
-                        std::optional<double> tol, double numerical, const std::string& no_far, const Options& options = {});
+                        std::optional<double> tol, double numerical, const std::string& no_far, const Options& options = {},
+                        bool at_limit = false);
 /// The thesis's scene of the parameters `solved` (d, K1, phase solved for the asymptotic data) with the start
 /// distance L doubled and the data b, v_inf (NaN: not given, d, K1 kept) solved for again; the arrival phase
 /// as given, or (NaN) the scene's own at L (a start phase kept has no limit L -> infinity: the extra way in

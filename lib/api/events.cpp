@@ -162,7 +162,7 @@ std::vector<Event> resolved(std::vector<Event> events, const BodyPoint& p, const
                             const State& start) {
   for (Event& e : events)
     if (e.kind == Event::Kind::departure && e.value == 0.0)
-      e.value = (guiding_centre(p, start) - centres[e.centre].c).norm();
+      e.value = (guiding_centre(p, start) - (e.about ? *e.about : centres[e.centre].c)).norm();
   return events;
 }
 
@@ -184,7 +184,7 @@ double event_function(const Event& e, const BodyPoint& p, const std::vector<Cent
     case Event::Kind::local_minimum: return (s.R - centres[e.centre].c).dot(s.v);
     case Event::Kind::radius: return (s.R - centres[e.centre].c).norm() - e.value;
     case Event::Kind::departure:
-    case Event::Kind::arrival: return (guiding_centre(p, s) - centres[e.centre].c).norm() - e.value;
+    case Event::Kind::arrival: return (guiding_centre(p, s) - (e.about ? *e.about : centres[e.centre].c)).norm() - e.value;
     case Event::Kind::plane: return e.normal.dot(s.R) - e.value;
   }
   return 0.0;
@@ -201,6 +201,7 @@ bool crosses(const Event& e, double g_a, double g_b) {
 
 double distance_for(const Event& e, const std::vector<Centre>& centres, const State& s) {
   const std::size_t c = e.kind == Event::Kind::plane ? 0 : e.centre;
+  if (e.about) return (s.R - *e.about).norm();
   return centres.empty() ? s.R.norm() : (s.R - centres[c].c).norm();
 }
 

@@ -165,8 +165,10 @@ Record encounter_record(const Encounter& e) {
   const Scattering& sc = e.scattering;
   Record out;
   out.text("outcome", std::string(outcome_name(e.outcome))).note("reason", e.reason).note("asymptotes", sc.asymptotes);
-  out.number("deflection", sc.deflection).number("out_of_plane", sc.out_of_plane).number("b_in", sc.b);
-  out.number("v_inf_in", sc.v_inf).number("time_delay", sc.time_delay).number("asymptote_error", e.asymptote_error);
+  out.number("deflection", sc.deflection).number("out_of_plane", sc.out_of_plane).number("out_of_plane_error", e.out_of_plane_error);
+  out.number("b_in", sc.b);
+  out.number("v_inf_in", sc.v_inf).number("b_in_error", e.b_error).number("v_inf_in_error", e.v_inf_error);
+  out.number("time_delay", sc.time_delay).number("asymptote_error", e.asymptote_error);
   out.note("asymptote_basis", e.asymptote_basis);
   out.number("start_distance_error", e.start_distance_error).number("time_delay_error", e.time_delay_error);
   out.note("start_distance_basis", e.start_distance_basis).count("start_distance_force_evals", e.start_distance_force_evals);

@@ -303,7 +303,13 @@ long add_row_start_distance(Encounter& e, const SweepSpec& spec, const std::vect
   Options o;
   o.track_invariants = false;
   o.cancel = spec.cancel;
-  return add_start_distance(e, body, far, spec.accuracy, numerical, "a scene file's body has no thesis start distance to double", o);
+  bool at_limit = false;  // a thesis point given by b or v_inf answers at the limit L -> infinity
+  if (spec.scene_text.empty()) {
+    const PointData d = point_data(spec, point);
+    at_limit = !(std::isnan(d.b) && std::isnan(d.v_inf));
+  }
+  return add_start_distance(e, body, far, spec.accuracy, numerical, "a scene file's body has no thesis start distance to double", o,
+                            at_limit);
 }
 
 /// The row of a run with its encounter (SweepSpec::scattering): integrate_checked with the encounter's

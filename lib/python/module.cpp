@@ -559,12 +559,16 @@ py::dict encounter_py(const Scene& scene, const std::string& method, double tol,
     // The far scene is made here, under the GIL (from the thesis's parameters, a Python dict).
     std::optional<Expected<Scene>> far_scene;
     if (thesis) far_scene = twice_as_far(*thesis);
+    const bool at_limit = thesis && [&] {
+      const ThesisParams t = thesis_params_from(*thesis);
+      return t.data.b.has_value() || t.data.v_inf.has_value();
+    }();
     std::function<Expected<Scene>()> far;
     if (far_scene) far = [&far_scene] { return *far_scene; };
     {
       py::gil_scoped_release free;
       r.run.encounter_force_evals = add_start_distance(r.encounter, body, far, tol, r.run.error.value,
-                         "the scene gives states, not the thesis's start distance L (thesis_scene() does)", o);
+                         "the scene gives states, not the thesis's start distance L (thesis_scene() does)", o, at_limit);
     }
     stop.raise();
   }

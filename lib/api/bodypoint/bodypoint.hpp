@@ -80,8 +80,12 @@ struct Event {
   /// The run ends at this event's first hit: the state there is the run's final state (RunResult::
   /// stopped, t_end its time) and the last of BodyResult::events. A fixed-step, time-transformed or
   /// step-size-controlled run stops stepping on the step that crosses it; the accuracy mode searches
-  /// its step over the whole span t_end and delivers the run cut at the event.
+  /// its step to twice the stop's time where the span asked for is much longer (a pilot run finds where
+  /// it falls), and delivers the run cut at the event.
   bool stop = false;
+  /// departure, arrival: the guiding centre's distance from this point instead of from the centre `centre`
+  /// (an encounter with several centres measures it from their far-field centre, far_field_centre).
+  std::optional<Vec3> about = std::nullopt;
   /// "closest", "local-min(1)", "r=5", "plane(1,0,0)=0", "departure": for outputs and messages.
   [[nodiscard]] std::string label() const;
 };
@@ -279,6 +283,14 @@ struct Encounter {
   /// asymptotes, or the body never came within half its start distance).
   double asymptote_error = Scattering::kNaN;
   std::string asymptote_basis;  ///< how asymptote_error was obtained, or why it is not known
+  /// The same model's error in the incoming asymptote's impact parameter and speed at infinity (b_in and
+  /// v_inf_in against their L -> infinity values), estimated the same way; NaN when not known.
+  double b_error = Scattering::kNaN, v_inf_error = Scattering::kNaN;
+  /// The out-of-plane angle's total error: the run's estimate, this model's part and the start distance's
+  /// (formed with deflection_error; NaN when a part is not known).
+  double out_of_plane_error = Scattering::kNaN;
+  double out_of_plane_model_error = Scattering::kNaN;  ///< its asymptotes' model part, as asymptote_error's
+  double out_of_plane_start_error = Scattering::kNaN;  ///< its start distance's part (0 where that part is exact)
   /// The error of the deflection and of the time delay that the start's finite distance L leaves against
   /// the limit L -> infinity of the scene as given (the observables converge as 1/L: 3 |x(L) - x(2L)| from
   /// the same scene started at 2L, the thesis's parameters with L doubled and b, v_inf solved again; a material point

@@ -393,13 +393,16 @@ def encounter(scene, *, t_end=None, method="auto", tol=1e-10, max_seconds=DEFAUL
     at the latest after two free passes; with t_end it runs to t_end. Returns outcome ("ok", or
     "incomplete" when the run ended before the body left: then deflection, out_of_plane, b_in, v_inf_in and
     time_delay are None), reason, deflection, out_of_plane, b_in, v_inf_in (the incoming asymptote's
-    impact parameter and speed at infinity, as measured: the sweep's columns of these names), time_delay, asymptote_error (the
-    asymptotes' model error in the deflection; 0 for B = 0) and asymptote_basis, start_distance_error and
-    time_delay_error (what the finite start distance L leaves against L -> infinity: a scene of
-    thesis_scene() is run again from 2L, a material point too; for a scene given by its states 0 for B = 0,
-    None otherwise) and
-    start_distance_basis, deflection_error (the deflection's total: the run's estimate, the asymptotes' and
-    the start distance's; None where a part is not known), K1_turn, spin_turn,
+    impact parameter and speed at infinity, as measured: the sweep's columns of these names), b_in_error,
+    v_inf_in_error (their asymptotes' model error), out_of_plane_error, time_delay, asymptote_error (the
+    asymptotes' model error in the deflection; for B = 0 about one centre its formula's rounding) and
+    asymptote_basis, start_distance_error and time_delay_error (what the finite start distance L leaves
+    against L -> infinity: a spinning body's scene of thesis_scene() is run again from 2L, and given by b or
+    v_inf its deflection, out_of_plane and time_delay are their values at that limit, 2 x(2L) - x(L); 0 for
+    a material point and for a scene given by its states, whose observables are its trajectory's),
+    start_distance_basis, start_distance_force_evals (the run from 2L; in run's total_force_evals too),
+    deflection_error (the deflection's total: the run's estimate, the asymptotes' and the start
+    distance's; None where a part is not known), K1_turn, spin_turn,
     r_min, t_min (the closest approach to any centre), asymptotes, direction_in and direction_out, K1,
     K2 (and K2Q) and E at both ends: the keys of ``simulate --scattering --json``'s "scattering" object.
     ``run`` holds the run's own fields, as integrate() gives a body's (method, steps, t_end,

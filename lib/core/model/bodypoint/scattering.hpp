@@ -75,6 +75,13 @@ struct Scattering {
   static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 };
 
+/// The single centre an encounter with `centres` is measured about far from all of them: the one centre,
+/// or for several Coulomb centres their total charge sum A at their |A|-weighted centre (for charges of one
+/// sign the charge centre, where their dipole vanishes: the field differs from it as 1/r^4 far away, and
+/// the asymptotes' model error says what that leaves at the run's distances). Nothing without a centre, or
+/// where a centre does not follow Coulomb's law.
+std::optional<Centre> far_field_centre(const std::vector<Centre>& centres);
+
 /// The encounter's observables from the first and last state of a run in this field; `elapsed` (the
 /// run's duration, t_end) gives the time delay.
 Scattering scattering(const BodyPoint& p, const std::vector<Centre>& centres, const State& start, const State& end,
