@@ -244,7 +244,7 @@ long add_start_distance(Encounter& e, const Body& body, const std::function<Expe
   // error the run's and the asymptotes' (issue #79: a spinning body's was "not known").
   if (!far || body.p.B == 0.0) {
     add_start_distance_error(e, nullptr, true, numerical);
-    if (!far && body.p.B != 0.0) e.start_distance_basis = "none: " + no_far + "; its observables are its trajectory's";
+    if (!far) e.start_distance_basis = "none: " + no_far + "; its observables are its trajectory's";
     return 0;
   }
   const Expected<Scene> scene = far();
