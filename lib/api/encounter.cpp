@@ -29,7 +29,7 @@ constexpr double kStartDistanceFactor = 2.0 * 1.5;
 /// An encounter given by asymptotic data answers at the limit L -> infinity: Richardson's 2 x(2L) - x(L)
 /// removes a 1/L term, and for a single term c/L^p with p >= 0.5 it is within 1.41 |x(L) - x(2L)| of the
 /// limit (0 at p = 1, 2/3 at p = 2, 1 as p grows); a margin of 1.5 on that. Table 3.1, b = 3, arrival
-/// phase 1: 0.0410657139 from L = 200 and 400, 0.0410657134 from 400 and 800, where x(200) is 1.1e-8 away.
+/// phase 1, TOL 1e-10: 0.0410657137 from L = 200 and 400, 0.0410657132 from 800 and 1600, where x(200) is 1.1e-8 away.
 constexpr double kLimitFactor = 1.5;
 
 double start_distance(const Body& body, const Centre& c) { return (detail::guiding_centre(body.p, body.s0) - c.c).norm(); }
