@@ -253,7 +253,7 @@ long add_start_distance_of(Encounter& e, const po::variables_map& vm, const Scen
   if (!vm.count("scene")) far = [&] { return thesis_scene_twice_as_far(so.params, so.b, so.v_inf, so.arrival_phase); };
   return add_start_distance(e, body, far, plan.search ? std::optional<double>(plan.tol) : std::nullopt, numerical,
                             "the scene file gives states, not the thesis's start distance L", {},
-                            !vm.count("scene") && (vm.count("b") || vm.count("v-inf")));
+                            !vm.count("scene") && answers_at_limit(so.b, so.v_inf));
 }
 
 /// One body's run and, with --reference, the reference state at its end.

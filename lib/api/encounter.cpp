@@ -194,13 +194,15 @@ void add_start_distance_error(Encounter& at_L, const EncounterResult* at_2L, boo
     Scattering& sc = at_L.scattering;
     const double far_error = (std::isfinite(at_2L->run.error.value) ? at_2L->run.error.value : 0.0) +
                              (std::isfinite(far.asymptote_error) ? far.asymptote_error : 0.0);
-    const double d_theta = sc.deflection - far.scattering.deflection, d_delay = sc.time_delay - far.scattering.time_delay;
-    sc.deflection = far.scattering.deflection - d_theta;
-    at_L.out_of_plane_start_error = kLimitFactor * std::abs(sc.out_of_plane - far.scattering.out_of_plane) + 2.0 * far_error;
-    sc.out_of_plane = 2.0 * far.scattering.out_of_plane - sc.out_of_plane;
-    sc.time_delay = far.scattering.time_delay - d_delay;
-    at_L.start_distance_error = kLimitFactor * std::abs(d_theta) + 2.0 * far_error;
-    at_L.time_delay_error = kLimitFactor * std::abs(d_delay);
+    // x at the limit, and its error without the far run's: kLimitFactor |x(L) - x(2L)|.
+    const auto to_limit = [](double& x, double x_far) {
+      const double error = kLimitFactor * std::abs(x - x_far);
+      x = 2.0 * x_far - x;
+      return error;
+    };
+    at_L.start_distance_error = to_limit(sc.deflection, far.scattering.deflection) + 2.0 * far_error;
+    at_L.out_of_plane_start_error = to_limit(sc.out_of_plane, far.scattering.out_of_plane) + 2.0 * far_error;
+    at_L.time_delay_error = to_limit(sc.time_delay, far.scattering.time_delay);
     at_L.start_distance_basis = "at the limit L -> infinity: 2 x(2L) - x(L) from the encounter started at twice the distance (" +
                                 fmt(far.scattering.deflection) + " rad there, estimated error " + fmt(far_error) +
                                 "), within 1.5 |x(L) - x(2L)| and twice that run's error";

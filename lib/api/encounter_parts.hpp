@@ -6,6 +6,7 @@
 
 #include "bodypoint/bodypoint.hpp"
 
+#include <cmath>
 #include <functional>
 #include <optional>
 #include <string>
@@ -61,6 +62,9 @@ void no_start_distance_error(Encounter& e, bool material, double numerical, cons
 /// twice_as_far_tol(tol), and with `at_limit` (a scene given by b or v_inf) the observables taken to the limit
 /// L -> infinity (add_start_distance_error). Returns the force evaluations of that second encounter (0 where
 /// none ran), also in Encounter::start_distance_force_evals.
+/// Whether a thesis scene given by these asymptotic data (NaN: not given) answers at the limit L -> infinity
+/// (`at_limit` of add_start_distance): given by b or v_inf.
+inline bool answers_at_limit(double b, double v_inf) { return !(std::isnan(b) && std::isnan(v_inf)); }
 long add_start_distance(Encounter& e, const Body& body, const std::function<Expected<Scene>()>& far,
                         std::optional<double> tol, double numerical, const std::string& no_far, const Options& options = {},
                         bool at_limit = false);

@@ -158,11 +158,16 @@ Vec3 guiding_centre(const BodyPoint& p, const State& s) {
   return K1sq > 0.0 ? Vec3(s.R + q.K1.cross(q.K2) / K1sq) : s.R;
 }
 
+namespace {
+/// The point a departure or arrival measures the guiding centre's distance from: Event::about, or its centre.
+Vec3 origin(const Event& e, const std::vector<Centre>& centres) { return e.about ? *e.about : centres[e.centre].c; }
+}  // namespace
+
 std::vector<Event> resolved(std::vector<Event> events, const BodyPoint& p, const std::vector<Centre>& centres,
                             const State& start) {
   for (Event& e : events)
     if (e.kind == Event::Kind::departure && e.value == 0.0)
-      e.value = (guiding_centre(p, start) - (e.about ? *e.about : centres[e.centre].c)).norm();
+      e.value = (guiding_centre(p, start) - origin(e, centres)).norm();
   return events;
 }
 
@@ -184,7 +189,7 @@ double event_function(const Event& e, const BodyPoint& p, const std::vector<Cent
     case Event::Kind::local_minimum: return (s.R - centres[e.centre].c).dot(s.v);
     case Event::Kind::radius: return (s.R - centres[e.centre].c).norm() - e.value;
     case Event::Kind::departure:
-    case Event::Kind::arrival: return (guiding_centre(p, s) - (e.about ? *e.about : centres[e.centre].c)).norm() - e.value;
+    case Event::Kind::arrival: return (guiding_centre(p, s) - origin(e, centres)).norm() - e.value;
     case Event::Kind::plane: return e.normal.dot(s.R) - e.value;
   }
   return 0.0;

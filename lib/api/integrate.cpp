@@ -255,10 +255,12 @@ constexpr double kStopPilotTol = 1e-6;
 constexpr double kStopMargin = 2.0;
 constexpr double kPlannedShorter = 1.5;
 /// The pilot itself costs a share of the answer (odeint-dopri5 follows the helix), so it runs only where the
-/// span asked for is over this many
-/// crossing times (the start's distance to the nearest centre over its speed): an encounter's own span is
-/// 4 of them, and one asked to its departure within twice that is searched whole, as before.
+/// span asked for is over this many crossing times (the start's distance to the nearest centre over its
+/// speed): an encounter's own span is 4 of them, and one asked to its departure within twice that is
+/// searched whole, as before.
 constexpr double kPilotAbove = 8.0;
+/// The pilot's first trial step (the controller takes it up or down from there).
+constexpr double kStopPilotFirstStep = 1e-3;
 
 /// The time the body takes to cover its distance to the nearest centre at its start speed (infinite at rest).
 double crossing_time(const Body& body, const std::vector<Centre>& centres) {
@@ -267,8 +269,6 @@ double crossing_time(const Body& body, const std::vector<Centre>& centres) {
   const double v = body.s0.v.norm();
   return v > 0.0 ? r / v : std::numeric_limits<double>::infinity();
 }
-/// Its first trial step (the controller takes it up or down from there).
-constexpr double kStopPilotFirstStep = 1e-3;
 
 /// The time of the first stop event of `options` on the way to a.t_end, found by the pilot (its force
 /// evaluations added to `evals`), or nothing where the pilot did not reach it.

@@ -295,21 +295,16 @@ PointData point_data(const SweepSpec& spec, const std::vector<double>& point) {
 long add_row_start_distance(Encounter& e, const SweepSpec& spec, const std::vector<double>& point, const Body& body,
                             double numerical) {
   std::function<Expected<Scene>()> far;
-  if (spec.scene_text.empty())
-    far = [&] {
-      const PointData d = point_data(spec, point);
-      return thesis_scene_twice_as_far(d.params, d.b, d.v_inf, d.arrival);
-    };
+  std::optional<PointData> d;  // the point's data, solved once for the far scene and the limit's rule
+  if (spec.scene_text.empty()) {
+    d = point_data(spec, point);
+    far = [&] { return thesis_scene_twice_as_far(d->params, d->b, d->v_inf, d->arrival); };
+  }
   Options o;
   o.track_invariants = false;
   o.cancel = spec.cancel;
-  bool at_limit = false;  // a thesis point given by b or v_inf answers at the limit L -> infinity
-  if (spec.scene_text.empty()) {
-    const PointData d = point_data(spec, point);
-    at_limit = !(std::isnan(d.b) && std::isnan(d.v_inf));
-  }
   return add_start_distance(e, body, far, spec.accuracy, numerical, "a scene file's body has no thesis start distance to double", o,
-                            at_limit);
+                            d && answers_at_limit(d->b, d->v_inf));
 }
 
 /// The row of a run with its encounter (SweepSpec::scattering): integrate_checked with the encounter's

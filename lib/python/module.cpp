@@ -530,9 +530,8 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
 /// The scene of thesis_scene()'s keywords `kw` from twice its start distance (thesis_scene_twice_as_far:
 /// the data given solved for again, the rest kept, the arrival phase the scene's own where none is given),
 /// or why there is none.
-Expected<Scene> twice_as_far(const py::dict& kw) {
-  const ThesisParams t = thesis_params_from(kw);
-  constexpr double kNotGiven = std::numeric_limits<double>::quiet_NaN();
+constexpr double kNotGiven = std::numeric_limits<double>::quiet_NaN();
+Expected<Scene> twice_as_far(const ThesisParams& t) {
   return thesis_scene_twice_as_far(t.solved, t.data.b.value_or(kNotGiven), t.data.v_inf.value_or(kNotGiven),
                                    t.data.arrival_phase.value_or(kNotGiven));
 }
@@ -558,11 +557,12 @@ py::dict encounter_py(const Scene& scene, const std::string& method, double tol,
   if (r.encounter.outcome == Outcome::ok) {
     // The far scene is made here, under the GIL (from the thesis's parameters, a Python dict).
     std::optional<Expected<Scene>> far_scene;
-    if (thesis) far_scene = twice_as_far(*thesis);
-    const bool at_limit = thesis && [&] {
-      const ThesisParams t = thesis_params_from(*thesis);
-      return t.data.b.has_value() || t.data.v_inf.has_value();
-    }();
+    bool at_limit = false;
+    if (thesis) {
+      const ThesisParams t = thesis_params_from(*thesis);  // solves the asymptotic data: once
+      far_scene = twice_as_far(t);
+      at_limit = answers_at_limit(t.data.b.value_or(kNotGiven), t.data.v_inf.value_or(kNotGiven));
+    }
     std::function<Expected<Scene>()> far;
     if (far_scene) far = [&far_scene] { return *far_scene; };
     {

@@ -133,10 +133,6 @@ std::optional<Asymptote> body_asymptote(const BodyPoint& p, const State& s, cons
   return a;
 }
 
-}  // namespace
-
-namespace {
-
 /// One leg's Coulomb time delay, -kappa/(mu v_inf^3) (1 + ln e) (scattering.hpp, time_delay), and for
 /// a spinning body the term that makes the delay converge: the guiding centre's kinetic energy
 /// (J P^2 - 2 B K2.K1/|K1| P)/(2D) is not P^2/(2 mu), so its time along a leg grows as
