@@ -103,7 +103,10 @@ RunOptions Search::run_options(double omega_c, bool may_deliver) const {
   o.omega_c = omega_c;
   o.cancel = delivery_.cancel;
   o.track_invariants = may_deliver && delivery_.track_invariants;
-  if (may_deliver) o.every = delivery_.every;
+  if (may_deliver) {
+    o.every = delivery_.every;
+    o.inside_steps = delivery_.inside_steps;
+  }
   return o;
 }
 

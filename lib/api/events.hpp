@@ -10,6 +10,7 @@
 #include "bodypoint/bodypoint.hpp"
 
 #include <functional>
+#include <limits>
 #include <vector>
 
 namespace bodypoint::detail {
@@ -37,22 +38,45 @@ class EventWatch {
     std::size_t event;
     double t_a, t_b, g_a, g_b;
     State s_a, s_b;
+    /// A long span (kHiddenSpin) whose g may cross zero more often than its ends show: locate() halves it.
+    bool open = false;
   };
   EventWatch(const std::vector<Event>& events, const BodyPoint& p, const std::vector<Centre>& centres)
-      : events_(events), p_(p), centres_(centres), g_(events.size()) {}
+      : events_(events), p_(p), centres_(centres), g_(events.size()),
+        nearest_(centres.size(), std::numeric_limits<double>::infinity()) {}
   void observe(double t, const State& s);
   [[nodiscard]] const std::vector<Bracket>& brackets() const { return brackets_; }
+  /// Spans between two observed states where g kept its sign but may have changed it twice in between:
+  /// a step that turns the spin or the direction to a centre by much (may_hide_roots), over which g's rate
+  /// could have taken it to zero and back. locate() samples them inside.
+  [[nodiscard]] const std::vector<Bracket>& hidden() const { return hidden_; }
+  /// The least distance to centre c observed so far (a closest approach below it is worth looking for).
+  [[nodiscard]] double nearest(std::size_t c) const { return nearest_[c]; }
 
  private:
   const std::vector<Event>& events_;
   const BodyPoint& p_;
   const std::vector<Centre>& centres_;
   std::vector<double> g_;
+  std::vector<double> nearest_;
   bool started_ = false;
   double t_ = 0.0;
   State s_;
-  std::vector<Bracket> brackets_;
+  std::vector<Bracket> brackets_, hidden_;
 };
+
+/// A step longer than this share of a turn of the spin (radians), or one that turns the direction to a
+/// centre by more than kHiddenTurn, can hold two sign changes of an event's function that the step's ends
+/// do not show (a helix wiggle: the steps of far-ip between its inner points, logh-bs's extrapolated macro
+/// steps). Shorter steps sample a turn at four points or more: a sign change and its return lie in
+/// different steps.
+inline constexpr double kHiddenSpin = 3.14159265358979323846 / 2.0;
+inline constexpr double kHiddenTurn = 3.14159265358979323846 / 4.0;
+/// The bound on |dg/dt| over such a step is this many times the larger of its values at the two ends
+/// (the helix keeps the size of the gyroscopic acceleration; the Coulomb part changes with r).
+inline constexpr double kRateMargin = 2.0;
+/// A hidden span is halved at most this many times (2^6 pieces) before it is taken to hold no root.
+inline constexpr int kMaxHalvings = 6;
 
 /// Integrates a state for a time tau > 0 with the run's method and configuration; adds the force
 /// evaluations it made to `evals`.

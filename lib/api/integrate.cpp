@@ -75,7 +75,7 @@ class WatchingSink {
       stop_step_ = s.step;
       return stop_run_ ? Flow::stop : Flow::go;
     }
-    if (!user_) return Flow::go;
+    if (!user_ || s.inside) return Flow::go;  // a state inside a step is the watch's alone
     if (s.step % every_ != 0) {
       pending_ = KeptSample::of(s);
       return Flow::go;
@@ -174,7 +174,9 @@ class OutputTimesSink {
       flow = emit(x);  // t = 0
       next_ = 1;
     } else {
-      for (double t = next_time(); t <= x.t && flow == Flow::go; t = next_time()) {
+      // The output times before a state inside the step (RunOptions::inside_steps) come before it; that
+      // state is handed on as it is (the watch's), the next output times still taken from the step's start.
+      for (double t = next_time(); (x.inside ? t < x.t : t <= x.t) && flow == Flow::go; t = next_time()) {
         if (t == x.t) {
           flow = emit(x);
         } else {
@@ -185,6 +187,7 @@ class OutputTimesSink {
         }
         ++next_;
       }
+      if (x.inside) return flow == Flow::go ? user_(x) : flow;
     }
     prev_ = KeptSample::of(x);
     return flow;
@@ -226,6 +229,7 @@ BodyResult run_watched(const Body& body, const std::vector<Centre>& centres, con
   inner.events.clear();
   inner.sink = &sink;
   inner.every = 1;
+  inner.inside_steps = true;  // an event between the ends of a step that holds several turns of the spin
   BodyResult r = integrate_valid_body(body, centres, method, how, inner);
   if (!ran(r.outcome)) return r;
   r.events = detail::locate(watch, events, body.p, centres, advancer(r, body, centres, how, options), r.event_force_evals);
@@ -403,7 +407,7 @@ BodyResult integrate_estimated(const Body& body, const std::vector<Centre>& cent
   if (options.sink) {
     back = [&options](const Sample& x) {
       const State s = time_reversed(x.s);
-      return (*options.sink)(Sample{x.step, -x.t, s, x.rel_dE, x.rel_dK2sq, x.abs_dK2Q});
+      return (*options.sink)(Sample{x.step, -x.t, s, x.rel_dE, x.rel_dK2sq, x.abs_dK2Q, x.inside});
     };
     o.sink = &back;
   }
@@ -657,7 +661,7 @@ Outcome Stepper::advance_to(double t) {
   if (options_.sink) {
     shifted = [this, t0, first](const Sample& s) {
       if (s.step == 0 && !first) return;
-      (*options_.sink)(Sample{s.step, t0 + s.t, s.s, s.rel_dE, s.rel_dK2sq, s.abs_dK2Q});
+      (*options_.sink)(Sample{s.step, t0 + s.t, s.s, s.rel_dE, s.rel_dK2sq, s.abs_dK2Q, s.inside});
     };
     opt.sink = &shifted;
   }

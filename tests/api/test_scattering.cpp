@@ -436,6 +436,38 @@ TEST(Encounter, TheClosestApproachIsTheGlobalMinimumNotAHelixWiggle) {
   EXPECT_THROW((void)integrate(s, "lp-kl8", FixedSteps{1e-3, 10}, stop), Error);
 }
 
+/// far-ip at h = 0.9 and logh-bs at 1e-8 per step against lp-kl8 at h = 1e-3: the three runs' states agree to
+/// ~1e-10 relative over this pass (r_min 9.0546216052 .. 9.0546216060), so the same event is the same to 1e-8.
+constexpr double kLongStepEventRel = 1e-8;
+
+TEST(Events, AStepThatHoldsSeveralTurnsOfTheSpinHidesNoEvent) {
+  // far-ip's steps turn the spin by 6 rad and logh-bs's macro steps by up to 10: between their ends the helix
+  // makes local minima of r and crosses r = 9.5 twice (W9: far-ip reported r_min = 11.12 at t = 29.23, logh-bs
+  // 10.76 at 27.57, for 9.0546 at 28.40). Every event the fine run has, they have, at its time and distance.
+  const Scene s = thesis_scene(SceneParams{});
+  Options o;
+  o.track_invariants = false;
+  o.events = {Event{Event::Kind::closest_approach}, Event{Event::Kind::local_minimum},
+              Event{Event::Kind::radius, 0, 9.5, Vec3::UnitX()}};
+  const Result fine = integrate(s, "lp-kl8", FixedSteps{1e-3, 60000}, o);
+  ASSERT_EQ(fine.outcome, Outcome::ok) << fine.reason;
+  const std::vector<EventHit>& want = fine.bodies.front().events;
+  ASSERT_GE(want.size(), 5u);  // the closest approach, minima, and r = 9.5 in and out
+  const std::vector<std::pair<const char*, Advance>> runs = {{"far-ip", FixedSteps{60.0 / 66.0, 66}},
+                                                             {"logh-bs", ControlledSteps{1e-4, 60.0, 1e-8}}};
+  for (const auto& [method, how] : runs) {
+    const Result r = integrate(s, method, how, o);
+    ASSERT_EQ(r.outcome, Outcome::ok) << method << ": " << r.reason;
+    const std::vector<EventHit>& got = r.bodies.front().events;
+    ASSERT_EQ(got.size(), want.size()) << method;
+    for (std::size_t k = 0; k < want.size(); ++k) {
+      EXPECT_EQ(got[k].event, want[k].event) << method << " hit " << k;
+      EXPECT_NEAR(got[k].t, want[k].t, kLongStepEventRel * want[k].t) << method << " hit " << k;
+      EXPECT_NEAR(got[k].r, want[k].r, kLongStepEventRel * want[k].r) << method << " hit " << k;
+    }
+  }
+}
+
 TEST(Encounter, ABodyThatBackScattersHasItsAsymptote) {
   // Spin along K1 (Kx = 5, Kz = 0), B = 0.7, b = 0.1: the guiding centre drifts back against K1.
   SceneParams p;

@@ -140,7 +140,15 @@ RunResult run_far_field(const Body& body, const std::vector<Centre>& centres, co
       Momenta x = to_momenta(body.p, body.s0);
       for (long i = 0; i < fixed.steps; ++i) {
         stepper.step(x, fixed.h);
-        if constexpr (std::decay_t<decltype(obs)>::active) obs(i + 1, x);
+        if constexpr (std::decay_t<decltype(obs)>::active) {
+          if (obs.wants_inside())
+            for (int j = 1; j <= stepper.inner_points(); ++j) {
+              double tau = 0.0;
+              const Momenta inner = stepper.at_point(j, tau);
+              obs.inside(i + 1, static_cast<double>(i) * fixed.h + tau, to_state(body.p, inner));
+            }
+          obs(i + 1, x);
+        }
         if (!sp::poll(obs, i + 1)) break;
       }
       return to_state(body.p, x);

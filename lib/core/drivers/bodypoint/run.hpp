@@ -30,6 +30,9 @@ struct Sample {
   double t;
   const State& s;
   double rel_dE, rel_dK2sq, abs_dK2Q;
+  /// A state inside step `step` (RunOptions::inside_steps: a collocation point of far-ip's step), not a
+  /// step's end; its deviations are those of the last step's end.
+  bool inside = false;
 };
 /// What a sink tells the run after a state: go on, or end the run at that state.
 enum class Flow { go, stop };
@@ -153,6 +156,11 @@ struct RunOptions {
   /// Time-transformed methods: the constant c of the time-step function (logH: Pi + c, TTL:
   /// sum |A_i|/r_i + c), so the physical step is at most ds/c; < 0: chosen from the scene.
   double omega_c = -1.0;
+  /// Also hands the sink the states a method knows inside its steps, flagged Sample::inside, before the
+  /// step's end: far-ip's collocation points (its step's dense output, as accurate as the step's end), where
+  /// one step holds several turns of the spin and an event's sign can change and change back. Event
+  /// location watches them; the other methods' steps hold no such states.
+  bool inside_steps = false;
   /// When given, polled every kPollStride steps of every loop (searches, companions and event
   /// refinements included): once another thread or a signal handler sets it, the run ends as
   /// Outcome::failed with the reason kStoppedOnRequest. The Python module's Ctrl-C and max_seconds.

@@ -147,6 +147,7 @@ void Stepper::step(Momenta& x, double h) {
   const Nodes& nd = nodes_for(n);
   const int N = n + 1;
   points = N;
+  h_ = h;
   if (Y_.rows() < N) {
     Y_.resize(N, 9);
     G_.resize(N, 9);
@@ -198,6 +199,14 @@ void Stepper::step(Momenta& x, double h) {
   x.R = z.R;
   x.K1 = Y.block<1, 3>(n, 3).transpose();
   x.K2 = z.K2;
+}
+
+Momenta Stepper::at_point(int j, double& tau) const {
+  const Nodes& nd = nodes_.at(points - 1);
+  tau = h_ * nd.sigma(j);
+  const Vec3 K1 = Y_.block<1, 3>(j, 3).transpose();
+  const Drifted z = drift(Y_.block<1, 3>(j, 0).transpose(), K1, Y_.block<1, 3>(j, 6).transpose(), tau);
+  return Momenta{z.R, K1, z.K2};
 }
 
 }  // namespace bodypoint::far_field

@@ -92,6 +92,12 @@ class Stepper {
   /// does not converge (the step is too long for the field where it is taken).
   void step(Momenta& x, double h);
 
+  /// The last step's inner collocation points (its first and last excluded): their number, and the state at
+  /// point j (1 <= j < inner_points() + 1) with its time from the step's start. The step's dense output: the
+  /// converged iterate drifted there, as accurate as the step's end, at no force evaluation.
+  [[nodiscard]] int inner_points() const { return points - 2; }
+  [[nodiscard]] Momenta at_point(int j, double& tau) const;
+
   long evals = 0;          ///< force evaluations (F and its Jacobian at a point): points x evaluating iterations
   long iterations = 0;     ///< Picard iterations over all steps
   int points = 0;          ///< Chebyshev points of the last step
@@ -119,6 +125,7 @@ class Stepper {
   BodyPoint p_;
   std::vector<Centre> centres_;
   double inv_D_, spin_;  ///< 1/D and B/D
+  double h_ = 0.0;       ///< the last step
   std::map<int, Nodes> nodes_;
   Block Y_, G_, next_;   ///< the iterate, its field and the next iterate: grown, never shrunk (no
                          ///< allocation inside a run's step loop once the largest step was taken)

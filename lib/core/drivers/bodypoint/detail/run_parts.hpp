@@ -17,8 +17,9 @@ struct KeptSample {
   double t = 0.0;
   State s;
   double rel_dE = 0.0, rel_dK2sq = 0.0, abs_dK2Q = 0.0;
-  static KeptSample of(const Sample& x) { return {x.step, x.t, x.s, x.rel_dE, x.rel_dK2sq, x.abs_dK2Q}; }
-  [[nodiscard]] Sample sample() const { return {step, t, s, rel_dE, rel_dK2sq, abs_dK2Q}; }
+  bool inside = false;
+  static KeptSample of(const Sample& x) { return {x.step, x.t, x.s, x.rel_dE, x.rel_dK2sq, x.abs_dK2Q, x.inside}; }
+  [[nodiscard]] Sample sample() const { return {step, t, s, rel_dE, rel_dK2sq, abs_dK2Q, inside}; }
 };
 /// The output interval of any way of advancing time (0: none).
 double output_interval(const Advance& how);

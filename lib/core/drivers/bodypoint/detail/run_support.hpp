@@ -96,7 +96,8 @@ class Monitor {
 
   Monitor(const BodyPoint& p, const Field& f, const State& s0, const RunOptions& options, Grid grid,
           ToPhysical to_physical)
-      : inv_(p, f, s0), grid_(grid), every_(options.every), sink_(options.sink), cancel_{options.cancel},
+      : inv_(p, f, s0), grid_(grid), every_(options.every), sink_(options.sink),
+        inside_(options.sink && options.inside_steps), cancel_{options.cancel},
         to_physical_(std::move(to_physical)) {
     hand(Sample{0, 0.0, s0, 0.0, 0.0, 0.0});
   }
@@ -119,6 +120,11 @@ class Monitor {
     if (stop_) return;  // the run ended where the sink said stop: nothing after it is observed
     inv_.update(s);
     hand(Sample{i, t, s, inv_.last_rel_dE(), inv_.last_rel_dK2sq(), inv_.last_abs_dK2Q()});
+  }
+  /// A state inside step i at time t (RunOptions::inside_steps), handed before that step's end.
+  [[nodiscard]] bool wants_inside() const { return inside_ && !stop_; }
+  void inside(long i, double t, const State& s) {
+    if (wants_inside()) hand(Sample{i, t, s, inv_.last_rel_dE(), inv_.last_rel_dK2sq(), inv_.last_abs_dK2Q(), true});
   }
   [[nodiscard]] bool wants_times() const { return sink_ && grid_.dt_out > 0.0; }
   /// After step i: false once the sink said Flow::stop (the loop then ends).
@@ -150,6 +156,7 @@ class Monitor {
   Grid grid_;
   long every_;
   const SampleSink* sink_;
+  bool inside_;
   CancelPoll cancel_;
   ToPhysical to_physical_;
   std::optional<SinkStop> stop_;
