@@ -130,8 +130,8 @@ void add_simulate_options(po::options_description& desc, SimulateOptions& o) {
        "locate events on the method's own steps and report them: closest (a closest approach; closest:K to "
        "centre K), r=RADIUS (r:K=RADIUS), x=X, y=Y, z=Z or plane=nx,ny,nz,offset")
       ("stop-at", po::value(&o.stop_text)->multitoken()->composing(),
-       "end the run at the first hit of this event (same forms as --event; e.g. r=300 once the body has left): "
-       "its state is the final one, its time t_end")
+       "end the run at the first hit of this event (same forms as --event; e.g. r=300 once the body has left; "
+       "closest: the least distance of the run to --t-end): its state is the final one, its time t_end")
       ("scattering", po::bool_switch(&o.scattering),
        "report the encounter: asymptotes, deflection, impact parameter, closest approach, K1 and spin turn "
        "(docs/physics.md, Scattering)")

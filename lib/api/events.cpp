@@ -144,10 +144,6 @@ void validate_events(const std::vector<Event>& events, const std::vector<Centre>
     if (e.kind == K::plane &&
         !(std::isfinite(e.value) && e.normal.allFinite() && e.normal.norm() > 0.0 && std::isfinite(e.normal.norm())))
       throw Error("event " + e.label() + ": a plane needs a finite non-zero normal and a finite offset");
-    if (e.kind == K::closest_approach && e.stop)
-      throw Error("event " + e.label() + ": a run cannot stop at its closest approach, which is known only at its end; "
-                  "stop at local-min (the first local minimum of the distance; for a spinning body it may be a "
-                  "wiggle of its helix) or at departure (the encounter has ended)");
   }
 }
 

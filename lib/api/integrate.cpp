@@ -57,19 +57,27 @@ void run_accurately(BodyResult& r, const Body& body, const std::vector<Centre>& 
 BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
                                 const Advance& how, const Options& options);
 
+/// Whether an event's first bracket ends the run: a stop event, except the closest approach, which is the
+/// least distance of the whole run (it is cut there afterwards: run_watched).
+bool ends_run(const Event& e) { return e.stop && e.kind != Event::Kind::closest_approach; }
+
 /// The sink of a run with events: every observed state goes to the watch; the caller's sink gets the
 /// states it asked for (every `every`-th step and the last; with dt_out all of them). Once a stop
 /// event is bracketed no later state is passed on; with `stop_run` the run is ended there (Flow::stop).
+/// A run that stops at its closest approach knows where only at its end: its states are held until then
+/// and those before the approach handed on (the caller's Flow::stop ends them, not the run).
 class WatchingSink {
  public:
   WatchingSink(detail::EventWatch& watch, const Options& options, bool every_state, bool stop_run)
       : watch_(watch), events_(options.events), user_(options.sink), every_(every_state ? 1 : options.every),
-        stop_run_(stop_run) {}
+        stop_run_(stop_run), hold_(std::any_of(events_.begin(), events_.end(), [](const Event& e) {
+          return e.stop && e.kind == Event::Kind::closest_approach;
+        })) {}
   Flow operator()(const Sample& s) {
     if (stopped_) return Flow::go;
     watch_.observe(s.t, s.s);
     for (; seen_ < watch_.brackets().size(); ++seen_)
-      stopped_ = stopped_ || events_[watch_.brackets()[seen_].event].stop;
+      stopped_ = stopped_ || ends_run(events_[watch_.brackets()[seen_].event]);
     if (stopped_) {
       pending_.reset();
       stop_step_ = s.step;
@@ -81,11 +89,24 @@ class WatchingSink {
       return Flow::go;
     }
     pending_.reset();
+    if (hold_) {
+      held_.push_back(KeptSample::of(s));
+      return Flow::go;
+    }
     return (*user_)(s);
   }
-  /// The last state: the one the every-th rule skipped, or the stop event's (its deviations given).
+  /// The last state: the one the every-th rule skipped, or the stop event's (its deviations given); the
+  /// states held for a stop at the closest approach before it.
   void finish(const EventHit* stop, double rel_dE, double rel_dK2sq, double abs_dK2Q) {
     if (!user_) return;
+    for (const KeptSample& k : held_) {
+      if (stop && k.t >= stop->t) {
+        stop_step_ = k.step;
+        break;
+      }
+      stop_step_ = k.step;
+      if ((*user_)(k.sample()) == Flow::stop) return;
+    }
     if (stop) (*user_)(Sample{stop_step_, stop->t, stop->s, rel_dE, rel_dK2sq, abs_dK2Q});
     else if (pending_) (*user_)(pending_->sample());
   }
@@ -96,6 +117,8 @@ class WatchingSink {
   const SampleSink* user_;
   long every_;
   bool stop_run_;
+  bool hold_;                     ///< a stop at the closest approach: the caller's states wait for the run's end
+  std::vector<KeptSample> held_;
   bool stopped_ = false;
   std::size_t seen_ = 0;
   long stop_step_ = 0;

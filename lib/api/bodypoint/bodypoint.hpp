@@ -62,8 +62,9 @@ namespace bodypoint {
 struct Event {
   enum class Kind {
     /// The run's closest approach to a centre: the smallest of the local minima of |R - c| (a spinning
-    /// body's helix makes several). Only that one is reported; it cannot stop a run (it is known only
-    /// at the run's end).
+    /// body's helix makes several). Only that one is reported. As a stop, it is known only at the run's
+    /// end: the run goes on to its end time and is cut at that least distance (states after it are not
+    /// handed on).
     closest_approach,
     local_minimum,  ///< every local minimum of |R - c| (g = (R - c).v turns from < 0 to >= 0)
     radius,         ///< |R - c| crosses `value`, either way
