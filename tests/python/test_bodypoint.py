@@ -377,6 +377,8 @@ LONG_CALLS = {
     "sweep": lambda s, **kw: bp.sweep({"d": [5, 10]}, "lp-y4,logh-y4", steps=3 * 10**7, **kw),
     "encounter": lambda s, **kw: bp.encounter(s, t_end=1e7, **kw),
     "stepper": lambda s, **kw: bp.Stepper(s, "gsl-rk8pd", 1e-14).advance_to(1e5, **kw),
+    # a Stepper made with a tolerance searches at its construction (rk4 at 1e-11 over 5000: 113 s)
+    "stepper search": lambda s, **kw: bp.Stepper(s, "rk4", tol=1e-11, t_end=5000, **kw),
 }
 
 

@@ -438,16 +438,17 @@ class Stepper:
     ``events`` / ``stop_at``: as integrate()'s, at absolute times. ``closest`` is the closest approach
     *so far*: a later segment that comes nearer replaces it (on table 3.1, after advance_to(28) a helix
     wiggle at t = 27.571, r = 10.76; after advance_to(28.5) the encounter's minimum, t = 28.399, r = 9.0546).
-    A segment has no error estimate of its own.
+    A segment has no error estimate of its own. Ctrl-C or ``max_seconds`` stop the search of a Stepper
+    made with ``tol`` as they stop a segment (KeyboardInterrupt, or bodypoint.Error for the budget).
     """
 
     def __init__(self, scene, method="auto", step=None, *, tol=None, t_end=None, body=0, events=(), stop_at=(),
-                 omega_c=None, invariants=True):
+                 omega_c=None, invariants=True, max_seconds=DEFAULT_MAX_SECONDS):
         self._s = _core._Stepper(_scene(scene), _index("body", body), _text("method", method),
                                  _number("step", step, optional=True), _texts("events", events),
                                  _texts("stop_at", stop_at), _number("omega_c", omega_c, optional=True),
                                  _number("tol", tol, optional=True), _number("t_end", t_end, optional=True),
-                                 _flag("invariants", invariants))
+                                 _flag("invariants", invariants), _number("max_seconds", max_seconds))
 
     def advance_to(self, t, *, max_seconds=DEFAULT_MAX_SECONDS):
         """Integrates from time to t (before time: backwards); returns the segment's Outcome (refused or
