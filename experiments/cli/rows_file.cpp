@@ -151,6 +151,27 @@ RowsContent read_rows_file(const std::string& path, std::size_t* dropped) {
   return c;
 }
 
+std::string sweep_key_of(const std::string& revision, const std::string& scene_text, const std::string& request) {
+  return hex64(fnv1a(revision)) + "-" + hex64(fnv1a(scene_text)) + "-" + hex64(fnv1a(request));
+}
+
+std::string key_difference(const std::string& was, const std::string& is) {
+  const auto parts = [](const std::string& key) {
+    std::vector<std::string> out;
+    std::stringstream ss(key);
+    for (std::string p; std::getline(ss, p, '-');) out.push_back(p);
+    return out;
+  };
+  const std::vector<std::string> a = parts(was), b = parts(is);
+  if (a.size() != 3 || b.size() != 3) return "another sweep (or another version of bodypoint)";
+  static const char* const what[3] = {"the build changed (another revision of bodypoint)", "the scene file was edited",
+                                      "the parameters, methods or accuracy differ"};
+  std::string out;
+  for (std::size_t k = 0; k < 3; ++k)
+    if (a[k] != b[k]) out += (out.empty() ? "" : "; ") + std::string(what[k]);
+  return out.empty() ? "the same sweep" : out;
+}
+
 std::string rows_file_text(const RowsContent& c) {
   std::string s = std::string(kMagic) + " key=" + c.key + " tasks=" + std::to_string(c.tasks) + "\n";
   for (const std::string& h : c.header) s += header_record(h);
@@ -170,8 +191,12 @@ RowJournal::RowJournal(std::string path, const std::string& key, std::size_t tas
   if (exists) {
     std::size_t dropped = 0;
     const RowsContent old = read_rows_file(path_, &dropped);
-    if (old.key != key || old.tasks != tasks)
-      throw Error("the journal '" + path_ + "' belongs to another sweep (other parameters, methods or build); delete it to start over");
+    if (old.key != key)
+      throw Error("the journal '" + path_ + "' belongs to another sweep (" + key_difference(old.key, key) +
+                  "); delete it to start over");
+    if (old.tasks != tasks)
+      throw Error("the journal '" + path_ + "' belongs to another sweep (" + std::to_string(old.tasks) + " rows, this one " +
+                  std::to_string(tasks) + "); delete it to start over");
     done_ = old.rows;
     if (dropped > 0)
       std::cerr << "bodypoint: resuming: dropped " << dropped << " torn record(s) of '" << path_ << "', they run again\n";
@@ -240,7 +265,8 @@ int cmd_merge(int argc, char** argv) {
       all.tasks = c.tasks;
       all.header = c.header;
     } else if (c.key != all.key || c.tasks != all.tasks) {
-      throw Error("'" + path + "' is a shard of another sweep than '" + inputs.front() + "'");
+      throw Error("'" + path + "' is a shard of another sweep than '" + inputs.front() + "' (" +
+                  (c.key != all.key ? key_difference(all.key, c.key) : "another number of rows") + ")");
     }
     for (auto& [index, row] : c.rows) {
       if (from.count(index)) throw Error("row " + std::to_string(index) + " is in both '" + from[index] + "' and '" + path + "'");

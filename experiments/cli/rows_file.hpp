@@ -2,7 +2,8 @@
 // the shards of one sweep run on several machines.
 //
 // A rows file is text, one record per line:
-//   #bodypoint-rows 1 key=<16 hex digits> tasks=<T>    first line: which sweep (key) and its size
+//   #bodypoint-rows 1 key=<B>-<S>-<Q> tasks=<T>       first line: which sweep (key: 16 hex digits each of
+//                                                      its build, scene file and request) and its size
 //   H\t<line>\t<check>                                 the CSV header of the sweep, line by line
 //   R\t<task index>\t<CSV row>\t<check>                 one finished row; check = FNV-1a of the rest
 // Two different rows under one task index are refused (an edited or mixed file), the same row twice
@@ -25,6 +26,13 @@ namespace bodypoint::cli {
 /// FNV-1a, 64 bits.
 std::uint64_t fnv1a(const std::string& s, std::uint64_t h = 1469598103934665603ull);
 std::string hex64(std::uint64_t x);
+
+/// A sweep's key: its build's revision, its scene file's text and the rest of its request, hashed apart so
+/// that a journal of another sweep says which of them changed (key_difference).
+std::string sweep_key_of(const std::string& revision, const std::string& scene_text, const std::string& request);
+/// What differs between two sweeps' keys, in words ("the scene file was edited"); for a key of another
+/// format, "another sweep".
+std::string key_difference(const std::string& was, const std::string& is);
 
 /// The rows of one sweep gathered from rows files.
 struct RowsContent {

@@ -475,6 +475,8 @@ int cmd_simulate(int argc, char** argv) {
     if (o.scattering) throw Error("--scattering measures an encounter forwards in time: drop --backward");
     plan.how = backwards(plan.how);
   }
+  if (o.scattering && is_backward(plan.how))
+    throw Error("--scattering measures an encounter forwards in time: give a positive --t-end");
   if (plan.automatic) o.method_name = "auto";
   apply_output_options(vm, o, scene, plan);
   add_events(o, scene, to_departure);

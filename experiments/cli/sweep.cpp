@@ -180,8 +180,8 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
 }
 
 std::string sweep_key(const SweepSpec& spec) {
-  std::string s = std::string(git_revision()) + "|" + describe(spec.base) + "|" + hex64(fnv1a(spec.scene_text)) + "|" + fmt(spec.h) + "|" +
-                  std::to_string(spec.steps) + "|" + fmt(spec.t_end) + "|" + fmt(spec.tol);
+  std::string s = describe(spec.base) + "|" + fmt(spec.h) + "|" + std::to_string(spec.steps) + "|" + fmt(spec.t_end) + "|" +
+                  fmt(spec.tol);
   for (const Axis& a : spec.axes) {
     s.append("|").append(a.param);
     for (double v : a.values) s.append(",").append(fmt(v));
@@ -190,7 +190,7 @@ std::string sweep_key(const SweepSpec& spec) {
   if (spec.scattering) s.append("|scattering");
   if (spec.accuracy) s.append("|accuracy=").append(fmt(*spec.accuracy));
   s.append("|").append(spec.estimate_error ? fmt(spec.max_error) : "no-estimate").append("|").append(fmt(spec.max_energy_error));
-  return hex64(fnv1a(s));
+  return sweep_key_of(git_revision(), spec.scene_text, s);
 }
 
 void write_sweep_csv(std::ostream& os, const SweepSpec& spec, const std::vector<std::string>& rows,

@@ -285,6 +285,8 @@ Expected<Scene> thesis_scene_twice_as_far(SceneParams solved, double b, double v
 EncounterResult encounter(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method, double tol,
                           double t_end, Options options) {
   const bool to_departure = std::isnan(t_end);
+  // An encounter is measured forwards in time (a negative t_end ran backwards, then read "did not finish").
+  if (!to_departure) require_positive(t_end, "an encounter's end time t_end");
   const double end = to_departure ? encounter_span(body, centres) : t_end;
   const Options o = encounter_options(body, centres, std::move(options), to_departure);
   EncounterResult r{integrate_body(body, centres, method, Accuracy{tol, end}, o), {}, o.events};

@@ -540,6 +540,7 @@ StepRequest with_default_end(StepRequest r, const MethodInfo* method) {
 
 Advance advance_for(const MethodInfo* m, const StepRequest& r) {
   if (r.t_end && r.steps) throw Error("give a number of steps or an end time t_end, not both");
+  if (r.t_end && !std::isfinite(*r.t_end)) require_positive(*r.t_end, "the end time t_end");  // -inf named as given
   if (searches(m, r)) {
     if (!r.tol) throw Error("method auto needs the accuracy to deliver, tol");
     if (r.h || r.steps) throw Error("the accuracy mode (tol) chooses the step: give the end time t_end, not h or steps");

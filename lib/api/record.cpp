@@ -5,6 +5,7 @@
 #include "bodypoint/io.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <ostream>
 #include <utility>
 
@@ -17,11 +18,13 @@ Record& add(Record& r, std::string key, Value v) {
   return r;
 }
 
-/// The step a run was asked for or chosen: h, ds, the first trial step, the accuracy mode's choice.
+/// The step a run was asked for or chosen: h, ds, the first trial step, the accuracy mode's choice. Its size,
+/// for every kind alike: a run backwards says so by its negative t_end (a fixed step read -0.01 there, a
+/// searched one 0.2).
 double step_of(const BodyResult& r, const Advance& how) {
-  if (const auto* f = std::get_if<FixedSteps>(&how)) return f->h;
-  if (const auto* f = std::get_if<FictitiousSteps>(&how)) return f->ds;
-  if (const auto* c = std::get_if<ControlledSteps>(&how)) return c->h0;
+  if (const auto* f = std::get_if<FixedSteps>(&how)) return std::abs(f->h);
+  if (const auto* f = std::get_if<FictitiousSteps>(&how)) return std::abs(f->ds);
+  if (const auto* c = std::get_if<ControlledSteps>(&how)) return std::abs(c->h0);
   return r.accuracy ? r.accuracy->h_chosen : Scattering::kNaN;
 }
 

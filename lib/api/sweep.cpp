@@ -431,6 +431,8 @@ void validate_sweep_rules(const SweepSpec& spec) {
   check_energy_bound(spec.max_energy_error);
   check_error_bound(spec.max_error);
   if (spec.axes.empty()) throw Error("the sweep has no varied parameter");
+  // 0: not given (the steps count); a sweep runs forwards (Python's sweep(t_end=-20) read "0 steps").
+  if (spec.t_end != 0.0) require_positive(spec.t_end, "the end time t_end");
   const bool file = !spec.scene_text.empty();
   for (const Axis& a : spec.axes) {
     if (a.param == "h" || (file && a.param == kBodyAxis)) continue;

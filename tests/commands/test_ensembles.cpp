@@ -148,7 +148,17 @@ TEST(Shards, MergeRefusesAMissingARepeatedOrAForeignShard) {
   expect_merge_refused(run_cli("merge --input " + files[0] + " " + files[1] + " " + files[2] + " " + files[1]), "is in both");
   const std::string other = (dir.path / "other.rows").string();
   ASSERT_EQ(run_cli(std::string(kShardSweep) + " --h 4e-3 --shard 2/3 --out " + other).code, 0);
-  expect_merge_refused(run_cli("merge --input " + files[0] + " " + other + " " + files[2]), "is a shard of another sweep");
+  expect_merge_refused(run_cli("merge --input " + files[0] + " " + other + " " + files[2]),
+                       "is a shard of another sweep than '" + files[0] + "' (the parameters, methods or accuracy differ)");
+  // The same sweep over a scene file edited between its shards says so (it blamed "parameters, methods or build").
+  const fs::path scene = dir.path / "scene.toml";
+  fs::copy_file(fs::path(BODYPOINT_SOURCE_DIR) / "scenes" / "two-centres.toml", scene);
+  const std::string over_scene = "sweep --scene " + scene.string() + " --param centre2.A --values -1,-2 --methods lp-y4 --h 1e-2 --steps 10";
+  const std::string first = (dir.path / "s1.rows").string(), second = (dir.path / "s2.rows").string();
+  ASSERT_EQ(run_cli(over_scene + " --shard 1/2 --out " + first).code, 0);
+  std::ofstream(scene, std::ios::app) << "# edited\n";
+  ASSERT_EQ(run_cli(over_scene + " --shard 2/2 --out " + second).code, 0);
+  expect_merge_refused(run_cli("merge --input " + first + " " + second), "(the scene file was edited)");
   expect_merge_refused(run_cli("merge --input " + std::string(BODYPOINT_SOURCE_DIR) + "/README.md"),
                        "is not a bodypoint rows file");
   // Inputs that are not regular files are refused at once (a FIFO blocked, /dev/zero read 4 GB).

@@ -384,19 +384,21 @@ bool is_backward(const Advance& how) {
 }
 
 Advance forwards(Advance how) {
+  // An end time that is not a finite number keeps its sign: check() then names the value given (-inf, not inf).
+  const auto size = [](double t) { return std::isfinite(t) ? std::abs(t) : t; };
   std::visit(
-      [](auto& a) {
+      [&size](auto& a) {
         using A = std::decay_t<decltype(a)>;
         if constexpr (std::is_same_v<A, FixedSteps>) {
           a.h = std::abs(a.h);
         } else if constexpr (std::is_same_v<A, FictitiousSteps>) {
           a.ds = std::abs(a.ds);
-          if (a.end.index() == 0) a.end = EndTime{std::abs(a.t_end())};
+          if (a.end.index() == 0) a.end = EndTime{size(a.t_end())};
         } else if constexpr (std::is_same_v<A, ControlledSteps>) {
           a.h0 = std::abs(a.h0);
-          a.t_end = std::abs(a.t_end);
+          a.t_end = size(a.t_end);
         } else {
-          a.t_end = std::abs(a.t_end);
+          a.t_end = size(a.t_end);
         }
       },
       how);
