@@ -186,7 +186,7 @@ std::string sweep_key(const SweepSpec& spec) {
     s.append("|").append(a.param);
     for (double v : a.values) s.append(",").append(fmt(v));
   }
-  for (const MethodInfo* m : spec.methods) s.append("|").append(m->name);
+  for (const MethodInfo* m : spec.methods) s.append("|").append(m ? m->name : "auto");
   if (spec.scattering) s.append("|scattering");
   if (spec.accuracy) s.append("|accuracy=").append(fmt(*spec.accuracy));
   s.append("|").append(spec.estimate_error ? fmt(spec.max_error) : "no-estimate").append("|").append(fmt(spec.max_energy_error));
@@ -354,7 +354,8 @@ void add_sweep_options(po::options_description& desc, SweepJob& job, std::string
       ("values", po::value<std::string>(), "explicit comma-separated values instead of a range")
       ("grid", po::value(&grid)->composing(), "instead of --param: one varied parameter of a grid, NAME=FROM:TO:STEP, "
        "NAME=log:FROM:TO:POINTS or NAME=a,b,c; repeat for each (every combination is run)")
-      ("methods", defaulted(&methods_arg), "comma-separated names, 'fixed' (every fixed-step method but the Kepler split kep-*) or 'all'")
+      ("methods", defaulted(&methods_arg), "comma-separated names, 'fixed' (every fixed-step method but the Kepler split kep-*) or "
+       "'all'; auto: the accuracy mode chooses each row's method (at --accuracy; listed alone, at --tol; column chosen)")
       ("tol", defaulted(&job.spec.tol), "adaptive methods: error tolerance")
       ("accuracy", po::value<double>(), "the accuracy mode: every method but the step-size-controlled peers delivers this "
        "relative error of the final state at --t-end, its step searched per row (columns h_chosen, search_force_evals)")
@@ -370,7 +371,7 @@ void add_sweep_options(po::options_description& desc, SweepJob& job, std::string
 /// The sweep's methods, base scene, data and steps from the parsed options: a value given is used or refused.
 void apply_sweep_options(const po::variables_map& vm, SceneOptions& so, StepOptions& st, const std::string& methods_arg,
                          SweepJob& job) {
-  job.spec.methods = methods_named(methods_arg);
+  job.spec.methods = sweep_methods_named(methods_arg);
   job.spec.base = so.params;
   // A value given is used, or refused: the tolerance per step whatever the methods, d or K1 beside
   // the asymptotic data solved for them.
@@ -383,6 +384,7 @@ void apply_sweep_options(const po::variables_map& vm, SceneOptions& so, StepOpti
   apply_fixed_data(vm, so, job.spec);
   apply_steps(vm, st, job.spec);
   if (vm.count("accuracy")) job.spec.accuracy = vm["accuracy"].as<double>();
+  settle_auto(job.spec);
   if (vm.count("scene")) {
     for (const SceneParameter& q : scene_parameters())
       if (!vm[std::string(q.name)].defaulted())

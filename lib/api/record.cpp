@@ -190,7 +190,7 @@ Record sweep_record(const SweepSpec& spec, const SweepRow& r) {
   const State& f = r.result.final;
   Record out;
   for (std::size_t a = 0; a < spec.axes.size(); ++a) out.number(spec.axes[a].param, a < r.point.size() ? r.point[a] : nan);
-  out.text("method", r.method ? std::string(r.method->name) : std::string());
+  out.text("method", r.automatic ? std::string("auto") : r.method ? std::string(r.method->name) : std::string());
   out.number("max_rel_dE", s.max_rel_dE).number("max_rel_dK2sq", s.max_rel_dK2sq).number("max_abs_dK2Q", s.max_abs_dK2Q);
   out.number("Rx", f.R.x()).number("Ry", f.R.y()).number("Rz", f.R.z());
   out.count("force_evals", r.result.force_evals).number("wall_s", r.result.wall_s);
@@ -212,6 +212,7 @@ Record sweep_record(const SweepSpec& spec, const SweepRow& r) {
   if (spec.accuracy) {  // the accuracy mode's choice and cost (the row's own run is its delivered one)
     out.number("h_chosen", r.accuracy ? r.accuracy->h_chosen : nan);
     out.count("search_force_evals", r.accuracy ? r.accuracy->force_evals : 0);
+    if (has_auto(spec)) out.text("chosen", r.automatic && r.method ? std::string(r.method->name) : std::string());
   }
   out.number("vx", f.v.x()).number("vy", f.v.y()).number("vz", f.v.z()).number("wx", f.w.x()).number("wy", f.w.y()).number("wz", f.w.z());
   return out;

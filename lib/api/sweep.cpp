@@ -54,6 +54,7 @@ Options sweep_options(const SweepSpec& spec) {
 
 /// The row of a finished run of the public API.
 SweepRow result_row(SweepRow row, BodyResult r) {
+  if (r.method) row.method = r.method;  // auto's choice
   if (!ran(r.outcome)) return unrun_row(std::move(row), r.outcome, r.reason);
   row.result = std::move(r.run);
   row.outcome = r.outcome;
@@ -310,11 +311,11 @@ long add_row_start_distance(Encounter& e, const SweepSpec& spec, const std::vect
 /// The row of a run with its encounter (SweepSpec::scattering): integrate_checked with the encounter's
 /// events (encounter_options: it stops at the departure, the sweep's end the latest), measured by
 /// measure_encounter; an encounter that did not finish by the end is the row's outcome (incomplete).
-SweepRow encounter_row(SweepRow row, const MethodInfo& method, const Scene& scene, const Advance& how,
+SweepRow encounter_row(SweepRow row, const MethodInfo* method, const Scene& scene, const Advance& how,
                        const SweepSpec& spec) {
   const Body& body = scene.bodies.front();
   const Options options = encounter_options(body, scene.centres, sweep_options(spec), true);
-  BodyResult r = detail::integrate_checked(body, scene.centres, &method, how, options);  // checked by validate_sweep
+  BodyResult r = detail::integrate_checked(body, scene.centres, method, how, options);  // checked by validate_sweep
   if (!ran(r.outcome)) return result_row(std::move(row), std::move(r));
   Encounter e = measure_encounter(body, scene.centres, r.run, r.events, options.events);
   if (e.outcome == Outcome::ok && r.outcome == Outcome::ok)
@@ -399,13 +400,48 @@ Advance to_common_end(const MethodInfo& method, const FixedSteps& f, double tol)
 }
 
 Advance point_advance(const SweepSpec& spec, const MethodInfo& method, const std::vector<double>& point) {
-  if (spec.accuracy && !is_step_controlled(method)) {
+  return point_advance(spec, &method, point);
+}
+
+Advance point_advance(const SweepSpec& spec, const MethodInfo* m, const std::vector<double>& point) {
+  if (!m && !spec.accuracy) throw Error("method auto needs the accuracy mode (SweepSpec::accuracy: the tolerance to deliver)");
+  if (spec.accuracy && (!m || !is_step_controlled(*m))) {
     if (spec.t_end > 0.0 || !spec.scattering) return Accuracy{*spec.accuracy, spec.t_end};
     // An encounter without an end: its span (the departure event stops the run), as simulate takes it.
     const Scene scene = point_scene(spec, point);
     return Accuracy{*spec.accuracy, encounter_span(scene.bodies.front(), scene.centres)};
   }
-  return to_common_end(method, sweep_steps(point_h(spec, point), spec.steps, spec.t_end, spec.base.law), spec.tol);
+  return to_common_end(*m, sweep_steps(point_h(spec, point), spec.steps, spec.t_end, spec.base.law), spec.tol);
+}
+
+std::vector<const MethodInfo*> sweep_methods_named(std::string_view list) {
+  std::vector<const MethodInfo*> ms;
+  std::string named;
+  for (std::size_t start = 0; start <= list.size();) {
+    const std::size_t comma = std::min(list.find(',', start), list.size());
+    const std::string_view name = list.substr(start, comma - start);
+    if (name == "auto") ms.push_back(nullptr);
+    else if (!name.empty()) named.append(named.empty() ? "" : ",").append(name);
+    start = comma + 1;
+  }
+  if (!named.empty())
+    for (const MethodInfo* m : methods_named(named)) ms.push_back(m);
+  if (ms.empty()) throw Error("the method list is empty");
+  return ms;
+}
+
+bool has_auto(const SweepSpec& spec) { return std::find(spec.methods.begin(), spec.methods.end(), nullptr) != spec.methods.end(); }
+
+void settle_auto(SweepSpec& spec) {
+  if (!has_auto(spec) || spec.accuracy) return;
+  if (spec.methods.size() > 1)
+    throw Error("auto chooses the method for an accuracy: give the accuracy (--accuracy, accuracy=) for a sweep that also "
+                "names methods, or list auto alone (its accuracy is then the tolerance tol, " + fmt(spec.tol) + ")");
+  spec.accuracy = spec.tol;
+  if (!(spec.t_end > 0.0) && spec.steps > 0 && !spec.scattering) {
+    spec.t_end = spec.h * static_cast<double>(spec.steps);  // the end time the steps asked for reach
+    spec.steps = 0;
+  }
 }
 
 std::string point_label(const SweepSpec& spec, const std::vector<double>& point) {
@@ -428,6 +464,8 @@ void fix_asymptotic_datum(SweepSpec& spec, const std::string& datum, double valu
 
 void validate_sweep_rules(const SweepSpec& spec) {
   if (spec.methods.empty()) throw Error("the method list is empty");
+  if (has_auto(spec) && !spec.accuracy)
+    throw Error("method auto needs the accuracy mode (SweepSpec::accuracy: the tolerance to deliver)");
   check_energy_bound(spec.max_energy_error);
   check_error_bound(spec.max_error);
   if (spec.axes.empty()) throw Error("the sweep has no varied parameter");
@@ -476,7 +514,7 @@ void validate_sweep_points(const SweepSpec& spec, std::size_t from, std::size_t 
     const std::vector<double> point = grid_point(spec, p);
     try {
       validate(point_scene(spec, point));
-      for (const MethodInfo* m : spec.methods) check(point_advance(spec, *m, point));
+      for (const MethodInfo* m : spec.methods) check(point_advance(spec, m, point));
     } catch (const Error& e) {
       throw Error(point_label(spec, point) + ": " + e.what());
     }
@@ -490,7 +528,7 @@ void validate_sweep(const SweepSpec& spec) {
 
 std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vector<std::size_t>& unit) {
   const std::size_t M = spec.methods.size();
-  const MethodInfo& method = *spec.methods[unit.front() % M];
+  const MethodInfo* asked = spec.methods[unit.front() % M];  // nullptr: auto
   std::vector<SweepRow> rows;
   std::vector<batch::Member> members;
   std::vector<Scene> scenes;
@@ -498,20 +536,21 @@ std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vect
     SweepRow row;
     row.task = i;
     row.point = grid_point(spec, i / M);
-    row.method = &method;
+    row.method = asked;
+    row.automatic = !asked;
     rows.push_back(std::move(row));
     scenes.push_back(point_scene(spec, rows.back().point));
     members.push_back({scenes.back().bodies.front().p, scenes.back().bodies.front().s0, scenes.back().centres.front().A});
   }
   if (unit.size() > 1) {  // a batch: one method, one step (plan_units), lanes that accept it
-    batch_rows(rows, spec, method, members, scenes);
+    batch_rows(rows, spec, *asked, members, scenes);
     return rows;
   }
   SweepRow& row = rows.front();
   const Scene& scene = scenes.front();
-  const Advance how = point_advance(spec, method, row.point);
-  if (spec.scattering) row = encounter_row(std::move(row), method, scene, how, spec);
-  else row = result_row(std::move(row), detail::integrate_checked(scene.bodies.front(), scene.centres, &method, how, sweep_options(spec)));
+  const Advance how = point_advance(spec, asked, row.point);
+  if (spec.scattering) row = encounter_row(std::move(row), asked, scene, how, spec);
+  else row = result_row(std::move(row), detail::integrate_checked(scene.bodies.front(), scene.centres, asked, how, sweep_options(spec)));
   return rows;
 }
 
@@ -525,12 +564,12 @@ std::vector<std::vector<std::size_t>> plan_units(const SweepSpec& spec, const st
   const std::size_t M = spec.methods.size(), lanes = simd && !spec.scattering && !spec.accuracy ? batch::width() : 1;
   std::map<std::pair<std::size_t, double>, std::vector<std::size_t>> open;  // (method, h) -> a filling batch
   for (std::size_t i : todo) {
-    const MethodInfo& method = *spec.methods[i % M];
-    const std::vector<double> point = grid_point(spec, i / M);
-    if (lanes < 2) {
+    if (lanes < 2) {  // the accuracy mode (auto's rows among them), encounters, no SIMD: each row alone
       units.push_back({i});
       continue;
     }
+    const MethodInfo& method = *spec.methods[i % M];
+    const std::vector<double> point = grid_point(spec, i / M);
     const Scene scene = point_scene(spec, point);
     if (!batch::accepts(method, scene.bodies.front(), scene.centres) ||
         (spec.cancel && static_cast<double>(std::get<FixedSteps>(point_advance(spec, method, point)).steps) >

@@ -31,6 +31,8 @@ Advance to_common_end(const MethodInfo& method, const FixedSteps& f, double tol)
 /// point's sweep_steps (h, n): fixed-step methods take those steps, time-transformed ones fictitious
 /// steps ds = h to T, step-size-controlled ones run to T from a first trial step h at tolerance tol.
 Advance point_advance(const SweepSpec& spec, const MethodInfo& method, const std::vector<double>& point);
+/// The same for a sweep's method entry (nullptr: auto, the accuracy mode).
+Advance point_advance(const SweepSpec& spec, const MethodInfo* method, const std::vector<double>& point);
 /// "d = 5, L = 100": a grid point for messages.
 std::string point_label(const SweepSpec& spec, const std::vector<double>& point);
 

@@ -485,7 +485,7 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
   s.max_error = max_error;
   for (const auto& [param, values] : axes) s.axes.push_back({param, values});
   for (const std::string& list : methods)
-    for (const MethodInfo* m : methods_named(list)) s.methods.push_back(m);
+    for (const MethodInfo* m : sweep_methods_named(list)) s.methods.push_back(m);
   // A datum swept beside the parameter it solves would silently replace it (the command line's rule).
   std::vector<std::string> swept, given;
   for (const Axis& a : s.axes) swept.push_back(a.param);
@@ -508,6 +508,7 @@ py::dict sweep_py(const std::vector<std::pair<std::string, std::vector<double>>>
   s.steps = t_end > 0.0 ? 0 : steps;
   s.t_end = t_end;
   s.tol = tol;
+  settle_auto(s);
   if (scene) {  // a scene file's text and name: its keys are the axes (with_scene_file)
     if (!base.empty()) throw Error("with a scene, set the scene's numbers in it or sweep its keys (centre2.A, body.B)");
     s = with_scene_file(std::move(s), scene->first, scene->second);

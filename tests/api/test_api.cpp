@@ -622,6 +622,45 @@ TEST(ApiSweep, RowsAreTypedAndEqualSingleRuns) {
   }
 }
 
+TEST(ApiSweep, AutoRowsAreTheAccuracyModesSingleRuns) {
+  // auto in a sweep (issue #80 item 1): each row is integrate()'s auto at the sweep's accuracy, the method it
+  // chose named in the row, a named method beside it unchanged; listed alone without an accuracy, auto
+  // delivers the tolerance tol to h x steps.
+  SweepSpec s;
+  s.axes = {{"d", {5.0, 20.0}}, {"B", {0.0, 0.7}}};
+  s.methods = sweep_methods_named("auto,lp-y4");
+  ASSERT_EQ(s.methods.front(), nullptr);
+  s.accuracy = 1e-8;
+  s.t_end = 20.0;
+  const std::vector<SweepRow> rows = run_sweep_rows(s, 2);
+  ASSERT_EQ(rows.size(), 8u);
+  for (const SweepRow& r : rows) {
+    const Scene scene = thesis_scene(point_params(s, r.point));
+    const Result one = integrate(scene, r.automatic ? "auto" : "lp-y4", Accuracy{1e-8, 20.0});
+    const BodyResult& b = one.bodies.front();
+    ASSERT_EQ(r.outcome, Outcome::ok) << point_label(s, r.point) << ": " << r.reason;
+    ASSERT_NE(r.method, nullptr);
+    EXPECT_EQ(r.method, b.method) << point_label(s, r.point);
+    EXPECT_EQ(r.result.final.R, b.run.final.R) << point_label(s, r.point);
+    EXPECT_LE(r.error.value, 1e-8);
+  }
+  EXPECT_TRUE(rows[0].automatic);
+  EXPECT_FALSE(rows[1].automatic);
+  SweepSpec alone;
+  alone.axes = {{"d", {5.0}}};
+  alone.methods = sweep_methods_named("auto");
+  alone.steps = 1000;
+  alone.h = 0.02;
+  settle_auto(alone);
+  ASSERT_EQ(alone.accuracy, std::optional<double>(alone.tol));
+  EXPECT_EQ(alone.t_end, 20.0);
+  EXPECT_LE(run_sweep_rows(alone, 1).front().error.value, alone.tol);
+  SweepSpec mixed = s;
+  mixed.accuracy.reset();
+  EXPECT_THROW(settle_auto(mixed), Error);
+  EXPECT_THROW(run_sweep_rows(mixed, 1), Error);  // a nullptr method without the accuracy mode
+}
+
 TEST(ApiSweep, AnInvalidPointIsNamed) {
   SweepSpec s;
   s.axes = {{"B", {0.5, 1.5}}};

@@ -438,6 +438,21 @@ def test_sweep_in_the_accuracy_mode_equals_integrate_per_row():
         bp.sweep({"d": [5]}, "lp-y4", steps=100, accuracy=tol)
 
 
+def test_sweep_takes_auto_as_integrate_takes_it():
+    # issue #80: "unknown method 'auto'" before; each row is integrate()'s auto, its choice in column chosen
+    tol = 1e-8
+    cols = bp.sweep({"d": [5, 20]}, "auto,lp-y4", t_end=30, accuracy=tol)
+    assert list(cols["method"]) == ["auto", "lp-y4"] * 2 and list(cols["outcome"]) == ["ok"] * 4
+    for i in (0, 2):
+        one = bp.integrate(bp.thesis_scene(d=cols["d"][i]), "auto", tol=tol, t_end=30)["bodies"][0]
+        assert cols["chosen"][i] == one["method"] and [cols["Rx"][i], cols["Ry"][i], cols["Rz"][i]] == one["R"].tolist()
+        assert cols["err_estimate"][i] <= tol
+    alone = bp.sweep({"d": [5]}, "auto", t_end=30)  # auto alone: the accuracy mode at tol
+    assert alone["err_estimate"][0] <= 1e-10 and alone["chosen"][0]
+    with pytest.raises(bp.Error, match="auto chooses the method for an accuracy"):
+        bp.sweep({"d": [5]}, "auto,lp-y4", t_end=30)
+
+
 def test_fourth_pass_messages_are_one_line_errors_naming_the_quantity():
     # Each raised a pybind11 TypeError (several lines) or a TypeError of Python's own, or echoed a key raw.
     with pytest.raises(bp.Error, match=r"^body must be a whole number >= 0, got -1$"):

@@ -53,6 +53,7 @@ struct Axis {
 /// methods, and everything else fixed.
 struct SweepSpec {
   std::vector<Axis> axes;
+  /// The methods of every point; nullptr: auto (the accuracy mode chooses the method for each row).
   std::vector<const MethodInfo*> methods;
   SceneParams base;         ///< the fixed scene parameters (table 3.1 unless changed)
   double h = kDefaultStep;  ///< fixed step (unless an axis varies h)
@@ -91,6 +92,15 @@ SweepSpec with_scene_file(SweepSpec spec, std::string text, std::string origin);
 /// Throws Error for an empty sweep, or a grid point whose scene or step is invalid (the point named).
 void validate_sweep(const SweepSpec& spec);
 
+/// The methods of a list of names for a sweep: methods_named()'s, with "auto" as nullptr.
+std::vector<const MethodInfo*> sweep_methods_named(std::string_view list);
+/// Whether the sweep has rows of auto.
+bool has_auto(const SweepSpec& spec);
+/// A sweep of auto alone without an accuracy is the accuracy mode at its tolerance `tol`, to its end time
+/// t_end (or h x steps); auto beside named methods needs SweepSpec::accuracy (Error otherwise: the named ones
+/// would change their meaning).
+void settle_auto(SweepSpec& spec);
+
 /// A fixed asymptotic datum (b, v_inf or arrival_phase) of the sweep: a one-value axis, solved for at every
 /// grid point as a varied one is (a sweep over L keeps b, not d; a sweep over b keeps the arrival phase, not
 /// the start phase). Throws Error naming it `named_as` (the command's option, Python's keyword) unless it is
@@ -101,7 +111,8 @@ void fix_asymptotic_datum(SweepSpec& spec, const std::string& datum, double valu
 struct SweepRow {
   std::size_t task = 0;
   std::vector<double> point;
-  const MethodInfo* method = nullptr;
+  const MethodInfo* method = nullptr;  ///< the method that ran (auto's choice for an automatic row)
+  bool automatic = false;              ///< the row asked for auto (SweepSpec::methods' nullptr)
   /// ok, diverged, unresolved, inaccurate or collision (assess()), refused (the method does not take
   /// the scene) or failed (the run stopped: a budget, a broken time transformation).
   Outcome outcome = Outcome::ok;

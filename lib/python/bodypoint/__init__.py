@@ -350,8 +350,8 @@ def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, accuracy=None
     and a scene of several bodies gives a row per body (the column "body", from 1). A thesis_scene()
     is swept as the thesis's parameters. ``methods``: names, a list of
     names separated by commas, "fixed" (every fixed-step method but the Kepler split) or "all", as
-    ``bodypoint sweep --methods`` takes them (named methods: "auto" is not one; ``accuracy`` below is the
-    accuracy mode for each). ``base``: fixed scene parameters, and fixed asymptotic data (b, v_inf,
+    ``bodypoint sweep --methods`` takes them, and "auto": the accuracy mode chooses each row's method
+    (column chosen), at ``accuracy``, or listed alone without it at ``tol``. ``base``: fixed scene parameters, and fixed asymptotic data (b, v_inf,
     arrival_phase: solved for at every point, a column each, as ``bodypoint sweep --b``); ``force_law`` as
     thesis_scene()'s. Steps of h: ``steps`` of them, or to ``t_end``; ``tol``: the step-size-controlled
     peers' tolerance per step. ``accuracy``: the accuracy mode, every other method delivering this
@@ -367,7 +367,9 @@ def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, accuracy=None
     longer than a second; None (the default) shows it where stderr is a terminal or in a Jupyter
     notebook, not in a script whose stderr is a file or pipe, nor under CI; True or False decide.
     """
-    if steps == 0 and t_end == 0.0 and not (scattering and accuracy is not None):
+    automatic = any(name.strip() == "auto" for m in ([methods] if isinstance(methods, str) else methods)
+                    for name in str(m).split(","))
+    if steps == 0 and t_end == 0.0 and not (scattering and (accuracy is not None or automatic)):
         raise Error("give steps or t_end (an encounter in the accuracy mode runs to its departure without them)")
     try:
         axes = list(dict(axes).items())
