@@ -211,14 +211,16 @@ RunResult run_fictitious(Stepper& s, typename Stepper::X x0, const Body& body, c
                          const FictitiousSteps& spec, const RunOptions& options) {
   using X = typename Stepper::X;
   FictitiousLoop<Stepper> loop(s, spec);
-  double t_reached = 0.0;
+  double t_reached = 0.0, carried = std::numeric_limits<double>::quiet_NaN();
   auto to_physical = [&s](const X& x) { return s.physical(x); };
   RunResult r = observe(body.p, field, body.s0, options, detail::grid_of(spec), to_physical, [&](auto& obs) {
     const X x = loop.run(x0, obs);
     t_reached = s.time(x);
+    if constexpr (requires { s.carried(x); }) carried = s.carried(x);
     return s.physical(x);
   });
   loop.stats().record(r, t_reached);
+  if (!r.stopped) r.carried = carried;  // a sink's stop: the final state is not the loop's
   return r;
 }
 
@@ -255,6 +257,7 @@ struct TransformedStepper {
     return k.lp.to_physical(q);
   }
   State physical(const X& x) const { return k.to_physical(x); }
+  static double carried(const X& x) { return K::carried(x); }
 };
 
 template <template <class, bool> class Kernel, const auto& Seq>
@@ -265,7 +268,9 @@ RunResult run_time_transformed(const Body& body, const std::vector<Centre>& cent
     using K = Kernel<std::decay_t<decltype(field)>, decltype(spin)::value>;
     K k(body.p, field, options.omega_c >= 0.0 ? options.omega_c : automatic_omega_c(body, centres, spec.ds));
     TransformedStepper<K, Seq> stepper{k, spec.ds};
-    RunResult r = run_fictitious(stepper, k.initial_state(body.s0), body, field, spec, options);
+    TimeState x0 = k.initial_state(body.s0);
+    if (!std::isnan(options.carried)) K::resume(x0, options.carried);
+    RunResult r = run_fictitious(stepper, x0, body, field, spec, options);
     r.force_evals = k.lp.evals;
     return r;
   });

@@ -660,6 +660,7 @@ void Stepper::set_state(const State& s, double t) {
   body_ = std::move(b);
   t_ = t;
   stopped_ = false;
+  carried_ = std::numeric_limits<double>::quiet_NaN();  // the new state's own energy shell
   accuracy_.reset();  // the search's estimate was for the states it ran from
 }
 
@@ -682,6 +683,7 @@ Outcome Stepper::advance_to(double t) {
   const bool first = steps_ == 0;
   SampleSink shifted;
   Options opt = options_;
+  opt.carried = carried_;  // the time transformation goes on where the last segment left it
   if (options_.sink) {
     shifted = [this, t0, first](const Sample& s) {
       if (s.step == 0 && !first) return;
@@ -700,6 +702,7 @@ Outcome Stepper::advance_to(double t) {
   }
   detail::keep_closest(events_, options_.events);  // the closest approach so far
   body_.s0 = r.run.final;
+  carried_ = r.run.stopped ? std::numeric_limits<double>::quiet_NaN() : r.run.carried;  // a cut state is not the run's end
   stopped_ = r.run.stopped;
   t_ = r.run.stopped ? t0 + r.run.t_end : t;
   force_evals_ += r.run.force_evals;

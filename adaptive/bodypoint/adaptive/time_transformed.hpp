@@ -74,6 +74,9 @@ struct LogHKernel {
     x.g = lp.field.potential(s0.R);  // E - T(0) = Pi(R0)
     return x;
   }
+  /// The carried variable (RunOptions::carried): g, from which a run goes on on its energy shell.
+  static double carried(const TimeState& x) { return x.g; }
+  static void resume(TimeState& x, double carried) { x.g = carried; }
   void begin_step(TimeState&) const {}
 
   void drift(TimeState& x, double ds) const {
@@ -132,6 +135,9 @@ struct TtlKernel {
     x.W += c;
     return x;
   }
+  /// The carried variable (RunOptions::carried): W, which tracks Omega + c along the numerical solution.
+  static double carried(const TimeState& x) { return x.W; }
+  static void resume(TimeState& x, double carried) { x.W = carried; }
   void begin_step(TimeState&) const {}
 
   void drift(TimeState& x, double ds) const {

@@ -392,6 +392,7 @@ class Stepper {
   bool stopped_ = false;
   std::optional<AccuracyReport> accuracy_;
   double accuracy_t_end_ = 0.0;
+  double carried_ = std::numeric_limits<double>::quiet_NaN();  ///< RunOptions::carried from the last segment
 };
 
 }  // namespace bodypoint
