@@ -13,7 +13,7 @@ coarsest rung meeting TOL with the next finer rung meeting it too) over the fami
 
 With --ratios it prints instead each method's error constant over the family's Verlet, k_m / k_verlet, on every
 scene and their geometric mean: how far a step predicted from a Verlet pilot pair by that mean may be off
-(docs/developers.md, "Limits, measured": the pilot pair run by the family's Verlet, measured and not kept).
+(docs/measurements.md, "Limits, measured": the pilot pair run by the family's Verlet, measured and not kept).
 """
 import argparse
 import csv

@@ -5,7 +5,7 @@ Runs `bodypoint simulate --tol TOL --reference` on a grid of 256 variants of the
 parameter d, spin Kz and Kx, coupling B) at TOL 1e-4, 1e-7 and 1e-10 to t = 80, and prints, for the
 build at hand: how many runs were refused, missed TOL, or had an estimate more than 3x below or above
 the delivered error (against Boost.Odeint rkf78 in long double); the worst ratio error/estimate; and
-the force evaluations of all searches and of their delivered runs. docs/developers.md ("Limits,
+the force evaluations of all searches and of their delivered runs. docs/measurements.md ("Limits,
 measured") quotes it for the search's geometry as it is and for the variants that were tried.
 
 With --out, every run is also written (atomically) as a CSV row: the scene, TOL, the method auto chose,

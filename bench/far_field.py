@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The far field of a spinning body: what bounds the step there (docs/developers.md, "Limits, measured").
+"""The far field of a spinning body: what bounds the step there (docs/measurements.md, "Limits, measured").
 
 Prints two tables:
 1. The error of the exact splittings lp-y4 and lp-kl6 at fixed steps h on a pass that stays far from the

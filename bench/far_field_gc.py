@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A far-field step set by the field's slow scale: a prototype, measured (docs/developers.md, "Limits, measured").
+"""A far-field step set by the field's slow scale: a prototype, measured (docs/measurements.md, "Limits, measured").
 
 The lead of the far field's resonances (bench/far_field.py): a step that does not kick but integrates the
 force's action along the exact helix, sampling the force only along the slow path of the guiding centre

@@ -1,5 +1,5 @@
 // far_field_kick: where the far field's spin resonances come from, and what kicks that know the spin
-// achieve against them (docs/developers.md, "Limits, measured").
+// achieve against them (docs/measurements.md, "Limits, measured").
 //
 // A pass that stays far from the centre (the thesis scene, Kz = 0.1, d = 50, t = 80), integrated by the
 // exact Lie-Poisson drift with three kinds of kick, in Strang's and Yoshida's 4th-order composition, at

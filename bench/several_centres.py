@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Where the time goes with several centres, and what far-ip under --tol costs (docs/developers.md, "Limits, measured").
+"""Where the time goes with several centres, and what far-ip under --tol costs (docs/measurements.md, "Limits, measured").
 
 Prints two tables, timed by the project's rules (a warm-up call of each configuration, then interleaved
 repeats; medians of wall and CPU time, spread = interquartile range / median of the wall times):

@@ -51,7 +51,7 @@ inline RunResult run(const MethodInfo& m, const Body& body, const std::vector<Ce
 
 /// A long pass whose rounding is amplified: thesis table 3.1 passing the centre at d = 2 from L = 6400,
 /// to t = 2L/6 = 2133. Runs at fixed ds from 0.017 to 0.043 are 0.8e-9 to 6.3e-9 off the reference, not
-/// falling with ds (docs/developers.md, kVerifyRatio).
+/// falling with ds (docs/measurements.md, kVerifyRatio).
 inline SceneParams rounded_pass() {
   SceneParams p;
   p.start.d = 2.0;

@@ -6,7 +6,7 @@
 // larger difference. Below kProbeBelowTol the third run gives way to the round-off probe (rounding.cpp), added
 // to the pair's difference. An estimate above what tol allows halves the step (a step too coarse for the
 // field errs more), until kMaxStalls halvings in a row did not halve it: the floor it met. A step the method
-// refuses (far-ip: its iteration does not converge there) is halved too. Measurements: docs/developers.md,
+// refuses (far-ip: its iteration does not converge there) is halved too. Measurements: docs/measurements.md,
 // "Tuned constants".
 #include "search.hpp"
 

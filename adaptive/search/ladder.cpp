@@ -16,7 +16,7 @@
 //    probe's floor added, rounding.cpp), verified where asked by a companion at h*/kVerifyRatio; otherwise
 //    back to 2.
 // Differences that stop shrinking far below 1 are round-off: the search reports the floor it met (what the
-// finest runs still differ by). Each constant's measurement: docs/developers.md, "Tuned constants".
+// finest runs still differ by). Each constant's measurement: docs/measurements.md, "Tuned constants".
 #include "search.hpp"
 
 #include "bodypoint/adaptive/methods.hpp"
@@ -64,7 +64,7 @@ constexpr double kVerifyRatio = 1.25;
 }  // namespace
 
 /// The pilot pair at h0 and h0/2 (a refused step halves h0); sets the first estimate and returns the finer
-/// run, never delivered (docs/developers.md, "Limits, measured": a pilot pair's estimate alone was 25x low;
+/// run, never delivered (docs/measurements.md, "Limits, measured": a pilot pair's estimate alone was 25x low;
 /// the coarser may be, bounded by finer runs: pilot_answer).
 Level Search::pilot(Level& coarse) {
   double h = initial_step(m_, b_, c_, t_end_);

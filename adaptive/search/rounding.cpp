@@ -2,7 +2,7 @@
 // be delivered is repeated kProbeRuns times, all but one with its roundings changed (a fictitious step moved
 // by a relative k kProbeShift, or k fixed steps more: the truncation error moves by far less than tol), one
 // from its start moved by kStartShift. An encounter amplifies round-off, which Richardson cannot tell from
-// truncation; runs that differ only in rounding measure it (docs/developers.md, "Limits, measured").
+// truncation; runs that differ only in rounding measure it (docs/measurements.md, "Limits, measured").
 #include "search.hpp"
 
 #include "bodypoint/adaptive/methods.hpp"

@@ -13,10 +13,10 @@
 namespace bodypoint::adaptive::detail {
 namespace {
 
-/// Budget of force evaluations (or KS steps) over all runs of one search (docs/developers.md, "Tuned constants").
+/// Budget of force evaluations (or KS steps) over all runs of one search (docs/measurements.md, "Tuned constants").
 constexpr double kMaxEvals = 2e9;
 /// The samples a run that may be delivered keeps for the caller's sink, at most (112 bytes each: 117 MB);
-/// beyond, the delivered run is made again with the sink (docs/developers.md, "Tuned constants").
+/// beyond, the delivered run is made again with the sink (docs/measurements.md, "Tuned constants").
 constexpr std::size_t kMaxKeptSamples = std::size_t{1} << 20;
 
 }  // namespace

@@ -5,7 +5,7 @@
 //                   checked against the runs before it (the search's steps are described there)
 //   rounding.cpp    the round-off probe below kProbeBelowTol: repeats that differ only in rounding
 //   exact_pair.cpp  methods without an order (ks, far-ip): a pair's difference bounds the error
-// Each tuned constant's measurement is in docs/developers.md, "Tuned constants". Internal: not installed.
+// Each tuned constant's measurement is in docs/measurements.md, "Tuned constants". Internal: not installed.
 #pragma once
 
 #include "bodypoint/adaptive/tolerance.hpp"

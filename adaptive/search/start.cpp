@@ -13,7 +13,7 @@
 namespace bodypoint::adaptive::detail {
 namespace {
 
-/// far-ip's first step turns the spin by at most this many turns (docs/developers.md, "Tuned constants").
+/// far-ip's first step turns the spin by at most this many turns (docs/measurements.md, "Tuned constants").
 constexpr double kFarFieldTurns = 1.0;
 
 double speed_of(const Body& b) { return b.s0.v.norm(); }

@@ -22,7 +22,7 @@ namespace {
 /// What auto's whole search costs with each composition table it may choose, measured: per decade of tol
 /// from 1e-4 to 1e-8, the geometric mean over the named scenes thesis, close, long, two-centres and
 /// three-centres of the search's force evaluations over the cheapest table's on that scene (bench/auto_costs:
-/// the searches as auto runs them, verified about several centres; docs/developers.md, "Tuned constants").
+/// the searches as auto runs them, verified about several centres; docs/measurements.md, "Tuned constants").
 /// auto takes the table of least cost at tol, interpolated in log10(tol) between decades, held above 1e-4.
 struct MeasuredCost {
   std::string_view table;

@@ -9,7 +9,7 @@
 // error estimation): in the asymptotic regime err(h) = C h^p, so two runs at h and h/r differ by
 // C h^p (1 - r^-p) and the finer one's error is their difference over r^p - 1. The run delivered is
 // the run reported: it carries the observers (RunOptions), nothing is integrated again. The steps of
-// the search: adaptive/search/ladder.cpp; each tuned constant's measurement: docs/developers.md.
+// the search: adaptive/search/ladder.cpp; each tuned constant's measurement: docs/measurements.md.
 //
 // `--method auto` (which method for a scene and a tol) is one layer up: bodypoint/methods.hpp.
 #pragma once

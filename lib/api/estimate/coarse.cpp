@@ -208,7 +208,7 @@ double coarse_ratio_limit(const MethodInfo& m, const std::vector<Centre>& centre
 /// stages sample the field within the step: at the same 2 rad a step, ttl-pefrl (4 evaluations) and the
 /// eighth-order ones are in their regime (logh-kl8 on the close scene: 2.1x for a 10 % larger ds, order 8's
 /// 2.14x); per step instead of per evaluation the check made 788 more of the estimate ladder's runs dearer
-/// and raised none that was low (docs/developers.md, "Limits, measured").
+/// and raised none that was low (docs/measurements.md, "Limits, measured").
 bool run_past_coarse_margin(const MethodInfo& m, const std::vector<Centre>& centres, const RunResult& run) {
   return coarse_ratio_limit(m, centres, run) * std::max(1, m.evals_per_step) < 1.0;
 }
