@@ -641,7 +641,9 @@ Options with_constant(Options o, const BodyResult& r) {
 }  // namespace
 
 Stepper::Stepper(std::string_view method, Body body, std::vector<Centre> centres, const Accuracy& a, Options options)
-    : Stepper(body, centres, searched(method, body, centres, a, options), options, a.t_end) {}
+    : Stepper(body, centres, searched(method, body, centres, a, options), options, a.t_end) {
+  asked_ = method;
+}
 
 Stepper::Stepper(const Body& body, const std::vector<Centre>& centres, const BodyResult& r, const Options& options,
                  double t_end)
@@ -657,11 +659,23 @@ void Stepper::set_state(const State& s, double t) {
   Body b = body_;
   b.s0 = s;
   validate(Scene{centres_, {b}});
+  if (accuracy_) {  // plan anew from the state written: to t_end, or the whole span again past it
+    const double left = accuracy_t_end_ - t;
+    const double span = left != 0.0 && (left > 0.0) == (accuracy_t_end_ > 0.0) ? left : accuracy_t_end_;
+    Options o = options_;
+    o.omega_c = -1.0;
+    const BodyResult r = searched(asked_, b, centres_, Accuracy{accuracy_->tol, span}, o);
+    method_ = r.method;
+    step_ = r.accuracy->h_chosen;
+    options_.omega_c = takes_time_step_constant(*method_) ? r.accuracy->omega_c : -1.0;
+    accuracy_ = r.accuracy;
+    accuracy_->basis += "; searched again from the state set at t = " + fmt(t) + " (the error it carried in not included)";
+    accuracy_t_end_ = t + span;
+  }
   body_ = std::move(b);
   t_ = t;
   stopped_ = false;
   carried_ = std::numeric_limits<double>::quiet_NaN();  // the new state's own energy shell
-  accuracy_.reset();  // the search's estimate was for the states it ran from
 }
 
 Outcome Stepper::advance_to(double t) {

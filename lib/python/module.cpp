@@ -636,8 +636,20 @@ struct PyStepper {
       else if (key == "w") s.w = vec3_of(v, "state w");
       else if (key != "t") throw Error(unknown_name("state key", key, {"t", "R", "v", "w"}));
     }
-    if (d.contains("t")) stepper.set_state(s, number_of(d["t"], "state t"));
-    else stepper.set_state(s);
+    const double t = d.contains("t") ? number_of(d["t"], "state t") : stepper.time();
+    // A stepper with a tolerance searches again from the state written: under Ctrl-C, without the GIL.
+    Interruptible stop(std::numeric_limits<double>::infinity());
+    stepper.cancel_with(stop.flag());
+    try {
+      py::gil_scoped_release free;
+      stepper.set_state(s, t);
+    } catch (const Error&) {
+      stepper.cancel_with(nullptr);
+      stop.raise();
+      throw;
+    }
+    stepper.cancel_with(nullptr);
+    stop.raise();
   }
   py::object accuracy() const {
     if (!stepper.accuracy()) return py::none();

@@ -572,11 +572,12 @@ def test_a_stepper_runs_backwards_is_integrate_in_one_segment_and_takes_a_state(
     estimate = bp.integrate(scene, "lp-kl8", h=0.01, t_end=50)["bodies"][0]["err_estimate"]
     assert s.time == 0
     assert np.linalg.norm(s.state["R"] - start["R"]) / np.linalg.norm(start["R"]) <= estimate
-    # A writable state: the next segment starts from it; the search's estimate no longer applies.
+    # A writable state: the next segment starts from it, planned anew (the search for the rest, to t_end).
     t = bp.Stepper(scene, tol=1e-8, t_end=20)
     t.advance_to(5)
     t.state = {"v": [1.0, 0.0, 0.0], "t": 7.0}
-    assert t.time == 7.0 and t.state["v"].tolist() == [1.0, 0.0, 0.0] and t.accuracy is None
+    assert t.time == 7.0 and t.state["v"].tolist() == [1.0, 0.0, 0.0]
+    assert t.accuracy["t_end"] == 20 and t.accuracy["err_estimate"] <= 1e-8 and "searched again" in t.accuracy["basis"]
     t.advance_to(8)
     with pytest.raises(bp.Error, match="unknown state key 'q'"):
         t.state = {"q": 1}

@@ -366,7 +366,12 @@ class Stepper {
   [[nodiscard]] const std::optional<AccuracyReport>& accuracy() const { return accuracy_; }
   [[nodiscard]] double accuracy_t_end() const { return accuracy_t_end_; }
   /// Replaces the current state (a kick, a corrected state), checked as a scene's; the time stays
-  /// unless given. The accuracy search's estimate no longer applies (accuracy() becomes empty).
+  /// unless given. A stepper given a step keeps it (accuracy() stays empty). One that asks for an accuracy
+  /// plans anew from the state written: the search runs again for the span from there to its t_end (the
+  /// whole span again once t_end is reached), method, step and accuracy() its new ones (a write w = -w at
+  /// the closest approach kept the step chosen for the old spin rate: "a step turned the spin by 3.19 rad");
+  /// that estimate is the rest of the chain's, not the error the state carried in. Error, the stepper
+  /// unchanged, when the search refuses.
   void set_state(const State& s);
   void set_state(const State& s, double t);
 
@@ -393,6 +398,7 @@ class Stepper {
   std::optional<AccuracyReport> accuracy_;
   double accuracy_t_end_ = 0.0;
   double carried_ = std::numeric_limits<double>::quiet_NaN();  ///< RunOptions::carried from the last segment
+  std::string asked_;  ///< with a tolerance: the method asked for ("auto" or a name), searched again after a write
 };
 
 }  // namespace bodypoint

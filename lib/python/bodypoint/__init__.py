@@ -433,7 +433,8 @@ class Stepper:
     the search and its estimate, which holds at t_end (landing on the segments' times only shortens
     steps). A time before ``time`` integrates backwards (time reversal; a symmetric splitting run
     forwards and back by the same steps returns to round-off). ``state`` can be set (a dict of R, v, w
-    and optionally t); the search's estimate then no longer applies (``accuracy`` is None).
+    and optionally t); a Stepper made with ``tol`` then searches again from the state written, for the
+    span to ``t_end`` (``accuracy`` its new search; the error the state carried in is not in it).
     One segment is integrate()'s run of the same steps bit for bit (``invariants`` tracked as there);
     segments land on their times with a shortened last step, so several segments differ from one run
     by round-off and that step's error. ab4 restarts its history at each segment.
@@ -467,7 +468,8 @@ class Stepper:
     state = property(lambda self: self._s.state, _set_state,
                      doc="the current state: t, R, v, w; set it with a dict of some of them (checked as a scene's)")
     accuracy = property(lambda self: self._s.accuracy,
-                        doc="with tol: the search (tol, t_end, err_estimate at t_end, h_chosen, basis, force_evals); else None")
+                        doc="with tol: the search (tol, t_end, err_estimate at t_end, h_chosen, basis, force_evals), "
+                            "made again after a state is set; else None")
     step = property(lambda self: self._s.step, doc="the segments' step (h, ds, or a tolerance per step)")
     events = property(lambda self: self._s.events, doc="events located so far: event, t, r, R, v, w")
     stopped = property(lambda self: self._s.stopped, doc="a stop event ended the last segment")
