@@ -54,11 +54,12 @@ struct CliResult {
   std::string out, err;
 };
 
-/// Runs `bodypoint ARGS` (no terminal, no standard input).
+/// Runs `bodypoint ARGS` (no terminal, no standard input), under CI=1: a command slowed by a busy machine
+/// past kNoticeSeconds would otherwise add its "working" line to the stderr a test reads.
 inline CliResult run_cli(const std::string& args) {
   namespace fs = std::filesystem;
   const fs::path err = fs::temp_directory_path() / ("bp_cli_err_" + std::to_string(::getpid()));
-  const std::string cmd = std::string(BODYPOINT_BIN) + " " + args + " 2>" + err.string() + " </dev/null";
+  const std::string cmd = "CI=1 " + std::string(BODYPOINT_BIN) + " " + args + " 2>" + err.string() + " </dev/null";
   CliResult r;
   FILE* p = ::popen(cmd.c_str(), "r");
   std::array<char, 4096> buf{};

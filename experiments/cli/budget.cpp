@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <iostream>
 #include <limits>
 #include <utility>
@@ -113,6 +114,30 @@ void check_budget(const WorkEstimate& e, double max_seconds, bool quiet) {
 }
 
 bool progress_wanted(bool quiet) { return !quiet && ::isatty(2) == 1 && std::getenv("CI") == nullptr; }
+
+bool notice_wanted(bool quiet) { return !quiet && std::getenv("CI") == nullptr; }
+
+WorkingNotice::WorkingNotice(const std::string& what, bool enabled) {
+  if (!enabled) return;
+  const std::time_t started = std::time(nullptr);
+  thread_ = std::thread([this, what, started] {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (done_cv_.wait_for(lock, std::chrono::duration<double>(kNoticeSeconds), [this] { return done_; })) return;
+    char at[16] = "";
+    std::strftime(at, sizeof at, "%H:%M:%S", std::localtime(&started));
+    std::fprintf(stderr, "bodypoint %s: working (started %s); its output follows when it is done\n", what.c_str(), at);
+    std::fflush(stderr);
+  });
+}
+
+WorkingNotice::~WorkingNotice() {
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    done_ = true;
+  }
+  done_cv_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
 
 ProgressBar::ProgressBar(const std::optional<WorkEstimate>& e, bool enabled) {
   if (!enabled || !e || e->seconds < kBarSeconds) return;

@@ -3,13 +3,16 @@
 // A run of more than kCalibrateAbove steps (a time-transformed run to an end time: when a short probe
 // says it needs that many) is first calibrated on kCalibrationSteps steps of the same method and body; the estimate (steps and seconds)
 // is printed when it is long, refused when it exceeds the budget, and drives a progress bar on a
-// terminal (never under CI, with --quiet, or when standard error is not a terminal).
+// terminal (never under CI, with --quiet, or when standard error is not a terminal); elsewhere a command
+// at work for more than kNoticeSeconds says so in one line (WorkingNotice).
 #pragma once
 
 #include "bodypoint/bodypoint.hpp"
 #include "bodypoint/run.hpp"
 
 #include <atomic>
+#include <condition_variable>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
@@ -54,6 +57,28 @@ void check_budget(const WorkEstimate& e, double max_seconds, bool quiet);
 
 /// True when a progress bar may be drawn: stderr is a terminal, CI is unset and not quiet.
 bool progress_wanted(bool quiet);
+
+/// True when a command says on stderr that it is still working (WorkingNotice): not quiet, CI unset.
+bool notice_wanted(bool quiet);
+
+/// One line on stderr once a command has worked kNoticeSeconds, from a thread while alive, so that a long
+/// call is not taken for a hang where no progress bar is drawn (a script's log, a pipe): "bodypoint
+/// sweep: working (started 10:19:34); its output follows when it is done".
+class WorkingNotice {
+ public:
+  WorkingNotice(const std::string& what, bool enabled);
+  ~WorkingNotice();
+  WorkingNotice(const WorkingNotice&) = delete;
+  WorkingNotice& operator=(const WorkingNotice&) = delete;
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable done_cv_;
+  bool done_ = false;
+  std::thread thread_;
+};
+/// Seconds of work after which WorkingNotice speaks (the progress bar's too).
+inline constexpr double kNoticeSeconds = 2.0;
 
 /// Draws elapsed/expected time on stderr from a thread while alive (when enabled and the run is long).
 class ProgressBar {

@@ -2,6 +2,7 @@
 #include "process.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/model.hpp"
+#include "budget.hpp"
 #include "cli.hpp"
 #include "mpi_sweep.hpp"
 #include "rows_file.hpp"
@@ -14,6 +15,7 @@
 #include <new>
 #include <string>
 #include <string_view>
+#include <unistd.h>
 
 #ifdef BODYPOINT_MPI_PROGRAM
 #include <climits>
@@ -94,6 +96,13 @@ int run_command(int argc, char** argv) {
     if (bodypoint::cli::launched_by_mpi() && cmd != "sweep")
       throw bodypoint::Error(cmd + " runs in one process: under an MPI launcher (more than one process) only sweep "
                              "shares its runs among the processes; start it without mpirun, or with -np 1");
+    // A command at work for more than kNoticeSeconds says so in one line, where no progress bar does
+    // (simulate draws its own on a terminal); --quiet and CI keep stderr for errors.
+    bool quiet = false;
+    for (int i = 2; i < argc; ++i) quiet = quiet || std::strcmp(argv[i], "--quiet") == 0 || std::strcmp(argv[i], "--help") == 0;
+    const bool bar = cmd == "simulate" && ::isatty(2) == 1;
+    const bodypoint::cli::WorkingNotice notice(cmd, bodypoint::cli::launcher_rank() == 0 && !bar &&
+                                                        bodypoint::cli::notice_wanted(quiet));
     if (cmd == "simulate") return bodypoint::cli::cmd_simulate(argc - 1, argv + 1);
     if (cmd == "methods") return bodypoint::cli::cmd_methods(argc - 1, argv + 1);
     if (cmd == "work-precision") return bodypoint::cli::cmd_work_precision(argc - 1, argv + 1);

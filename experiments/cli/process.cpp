@@ -47,6 +47,7 @@ std::atomic<long> g_counter{0};
 std::atomic<bool> g_deadline{false};
 std::atomic<long long> g_deadline_ns{0};
 char g_deadline_message[512];
+std::atomic<bool> g_journal_open{false};  ///< note_journal()
 
 long long monotonic_ns() {
   timespec ts{};
@@ -90,7 +91,9 @@ constexpr unsigned kInterruptGraceSeconds = 1;
 /// saying why (only async-signal-safe calls: the message is composed by hand, alarm() arms the timer).
 void arm_interrupt_grace(int sig) {
   static constexpr char kHead[] = "bodypoint: error: interrupted by signal ";
-  static constexpr char kTail[] = "; the rows finished so far are in the journal, finish with --resume\n";
+  static constexpr char kJournal[] = "; the rows finished so far are in the journal, finish with --resume\n";
+  static constexpr char kNone[] = "; no output written\n";
+  const char* const kTail = g_journal_open.load() ? kJournal : kNone;
   std::size_t n = 0;
   for (const char* c = kHead; *c && n + 1 < sizeof g_deadline_message; ++c) g_deadline_message[n++] = *c;
   char digits[12];
@@ -263,6 +266,8 @@ bool through_descriptor(const std::string& path) {
 }
 
 }  // namespace
+
+void note_journal(bool open) { g_journal_open.store(open); }
 
 AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
   if (path_.empty()) throw Error("output path is empty");

@@ -63,6 +63,10 @@ void install_signal_cleanup(bool say = true);
 /// The signal received since install_signal_cleanup(), or 0.
 int interrupted();
 
+/// Whether a journal of finished rows is open (RowJournal): what the line of an interrupted loop says
+/// (a sweep to standard output has none: "no output written", not "finish with --resume").
+void note_journal(bool open);
+
 /// The whole process's budget of wall-clock time (--max-seconds of every command): when it has passed,
 /// every loop (runs, the accuracy search, the reference, peers' steppers, timing repeats, a sweep's row)
 /// is stopped alike, by SIGALRM: the temporary and lock files go, "<what>" is printed as the one-line

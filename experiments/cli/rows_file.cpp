@@ -213,9 +213,11 @@ RowJournal::RowJournal(std::string path, const std::string& key, std::size_t tas
     write_all(fd_, rows_file_text(fresh), path_);
   }
   sync();
+  note_journal(true);
 }
 
 RowJournal::~RowJournal() {
+  note_journal(false);
   if (fd_ >= 0) {
     ::fsync(fd_);
     ::close(fd_);
