@@ -654,12 +654,34 @@ Stepper::Stepper(const Body& body, const std::vector<Centre>& centres, const Bod
 
 void Stepper::set_state(const State& s) { set_state(s, t_); }
 
+namespace {
+
+/// A write that changes none of the scene's time scales by more than this share keeps the plan (a small kick
+/// or correction, written every segment, would otherwise pay a search each time).
+constexpr double kReplanScaleChange = 0.1;
+
+/// Whether the state `to` written over `from` moves a time scale of the step's: the spin's rate (B/D)|K1|,
+/// the speed, or the distance to the nearest centre, by more than kReplanScaleChange.
+bool moves_time_scales(const Body& body, const State& to, const std::vector<Centre>& centres) {
+  const auto moved = [](double a, double b) { return std::abs(a - b) > kReplanScaleChange * std::max(std::abs(a), std::abs(b)); };
+  const auto nearest = [&centres](const State& s) {
+    double r = std::numeric_limits<double>::infinity();
+    for (const Centre& c : centres) r = std::min(r, (s.R - c.c).norm());
+    return r;
+  };
+  const State& from = body.s0;
+  return moved(to_momenta(body.p, from).K1.norm(), to_momenta(body.p, to).K1.norm()) || moved(from.v.norm(), to.v.norm()) ||
+         moved(nearest(from), nearest(to));
+}
+
+}  // namespace
+
 void Stepper::set_state(const State& s, double t) {
   if (!std::isfinite(t)) throw Error("the stepper's time must be a finite number, got " + fmt(t));
   Body b = body_;
   b.s0 = s;
   validate(Scene{centres_, {b}});
-  if (accuracy_) {  // plan anew from the state written: to t_end, or the whole span again past it
+  if (accuracy_ && moves_time_scales(body_, b.s0, centres_)) {  // plan anew: to t_end, or the whole span again past it
     const double left = accuracy_t_end_ - t;
     const double span = left != 0.0 && (left > 0.0) == (accuracy_t_end_ > 0.0) ? left : accuracy_t_end_;
     Options o = options_;

@@ -349,6 +349,14 @@ TEST(Api, AStepperWithATolerancePlansAnewAfterAStateIsWritten) {
   const double t1 = 28.4, tol = 1e-10;
   Stepper stepper("auto", s.bodies.front(), s.centres, Accuracy{tol, 60.0});
   ASSERT_EQ(stepper.advance_to(t1), Outcome::ok) << stepper.reason();
+  // A small correction (R moved by 1e-6) moves no time scale: the plan and its report stay, no search.
+  const AccuracyReport planned = *stepper.accuracy();
+  State nudged = stepper.state();
+  nudged.R.x() += 1e-6;
+  stepper.set_state(nudged);
+  ASSERT_TRUE(stepper.accuracy().has_value());
+  EXPECT_EQ(stepper.accuracy()->h_chosen, planned.h_chosen);
+  EXPECT_EQ(stepper.accuracy()->basis, planned.basis);
   State flipped = stepper.state();
   flipped.w = -flipped.w;
   stepper.set_state(flipped);

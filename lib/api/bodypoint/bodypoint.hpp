@@ -366,8 +366,9 @@ class Stepper {
   [[nodiscard]] const std::optional<AccuracyReport>& accuracy() const { return accuracy_; }
   [[nodiscard]] double accuracy_t_end() const { return accuracy_t_end_; }
   /// Replaces the current state (a kick, a corrected state), checked as a scene's; the time stays
-  /// unless given. A stepper given a step keeps it (accuracy() stays empty). One that asks for an accuracy
-  /// plans anew from the state written: the search runs again for the span from there to its t_end (the
+  /// unless given. A stepper given a step keeps it (accuracy() stays empty). One that asks for an accuracy,
+  /// when the write moves a time scale of its step (the spin's rate, the speed or the distance to the nearest
+  /// centre) by more than 10 %, plans anew from the state written: the search runs again for the span from there to its t_end (the
   /// whole span again once t_end is reached), method, step and accuracy() its new ones (a write w = -w at
   /// the closest approach kept the step chosen for the old spin rate: "a step turned the spin by 3.19 rad");
   /// that estimate is the rest of the chain's, not the error the state carried in. Error, the stepper
