@@ -230,18 +230,13 @@ double event_scale(const Event& e, const BodyPoint& p, const std::vector<Centre>
 /// An upper bound on |dg/dt| at state s (before kRateMargin): d/dt (R - c).v = |v|^2 + (R - c).a for an
 /// approach, |v| for a radius, |n||v| for a plane; the guiding centre of an arrival or departure moves
 /// smoothly (0: it hides no root).
-double rate_bound(const Event& e, const BodyPoint& p, const std::vector<Centre>& centres, const State& s) {
+double rate_bound(const Event& e, const BodyPoint& p, const CentreList& field, const State& s) {
   switch (e.kind) {
     case Event::Kind::closest_approach:
     case Event::Kind::local_minimum: {
-      Vec3 F = Vec3::Zero();
-      for (const Centre& k : centres) {
-        const Vec3 d = s.R - k.c;
-        F -= k.A * d / (d.squaredNorm() * d.norm());
-      }
-      const double D = p.m * p.J - p.B * p.B;
-      const Vec3 a = (p.J * F - p.B * p.B * s.w.cross(s.v)) / D;  // docs/physics.md, equations of motion
-      return s.v.squaredNorm() + (s.R - centres[e.centre].c).norm() * a.norm();
+      // docs/physics.md, equations of motion: D dv/dt = J F - B^2 (w x v)
+      const Vec3 a = (p.J * field.force(s.R) - p.B * p.B * s.w.cross(s.v)) / p.D();
+      return s.v.squaredNorm() + (s.R - field.centres[e.centre].c).norm() * a.norm();
     }
     case Event::Kind::radius: return s.v.norm();
     case Event::Kind::plane: return e.normal.norm() * s.v.norm();
@@ -253,8 +248,7 @@ double rate_bound(const Event& e, const BodyPoint& p, const std::vector<Centre>&
 
 /// Whether the span from a to b (dt long) is one that can hide two sign changes (kHiddenSpin, kHiddenTurn).
 bool long_span(const BodyPoint& p, const std::vector<Centre>& centres, const State& a, const State& b, double dt) {
-  const double D = p.m * p.J - p.B * p.B;
-  const double spin = std::abs(p.B) / D * std::max((p.m * a.v + p.B * a.w).norm(), (p.m * b.v + p.B * b.w).norm()) * dt;
+  const double spin = std::abs(p.B) / p.D() * std::max(to_momenta(p, a).K1.norm(), to_momenta(p, b).K1.norm()) * dt;
   if (spin > kHiddenSpin) return true;
   for (const Centre& k : centres) {
     const Vec3 da = a.R - k.c, db = b.R - k.c;
@@ -263,27 +257,27 @@ bool long_span(const BodyPoint& p, const std::vector<Centre>& centres, const Sta
   return false;
 }
 
-/// Whether g can have crossed zero in a span dt long more often than its ends show (twice more, or at all
-/// where they have one sign): at the rate bound it can travel |g_a| + |g_b| and more.
-bool may_hide_roots(double g_a, double g_b, double rate, double dt) {
+/// Whether g can have crossed zero between the states a and b (g_a, g_b, dt apart) more often than its ends
+/// show (twice more, or at all where they have one sign): a long span (long_span) over which, at the rate
+/// bound, g can travel |g_a| + |g_b| and more.
+bool may_hide_roots(const Event& e, const BodyPoint& p, const CentreList& field, const State& a, const State& b,
+                    double g_a, double g_b, double dt) {
+  if (!long_span(p, field.centres, a, b, dt)) return false;
+  const double rate = std::max(rate_bound(e, p, field, a), rate_bound(e, p, field, b));
   return std::abs(g_a) + std::abs(g_b) < kRateMargin * rate * dt;
 }
 
 }  // namespace
 
 void EventWatch::observe(double t, const State& s) {
-  const bool long_step = started_ && t > t_ && long_span(p_, centres_, s_, s, t - t_);
   for (std::size_t k = 0; k < events_.size(); ++k) {
     const Event& e = events_[k];
     double g = event_function(e, p_, centres_, s);
     if (!started_ && std::abs(g) <= kStartUlps * std::numeric_limits<double>::epsilon() * event_scale(e, p_, centres_, s))
       g = 0.0;
-    const bool crossed = started_ && t > t_ && crosses(e, g_[k], g);
-    bool open = false;
-    if (long_step) {
-      const double rate = std::max(rate_bound(e, p_, centres_, s_), rate_bound(e, p_, centres_, s));
-      open = may_hide_roots(g_[k], g, rate, t - t_);
-    }
+    const bool stepped = started_ && t > t_;
+    const bool crossed = stepped && crosses(e, g_[k], g);
+    const bool open = stepped && may_hide_roots(e, p_, field_, s_, s, g_[k], g, t - t_);
     if (crossed) brackets_.push_back({k, t_, t, g_[k], g, s_, s, open});
     else if (open) hidden_.push_back({k, t_, t, g_[k], g, s_, s, true});
     g_[k] = g;
@@ -297,12 +291,13 @@ void EventWatch::observe(double t, const State& s) {
 namespace {
 
 /// The sign changes inside a hidden span, as brackets: the span is halved on the run's own configuration
-/// until a half shows a change, or its halves hide none (may_cross_between), or kMaxHalvings. An approach
+/// until a half shows a change, or its halves hide none (may_hide_roots), or kMaxHalvings. An approach
 /// whose span cannot come nearer the centre than the run already was (its ends less the distance its speed
 /// covers) is the run's closest approach no more and is not looked into.
 void open_hidden(const EventWatch::Bracket& span, int depth, const EventWatch& watch, const std::vector<Event>& events,
-                 const BodyPoint& p, const std::vector<Centre>& centres, const Advancer& advance, long& evals,
+                 const BodyPoint& p, const CentreList& field, const Advancer& advance, long& evals,
                  std::vector<EventWatch::Bracket>& out) {
+  const std::vector<Centre>& centres = field.centres;
   const Event& e = events[span.event];
   const double dt = span.t_b - span.t_a;
   if (e.kind == Event::Kind::closest_approach) {
@@ -318,12 +313,8 @@ void open_hidden(const EventWatch::Bracket& span, int depth, const EventWatch& w
   const EventWatch::Bracket halves[2] = {{span.event, span.t_a, t_mid, span.g_a, g_mid, span.s_a, mid},
                                          {span.event, t_mid, span.t_b, g_mid, span.g_b, mid, span.s_b}};
   for (const EventWatch::Bracket& h : halves) {
-    bool open = false;
-    if (depth + 1 < kMaxHalvings && long_span(p, centres, h.s_a, h.s_b, h.t_b - h.t_a)) {
-      const double rate = std::max(rate_bound(e, p, centres, h.s_a), rate_bound(e, p, centres, h.s_b));
-      open = may_hide_roots(h.g_a, h.g_b, rate, h.t_b - h.t_a);
-    }
-    if (open) open_hidden(h, depth + 1, watch, events, p, centres, advance, evals, out);
+    const bool open = depth + 1 < kMaxHalvings && may_hide_roots(e, p, field, h.s_a, h.s_b, h.g_a, h.g_b, h.t_b - h.t_a);
+    if (open) open_hidden(h, depth + 1, watch, events, p, field, advance, evals, out);
     else if (crosses(e, h.g_a, h.g_b)) out.push_back(h);
   }
 }
@@ -334,12 +325,13 @@ std::vector<EventHit> locate(const EventWatch& watch, const std::vector<Event>& 
                              const std::vector<Centre>& centres, const Advancer& advance, long& evals) {
   std::vector<EventHit> hits;
   std::vector<EventWatch::Bracket> brackets;
+  const CentreList field{centres};
   for (const EventWatch::Bracket& b : watch.brackets()) {
-    if (b.open) open_hidden(b, 0, watch, events, p, centres, advance, evals, brackets);
+    if (b.open) open_hidden(b, 0, watch, events, p, field, advance, evals, brackets);
     else brackets.push_back(b);
   }
   for (const EventWatch::Bracket& span : watch.hidden())
-    open_hidden(span, 0, watch, events, p, centres, advance, evals, brackets);
+    open_hidden(span, 0, watch, events, p, field, advance, evals, brackets);
   for (const EventWatch::Bracket& b : brackets) {
     const Event& e = events[b.event];
     // g(tau) on [lo, hi] within [0, t_b - t_a]; g(lo) < 0 <= g(hi) after orienting the sign.

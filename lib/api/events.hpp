@@ -8,6 +8,7 @@
 #pragma once
 
 #include "bodypoint/bodypoint.hpp"
+#include "bodypoint/field.hpp"
 
 #include <functional>
 #include <limits>
@@ -42,7 +43,7 @@ class EventWatch {
     bool open = false;
   };
   EventWatch(const std::vector<Event>& events, const BodyPoint& p, const std::vector<Centre>& centres)
-      : events_(events), p_(p), centres_(centres), g_(events.size()),
+      : events_(events), p_(p), centres_(centres), field_{centres}, g_(events.size()),
         nearest_(centres.size(), std::numeric_limits<double>::infinity()) {}
   void observe(double t, const State& s);
   [[nodiscard]] const std::vector<Bracket>& brackets() const { return brackets_; }
@@ -57,6 +58,7 @@ class EventWatch {
   const std::vector<Event>& events_;
   const BodyPoint& p_;
   const std::vector<Centre>& centres_;
+  CentreList field_;  ///< the force that bounds an approach's rate (may_hide_roots)
   std::vector<double> g_;
   std::vector<double> nearest_;
   bool started_ = false;
