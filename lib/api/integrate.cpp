@@ -290,9 +290,15 @@ constexpr double kPilotAbove = 8.0;
 constexpr double kStopPilotFirstStep = 1e-3;
 
 /// The time the body takes to cover its distance to the nearest centre at its start speed (infinite at rest).
-double crossing_time(const Body& body, const std::vector<Centre>& centres) {
+/// The distance from R to the nearest centre (infinite without one).
+double nearest_distance(const std::vector<Centre>& centres, const Vec3& R) {
   double r = std::numeric_limits<double>::infinity();
-  for (const Centre& c : centres) r = std::min(r, (body.s0.R - c.c).norm());
+  for (const Centre& c : centres) r = std::min(r, (R - c.c).norm());
+  return r;
+}
+
+double crossing_time(const Body& body, const std::vector<Centre>& centres) {
+  const double r = nearest_distance(centres, body.s0.R);
   const double v = body.s0.v.norm();
   return v > 0.0 ? r / v : std::numeric_limits<double>::infinity();
 }
@@ -664,14 +670,9 @@ constexpr double kReplanScaleChange = 0.1;
 /// the speed, or the distance to the nearest centre, by more than kReplanScaleChange.
 bool moves_time_scales(const Body& body, const State& to, const std::vector<Centre>& centres) {
   const auto moved = [](double a, double b) { return std::abs(a - b) > kReplanScaleChange * std::max(std::abs(a), std::abs(b)); };
-  const auto nearest = [&centres](const State& s) {
-    double r = std::numeric_limits<double>::infinity();
-    for (const Centre& c : centres) r = std::min(r, (s.R - c.c).norm());
-    return r;
-  };
   const State& from = body.s0;
   return moved(to_momenta(body.p, from).K1.norm(), to_momenta(body.p, to).K1.norm()) || moved(from.v.norm(), to.v.norm()) ||
-         moved(nearest(from), nearest(to));
+         moved(nearest_distance(centres, from.R), nearest_distance(centres, to.R));
 }
 
 }  // namespace
