@@ -93,6 +93,23 @@ void bound_by_second(ErrorEstimate& e, const MethodInfo& m, const Body& body, lo
 /// A run of fewer steps than this has no asymptotic regime of its own: a second companion bounds it too.
 inline constexpr long kFewSteps = 4;
 
+/// A Stepper's companion over one segment `how` (forwards), `level` levels finer (fine.cpp, the fine companion:
+/// h or ds over 2^level with the same time-step constant, a tolerance per step over 10^level): how it advances,
+/// what its difference to the run is multiplied by, its basis; nullopt, `none` saying why, where there is none.
+struct SegmentCompanion {
+  Advance how;
+  double factor = 1.0;
+  std::string basis;
+};
+std::optional<SegmentCompanion> segment_companion(const MethodInfo& m, const Body& body, const Advance& how, int level,
+                                                  std::string& none);
+/// Whether a companion that took `companion_steps` refines a segment of `how` that took `run_steps` (fine.cpp:
+/// a time-transformed one at least 1.5 times the steps, a controlled one more).
+bool companion_refines(const Advance& how, long run_steps, long companion_steps);
+/// A time-transformed companion that takes fewer than 1.5 times the run's steps did not refine it (a controlled
+/// one: no more steps); it is refined again, up to this many levels (ds/1024, tol/1e10): a run's and a Stepper's.
+inline constexpr int kMaxCompanionLevels = 10;
+
 /// A fixed-step run's companion `level` levels finer (h/2^level, 2^level times the steps), the estimate
 /// from the final states of the run and its first companion, and whether the second companion confirms
 /// it (the difference falls as h^p): for a batch's lanes, which run them outside integrate().

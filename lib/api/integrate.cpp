@@ -579,6 +579,12 @@ Advance advance_for(const MethodInfo* m, const StepRequest& r) {
 
 namespace {
 
+/// A stepper asked for a tolerance at or below this has a draw of the rounding beside its companion: a chain's
+/// error can fall a decade below the tolerance (a leg back cancelling the way out's), where the companion pair
+/// alone can agree by chance (rk4 at tol 1e-10 forwards and back on a spinning pass: 4.7e-11 off, read 1.4e-11).
+constexpr double kDrawTolerance = 10.0 * adaptive::kProbeBelowTol;
+
+
 /// A Stepper's segment of `span` (> 0) forwards: the step, fictitious step or tolerance per step it
 /// was built with.
 Advance segment_of(const MethodInfo& method, double step, double span) {
@@ -616,6 +622,7 @@ Stepper::Stepper(Checked, const MethodInfo& method, const Body& body, const std:
   // A departure through the start's distance is the stepper's start, not each segment's (the events
   // were checked with the request).
   options_.events = detail::resolved(options_.events, body_.p, centres_, body_.s0);
+  twin_.none = "none: a stepper given a step has no error estimate (one that asks for a tolerance has)";
 }
 
 Advance Stepper::segment(double span) const { return segment_of(*method_, step_, span); }
@@ -654,13 +661,129 @@ Stepper::Stepper(std::string_view method, Body body, std::vector<Centre> centres
 Stepper::Stepper(const Body& body, const std::vector<Centre>& centres, const BodyResult& r, const Options& options,
                  double t_end)
     : Stepper(Checked{}, *r.method, body, centres, r.accuracy->h_chosen, with_constant(options, r)) {
+  searched_ = r.accuracy;
   accuracy_ = r.accuracy;
   accuracy_t_end_ = t_end;
+  twin_.s = body.s0;
+  if (r.accuracy->tol <= kDrawTolerance) twin_.draw = detail::start_moved_by_rounding(body.s0, detail::rounding_way(1));
+  if (!options.estimate_error) {
+    twin_.none = "none: the error estimate is off (Options::estimate_error)";
+    return;
+  }
+  if (const auto c = detail::segment_companion(*method_, body_, segment(1.0), 1, twin_.none)) {
+    twin_.none.clear();
+    twin_.factor = c->factor;
+    twin_.basis = c->basis;
+  }
+}
+
+ErrorEstimate Stepper::error() const {
+  ErrorEstimate e;
+  e.force_evals = twin_.force_evals;
+  if (!twin_.none.empty()) {
+    e.basis = twin_.none;
+    return e;
+  }
+  e.value = twin_.factor * adaptive::state_distance(body_.s0, twin_.s);
+  e.basis = twin_.basis + ", beside every segment and write (the chain's error at t = " + fmt(t_) + ")";
+  if (twin_.draw && detail::at_rounding_level(e)) {
+    detail::add_rounding_spread(e, body_.s0, *twin_.draw, 0, 0.0, detail::kRepeatRoundingDraw);
+    detail::bound_from_draws(e);
+  }
+  e.force_evals = twin_.force_evals;
+  return e;
+}
+
+State Stepper::error_state() const {
+  State e{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+  if (!twin_.none.empty()) return e;
+  e.R = twin_.factor * (body_.s0.R - twin_.s.R);
+  e.v = twin_.factor * (body_.s0.v - twin_.s.v);
+  e.w = twin_.factor * (body_.s0.w - twin_.s.w);
+  return e;
+}
+
+void Stepper::carry_error(const State& e) {
+  if (!twin_.none.empty())
+    throw Error("this stepper has no companion to carry an error in (" + twin_.none + "): ask for a tolerance");
+  if (!(e.R.allFinite() && e.v.allFinite() && e.w.allFinite())) throw Error("the error carried in must be finite");
+  // error_state() is the difference times the factor: the companion goes where its difference is e over it, as
+  // the same chain in one stepper would have it (a leg back whose error cancels the way out's is then read as
+  // that: rk4 at tol 1e-8 out to 30 and back as two steppers, 3.6e-11 off, read 2.0e-10 with e placed whole).
+  twin_.s.R = body_.s0.R - e.R / twin_.factor;
+  twin_.s.v = body_.s0.v - e.v / twin_.factor;
+  twin_.s.w = body_.s0.w - e.w / twin_.factor;
+  report_chain();
+}
+
+void Stepper::report_chain() {
+  if (!searched_) return;
+  accuracy_ = searched_;
+  const ErrorEstimate e = error();
+  if (steps_ == 0 && twin_.force_evals == 0 && e.value == 0.0) return;  // nothing run or carried yet: the search's
+  accuracy_->err_estimate = e.value;
+  accuracy_->basis = "the chain's error at t = " + fmt(t_) + ": " + e.basis + "; the search: " + searched_->basis;
+}
+
+bool Stepper::advance_companion(double t1, long run_steps, std::string& broke) {
+  if (!twin_.none.empty() || t1 == t_) return true;
+  const Advance fwd = segment(std::abs(t1 - t_));
+  Options o = options_;
+  o.sink = nullptr;
+  o.events.clear();
+  o.track_invariants = false;  // the run's flags judge the run; the companion only has to get through
+  o.carried = twin_.carried;
+  Body b = body_;
+  b.s0 = twin_.s;
+  for (int level = 1; level <= detail::kMaxCompanionLevels; ++level) {
+    std::string none;
+    const auto c = detail::segment_companion(*method_, b, fwd, level, none);
+    if (!c) {
+      twin_.none = "none from t = " + fmt(t_) + ": " + none;
+      return true;
+    }
+    if (level == 1) twin_.factor = c->factor, twin_.basis = c->basis;  // the method may be new (a write planned anew)
+    const BodyResult x = integrate_estimated(b, centres_, method_, t1 < t_ ? backwards(c->how) : c->how, o);
+    twin_.force_evals += x.run.force_evals;
+    if (x.outcome == Outcome::failed && x.reason == kStoppedOnRequest) return false;
+    const bool finite = x.run.final.R.allFinite() && x.run.final.v.allFinite() && x.run.final.w.allFinite();
+    if (!finite || !ran(x.outcome) || x.outcome == Outcome::diverged || x.outcome == Outcome::collision) {
+      broke = "the " + c->basis + " broke down between t = " + fmt(t_) + " and " + fmt(t1) + " (" +
+              (x.reason.empty() ? std::string(outcome_name(x.outcome)) : x.reason) + ")";
+      twin_.none = "none: " + broke;
+      return true;
+    }
+    if (detail::companion_refines(fwd, run_steps, x.run.steps) || level == detail::kMaxCompanionLevels) {
+      twin_.s = x.run.final;
+      twin_.carried = x.run.carried;
+      break;
+    }
+  }
+  if (!twin_.draw) return true;
+  // The draw of the rounding: the segment's own steps off its grid (a repeat, not a finer run).
+  b.s0 = *twin_.draw;
+  o.carried = twin_.draw_carried;
+  const BodyResult y = integrate_estimated(b, centres_, method_, t1 < t_ ? backwards(detail::off_grid(fwd)) : detail::off_grid(fwd), o);
+  twin_.force_evals += y.run.force_evals;
+  if (y.outcome == Outcome::failed && y.reason == kStoppedOnRequest) return false;
+  twin_.draw = y.run.final;  // a draw that broke down is not finite: add_rounding_spread leaves it out
+  twin_.draw_carried = y.run.carried;
+  return true;
 }
 
 void Stepper::set_state(const State& s) { set_state(s, t_); }
 
+void Stepper::apply(const std::function<State(const State&)>& write_state) {
+  const State s = write_state(body_.s0);
+  if (!carries_error()) return set_state(s);
+  const State c = write_state(twin_.s);
+  set_state(s, t_, c);
+}
+
 namespace {
+
+/// A written vector within this relative distance of a multiple of the one it replaced was scaled (written_over).
+constexpr double kScaledWrite = 1e-12;
 
 /// A write that changes none of the scene's time scales by more than this share keeps the plan (a small kick
 /// or correction, written every segment, would otherwise pay a search each time).
@@ -677,8 +800,38 @@ bool moves_time_scales(const Body& body, const State& to, const std::vector<Cent
 
 }  // namespace
 
-void Stepper::set_state(const State& s, double t) {
+namespace {
+
+/// The companion's state after a write that took the stepper's state from `from` to `to`, each vector as the
+/// write moved the stepper's: a vector scaled by a number (w = -w, a speed halved) is scaled alike, so that the
+/// error it carried turns with it; any other is moved by the same change (a kick). (A write w = -w taken as a
+/// change left the companion's w error unturned: on table 3.1 at tol 1e-8, read 3e-8 for 8e-7.)
+Vec3 written_vector(const Vec3& twin, const Vec3& from, const Vec3& to) {
+  if (to == from) return twin;
+  const double n = from.squaredNorm();
+  if (n > 0.0) {
+    const double c = from.dot(to) / n;
+    if ((to - c * from).norm() <= kScaledWrite * to.norm()) return c * twin;
+  }
+  return twin + (to - from);
+}
+
+State written_over(const State& twin, const State& from, const State& to) {
+  return State{written_vector(twin.R, from.R, to.R), written_vector(twin.v, from.v, to.v), written_vector(twin.w, from.w, to.w)};
+}
+
+}  // namespace
+
+void Stepper::set_state(const State& s, double t, const State& companion) { write(s, t, &companion); }
+
+void Stepper::set_state(const State& s, double t) { write(s, t, nullptr); }
+
+void Stepper::write(const State& s, double t, const State* companion) {
   if (!std::isfinite(t)) throw Error("the stepper's time must be a finite number, got " + fmt(t));
+  if (companion && !twin_.none.empty())
+    throw Error("this stepper has no companion to write (" + twin_.none + "): ask for a tolerance");
+  if (companion && !(companion->R.allFinite() && companion->v.allFinite() && companion->w.allFinite()))
+    throw Error("the companion's state written must be finite");
   Body b = body_;
   b.s0 = s;
   validate(Scene{centres_, {b}});
@@ -691,14 +844,18 @@ void Stepper::set_state(const State& s, double t) {
     method_ = r.method;
     step_ = r.accuracy->h_chosen;
     options_.omega_c = takes_time_step_constant(*method_) ? r.accuracy->omega_c : -1.0;
-    accuracy_ = r.accuracy;
-    accuracy_->basis += "; searched again from the state set at t = " + fmt(t) + " (the error it carried in not included)";
+    searched_ = r.accuracy;
+    searched_->basis += "; searched again from the state set at t = " + fmt(t);
     accuracy_t_end_ = t + span;
   }
+  twin_.s = companion ? *companion : written_over(twin_.s, body_.s0, b.s0);
+  twin_.carried = std::numeric_limits<double>::quiet_NaN();
+  if (twin_.draw) twin_.draw = written_over(*twin_.draw, body_.s0, b.s0), twin_.draw_carried = twin_.carried;
   body_ = std::move(b);
   t_ = t;
   stopped_ = false;
   carried_ = std::numeric_limits<double>::quiet_NaN();  // the new state's own energy shell
+  report_chain();
 }
 
 Outcome Stepper::advance_to(double t) {
@@ -733,6 +890,12 @@ Outcome Stepper::advance_to(double t) {
     reason_ = r.reason;
     return r.outcome;
   }
+  const double t1 = r.run.stopped ? t0 + r.run.t_end : t;
+  std::string broke;
+  if (!advance_companion(t1, r.run.steps, broke)) {  // stopped on request: the segment is not kept
+    reason_ = kStoppedOnRequest;
+    return Outcome::failed;
+  }
   for (EventHit h : r.events) {
     h.t += t0;
     events_.push_back(h);
@@ -741,10 +904,15 @@ Outcome Stepper::advance_to(double t) {
   body_.s0 = r.run.final;
   carried_ = r.run.stopped ? std::numeric_limits<double>::quiet_NaN() : r.run.carried;  // a cut state is not the run's end
   stopped_ = r.run.stopped;
-  t_ = r.run.stopped ? t0 + r.run.t_end : t;
+  t_ = t1;
   force_evals_ += r.run.force_evals;
   steps_ += r.run.steps;
   if (r.outcome != Outcome::ok) reason_ = r.reason;
+  report_chain();
+  if (!broke.empty() && (r.outcome == Outcome::ok || r.outcome == Outcome::inaccurate)) {
+    reason_ = broke + ": a finer step did not get through the scene, so this step does not resolve it and its error is unknown";
+    return Outcome::unresolved;
+  }
   return r.outcome;
 }
 

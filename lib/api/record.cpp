@@ -147,7 +147,10 @@ Record body_record(const BodyResult& r, const Advance& how, const std::vector<Ev
   out.text("outcome", std::string(outcome_name(r.outcome))).note("reason", r.reason).number("h", step_of(r, how));
   if (const auto* c = std::get_if<ControlledSteps>(&how)) out.number("tol", c->tol);
   if (const auto* a = r.accuracy ? &*r.accuracy : nullptr) {
-    out.number("tol", a->tol).number("h_chosen", a->h_chosen).count("search_runs", a->runs);
+    out.number("tol", a->tol).number("h_chosen", a->h_chosen);
+    // The time-step constant the search delivered with ds: the run is reproduced only with both (--omega-c).
+    if (r.method && r.method->traits.takes_omega_c) out.number("omega_c", a->omega_c);
+    out.count("search_runs", a->runs);
     out.count("search_force_evals", a->force_evals).number("search_wall_s", a->wall_s);
   }
   if (!r.chosen.empty()) out.text("chosen", r.chosen);

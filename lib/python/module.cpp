@@ -627,22 +627,49 @@ struct PyStepper {
     o.omega_c = omega_c.value_or(-1.0);
     return Stepper(m, scene.bodies[body], scene.centres, *step, o);
   }
-  void set_state(const py::dict& d) {
-    State s = stepper.state();
+  /// `s` with the entries of d (R, v, w; t when `t_allowed`) written over it.
+  static State written(State s, const py::dict& d, bool t_allowed) {
     for (const auto& [k, v] : d) {
       const std::string key = k.cast<std::string>();
       if (key == "R") s.R = vec3_of(v, "state R");
       else if (key == "v") s.v = vec3_of(v, "state v");
       else if (key == "w") s.w = vec3_of(v, "state w");
-      else if (key != "t") throw Error(unknown_name("state key", key, {"t", "R", "v", "w"}));
+      else if (key != "t" || !t_allowed) throw Error(unknown_name("state key", key, {"t", "R", "v", "w"}));
     }
+    return s;
+  }
+  static py::dict state_dict(const State& s, double t) {
+    py::dict d;
+    d["t"] = t;
+    d["R"] = vec(s.R);
+    d["v"] = vec(s.v);
+    d["w"] = vec(s.w);
+    return d;
+  }
+  void set_state(const py::dict& d) {
+    const State s = written(stepper.state(), d, true);
     const double t = d.contains("t") ? number_of(d["t"], "state t") : stepper.time();
+    write(s, t, std::nullopt);
+  }
+  /// The write f (a state dict to a dict of the entries it writes) applied to the state and the companion's.
+  void apply(const py::function& f) {
+    const auto of = [&](const State& x) {
+      const py::object out = f(state_dict(x, stepper.time()));
+      if (!py::isinstance<py::dict>(out)) throw Error("apply's function must return a dict of R, v, w");
+      return written(x, out.cast<py::dict>(), false);
+    };
+    const State s = of(stepper.state());
+    if (!stepper.carries_error()) return write(s, stepper.time(), std::nullopt);
+    write(s, stepper.time(), of(stepper.companion_state()));
+  }
+  void write(const State& s, double t, const std::optional<State>& companion) {
     // A stepper with a tolerance searches again from the state written: under Ctrl-C, without the GIL.
     Interruptible stop(std::numeric_limits<double>::infinity());
     stepper.cancel_with(stop.flag());
     try {
       py::gil_scoped_release free;
-      stepper.set_state(s, t);
+      if (companion) stepper.set_state(s, t, *companion);
+      else stepper.set_state(s, t);
     } catch (const Error&) {
       stepper.cancel_with(nullptr);
       stop.raise();
@@ -659,9 +686,35 @@ struct PyStepper {
     d["t_end"] = stepper.accuracy_t_end();
     d["err_estimate"] = a.err_estimate;
     d["h_chosen"] = a.h_chosen;
+    if (stepper.method().traits.takes_omega_c) d["omega_c"] = a.omega_c;
     d["basis"] = a.basis;
     d["force_evals"] = a.force_evals;
     return d;
+  }
+  py::dict error() const {
+    const ErrorEstimate e = stepper.error();
+    const State x = stepper.error_state();
+    py::dict d;
+    d["t"] = stepper.time();
+    d["estimate"] = e.known() ? py::cast(e.value) : py::none();
+    d["basis"] = e.basis;
+    d["R"] = vec(x.R);
+    d["v"] = vec(x.v);
+    d["w"] = vec(x.w);
+    d["force_evals"] = e.force_evals;
+    return d;
+  }
+  void carry_error(const py::dict& d) {
+    State x{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+    for (const auto& [k, v] : d) {
+      const std::string key = k.cast<std::string>();
+      if (key == "R") x.R = vec3_of(v, "error R");
+      else if (key == "v") x.v = vec3_of(v, "error v");
+      else if (key == "w") x.w = vec3_of(v, "error w");
+      else if (key != "t" && key != "estimate" && key != "basis" && key != "force_evals")
+        throw Error(unknown_name("error key", key, {"R", "v", "w"}));
+    }
+    stepper.carry_error(x);
   }
   std::string advance_to(double t, double max_seconds) {
     Interruptible stop(max_seconds);
@@ -675,14 +728,7 @@ struct PyStepper {
     stop.raise();
     return std::string(outcome_name(o));
   }
-  py::dict state() const {
-    py::dict d;
-    d["t"] = stepper.time();
-    d["R"] = vec(stepper.state().R);
-    d["v"] = vec(stepper.state().v);
-    d["w"] = vec(stepper.state().w);
-    return d;
-  }
+  py::dict state() const { return state_dict(stepper.state(), stepper.time()); }
   py::list hits() const {
     py::list l;
     for (const EventHit& h : stepper.events()) l.append(to_py(event_record(h, labels)));
@@ -753,6 +799,9 @@ void bind_stepper(py::module_& mod) {
       .def_property_readonly("time", [](const PyStepper& s) { return s.stepper.time(); })
       .def_property("state", &PyStepper::state, &PyStepper::set_state)
       .def_property_readonly("accuracy", &PyStepper::accuracy)
+      .def_property_readonly("error", &PyStepper::error)
+      .def("carry_error", &PyStepper::carry_error, py::arg("error"))
+      .def("apply", &PyStepper::apply, py::arg("write"))
       .def_property_readonly("step", [](const PyStepper& s) { return s.stepper.step(); })
       .def_property_readonly("events", &PyStepper::hits)
       .def_property_readonly("stopped", [](const PyStepper& s) { return s.stepper.stopped(); })

@@ -323,7 +323,11 @@ EncounterResult encounter(const Body& body, const std::vector<Centre>& centres, 
 ///   step: fixed-step methods: the largest step <= step that lands on t; time-transformed methods: the
 ///         fictitious step ds; step-size-controlled methods: the tolerance per step, and the first
 ///         trial step is min(1e-3, t - time()).
-/// A segment has no error estimate (Options::estimate_error is off for it). A time before time()
+/// A stepper that asks for an accuracy carries its error: a companion run one level finer (h/2, ds/2 with the
+/// same time-step constant, a tenth of the tolerance per step) goes beside it from the start through every
+/// segment and every write, and error() is what the two differ by (Richardson at the method's order) at
+/// time(): the whole chain's error, segments, writes and the way back included. A stepper given a step
+/// has none (error() says so). A time before time()
 /// integrates backwards (the time-reversed run, is_backward): forwards and back by the same steps, a
 /// symmetric splitting returns to its start to round-off. Events: each segment locates its hits at
 /// absolute times; the closest approach (Event::closest_approach) is the nearest *so far*, replaced
@@ -361,20 +365,41 @@ class Stepper {
   void cancel_with(const std::atomic<bool>* flag) { options_.cancel = flag; }
   /// The step of the segments: h, a time-transformed method's ds, a controlled method's tolerance per step.
   [[nodiscard]] double step() const { return step_; }
-  /// With a tolerance: the search that chose the method and step, its estimate (at its t_end) included;
-  /// none for a stepper given a step, or once its state was set.
+  /// With a tolerance: the search that chose the method and step; its err_estimate is the search's (at its
+  /// t_end) until a segment ran, then error()'s at time(). None for a stepper given a step.
   [[nodiscard]] const std::optional<AccuracyReport>& accuracy() const { return accuracy_; }
+  /// The estimated error of the state at time(): the companion's (a stepper that asks for an accuracy,
+  /// Options::estimate_error on), a relative error of R and v as a run's (ErrorEstimate); NaN, the basis
+  /// saying why, where there is none. Its force_evals are the companion's so far.
+  [[nodiscard]] ErrorEstimate error() const;
+  /// The estimated error of each component of the state at time() (state() less the true state, estimated);
+  /// zero where error() is not known.
+  [[nodiscard]] State error_state() const;
+  /// Carries an error into the current state (a state that came out of another run with its error_state(), so
+  /// that a chain of separate runs reports the chain's error): the companion is put at state() - e. Error
+  /// when the stepper has no companion.
+  void carry_error(const State& e);
   [[nodiscard]] double accuracy_t_end() const { return accuracy_t_end_; }
   /// Replaces the current state (a kick, a corrected state), checked as a scene's; the time stays
   /// unless given. A stepper given a step keeps it (accuracy() stays empty). One that asks for an accuracy,
   /// when the write moves a time scale of its step (the spin's rate, the speed or the distance to the nearest
   /// centre) by more than 10 %, plans anew from the state written: the search runs again for the span from there to its t_end (the
   /// whole span again once t_end is reached), method, step and accuracy() its new ones (a write w = -w at
-  /// the closest approach kept the step chosen for the old spin rate: "a step turned the spin by 3.19 rad");
-  /// that estimate is the rest of the chain's, not the error the state carried in. Error, the stepper
-  /// unchanged, when the search refuses.
+  /// the closest approach kept the step chosen for the old spin rate: "a step turned the spin by 3.19 rad").
+  /// The companion takes the same write, so that the error the state carried in goes on in error(): each
+  /// of R, v, w that the write scaled by a number (w = -w) is scaled alike in the companion, any other moved by
+  /// the same change (a kick). A write that is another map is given as one (apply), or with the companion's
+  /// state written too. Error, the stepper unchanged, when the search refuses.
   void set_state(const State& s);
   void set_state(const State& s, double t);
+  void set_state(const State& s, double t, const State& companion);
+  /// A write that is a map of the state (a reflection, a rotation of the spin): applied to the state and to
+  /// the companion's, as set_state(write(state()), time(), write(companion_state())).
+  void apply(const std::function<State(const State&)>& write);
+  /// Whether a companion goes beside the segments (error() can be known).
+  [[nodiscard]] bool carries_error() const { return twin_.none.empty(); }
+  /// The companion's state at time() (error() is what it differs by from state()); state() where there is none.
+  [[nodiscard]] const State& companion_state() const { return twin_.none.empty() ? twin_.s : body_.s0; }
 
  private:
   /// A segment of `span` (> 0) forwards: the step, fictitious step or tolerance per step it was built with.
@@ -400,6 +425,28 @@ class Stepper {
   double accuracy_t_end_ = 0.0;
   double carried_ = std::numeric_limits<double>::quiet_NaN();  ///< RunOptions::carried from the last segment
   std::string asked_;  ///< with a tolerance: the method asked for ("auto" or a name), searched again after a write
+  /// The companion beside the segments (error()): its state and carried time transformation, the factor its
+  /// difference is taken at (the coarsest level's), its basis, or why there is none (`none` non-empty).
+  struct Companion {
+    State s;
+    double carried = std::numeric_limits<double>::quiet_NaN();
+    double factor = 1.0;
+    std::string basis, none;
+    long force_evals = 0;
+    /// With a tolerance near the rounding level: a draw of the rounding beside them, the run's steps off its
+    /// grid from the start moved by a rounding (error() below that level takes it in, as a run's estimate does).
+    std::optional<State> draw;
+    double draw_carried = std::numeric_limits<double>::quiet_NaN();
+  };
+  Companion twin_;
+  std::optional<AccuracyReport> searched_;  ///< the search as it reported (accuracy_ is it with error()'s estimate)
+  /// Runs the companion beside the segment the stepper made from t_ to t1 in `run_steps` steps (not yet kept):
+  /// false when it was stopped on request (the segment is then not kept); `broke` says why where it broke down.
+  bool advance_companion(double t1, long run_steps, std::string& broke);
+  /// accuracy_ from searched_ and error() at time().
+  void report_chain();
+  /// set_state's work: the companion's state written too where given, else as set_state says.
+  void write(const State& s, double t, const State* companion);
 };
 
 }  // namespace bodypoint

@@ -19,9 +19,8 @@ namespace {
 constexpr double kTolRatio = 10.0;
 
 /// A time-transformed companion that takes fewer than this many times the run's steps did not refine it
-/// (a controlled one: no more steps); it is refined again, up to kMaxCompanionLevels levels (ds/1024, tol/1e10).
+/// (a controlled one: no more steps); it is refined again, up to kMaxCompanionLevels levels (estimate.hpp).
 constexpr double kRefined = 1.5;
-constexpr int kMaxCompanionLevels = 10;
 
 /// The smallest tolerance per step a companion is run with (run.cpp refuses smaller ones).
 constexpr double kMinCompanionTol = 1e-15;
@@ -267,6 +266,17 @@ ErrorEstimate fixed_step_estimate(const MethodInfo& m, const Body& body, const s
     e.value = adaptive::coarser_run_error(1.0, kStepRatio, p) * adaptive::state_distance(run, companion);
   }
   return e;
+}
+
+std::optional<SegmentCompanion> segment_companion(const MethodInfo& m, const Body& body, const Advance& how, int level,
+                                                  std::string& none) {
+  std::optional<Companion> c = companion_of(m, body, how, level, none);
+  if (!c) return std::nullopt;
+  return SegmentCompanion{std::move(c->how), c->factor, std::move(c->basis)};
+}
+
+bool companion_refines(const Advance& how, long run_steps, long companion_steps) {
+  return refines(how, run_steps, companion_steps);
 }
 
 }  // namespace bodypoint::detail

@@ -441,7 +441,10 @@ class Stepper:
     ``events`` / ``stop_at``: as integrate()'s, at absolute times. ``closest`` is the closest approach
     *so far*: a later segment that comes nearer replaces it (on table 3.1, after advance_to(28) a helix
     wiggle at t = 27.571, r = 10.76; after advance_to(28.5) the encounter's minimum, t = 28.399, r = 9.0546).
-    A segment has no error estimate of its own. Ctrl-C or ``max_seconds`` stop the search of a Stepper
+    A Stepper made with ``tol`` carries its error: a companion one level finer (h/2, ds/2) goes beside it
+    through every segment and every write (taken as a change), and ``error`` is the chain's error at
+    ``time``, forwards and back included; ``carry_error`` hands one Stepper's ``error`` to the next where
+    runs are chained. One given a step has none. Ctrl-C or ``max_seconds`` stop the search of a Stepper
     made with ``tol`` as they stop a segment (KeyboardInterrupt, or bodypoint.Error for the budget).
     """
 
@@ -468,8 +471,28 @@ class Stepper:
     state = property(lambda self: self._s.state, _set_state,
                      doc="the current state: t, R, v, w; set it with a dict of some of them (checked as a scene's)")
     accuracy = property(lambda self: self._s.accuracy,
-                        doc="with tol: the search (tol, t_end, err_estimate at t_end, h_chosen, basis, force_evals), "
-                            "made again after a state is set; else None")
+                        doc="with tol: the search (tol, t_end, h_chosen, basis, force_evals), made again after a write "
+                            "that moves a time scale; err_estimate is the search's (at t_end) until a segment ran, then "
+                            "the chain's at time (as error); else None")
+    error = property(lambda self: self._s.error,
+                     doc="the estimated error at time: t, estimate (relative, of R and v; None where there is none), "
+                         "basis, R, v, w (the state less the true one, estimated) and the companion's force_evals")
+
+    def apply(self, write):
+        """Writes the state by a map: ``write`` takes a state dict (t, R, v, w) and returns a dict of the
+        entries it writes; it is applied to the state and to the companion's, so that the error carried
+        turns with the write. ``s.state = {...}`` scales the companion's R, v or w where the write scaled
+        them (w = -w) and moves them by the same change otherwise (a kick)."""
+        if not callable(write):
+            raise Error(f"write must be a function of the state, got {type(write).__name__}")
+        self._s.apply(write)
+
+    def carry_error(self, error):
+        """Carries an error into the current state: a dict of R, v, w (another Stepper's ``error``), so that
+        a chain of separate Steppers reports the chain's error. Needs a Stepper made with ``tol``."""
+        if not isinstance(error, dict):
+            raise Error(f"error must be a dict of R, v, w, got {type(error).__name__}")
+        self._s.carry_error(error)
     step = property(lambda self: self._s.step, doc="the segments' step (h, ds, or a tolerance per step)")
     events = property(lambda self: self._s.events, doc="events located so far: event, t, r, R, v, w")
     stopped = property(lambda self: self._s.stopped, doc="a stop event ended the last segment")
