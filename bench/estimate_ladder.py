@@ -13,7 +13,7 @@ scene). A run refused by a flag is made again with the bounds lifted, to know it
   - runs with no estimate, and the methods' refusals of scenes they do not take (not flags).
 
 Usage (from the repository, after the build; a few minutes on 2 cores):
-    /usr/bin/python3 bench/estimate_ladder.py [build/bin/bodypoint] [--threads 2] [--csv out.csv]
+    /usr/bin/python3 bench/estimate_ladder.py [build/bin/bodypoint] [--threads 2] [--csv out.csv] [--unseen]
 """
 import argparse
 import csv
@@ -94,6 +94,41 @@ w = [0.0, 0.0, 1.0]
 """
 
 
+# Scenes the estimate was not tuned on (`--unseen`, issue #81): a tilted spin, a slow close pass, a spinning
+# body about an attracting centre, a far pass, and a material body through three centres of mixed sign.
+MIXED_CENTRES = """[[centre]]
+position = [0.0, 0.0, 0.0]
+A = -1.5
+[[centre]]
+position = [25.0, -4.0, 0.0]
+A = 1.0
+[[centre]]
+position = [50.0, 5.0, 2.0]
+A = -0.5
+[[body]]
+name = "material"
+m = 1.0
+B = 0.0
+J = 1.0
+R = [-60.0, 1.5, 0.3]
+v = [4.0, 0.0, 0.0]
+w = [0.0, 0.0, 0.0]
+"""
+
+
+def unseen_scenes(folder):
+    path = os.path.join(folder, "mixed-centres.toml")
+    with open(path, "w") as f:
+        f.write(MIXED_CENTRES)
+    return [
+        ("tilted-spin", ["--B", "0.5", "--d", "6", "--Kx", "4", "--Kz", "2"], "30"),
+        ("slow-close", ["--d", "2", "--K1", "2"], "60"),
+        ("attracting-spin", ["--A", "1.5", "--B", "0.8", "--d", "4"], "60"),
+        ("far-pass", ["--d", "30", "--L", "100"], "40"),
+        ("mixed-centres", ["--scene", path], "40"),
+    ]
+
+
 def scenes(folder):
     files = {}
     for name, text in [("two-centres", TWO_CENTRES), ("bound", bound_orbit(0.0)), ("bound-spin", bound_orbit(0.7)),
@@ -159,6 +194,7 @@ def one(binary, job):
     if lifted is not None:
         row["R"], row["v"] = lifted["R"], lifted["v"]
         row["estimate"] = lifted["err_estimate"]
+        row["basis"] = lifted.get("err_basis", "")
     return row
 
 
@@ -167,11 +203,12 @@ def main():
     ap.add_argument("binary", nargs="?", default="build/bin/bodypoint")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--csv")
+    ap.add_argument("--unseen", action="store_true", help="five scenes the estimate was not tuned on instead")
     a = ap.parse_args()
     listing = subprocess.run([a.binary, "methods", "--csv"], capture_output=True, text=True, check=True).stdout
     methods = list(csv.DictReader(listing.splitlines()))
     with tempfile.TemporaryDirectory() as folder:
-        scene_list = scenes(folder)
+        scene_list = unseen_scenes(folder) if a.unseen else scenes(folder)
         refs = references(a.binary, scene_list)
         jobs = [(s, args, t, m, step) for s, args, t in scene_list for m in methods
                 for step in (TOLS if m["advance"] == "controlled" else STEPS)]
@@ -242,10 +279,10 @@ def print_cost(rows):
 def write_rows(path, rows):
     with open(path, "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["scene", "method", "step", "exit", "error", "estimate", "force_evals", "estimate_force_evals", "reason"])
+        w.writerow(["scene", "method", "step", "exit", "error", "estimate", "force_evals", "estimate_force_evals", "reason", "basis"])
         for r in rows:
             w.writerow([r["scene"], r["method"], r["step"], r["exit"], r.get("error", ""), r.get("estimate", ""),
-                        r.get("force_evals", ""), r.get("estimate_force_evals", ""), r["reason"]])
+                        r.get("force_evals", ""), r.get("estimate_force_evals", ""), r["reason"], r.get("basis", "")])
 
 
 if __name__ == "__main__":

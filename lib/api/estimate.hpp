@@ -60,11 +60,16 @@ double coarse_ratio_limit(const MethodInfo& m, const std::vector<Centre>& centre
 /// The estimate from the run's and the coarse companion's final states; nullopt where it is not trusted
 /// (a coarse state not finite, an estimate above kCoarseTrusted, estimate/coarse.cpp): the fine companion decides.
 std::optional<ErrorEstimate> coarse_estimate(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
-                                             const CoarseCompanion& c, const State& run, const State& coarse);
+                                             const CoarseCompanion& c, const State& run, const State& coarse, long run_steps);
 /// Whether a coarse pair whose estimate e would be trusted asks a second coarse companion: at 1e-8 or above
 /// (kSecondCoarseFrom; nearer the rounding level the pair's difference is partly rounding), where the method's
 /// flow is not exact (estimate/coarse.cpp).
 bool asks_second_coarse(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres, const ErrorEstimate& e);
+/// Whether a coarse pair whose estimate e is trusted below kSecondCoarseFrom asks a second coarse companion to
+/// sharpen it: the order assumed on the coarse side is capped below the method's, and e is above the rounding
+/// level; where the three runs observe a higher order, Richardson takes it (observed_order_agrees), where not, e stands.
+bool sharpened_by_second_coarse(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
+                                const CoarseCompanion& c, const ErrorEstimate& e);
 /// Whether a second coarse companion c2 (the coarse run's own, c2.ratio times its step) shows the pair (run,
 /// coarse) in its asymptotic regime: the order the three final states observe lies within one of the orders
 /// the estimate assumes (estimate/coarse.cpp, kObservedOrderSlack); where it does, e's basis says so.

@@ -97,28 +97,40 @@ void second_coarse_batch(const MethodInfo& method, const detail::CoarseCompanion
                          const std::vector<Scene>& scenes, const std::vector<RunResult>& results,
                          const std::vector<RunResult>& coarse, std::vector<std::optional<ErrorEstimate>>& out,
                          std::vector<ErrorEstimate>& cost) {
-  const auto asks = [&](std::size_t k) {
-    return out[k] && detail::asks_second_coarse(method, scenes[k].bodies.front(), scenes[k].centres, *out[k]);
-  };
+  // As integrate(): a lane asks to keep its pair (asks_second_coarse) or to sharpen it (sharpened_by_second_coarse).
+  enum class Second { none, asks, sharpens };
+  std::vector<Second> second(out.size(), Second::none);
   double max_ratio = ErrorEstimate::kStepRatio;
   bool any = false;
-  for (std::size_t k = 0; k < out.size(); ++k)
-    if (asks(k)) any = true, max_ratio = std::min(max_ratio, detail::coarse_ratio_limit(method, scenes[k].centres, coarse[k]));
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    if (!out[k]) continue;
+    const Body& body = scenes[k].bodies.front();
+    second[k] = detail::asks_second_coarse(method, body, scenes[k].centres, *out[k]) ? Second::asks
+                : detail::sharpened_by_second_coarse(method, body, scenes[k].centres, c, *out[k]) ? Second::sharpens
+                                                                                                  : Second::none;
+    if (second[k] != Second::none)
+      any = true, max_ratio = std::min(max_ratio, detail::coarse_ratio_limit(method, scenes[k].centres, coarse[k]));
+  }
   if (!any) return;
   const auto c2 = detail::coarse_companion(method, c.how, std::get<FixedSteps>(c.how).steps, max_ratio);
   if (!c2) return;
   const auto y = batch::run(method, moved, std::get<FixedSteps>(c2->how));
   for (std::size_t k = 0; k < out.size(); ++k) {
-    if (!asks(k)) continue;
-    out[k]->force_evals += y[k].force_evals;
-    out[k]->wall_s += y[k].wall_s;
+    if (second[k] == Second::none) continue;
     const bool ok = assess(y[k], checks_for(method, scenes[k].centres, detail::kCoarseEnergyBound)).outcome == Outcome::ok;
+    ErrorEstimate trial = *out[k];
+    trial.force_evals += y[k].force_evals;
+    trial.wall_s += y[k].wall_s;
     if (ok && detail::observed_order_agrees(method, scenes[k].bodies.front(), c, *c2, results[k].final, coarse[k].final,
-                                            y[k].final, *out[k]))
-      continue;
-    cost[k].force_evals += y[k].force_evals;
-    cost[k].wall_s += y[k].wall_s;
-    out[k].reset();
+                                            y[k].final, trial)) {
+      *out[k] = std::move(trial);
+    } else if (second[k] == Second::sharpens) {  // the capped estimate stands
+      out[k]->force_evals = trial.force_evals, out[k]->wall_s = trial.wall_s;
+    } else {
+      cost[k].force_evals += y[k].force_evals;
+      cost[k].wall_s += y[k].wall_s;
+      out[k].reset();
+    }
   }
 }
 
@@ -149,7 +161,7 @@ std::vector<std::optional<ErrorEstimate>> coarse_estimates(const MethodInfo& met
     if (!(coarse[k].final.R.allFinite() && coarse[k].final.v.allFinite())) continue;
     coarse_side[k] = detail::coarse_side_of(method, scenes[k].bodies.front(), *c, results[k].final, coarse[k].final);
     out[k] = detail::coarse_estimate(method, scenes[k].bodies.front(), scenes[k].centres, *c, results[k].final,
-                                     coarse[k].final);
+                                     coarse[k].final, results[k].steps);
     if (out[k]) out[k]->force_evals = coarse[k].force_evals, out[k]->wall_s = coarse[k].wall_s;
   }
   second_coarse_batch(method, *c, moved, scenes, results, coarse, out, cost);

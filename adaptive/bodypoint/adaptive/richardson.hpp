@@ -14,6 +14,11 @@ inline double finer_run_error(double difference, double ratio, int p) {
   return difference / (std::pow(ratio, p) - 1.0);
 }
 
+/// The same at an order observed (not an integer): observed_order's.
+inline double finer_run_error(double difference, double ratio, double q) {
+  return difference / (std::pow(ratio, q) - 1.0);
+}
+
 /// The error of the coarser of the two: difference / (1 - ratio^-p), ratio^p times the finer run's.
 inline double coarser_run_error(double difference, double ratio, int p) {
   return difference / (1.0 - std::pow(ratio, -p));
