@@ -48,15 +48,20 @@ A = -2.0
 position = [40.0, 6.0, 0.0]
 A = -1.0
 """
-TWO_CENTRES = CENTRES + """[[body]]
+def material_body(R, v):
+    """A material point (B = 0) started from R with velocity v, as scene-file text."""
+    return f"""[[body]]
 name = "material"
 m = 1.0
 B = 0.0
 J = 1.0
-R = [-150.0, 3.0, 0.0]
-v = [5.0, 0.0, 0.0]
+R = {R}
+v = {v}
 w = [0.0, 0.0, 0.0]
 """
+
+
+TWO_CENTRES = CENTRES + material_body([-150.0, 3.0, 0.0], [5.0, 0.0, 0.0])
 
 
 # Several centres with the thesis's spinning body: two repelling, then one attracting beyond them (the
@@ -105,15 +110,7 @@ A = 1.0
 [[centre]]
 position = [50.0, 5.0, 2.0]
 A = -0.5
-[[body]]
-name = "material"
-m = 1.0
-B = 0.0
-J = 1.0
-R = [-60.0, 1.5, 0.3]
-v = [4.0, 0.0, 0.0]
-w = [0.0, 0.0, 0.0]
-"""
+""" + material_body([-60.0, 1.5, 0.3], [4.0, 0.0, 0.0])
 
 
 def unseen_scenes(folder):

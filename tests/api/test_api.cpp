@@ -320,13 +320,18 @@ TEST(Api, AStepperContinuesAsOneRunOfTheSameSteps) {
 /// (they were 3.7e-8 apart when each segment set logH's g = E - T afresh on its start's energy).
 constexpr double kSegmentsOnTheRunsShell = 2e-11;
 
-TEST(Api, ATimeTransformedSteppersSegmentsGoOnAsOneRun) {
+/// A close pass with a fast spin (B = 0.9, d = 4, L = 40, Kx = 3): where segments and their estimate were measured.
+Scene spinning_pass() {
   SceneParams p;
   p.B = 0.9;
   p.start.d = 4.0;
   p.start.L = 40.0;
   p.start.Kx = 3.0;
-  const Scene s = thesis_scene(p);
+  return thesis_scene(p);
+}
+
+TEST(Api, ATimeTransformedSteppersSegmentsGoOnAsOneRun) {
+  const Scene s = spinning_pass();
   for (const char* method : {"logh-pefrl", "ttl-pefrl"}) {
     Stepper one(method, s.bodies.front(), s.centres, 0.003), seven(method, s.bodies.front(), s.centres, 0.003);
     ASSERT_EQ(one.advance_to(25.0), Outcome::ok) << one.reason();
@@ -387,12 +392,7 @@ double state_error(const State& a, const State& b) { return std::max(rel(a.R, b.
 
 TEST(Api, AStepperCarriesItsErrorThroughSegmentsWritesAndTheWayBack) {
   // Segments: an unseen spinning pass in 25 segments (the search's estimate, reused, was 5.1x low at 50).
-  SceneParams p;
-  p.B = 0.9;
-  p.start.d = 4.0;
-  p.start.L = 40.0;
-  p.start.Kx = 3.0;
-  const Scene spin = thesis_scene(p);
+  const Scene spin = spinning_pass();
   Stepper cut("auto", spin.bodies.front(), spin.centres, Accuracy{1e-6, 25.0});
   Stepper ref("lp-kl8", spin.bodies.front(), spin.centres, 1e-3);
   for (int k = 1; k <= 25; ++k) {
