@@ -108,6 +108,9 @@ struct SegmentCompanion {
 };
 std::optional<SegmentCompanion> segment_companion(const MethodInfo& m, const Body& body, const Advance& how, int level,
                                                   std::string& none);
+/// Whether a companion run broke down (a non-finite state, diverged, fell onto a centre, failed other than on
+/// request): the run's step then does not resolve what a finer one could not get through (fine.cpp).
+bool companion_broke_down(const BodyResult& x);
 /// Whether a companion that took `companion_steps` refines a segment of `how` that took `run_steps` (fine.cpp:
 /// a time-transformed one at least 1.5 times the steps, a controlled one more).
 bool companion_refines(const Advance& how, long run_steps, long companion_steps);

@@ -584,7 +584,6 @@ namespace {
 /// alone can agree by chance (rk4 at tol 1e-10 forwards and back on a spinning pass: 4.7e-11 off, read 1.4e-11).
 constexpr double kDrawTolerance = 10.0 * adaptive::kProbeBelowTol;
 
-
 /// A Stepper's segment of `span` (> 0) forwards: the step, fictitious step or tolerance per step it
 /// was built with.
 Advance segment_of(const MethodInfo& method, double step, double span) {
@@ -680,7 +679,7 @@ Stepper::Stepper(const Body& body, const std::vector<Centre>& centres, const Bod
 ErrorEstimate Stepper::error() const {
   ErrorEstimate e;
   e.force_evals = twin_.force_evals;
-  if (!twin_.none.empty()) {
+  if (!carries_error()) {
     e.basis = twin_.none;
     return e;
   }
@@ -690,13 +689,12 @@ ErrorEstimate Stepper::error() const {
     detail::add_rounding_spread(e, body_.s0, *twin_.draw, 0, 0.0, detail::kRepeatRoundingDraw);
     detail::bound_from_draws(e);
   }
-  e.force_evals = twin_.force_evals;
   return e;
 }
 
 State Stepper::error_state() const {
-  State e{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
-  if (!twin_.none.empty()) return e;
+  State e;
+  if (!carries_error()) return e;
   e.R = twin_.factor * (body_.s0.R - twin_.s.R);
   e.v = twin_.factor * (body_.s0.v - twin_.s.v);
   e.w = twin_.factor * (body_.s0.w - twin_.s.w);
@@ -704,9 +702,9 @@ State Stepper::error_state() const {
 }
 
 void Stepper::carry_error(const State& e) {
-  if (!twin_.none.empty())
+  if (!carries_error())
     throw Error("this stepper has no companion to carry an error in (" + twin_.none + "): ask for a tolerance");
-  if (!(e.R.allFinite() && e.v.allFinite() && e.w.allFinite())) throw Error("the error carried in must be finite");
+  if (!is_finite(e)) throw Error("the error carried in must be finite");
   // error_state() is the difference times the factor: the companion goes where its difference is e over it, as
   // the same chain in one stepper would have it (a leg back whose error cancels the way out's is then read as
   // that: rk4 at tol 1e-8 out to 30 and back as two steppers, 3.6e-11 off, read 2.0e-10 with e placed whole).
@@ -726,7 +724,7 @@ void Stepper::report_chain() {
 }
 
 bool Stepper::advance_companion(double t1, long run_steps, std::string& broke) {
-  if (!twin_.none.empty() || t1 == t_) return true;
+  if (!carries_error() || t1 == t_) return true;
   const Advance fwd = segment(std::abs(t1 - t_));
   Options o = options_;
   o.sink = nullptr;
@@ -746,8 +744,7 @@ bool Stepper::advance_companion(double t1, long run_steps, std::string& broke) {
     const BodyResult x = integrate_estimated(b, centres_, method_, t1 < t_ ? backwards(c->how) : c->how, o);
     twin_.force_evals += x.run.force_evals;
     if (x.outcome == Outcome::failed && x.reason == kStoppedOnRequest) return false;
-    const bool finite = x.run.final.R.allFinite() && x.run.final.v.allFinite() && x.run.final.w.allFinite();
-    if (!finite || !ran(x.outcome) || x.outcome == Outcome::diverged || x.outcome == Outcome::collision) {
+    if (detail::companion_broke_down(x) || x.outcome == Outcome::refused) {
       broke = "the " + c->basis + " broke down between t = " + fmt(t_) + " and " + fmt(t1) + " (" +
               (x.reason.empty() ? std::string(outcome_name(x.outcome)) : x.reason) + ")";
       twin_.none = "none: " + broke;
@@ -798,10 +795,6 @@ bool moves_time_scales(const Body& body, const State& to, const std::vector<Cent
          moved(nearest_distance(centres, from.R), nearest_distance(centres, to.R));
 }
 
-}  // namespace
-
-namespace {
-
 /// The companion's state after a write that took the stepper's state from `from` to `to`, each vector as the
 /// write moved the stepper's: a vector scaled by a number (w = -w, a speed halved) is scaled alike, so that the
 /// error it carried turns with it; any other is moved by the same change (a kick). (A write w = -w taken as a
@@ -828,10 +821,9 @@ void Stepper::set_state(const State& s, double t) { write(s, t, nullptr); }
 
 void Stepper::write(const State& s, double t, const State* companion) {
   if (!std::isfinite(t)) throw Error("the stepper's time must be a finite number, got " + fmt(t));
-  if (companion && !twin_.none.empty())
+  if (companion && !carries_error())
     throw Error("this stepper has no companion to write (" + twin_.none + "): ask for a tolerance");
-  if (companion && !(companion->R.allFinite() && companion->v.allFinite() && companion->w.allFinite()))
-    throw Error("the companion's state written must be finite");
+  if (companion && !is_finite(*companion)) throw Error("the companion's state written must be finite");
   Body b = body_;
   b.s0 = s;
   validate(Scene{centres_, {b}});
@@ -863,7 +855,7 @@ Outcome Stepper::advance_to(double t) {
     throw Error("advance_to needs a finite time other than the current one (" + fmt(t_) + "), got " + fmt(t));
   // A segment starts where the last one ended; a state that is no longer a motion (the last segment
   // diverged) is not run on.
-  if (!(body_.s0.R.allFinite() && body_.s0.v.allFinite() && body_.s0.w.allFinite())) {
+  if (!is_finite(body_.s0)) {
     reason_ = "the stepper's state is not finite (" + (reason_.empty() ? std::string("a segment diverged") : reason_) +
               "): set_state() a new one";
     return Outcome::refused;

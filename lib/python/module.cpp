@@ -627,14 +627,19 @@ struct PyStepper {
     o.omega_c = omega_c.value_or(-1.0);
     return Stepper(m, scene.bodies[body], scene.centres, *step, o);
   }
-  /// `s` with the entries of d (R, v, w; t when `t_allowed`) written over it.
-  static State written(State s, const py::dict& d, bool t_allowed) {
+  /// `s` with the entries R, v, w of d written over it (`what`: "state" or "error", for the messages); the
+  /// keys in `passed` are read elsewhere or not at all, any other is refused.
+  static State written(State s, const py::dict& d, const std::string& what, std::initializer_list<std::string_view> passed) {
     for (const auto& [k, v] : d) {
       const std::string key = k.cast<std::string>();
-      if (key == "R") s.R = vec3_of(v, "state R");
-      else if (key == "v") s.v = vec3_of(v, "state v");
-      else if (key == "w") s.w = vec3_of(v, "state w");
-      else if (key != "t" || !t_allowed) throw Error(unknown_name("state key", key, {"t", "R", "v", "w"}));
+      if (key == "R") s.R = vec3_of(v, what + " R");
+      else if (key == "v") s.v = vec3_of(v, what + " v");
+      else if (key == "w") s.w = vec3_of(v, what + " w");
+      else if (std::find(passed.begin(), passed.end(), key) == passed.end()) {
+        std::vector<std::string> known{"R", "v", "w"};
+        if (what == "state") known.insert(known.begin(), passed.begin(), passed.end());
+        throw Error(unknown_name(what + " key", key, known));
+      }
     }
     return s;
   }
@@ -647,7 +652,7 @@ struct PyStepper {
     return d;
   }
   void set_state(const py::dict& d) {
-    const State s = written(stepper.state(), d, true);
+    const State s = written(stepper.state(), d, "state", {"t"});
     const double t = d.contains("t") ? number_of(d["t"], "state t") : stepper.time();
     write(s, t, std::nullopt);
   }
@@ -656,7 +661,7 @@ struct PyStepper {
     const auto of = [&](const State& x) {
       const py::object out = f(state_dict(x, stepper.time()));
       if (!py::isinstance<py::dict>(out)) throw Error("apply's function must return a dict of R, v, w");
-      return written(x, out.cast<py::dict>(), false);
+      return written(x, out.cast<py::dict>(), "state", {});
     };
     const State s = of(stepper.state());
     if (!stepper.carries_error()) return write(s, stepper.time(), std::nullopt);
@@ -705,16 +710,8 @@ struct PyStepper {
     return d;
   }
   void carry_error(const py::dict& d) {
-    State x{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
-    for (const auto& [k, v] : d) {
-      const std::string key = k.cast<std::string>();
-      if (key == "R") x.R = vec3_of(v, "error R");
-      else if (key == "v") x.v = vec3_of(v, "error v");
-      else if (key == "w") x.w = vec3_of(v, "error w");
-      else if (key != "t" && key != "estimate" && key != "basis" && key != "force_evals")
-        throw Error(unknown_name("error key", key, {"R", "v", "w"}));
-    }
-    stepper.carry_error(x);
+    // A Stepper's `error` dict is taken as it is: its other entries say what the vector is.
+    stepper.carry_error(written(State{}, d, "error", {"t", "estimate", "basis", "force_evals"}));
   }
   std::string advance_to(double t, double max_seconds) {
     Interruptible stop(max_seconds);

@@ -96,10 +96,7 @@ bool refines(const Advance& how, long run_steps, long companion_steps) {
 /// companion at ds/2 failed, and the run read ok). The run is flagged unresolved, the companion's reason
 /// quoted. A companion stopped on request, or ended at another stop event, did not break down.
 void flag_broken_companion(BodyResult& r, const BodyResult& x, const std::string& basis) {
-  const bool finite = x.run.final.R.allFinite() && x.run.final.v.allFinite();
-  const bool broke = !finite || x.outcome == Outcome::diverged || x.outcome == Outcome::collision ||
-                     (x.outcome == Outcome::failed && x.reason != kStoppedOnRequest);
-  if (!broke || (r.outcome != Outcome::ok && r.outcome != Outcome::inaccurate)) return;
+  if (!companion_broke_down(x) || (r.outcome != Outcome::ok && r.outcome != Outcome::inaccurate)) return;
   r.outcome = Outcome::unresolved;
   r.reason = "the " + basis + " broke down (" + (x.reason.empty() ? std::string(outcome_name(x.outcome)) : x.reason) +
              "): a finer step did not get through the scene, so this run's step does not resolve it and its error is unknown";
@@ -266,6 +263,11 @@ ErrorEstimate fixed_step_estimate(const MethodInfo& m, const Body& body, const s
     e.value = adaptive::coarser_run_error(1.0, kStepRatio, p) * adaptive::state_distance(run, companion);
   }
   return e;
+}
+
+bool companion_broke_down(const BodyResult& x) {
+  return !is_finite(x.run.final) || x.outcome == Outcome::diverged || x.outcome == Outcome::collision ||
+         (x.outcome == Outcome::failed && x.reason != kStoppedOnRequest);
 }
 
 std::optional<SegmentCompanion> segment_companion(const MethodInfo& m, const Body& body, const Advance& how, int level,

@@ -310,7 +310,7 @@ Checks checks_for(const MethodInfo& m, const std::vector<Centre>& centres, doubl
 
 Health assess(const RunResult& r, const Checks& checks) {
   const State& f = r.final;
-  const bool finite = f.R.allFinite() && f.v.allFinite() && f.w.allFinite();
+  const bool finite = is_finite(f);
   const InvariantStats* inv = r.invariants ? &*r.invariants : nullptr;
   const bool fell = inv && inv->min_r_attracting < kCollisionFraction * inv->r0_attracting;
   const bool energy = inv && checks.energy_is_integral;

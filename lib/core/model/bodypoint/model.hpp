@@ -90,6 +90,9 @@ struct State {
   Vec3 w = Vec3::Zero();
 };
 
+/// Whether every component of the state is a finite number.
+inline bool is_finite(const State& s) { return s.R.allFinite() && s.v.allFinite() && s.w.allFinite(); }
+
 /// Time reversal (docs/physics.md, "Time reversal"): the equations keep their form under t -> -t,
 /// v -> -v, w -> -w (the kinetic energy is quadratic in the velocities, the potential depends on R
 /// alone), so a run backwards in time is the forward run of the reversed state, reversed again.
