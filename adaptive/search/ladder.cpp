@@ -6,7 +6,10 @@
 // like C h^p there: the three last runs fit an order between p - kOrderSlack and p + kOrderExcess, or (a
 // ladder of two) the estimate is what the coarser runs predicted for it, within kAgree.
 // 1. Pilot pair: runs at a coarse step h0 (start.cpp) and h0/2, with the c of h0. A run the method refuses
-//    (logH's E - T + c <= 0, a non-finite state) halves h0.
+//    (logH's E - T + c <= 0, a non-finite state) halves h0. A planned step h* (Accuracy::first_step: a map's
+//    plan, from the step its nearest pilot row delivered) replaces the pilot pair by the answer at h* and its
+//    companion at kCompanionRatio h*, judged as a new ladder of step 2 is; a planned pair far below its
+//    target starts once more from the step it predicts (replanned).
 // 2. The latest estimate predicts the step h* that gives kTarget tol. When h*'s own c is well below the
 //    ladder's (far from the centres a run costs ~c/ds steps per unit time), a new ladder starts: the answer
 //    at h* and its companion at kCompanionRatio h* (half the cost of the answer). Otherwise the answer at
@@ -31,9 +34,8 @@
 namespace bodypoint::adaptive::detail {
 namespace {
 
-/// The predicted step aims at this fraction of tol (a prediction from a coarser pair is uncertain by a
-/// factor of a few, and a miss costs one more run).
-constexpr double kTarget = 0.3;
+/// The predicted step aims at this fraction of tol (tolerance.hpp).
+constexpr double kTarget = kTargetShare;
 /// The answer's companion runs at this multiple of its step: it costs 1/kCompanionRatio of the answer.
 constexpr double kCompanionRatio = 2.0;
 /// A triple whose observed order is this much below p is not smooth in h there.
@@ -57,6 +59,8 @@ constexpr double kMinAimShare = 0.1;
 constexpr double kUnresolvedPair = 1.0;
 /// Differences at or below this relative size are at the round-off level of a run of 1e3..1e6 steps.
 constexpr double kRoundOff = 1e-13;
+/// A planned pair far below its target starts once more at most this many times coarser (replanned()).
+constexpr double kMaxReplanGain = 4.0;
 /// A run about to be delivered is verified by a companion at its step over this ratio, which costs this many
 /// of its runs.
 constexpr double kVerifyRatio = 1.25;
@@ -89,6 +93,64 @@ Level Search::pilot(Level& coarse) {
   }
 }
 
+/// A ladder started at a planned step (Accuracy::first_step, a map's plan): the answer at that step and its
+/// companion at kCompanionRatio times it with the companion's constant c, as refine() starts a new ladder, in
+/// place of the pilot pair. False (rungs empty) where the method breaks down there or the pair follows no
+/// common trajectory: the search then starts from its own pilot.
+bool Search::seeded(std::vector<Level>& rungs) {
+  if (!(seed_ > 0.0)) return false;
+  const double h_c = kCompanionRatio * seed_;
+  Attempt<bool> pair = attempt([&] {
+    rungs.push_back(run_at(h_c, h_c, false));
+    rungs.push_back(run_at(seed_, h_c, true));
+    return state_distance(rungs[0].run.final, rungs[1].run.final) <= kUnresolvedPair;
+  });
+  if (pair.value && *pair.value) {
+    estimate_ = pair_estimate(rungs[0], rungs[1]);
+    return true;
+  }
+  rungs.clear();
+  return false;
+}
+
+/// A planned pair whose estimate lies far below its target (the row is easier than the pilot it was planned
+/// from) starts once more at the step its estimate predicts, at most kMaxReplanGain times coarser: refined from
+/// there, the ladder would only go finer and deliver far more accuracy than asked (a map over B at 1e-8:
+/// 1e-11). True with the new pair in `rungs`.
+bool Search::replanned(std::vector<Level>& rungs, double& h_c) {
+  if (replanned_) return false;
+  replanned_ = true;
+  const double h = seed_;
+  seed_ = h * std::min(std::pow(kTarget * tol_ / estimate_, 1.0 / p_), kMaxReplanGain);
+  std::vector<Level> coarser;
+  if (!seeded(coarser)) return false;
+  rungs = std::move(coarser);
+  h_c = rungs.front().h;
+  return true;
+}
+
+/// The ladder's first pair: the planned one (seeded) or the pilot's; its constant's step in `h_c`. True for a
+/// planned pair, which is judged as refine()'s new ladder is: its estimate is expected near kTarget tol.
+bool Search::first_pair(std::vector<Level>& rungs, double& h_c) {
+  if (seeded(rungs)) {
+    h_c = rungs.front().h;
+    return true;
+  }
+  Level coarse;
+  Level fine = pilot(coarse);
+  h_c = coarse.h;
+  rungs.push_back(std::move(coarse));
+  rungs.push_back(std::move(fine));
+  return false;
+}
+
+/// The refusal of a TOL that finer runs, still differing by `d`, do not reach.
+Error Search::out_of_reach(double d) const {
+  return Error("tol " + fmt_tol() + " is out of reach of " + std::string(m_.name) +
+               " on this scene: runs at finer steps still differ by " + short_number(d) +
+               " (round-off amplified by the scene, or resonances that refinement does not remove)");
+}
+
 /// The pilot's coarse run itself, where the ladder's first refinement leaves it the best-checked answer:
 /// the finest run bounds its error within TOL (their difference over 1 - r^-q, q the lower of p and the
 /// order the three runs observe) and the three show at least order p - kOrderSlack (a higher order only
@@ -109,27 +171,30 @@ std::optional<Level> Search::pilot_answer(std::vector<Level>& rungs) {
 /// (Richardson, order p) and checked by the run before that (file comment).
 Level Search::ladder() {
   std::vector<Level> rungs;  // runs sharing the constant c of step h_c, coarse to fine
-  Level coarse;
-  Level fine = pilot(coarse);
-  double h_c = coarse.h;
-  rungs.push_back(std::move(coarse));
-  rungs.push_back(std::move(fine));
+  double h_c = 0.0;
+  bool planned = first_pair(rungs, h_c);
   double best_bound = std::numeric_limits<double>::infinity();
   int stalled = 0;
   bool verified_finer = false;  // the newest rung is a verification's companion: estimate it first
   for (int k = 0; k < kMaxRefinements; ++k) {
-    const double expected = verified_finer ? estimate_ * std::pow(rungs.back().h / rungs[rungs.size() - 2].h, p_)
-                                           : refine(rungs, h_c);
+    const double expected = planned          ? kTarget * tol_
+                            : verified_finer ? estimate_ * std::pow(rungs.back().h / rungs[rungs.size() - 2].h, p_)
+                                             : refine(rungs, h_c);
     verified_finer = false;
-    if (k == 0) {
+    if (k == 0 && !planned) {
       if (std::optional<Level> answer = pilot_answer(rungs)) return std::move(*answer);
       rungs.front().samples = {};
     }
+    const bool from_plan = std::exchange(planned, false);
     Level& a = rungs[rungs.size() - 2];
     a.samples = {};  // only the newest run can still be delivered: its predecessors' samples go
     estimate_ = pair_estimate(a, rungs.back());
     last_estimate_ = estimate_;
     const double d = state_distance(a.run.final, rungs.back().run.final);
+    if (from_plan && estimate_ < expected / kAgree && d > kRoundOff && replanned(rungs, h_c)) {
+      planned = true;  // a coarser planned pair, judged as the first was
+      continue;
+    }
     if (d <= kRoundOff && estimate_ > kAccept * tol_)
       throw Error("tol " + fmt_tol() + " is below the round-off floor of " + std::string(m_.name) +
                   " on this scene (estimate " + short_number(estimate_) + ")");
@@ -158,9 +223,7 @@ Level Search::ladder() {
       // The floor is what finer runs still disagree by, not the smallest estimate: an early pair can agree
       // by chance (B = 0.9, b = 1 at tol 1e-12: first estimate 9.9e-15, then three refinements each 4e-12
       // apart, which one of them must be wrong by half of).
-      throw Error("tol " + fmt_tol() + " is out of reach of " + std::string(m_.name) +
-                  " on this scene: runs at finer steps still differ by " + short_number(d) +
-                  " (round-off amplified by the scene, or resonances that refinement does not remove)");
+      throw out_of_reach(d);
     }
   }
   throw Error("tol " + fmt_tol() + ": " + std::string(m_.name) + " did not reach it in " +

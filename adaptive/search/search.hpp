@@ -87,8 +87,8 @@ class Search {
  public:
   Search(const MethodInfo& m, const Body& b, const std::vector<Centre>& c, const Accuracy& a,
          const RunOptions& delivery, bool verify)
-      : m_(m), b_(b), c_(c), tol_(a.tol), t_end_(a.t_end), dt_out_(a.dt_out), p_(effective_order(m, b)),
-        delivery_(delivery), verify_(verify) {}
+      : m_(m), b_(b), c_(c), tol_(a.tol), t_end_(a.t_end), dt_out_(a.dt_out), seed_(a.first_step),
+        p_(effective_order(m, b)), delivery_(delivery), verify_(verify) {}
 
   /// The delivered run with its estimate (runs.cpp), from the ladder (order p) or the exact pair.
   ToleranceResult search();
@@ -103,6 +103,10 @@ class Search {
 
   // ladder.cpp
   Level pilot(Level& coarse);
+  bool seeded(std::vector<Level>& rungs);
+  bool first_pair(std::vector<Level>& rungs, double& h_c);
+  [[nodiscard]] Error out_of_reach(double d) const;
+  bool replanned(std::vector<Level>& rungs, double& h_c);
   std::optional<Level> pilot_answer(std::vector<Level>& rungs);
   Level ladder();
   double refine(std::vector<Level>& rungs, double& h_c);
@@ -127,6 +131,8 @@ class Search {
   const Body& b_;
   const std::vector<Centre>& c_;
   double tol_, t_end_, dt_out_;
+  double seed_;  ///< Accuracy::first_step: a planned step (0: the search's own pilot)
+  bool replanned_ = false;  ///< the planned start was moved once (replanned())
   int p_;
   RunOptions delivery_;
   bool verify_;  ///< a run about to be delivered is checked against a companion at a finer step (ladder.cpp)

@@ -133,7 +133,7 @@ void coordinate(const MpiSession& mpi, Board& board) {
 }
 
 /// A rank other than 0: asks for a unit, runs it, sends its rows with the next request.
-void serve(const SweepSpec& spec) {
+void serve(const SweepSpec& spec, const MapPlan& plan) {
   std::string msg;
   for (;;) {
     MPI_Send(msg.data(), static_cast<int>(msg.size()), MPI_CHAR, 0, kTagRow, MPI_COMM_WORLD);
@@ -147,7 +147,7 @@ void serve(const SweepSpec& spec) {
     const std::vector<std::size_t> unit(next.begin(), next.end());
     msg.clear();
     try {
-      const std::vector<std::string> rows = run_sweep_unit(spec, unit);
+      const std::vector<std::string> rows = run_sweep_unit(spec, unit, &plan);
       for (std::size_t k = 0; k < unit.size(); ++k) msg += std::to_string(unit[k]) + "\t" + rows[k] + "\n";
     } catch (const std::exception& e) {  // this rank's error, for rank 0 to report: it alone prints
       msg = std::string("!") + e.what();
@@ -174,15 +174,17 @@ bool MpiSession::agree(bool go) const {
 
 std::vector<std::string> run_sweep_mpi(const MpiSession& mpi, const SweepSpec& spec, const SweepControl& control) {
   const CooperativeInterrupt stop_at_row_boundary;  // a signal stops the handing out of tasks
+  // Every rank makes the map's plan (its pilots), so that auto's rows are the same whichever rank runs them.
+  const MapPlan plan = plan_map(spec, std::max(1u, control.threads));
   if (mpi.rank() != 0) {
-    serve(spec);
+    serve(spec, plan);
     return {};
   }
   Board board(spec, control);
   auto worker = [&] {
     try {
       for (std::vector<std::size_t> unit; !(unit = board.take()).empty();) {
-        const std::vector<std::string> rows = run_sweep_unit(spec, unit);
+        const std::vector<std::string> rows = run_sweep_unit(spec, unit, &plan);
         for (std::size_t k = 0; k < unit.size(); ++k) board.finish(unit[k], rows[k]);
       }
     } catch (...) {

@@ -249,12 +249,12 @@ class TrajectoryFile {
 /// The start distance's part of an encounter's error: the thesis's scene at 2L with the same asymptotic
 /// data, run to its departure by auto (twice_as_far_tol); not known for a scene file's states.
 long add_start_distance_of(Encounter& e, const po::variables_map& vm, const SceneOptions& so, const RunPlan& plan,
-                           const Body& body, double numerical) {
+                           const Body& body, const BodyResult& near) {
   std::function<Expected<Scene>()> far;
   if (!vm.count("scene")) far = [&] { return thesis_scene_twice_as_far(so.params, so.b, so.v_inf, so.arrival_phase); };
-  return add_start_distance(e, body, far, plan.search ? std::optional<double>(plan.tol) : std::nullopt, numerical,
+  return add_start_distance(e, body, far, plan.search ? std::optional<double>(plan.tol) : std::nullopt, near.error.value,
                             "the scene file gives states, not the thesis's start distance L", {},
-                            !vm.count("scene") && answers_at_limit(so.b, so.v_inf));
+                            !vm.count("scene") && answers_at_limit(so.b, so.v_inf), &near);
 }
 
 /// One body's run and, with --reference, the reference state at its end.
@@ -503,7 +503,7 @@ int cmd_simulate(int argc, char** argv) {
       enc[b] = measure_encounter(scene.bodies[b], scene.centres, runs[b].run.run, runs[b].run.events, o.body_events[b]);
       if (enc[b]->outcome != Outcome::ok)
         throw Error("body '" + scene.bodies[b].name + "': " + enc[b]->reason + "; no output written");
-      runs[b].run.encounter_force_evals = add_start_distance_of(*enc[b], vm, o.so, plan, scene.bodies[b], runs[b].run.error.value);
+      runs[b].run.encounter_force_evals = add_start_distance_of(*enc[b], vm, o.so, plan, scene.bodies[b], runs[b].run);
     }
   if (file) file->commit();
   if (o.json) {

@@ -76,9 +76,9 @@ std::vector<double> log_range(double from, double to, long points) {
 
 std::string format_row(const SweepSpec& spec, const SweepRow& r) { return csv_row(sweep_record(spec, r)); }
 
-std::vector<std::string> run_sweep_unit(const SweepSpec& spec, const std::vector<std::size_t>& unit) {
+std::vector<std::string> run_sweep_unit(const SweepSpec& spec, const std::vector<std::size_t>& unit, const MapPlan* plan) {
   std::vector<std::string> rows;
-  for (const SweepRow& r : run_sweep_unit_rows(spec, unit)) rows.push_back(format_row(spec, r));
+  for (const SweepRow& r : run_sweep_unit_rows(spec, unit, plan)) rows.push_back(format_row(spec, r));
   return rows;
 }
 
@@ -133,7 +133,9 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
                       (grid ? " (the varied ones excepted)" : " (the varied one excepted)");
   if (!sweeps_h) fixed += " h=" + fmt(spec.h);
   fixed += spec.t_end > 0 ? " t_end=" + fmt(spec.t_end) : " steps=" + std::to_string(spec.steps);
-  if (spec.accuracy) fixed += " accuracy=" + fmt(*spec.accuracy) + " (the accuracy mode: each row's step searched for it)";
+  if (spec.accuracy)
+    fixed += " accuracy=" + fmt(*spec.accuracy) + " (the accuracy mode: each row's step searched for it" +
+             (has_auto(spec) ? std::string("; auto's rows from the step of their nearest pilot row, named in err_basis)") : std::string(")"));
   if (spec.base.law == ForceLaw::thesis_code) fixed += " (the code's loop: n - 1 steps of exactly h)";
   // The column names come first, the description after them as comments (numpy's
   // genfromtxt(names=True, comments="#") takes the first line for the names; pandas' read_csv(comment="#")
@@ -355,10 +357,11 @@ void add_sweep_options(po::options_description& desc, SweepJob& job, std::string
       ("grid", po::value(&grid)->composing(), "instead of --param: one varied parameter of a grid, NAME=FROM:TO:STEP, "
        "NAME=log:FROM:TO:POINTS or NAME=a,b,c; repeat for each (every combination is run)")
       ("methods", defaulted(&methods_arg), "comma-separated names, 'fixed' (every fixed-step method but the Kepler split kep-*) or "
-       "'all'; auto: the accuracy mode chooses each row's method (at --accuracy; listed alone, at --tol; column chosen)")
+       "'all'; auto: the accuracy mode chooses each row's method (at --accuracy; listed alone, at --tol; column chosen), "
+       "and rows start at the step of their nearest pilot row (docs/physics.md, 'A map at an accuracy')")
       ("tol", defaulted(&job.spec.tol), "adaptive methods: error tolerance")
       ("accuracy", po::value<double>(), "the accuracy mode: every method but the step-size-controlled peers delivers this "
-       "relative error of the final state at --t-end, its step searched per row (columns h_chosen, search_force_evals)")
+       "relative error of the final state at --t-end, its step searched per row (columns h_chosen, omega_c, search_force_evals)")
       ("threads", po::value(&job.threads)->default_value(0), "worker threads (0: all cores)")
       ("out", po::value(&job.out), "CSV file (default: standard output); with --shard, this shard's rows file")
       ("resume", po::bool_switch(&job.resume), "finish an interrupted run of the same sweep and --out from its journal")

@@ -26,8 +26,10 @@ Axis parse_axis(const std::string& item);
 
 /// Runs task i (grid point i / methods, method i % methods) and returns its CSV row.
 std::string run_sweep_task(const SweepSpec& spec, std::size_t i);
-/// Runs a unit of plan_units (one task, or a batch) and returns its CSV rows in the unit's order.
-std::vector<std::string> run_sweep_unit(const SweepSpec& spec, const std::vector<std::size_t>& unit);
+/// Runs a unit of plan_units (one task, or a batch) and returns its CSV rows in the unit's order; auto's rows
+/// from the map's plan where one is given (plan_map: every rank of an MPI sweep makes the same).
+std::vector<std::string> run_sweep_unit(const SweepSpec& spec, const std::vector<std::size_t>& unit,
+                                        const MapPlan* plan = nullptr);
 /// One CSV row (the columns of sweep_header) of a task's result.
 std::string format_row(const SweepSpec& spec, const SweepRow& row);
 

@@ -131,7 +131,7 @@ Point run_point(const Series& s, double b, double psi) {
   }
   p.force_evals += add_start_distance(
       r.encounter, body, [&] { return thesis_scene_twice_as_far(params, b, kNaN, arrival); }, p.tol, r.run.error.value, "", o,
-      answers_at_limit(b, kNaN));
+      answers_at_limit(b, kNaN), &r.run);
   p.sc = r.encounter.scattering;
   p.asymptote_error = r.encounter.asymptote_error;
   p.start_distance_error = r.encounter.start_distance_error;

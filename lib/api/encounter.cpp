@@ -3,6 +3,7 @@
 #include "bodypoint/io.hpp"
 #include "bodypoint/scattering.hpp"
 #include "bodypoint/detail/model_parts.hpp"
+#include "choice.hpp"
 #include "encounter_parts.hpp"
 #include "events.hpp"
 
@@ -221,12 +222,38 @@ void add_start_distance_error(Encounter& at_L, const EncounterResult* at_2L, boo
   at_L.out_of_plane_error = numerical + at_L.out_of_plane_model_error + at_L.out_of_plane_start_error;
 }
 
-EncounterResult encounter_twice_as_far(const Scene& far, double tol, const Options& options) {
+namespace {
+
+/// An encounter run to its departure (or t_end) at the accuracy `a`, as encounter() runs it.
+EncounterResult encounter_at(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method, Accuracy a,
+                             Options options, bool to_departure) {
+  const Options o = encounter_options(body, centres, std::move(options), to_departure);
+  EncounterResult r{integrate_body(body, centres, method, a, o), {}, o.events};
+  if (r.run.outcome != Outcome::ok) {
+    r.encounter.outcome = r.run.outcome;
+    r.encounter.reason = r.run.reason;
+    return r;
+  }
+  r.encounter = measure_encounter(body, centres, r.run.run, r.run.events, o.events);
+  return r;
+}
+
+}  // namespace
+
+EncounterResult encounter_twice_as_far(const Scene& far, double tol, const Options& options, const BodyResult* near) {
   constexpr double kLooser = 100.0, kLoosest = 1e-6;
-  for (;; tol *= kLooser) {
-    EncounterResult r = encounter(far.bodies.front(), far.centres, nullptr, tol, Scattering::kNaN, options);
+  const Body& body = far.bodies.front();
+  const double span = encounter_span(body, far.centres);
+  for (Accuracy a{tol, span};; a.tol *= kLooser) {
+    // The same encounter from L: its near field is this one's, so its delivered step is where this search starts
+    // (a map's plan, Accuracy::first_step), where auto chooses its method here too at the same tol.
+    a.first_step = near && near->accuracy && near->method && near->accuracy->tol == a.tol &&
+                           &detail::choose_method_for(body, far.centres, a.tol, nullptr) == near->method
+                       ? near->accuracy->h_chosen
+                       : 0.0;
+    EncounterResult r = encounter_at(body, far.centres, nullptr, a, options, true);
     if (r.run.outcome != Outcome::failed || r.run.reason.find("out of reach") == std::string::npos ||
-        tol * kLooser > kLoosest)
+        a.tol * kLooser > kLoosest)
       return r;
   }
 }
@@ -238,7 +265,7 @@ void no_start_distance_error(Encounter& e, bool material, double numerical, cons
 
 long add_start_distance(Encounter& e, const Body& body, const std::function<Expected<Scene>()>& far,
                         std::optional<double> tol, double numerical, const std::string& no_far, const Options& options,
-                        bool at_limit) {
+                        bool at_limit, const BodyResult* near) {
   // A material point's Kepler hyperbola is that of its states, wherever they are: a scene given by its
   // start state has the observables of that trajectory, and one given by asymptotic data keeps K1 as its
   // momentum at infinity (speed_at_infinity_of), so no start distance changes them. A scene that gives
@@ -254,7 +281,7 @@ long add_start_distance(Encounter& e, const Body& body, const std::function<Expe
     no_start_distance_error(e, false, numerical, "the scene from twice the start distance has no such data (" + scene.error() + ")");
     return 0;
   }
-  const EncounterResult r = encounter_twice_as_far(*scene, twice_as_far_tol(tol), options);
+  const EncounterResult r = encounter_twice_as_far(*scene, twice_as_far_tol(tol), options, near);
   add_start_distance_error(e, &r, false, numerical, at_limit);
   e.start_distance_force_evals = r.run.total_force_evals();
   return e.start_distance_force_evals;
@@ -287,16 +314,8 @@ EncounterResult encounter(const Body& body, const std::vector<Centre>& centres, 
   const bool to_departure = std::isnan(t_end);
   // An encounter is measured forwards in time (a negative t_end ran backwards, then read "did not finish").
   if (!to_departure) require_positive(t_end, "an encounter's end time t_end");
-  const double end = to_departure ? encounter_span(body, centres) : t_end;
-  const Options o = encounter_options(body, centres, std::move(options), to_departure);
-  EncounterResult r{integrate_body(body, centres, method, Accuracy{tol, end}, o), {}, o.events};
-  if (r.run.outcome != Outcome::ok) {
-    r.encounter.outcome = r.run.outcome;
-    r.encounter.reason = r.run.reason;
-    return r;
-  }
-  r.encounter = measure_encounter(body, centres, r.run.run, r.run.events, o.events);
-  return r;
+  return encounter_at(body, centres, method, Accuracy{tol, to_departure ? encounter_span(body, centres) : t_end},
+                      std::move(options), to_departure);
 }
 
 }  // namespace bodypoint

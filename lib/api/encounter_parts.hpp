@@ -50,8 +50,11 @@ void add_start_distance_error(Encounter& at_L, const EncounterResult* at_2L, boo
                               bool at_limit = false);
 /// The encounter of `far` (the thesis's scene from 2L) by auto at `tol` (twice_as_far_tol), looser by
 /// 100x while auto refuses it as out of reach, to 1e-6 at most (the 1/L term it measures is 1e-6..1e-3
-/// at L = 200..1600; auto at 1e-10 is out of reach from L = 3200).
-EncounterResult encounter_twice_as_far(const Scene& far, double tol, const Options& options = {});
+/// at L = 200..1600; auto at 1e-10 is out of reach from L = 3200). With `near` (the same encounter's run
+/// from L, by auto or a named method at the same tol) its search starts at that run's delivered step where
+/// auto chooses the same method here: the near field, which sets the step, is the same.
+EncounterResult encounter_twice_as_far(const Scene& far, double tol, const Options& options = {},
+                                       const BodyResult* near = nullptr);
 /// The same when the start distance cannot be doubled (a scene given by its states): the part is not
 /// known (`why`), nor is the total, for B != 0.
 void no_start_distance_error(Encounter& e, bool material, double numerical, const std::string& why);
@@ -60,14 +63,15 @@ void no_start_distance_error(Encounter& e, bool material, double numerical, cons
 /// saying so: its observables are its trajectory's); not known (its reason) where `far()` finds no scene
 /// there; otherwise the encounter from `far()` (thesis_scene_twice_as_far) run by auto at
 /// twice_as_far_tol(tol), and with `at_limit` (a scene given by b or v_inf) the observables taken to the limit
-/// L -> infinity (add_start_distance_error). Returns the force evaluations of that second encounter (0 where
+/// L -> infinity (add_start_distance_error); `near`, the run from L, seeds the far run's search
+/// (encounter_twice_as_far). Returns the force evaluations of that second encounter (0 where
 /// none ran), also in Encounter::start_distance_force_evals.
 /// Whether a thesis scene given by these asymptotic data (NaN: not given) answers at the limit L -> infinity
 /// (`at_limit` of add_start_distance): given by b or v_inf.
 inline bool answers_at_limit(double b, double v_inf) { return !(std::isnan(b) && std::isnan(v_inf)); }
 long add_start_distance(Encounter& e, const Body& body, const std::function<Expected<Scene>()>& far,
                         std::optional<double> tol, double numerical, const std::string& no_far, const Options& options = {},
-                        bool at_limit = false);
+                        bool at_limit = false, const BodyResult* near = nullptr);
 /// The thesis's scene of the parameters `solved` (d, K1, phase solved for the asymptotic data) with the start
 /// distance L doubled and the data b, v_inf (NaN: not given, d, K1 kept) solved for again; the arrival phase
 /// as given, or (NaN) the scene's own at L (a start phase kept has no limit L -> infinity: the extra way in

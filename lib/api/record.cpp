@@ -214,6 +214,7 @@ Record sweep_record(const SweepSpec& spec, const SweepRow& r) {
   out.count("steps", r.result.steps).number("t_end", r.result.t_end);
   if (spec.accuracy) {  // the accuracy mode's choice and cost (the row's own run is its delivered one)
     out.number("h_chosen", r.accuracy ? r.accuracy->h_chosen : nan);
+    out.number("omega_c", r.accuracy && r.method && r.method->traits.takes_omega_c ? r.accuracy->omega_c : nan);
     out.count("search_force_evals", r.accuracy ? r.accuracy->force_evals : 0);
     if (has_auto(spec)) out.text("chosen", r.automatic && r.method ? std::string(r.method->name) : std::string());
   }

@@ -7,6 +7,7 @@
 #include "bodypoint/io.hpp"
 #include "bodypoint/scene_file.hpp"
 #include "checked.hpp"
+#include "choice.hpp"
 #include "encounter_parts.hpp"
 #include "estimate.hpp"
 #include "sweep_tasks.hpp"
@@ -20,6 +21,7 @@
 #include <exception>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <utility>
 
@@ -200,6 +202,40 @@ void confirm_deeper_lanes(std::vector<SweepRow>& rows, const SweepSpec& spec, co
   }
 }
 
+/// The last steps of a batch's estimates, as integrate() takes them: lanes at the rounding level add draws of
+/// it, a second companion bounds the fine pairs it was asked for, and every lane is settled (flags, bounds).
+void settle_lanes(std::vector<SweepRow>& rows, const SweepSpec& spec, const MethodInfo& method,
+                  const std::vector<batch::Member>& members, const std::vector<Scene>& scenes, const FixedSteps& how,
+                  const std::vector<std::optional<ErrorEstimate>>& by_coarse, const std::vector<std::optional<double>>& coarse_side,
+                  const std::vector<RunResult>& companions, const std::vector<RunResult>& second) {
+  // As integrate(): lanes whose fine estimate is at the rounding level add more draws of it, repeats off
+  // their grid (estimate.hpp).
+  std::vector<const State*> finals(rows.size());
+  std::vector<ErrorEstimate*> drawn(rows.size(), nullptr);
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    finals[k] = &rows[k].result.final;
+    if (spec.estimate_error && !by_coarse[k] && detail::at_rounding_level(rows[k].error)) drawn[k] = &rows[k].error;
+  }
+  lane_rounding_draws(method, members, [&how](int k) { return detail::off_grid(how, k); }, finals, drawn,
+                      detail::kRepeatRoundingDraw);
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    if (!spec.estimate_error || by_coarse[k] || !estimable(rows[k].outcome) || second.empty()) continue;
+    ErrorEstimate& e = rows[k].error;
+    const bool check = detail::checks_fine_pair(method, scenes[k].centres, rows[k].result, coarse_side[k], e.value);
+    if (rows[k].outcome != Outcome::unresolved) {  // a flagged lane counted its second companion above
+      if (!check && how.steps >= detail::kFewSteps) continue;
+      e.force_evals += second[k].force_evals;
+      e.wall_s += second[k].wall_s;
+    }
+    if (second[k].final.R.allFinite() && second[k].final.v.allFinite())
+      detail::bound_by_second(e, method, scenes[k].bodies.front(), how.steps, check, rows[k].result.final,
+                              companions[k].final, second[k].final);
+  }
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    detail::settle(rows[k].outcome, rows[k].reason, rows[k].warnings, rows[k].error, spec.max_error, spec.max_energy_error,
+                   detail::final_energy_error(scenes[k].bodies.front(), scenes[k].centres, rows[k].result.final));
+}
+
 /// The rows of a batch: its lanes, judged by assess() and, with SweepSpec::estimate_error, by the
 /// estimate from a coarse companion batch or, where that is not trusted, from companion batches at h/2
 /// (and h/4 for flagged lanes): the same kernel and the same rule as integrate() alone (estimate/).
@@ -255,32 +291,7 @@ void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const Method
     }
   }
   confirm_deeper_lanes(rows, spec, method, members, how, by_coarse, companions, second);
-  // As integrate(): lanes whose fine estimate is at the rounding level add more draws of it, repeats off
-  // their grid (estimate.hpp).
-  std::vector<const State*> finals(rows.size());
-  std::vector<ErrorEstimate*> drawn(rows.size(), nullptr);
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    finals[k] = &rows[k].result.final;
-    if (spec.estimate_error && !by_coarse[k] && detail::at_rounding_level(rows[k].error)) drawn[k] = &rows[k].error;
-  }
-  lane_rounding_draws(method, members, [&how](int k) { return detail::off_grid(how, k); }, finals, drawn,
-                      detail::kRepeatRoundingDraw);
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    if (!spec.estimate_error || by_coarse[k] || !estimable(rows[k].outcome) || second.empty()) continue;
-    ErrorEstimate& e = rows[k].error;
-    const bool check = detail::checks_fine_pair(method, scenes[k].centres, rows[k].result, coarse_side[k], e.value);
-    if (rows[k].outcome != Outcome::unresolved) {  // a flagged lane counted its second companion above
-      if (!check && how.steps >= detail::kFewSteps) continue;
-      e.force_evals += second[k].force_evals;
-      e.wall_s += second[k].wall_s;
-    }
-    if (second[k].final.R.allFinite() && second[k].final.v.allFinite())
-      detail::bound_by_second(e, method, scenes[k].bodies.front(), how.steps, check, rows[k].result.final,
-                              companions[k].final, second[k].final);
-  }
-  for (std::size_t k = 0; k < rows.size(); ++k)
-    detail::settle(rows[k].outcome, rows[k].reason, rows[k].warnings, rows[k].error, spec.max_error, spec.max_energy_error,
-                   detail::final_energy_error(scenes[k].bodies.front(), scenes[k].centres, rows[k].result.final));
+  settle_lanes(rows, spec, method, members, scenes, how, by_coarse, coarse_side, companions, second);
 }
 
 /// A grid point's thesis parameters, and the asymptotic data its axes give (NaN: not given), solved in.
@@ -306,7 +317,7 @@ PointData point_data(const SweepSpec& spec, const std::vector<double>& point) {
 /// distance (thesis_scene_twice_as_far: the point's data b, v_inf, arrival phase solved for again, the
 /// rest kept), run to its departure by auto (twice_as_far_tol).
 long add_row_start_distance(Encounter& e, const SweepSpec& spec, const std::vector<double>& point, const Body& body,
-                            double numerical) {
+                            const BodyResult& near) {
   std::function<Expected<Scene>()> far;
   std::optional<PointData> d;  // the point's data, solved once for the far scene and the limit's rule
   if (spec.scene_text.empty()) {
@@ -316,8 +327,8 @@ long add_row_start_distance(Encounter& e, const SweepSpec& spec, const std::vect
   Options o;
   o.track_invariants = false;
   o.cancel = spec.cancel;
-  return add_start_distance(e, body, far, spec.accuracy, numerical, "a scene file's body has no thesis start distance to double", o,
-                            d && answers_at_limit(d->b, d->v_inf));
+  return add_start_distance(e, body, far, spec.accuracy, near.error.value, "a scene file's body has no thesis start distance to double", o,
+                            d && answers_at_limit(d->b, d->v_inf), &near);
 }
 
 /// The row of a run with its encounter (SweepSpec::scattering): integrate_checked with the encounter's
@@ -331,7 +342,7 @@ SweepRow encounter_row(SweepRow row, const MethodInfo* method, const Scene& scen
   if (!ran(r.outcome)) return result_row(std::move(row), std::move(r));
   Encounter e = measure_encounter(body, scene.centres, r.run, r.events, options.events);
   if (e.outcome == Outcome::ok && r.outcome == Outcome::ok)
-    row.start_distance_force_evals = add_row_start_distance(e, spec, row.point, body, r.error.value);
+    row.start_distance_force_evals = add_row_start_distance(e, spec, row.point, body, r);
   row.r_min = e.r_min;
   row.t_min = e.t_min;
   row.asymptote_error = e.asymptote_error;
@@ -538,7 +549,97 @@ void validate_sweep(const SweepSpec& spec) {
   validate_sweep_points(spec, 0, sweep_points(spec));
 }
 
-std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vector<std::size_t>& unit) {
+namespace {
+
+/// A planned step is at most this many times the pilot's delivered step: a pilot delivered far below its
+/// target (its estimate 1e-3 tol, where a coarser run of the ladder was the answer) predicts a step the
+/// estimate of one run does not extrapolate to.
+constexpr double kPlanMaxGain = 2.0;
+
+/// The pilots of an axis of n values: ceil(sqrt(n)), the j-th at the middle of its share of the axis.
+std::size_t axis_pilots(std::size_t n) { return static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(n)))); }
+std::size_t pilot_index(std::size_t n, std::size_t j) { return (2 * j + 1) * n / (2 * axis_pilots(n)); }
+
+/// The task of the pilot nearest to grid point p, in the column `column` of M methods.
+std::size_t nearest_pilot(const SweepSpec& spec, std::size_t p, std::size_t column) {
+  std::vector<std::size_t> index(spec.axes.size());
+  for (std::size_t a = spec.axes.size(); a-- > 0; p /= spec.axes[a].values.size()) index[a] = p % spec.axes[a].values.size();
+  std::size_t pilot = 0;
+  for (std::size_t a = 0; a < spec.axes.size(); ++a) {
+    const std::size_t n = spec.axes[a].values.size();
+    pilot = pilot * n + pilot_index(n, std::min(index[a] * axis_pilots(n) / n, axis_pilots(n) - 1));
+  }
+  return pilot * spec.methods.size() + column;
+}
+
+std::size_t auto_column(const SweepSpec& spec) {
+  return static_cast<std::size_t>(std::find(spec.methods.begin(), spec.methods.end(), nullptr) - spec.methods.begin());
+}
+
+/// `how` (an auto row's Accuracy) starts at the plan's step of the row's nearest pilot where auto chooses the
+/// pilot's method here. Returns that pilot's task, or nothing where the row is not planned.
+std::optional<std::size_t> start_as_planned(const MapPlan& plan, const SweepSpec& spec, const Scene& scene, std::size_t task,
+                                            Advance& how) {
+  auto* a = std::get_if<Accuracy>(&how);
+  const auto it = plan.steps.find(nearest_pilot(spec, task / spec.methods.size(), auto_column(spec)));
+  if (!a || it == plan.steps.end() || !(it->second.first_step > 0.0)) return std::nullopt;
+  try {
+    if (&detail::choose_method_for(scene.bodies.front(), scene.centres, *spec.accuracy, nullptr) != it->second.method)
+      return std::nullopt;
+  } catch (const Error&) {
+    return std::nullopt;  // the row's own search says why
+  }
+  a->first_step = it->second.first_step;
+  return it->first;
+}
+
+}  // namespace
+
+MapPlan plan_map(const SweepSpec& spec, unsigned threads) {
+  MapPlan plan;
+  if (!has_auto(spec) || !spec.accuracy) return plan;
+  std::vector<std::size_t> pilots{0};  // grid points, built axis by axis
+  for (const Axis& axis : spec.axes) {
+    std::vector<std::size_t> longer;
+    for (std::size_t p : pilots)
+      for (std::size_t j = 0; j < axis_pilots(axis.values.size()); ++j)
+        longer.push_back(p * axis.values.size() + pilot_index(axis.values.size(), j));
+    pilots = std::move(longer);
+  }
+  for (std::size_t& p : pilots) p = p * spec.methods.size() + auto_column(spec);
+  std::vector<SweepRow> rows(pilots.size());
+  std::atomic<std::size_t> next{0};
+  std::mutex mutex;
+  std::exception_ptr error;
+  auto worker = [&] {
+    try {
+      for (std::size_t k; (k = next++) < pilots.size();) rows[k] = run_sweep_unit_rows(spec, {pilots[k]}).front();
+    } catch (...) {
+      const std::lock_guard<std::mutex> lock(mutex);
+      if (!error) error = std::current_exception();
+      next = pilots.size();
+    }
+  };
+  {
+    const WorkerThreads pool(static_cast<unsigned>(std::min<std::size_t>(std::max(threads, 1u), pilots.size())) - 1, worker);
+    worker();
+  }
+  if (error) std::rethrow_exception(error);
+  for (std::size_t k = 0; k < pilots.size(); ++k) {
+    const SweepRow& row = rows[k];
+    MapPlan::Step step{row.method, 0.0};
+    if (row.outcome == Outcome::ok && row.method && row.accuracy && row.accuracy->err_estimate > 0.0 && row.accuracy->h_chosen > 0.0) {
+      const double order = adaptive::effective_order(*row.method, point_scene(spec, row.point).bodies.front());
+      const double aim = adaptive::kTargetShare * *spec.accuracy / row.accuracy->err_estimate;
+      step.first_step = row.accuracy->h_chosen * (order > 0.0 ? std::clamp(std::pow(aim, 1.0 / order), 1.0, kPlanMaxGain) : 1.0);
+    }
+    plan.steps.emplace(pilots[k], step);
+    plan.pilots.emplace(pilots[k], std::move(rows[k]));
+  }
+  return plan;
+}
+
+std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vector<std::size_t>& unit, const MapPlan* plan) {
   const std::size_t M = spec.methods.size();
   const MethodInfo* asked = spec.methods[unit.front() % M];  // nullptr: auto
   std::vector<SweepRow> rows;
@@ -559,10 +660,18 @@ std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vect
     return rows;
   }
   SweepRow& row = rows.front();
+  if (plan && !asked)
+    if (const auto pilot = plan->pilots.find(row.task); pilot != plan->pilots.end()) return {pilot->second};
   const Scene& scene = scenes.front();
-  const Advance how = point_advance(spec, asked, row.point);
+  Advance how = point_advance(spec, asked, row.point);
+  const std::optional<std::size_t> pilot = plan && !asked ? start_as_planned(*plan, spec, scene, row.task, how) : std::nullopt;
   if (spec.scattering) row = encounter_row(std::move(row), asked, scene, how, spec);
   else row = result_row(std::move(row), detail::integrate_checked(scene.bodies.front(), scene.centres, asked, how, sweep_options(spec)));
+  if (pilot && row.accuracy) {
+    const std::string planned = "; its first step planned from the row at " + point_label(spec, grid_point(spec, *pilot / M));
+    row.accuracy->basis += planned;
+    row.error.basis += planned;
+  }
   return rows;
 }
 
@@ -605,13 +714,21 @@ std::size_t shard_of(const SweepSpec& spec, std::size_t task, std::size_t shards
 
 void run_sweep_tasks(const SweepSpec& spec, const std::vector<std::size_t>& todo, const SweepRunner& runner) {
   if (!runner.validated) validate_sweep(spec);
-  const auto units = plan_units(spec, todo, runner.simd);
+  // auto's rows start at the map's plan (its pilots run first); a pilot this runner was asked for is its row.
+  const MapPlan plan = todo.empty() ? MapPlan{} : plan_map(spec, runner.threads);
+  std::vector<std::size_t> rest;
+  for (std::size_t i : todo) {
+    const auto pilot = plan.pilots.find(i);
+    if (pilot == plan.pilots.end()) rest.push_back(i);
+    else if (runner.on_row) runner.on_row(SweepRow(pilot->second));
+  }
+  const auto units = plan_units(spec, rest, runner.simd);
   std::atomic<std::size_t> next{0};
   std::mutex mutex;  // on_row and the first error
   std::exception_ptr error;
   auto worker = [&] {
     for (std::size_t k; !(runner.stop && runner.stop()) && (k = next++) < units.size();) {
-      std::vector<SweepRow> rows = run_sweep_unit_rows(spec, units[k]);
+      std::vector<SweepRow> rows = run_sweep_unit_rows(spec, units[k], &plan);
       std::lock_guard<std::mutex> lock(mutex);
       try {
         if (runner.on_row)
@@ -623,7 +740,8 @@ void run_sweep_tasks(const SweepSpec& spec, const std::vector<std::size_t>& todo
     }
   };
   {
-    const WorkerThreads pool(static_cast<unsigned>(std::min<std::size_t>(runner.threads, units.size())) - 1, worker);
+    // Threads beside this one: none for a single unit or none at all (every row a pilot).
+    const WorkerThreads pool(static_cast<unsigned>(std::min<std::size_t>(runner.threads, std::max<std::size_t>(units.size(), 1))) - 1, worker);
     worker();
   }
   if (error) std::rethrow_exception(error);

@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -47,8 +48,28 @@ void validate_sweep_rules(const SweepSpec& spec);
 std::size_t sweep_points(const SweepSpec& spec);
 void validate_sweep_points(const SweepSpec& spec, std::size_t from, std::size_t to);
 
-/// Runs one unit; its rows in the unit's order.
-std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vector<std::size_t>& unit);
+/// A map's plan for its auto rows (SweepSpec::methods' nullptr at SweepSpec::accuracy). Its pilots are a
+/// coarser grid inside the map: on an axis of n values, ceil(sqrt(n)) of them, each in the middle of its
+/// share of the axis. A pilot's row is searched as a single run is, and the step it delivered, aimed at the
+/// search's target share of tol, is the first step (Accuracy::first_step) of the rows nearest to it that
+/// choose the same method; a row whose nearest pilot chose another method, or delivered nothing, is searched
+/// from its own pilot pair. The plan depends on the sweep alone, never on which rows a shard, a rank or a
+/// resumed journal runs, so no row's result does either.
+struct MapPlan {
+  struct Step {
+    const MethodInfo* method = nullptr;  ///< the pilot's choice
+    double first_step = 0.0;             ///< 0: the pilot delivered nothing to plan from
+  };
+  std::map<std::size_t, Step> steps;       ///< by the pilot's task
+  std::map<std::size_t, SweepRow> pilots;  ///< the pilots' rows, by task
+};
+/// The plan of `spec` (empty without auto at an accuracy), its pilots run on `threads` threads.
+MapPlan plan_map(const SweepSpec& spec, unsigned threads = 1);
+
+/// Runs one unit; its rows in the unit's order. With a plan, auto's rows start at its steps and a pilot's
+/// row is the plan's.
+std::vector<SweepRow> run_sweep_unit_rows(const SweepSpec& spec, const std::vector<std::size_t>& unit,
+                                          const MapPlan* plan = nullptr);
 
 /// The shard (0 .. shards-1) that runs task i = point * M + method: (point + method) % shards, so that
 /// every shard gets every method on an equal share of the points.

@@ -569,7 +569,7 @@ py::dict encounter_py(const Scene& scene, const std::string& method, double tol,
     {
       py::gil_scoped_release free;
       r.run.encounter_force_evals = add_start_distance(r.encounter, body, far, tol, r.run.error.value,
-                         "the scene gives states, not the thesis's start distance L (thesis_scene() does)", o, at_limit);
+                         "the scene gives states, not the thesis's start distance L (thesis_scene() does)", o, at_limit, &r.run);
     }
     stop.raise();
   }

@@ -750,6 +750,62 @@ TEST(ApiSweep, RowsAreTypedAndEqualSingleRuns) {
   }
 }
 
+TEST(ApiSweep, AutoRowsFollowOneMapPlanThatDependsOnTheSweepAlone) {
+  // Issue #80 item 2: the pilots (ceil(sqrt(n)) values of an axis of n) are searched as single runs; every other
+  // row starts at its nearest pilot's step. Each row delivers TOL against a run far finer, is reproduced by its
+  // method at its h_chosen and omega_c, and is the same whichever rows a runner is given (a shard, a journal).
+  constexpr double kTol = 1e-7;
+  constexpr double kReferenceTol = 1e-10;  // the reference's own error, 1e-3 of TOL, is added to the bound
+  SweepSpec s;
+  s.axes = {{"d", {5.0, 7.0, 9.0, 11.0, 13.0}}, {"B", {0.5, 0.7, 0.9}}};
+  s.methods = sweep_methods_named("auto");
+  s.accuracy = kTol;
+  s.t_end = 30.0;
+  const std::vector<SweepRow> rows = run_sweep_rows(s, 2);
+  const MapPlan plan = plan_map(s, 1);
+  ASSERT_EQ(plan.pilots.size(), 6u);  // d = 5, 9, 13 (indices 0, 2, 4 of 5) by B = 0.5, 0.9 (0, 2 of 3)
+  EXPECT_EQ(plan.pilots.count(0), 1u);
+  EXPECT_EQ(plan.pilots.count(14), 1u);
+  std::size_t planned = 0;
+  for (const SweepRow& r : rows) {
+    const std::string at = point_label(s, r.point);
+    ASSERT_EQ(r.outcome, Outcome::ok) << at << ": " << r.reason;
+    ASSERT_TRUE(r.accuracy.has_value()) << at;
+    EXPECT_LE(r.error.value, kTol) << at;
+    const Scene scene = thesis_scene(point_params(s, r.point));
+    const BodyResult ref = integrate(scene, "auto", Accuracy{kReferenceTol, s.t_end}).bodies.front();
+    ASSERT_TRUE(ref.accuracy.has_value()) << at;
+    EXPECT_LE(adaptive::state_distance(r.result.final, ref.run.final), kTol + ref.accuracy->err_estimate) << at;
+    if (plan.pilots.count(r.task)) {  // a pilot is the single run's search
+      const BodyResult one = integrate(scene, "auto", Accuracy{kTol, s.t_end}).bodies.front();
+      EXPECT_EQ(r.result.final.R, one.run.final.R) << at;
+      EXPECT_EQ(r.error.basis.find("planned from"), std::string::npos) << at;
+      continue;
+    }
+    planned += r.error.basis.find("planned from") != std::string::npos;
+    Options again;
+    again.estimate_error = false;
+    again.omega_c = r.accuracy->omega_c;
+    const Advance step = is_time_transformed(*r.method)
+                             ? Advance(FictitiousSteps{r.accuracy->h_chosen, EndTime{s.t_end}})
+                             : Advance(FixedSteps{r.accuracy->h_chosen, r.result.steps});
+    EXPECT_EQ(integrate(scene, std::string(r.method->name), step, again).bodies.front().run.final.R, r.result.final.R) << at;
+  }
+  EXPECT_EQ(planned, rows.size() - plan.pilots.size());
+  // A runner given the odd tasks alone (a shard, the rest of a journal) makes the same plan and rows.
+  std::vector<std::size_t> odd;
+  for (std::size_t i = 1; i < rows.size(); i += 2) odd.push_back(i);
+  SweepRunner runner;
+  std::vector<SweepRow> some;
+  runner.on_row = [&some](SweepRow&& r) { some.push_back(std::move(r)); };
+  run_sweep_tasks(s, odd, runner);
+  ASSERT_EQ(some.size(), odd.size());
+  for (const SweepRow& r : some) {
+    EXPECT_EQ(r.result.final.R, rows[r.task].result.final.R) << point_label(s, r.point);
+    EXPECT_EQ(r.accuracy->force_evals, rows[r.task].accuracy->force_evals) << point_label(s, r.point);
+  }
+}
+
 TEST(ApiSweep, AutoRowsAreTheAccuracyModesSingleRuns) {
   // auto in a sweep (issue #80 item 1): each row is integrate()'s auto at the sweep's accuracy, the method it
   // chose named in the row, a named method beside it unchanged; listed alone without an accuracy, auto

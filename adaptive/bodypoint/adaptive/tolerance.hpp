@@ -28,6 +28,9 @@ namespace bodypoint::adaptive {
 /// floor of 1e-15..1e-13 relative (README, round-off floor test), so a smaller error cannot be
 /// delivered, nor estimated, in double precision.
 inline constexpr double kMinTolerance = 1e-13;
+/// A step the search predicts, or a map plans (Accuracy::first_step), aims its estimate at this fraction of
+/// tol: a prediction from a coarser pair is uncertain by a factor of a few, and a miss costs one more run.
+inline constexpr double kTargetShare = 0.3;
 
 /// Below this tolerance a run about to be delivered is repeated kProbeRuns times: with its roundings
 /// changed (all but one), and once from its start moved by a rounding; what they differ by is added to the estimate

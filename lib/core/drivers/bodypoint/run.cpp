@@ -366,6 +366,7 @@ void check(const Advance& how) {
                         "precision can deliver (a step's rounding is ~1e-16 relative; the smallest taken is 1e-15)");
         } else {
           require_positive(a.t_end, "the end time t_end");
+          require_non_negative(a.first_step, "the planned first step first_step");
         }
         require_non_negative(a.dt_out, "the output interval dt_out");
       },

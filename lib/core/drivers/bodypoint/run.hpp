@@ -133,6 +133,11 @@ struct ControlledSteps {
 struct Accuracy {
   double tol, t_end;
   double dt_out = 0.0;  ///< with a sink: samples at t = k dt_out
+  /// A step planned for this scene (a map's plan: the step its pilot row delivered, carried to the rows
+  /// that choose the same method): the search starts its ladder there, the answer at this step and its
+  /// companion at twice it, instead of its own pilot pair; 0: the search's own pilot. Either way the
+  /// delivered estimate is the ladder's, trusted by the same rules.
+  double first_step = 0.0;
 };
 using Advance = std::variant<FixedSteps, FictitiousSteps, ControlledSteps, Accuracy>;
 
