@@ -295,26 +295,32 @@ bool cheaper_pick(const TolRow& r, const TolRow* best) {
          (r.force_evals == best->force_evals && faster_pick(r.time, &best->time));
 }
 
-/// The cheapest peer run at auto's tolerance that met it (cheaper_pick), and how many met it.
+/// Whether `r` is a third-party peer's run at its tolerance (not auto, not a ladder, not one of bodypoint's own
+/// configurations, nor logh-bs: the peer column compares auto with other projects' code).
+bool third_party_at_tol(const TolRow& r) {
+  return !r.is_auto && !r.is_ladder && !r.is_own && method_or_throw(r.method).traits.third_party;
+}
+
+/// The cheapest third-party peer run at auto's tolerance that met it (cheaper_pick), and how many met it.
 std::pair<const TolRow*, int> cheapest_meeting(const std::vector<TolRow>& rows, const TolRow& a) {
   const TolRow* best = nullptr;
   int meeting = 0;
   for (const TolRow& r : rows) {
-    if (r.is_auto || r.is_ladder || r.scene != a.scene || r.tol != a.tol || !r.met) continue;
+    if (!third_party_at_tol(r) || r.scene != a.scene || r.tol != a.tol || !r.met) continue;
     ++meeting;
     if (cheaper_pick(r, best)) best = &r;
   }
   return {best, meeting};
 }
 
-/// Oracle: the cheapest ladder configuration delivering TOL whose next finer one delivers it too
+/// Oracle: the cheapest third-party ladder configuration delivering TOL whose next finer one delivers it too
 /// (cheaper_pick: the fewest force evaluations, so that the choice does not depend on the machine).
 const TolRow* oracle_for(const std::vector<TolRow>& rows, const TolRow& a) {
   const TolRow* oracle = nullptr;
   for (std::size_t i = 0; i + 1 < rows.size(); ++i) {
     const TolRow& r = rows[i];
     const TolRow& next = rows[i + 1];
-    if (!r.is_ladder || r.scene != a.scene || !(r.err <= a.tol)) continue;
+    if (!r.is_ladder || !method_or_throw(r.method).traits.third_party || r.scene != a.scene || !(r.err <= a.tol)) continue;
     if (!(next.is_ladder && next.method == r.method && next.scene == r.scene && next.err <= a.tol)) continue;
     if (cheaper_pick(r, oracle)) oracle = &r;
   }
@@ -590,7 +596,8 @@ void run_by_tolerance(const std::vector<NamedScene>& scenes, const std::vector<d
     time_rows(rows, first, rules);
   }
   if (csv) write_tol_rows(*csv, rows, rules);
-  write_tol_summary(summary, rows, peers.size());
+  const auto third_party = std::count_if(peers.begin(), peers.end(), [](const std::string& p) { return method_or_throw(p).traits.third_party; });
+  write_tol_summary(summary, rows, static_cast<std::size_t>(third_party));
 }
 
 }  // namespace bodypoint::cli

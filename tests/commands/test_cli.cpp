@@ -285,6 +285,27 @@ TEST(Cli, ByTolComparesAutoWithBodypointsOwnFastestConfiguration) {
                        "saying so (its run and estimate), force evaluations: median"), std::string::npos) << r.out;
   ASSERT_EQ(trusted.size(), 2u) << "one per TOL";
   for (const auto& [tol, evals] : trusted) EXPECT_GE(evals, fastest.at(tol)) << "TOL " << tol;
+  // Issue #83 M1: the peer columns (at TOL, and the peer's best case) name other projects' code only; they
+  // read "logh-verlet (180 evals)", bodypoint's own configuration, on thesis at 1e-4.
+  std::stringstream table(r.out);
+  int rows = 0;
+  for (std::string row; std::getline(table, row);) {
+    if (row.rfind("| thesis |", 0) != 0) continue;
+    ++rows;
+    std::vector<std::string> cells;
+    std::stringstream split(row);
+    for (std::string cell; std::getline(split, cell, '|');) cells.push_back(cell);
+    ASSERT_GE(cells.size(), 14u) << row;
+    for (const std::size_t column : {9u, 13u}) {  // cheapest peer meeting TOL; cheapest peer config delivering TOL
+      std::stringstream words(cells[column]);
+      std::string name;
+      words >> name;
+      if (name != "none") {
+        EXPECT_TRUE(method_or_throw(name).traits.third_party) << "column " << column << ": " << row;
+      }
+    }
+  }
+  EXPECT_EQ(rows, 2) << r.out;
   fs::remove(out);
 }
 

@@ -263,6 +263,7 @@ MethodTraits catalogue_traits(Family f) {
       break;
     case Family::Odeint:
       t.peer = true;
+      t.third_party = true;
       t.in_fixed_set = true;
       break;
     case Family::OdeintAdaptive:
@@ -270,6 +271,7 @@ MethodTraits catalogue_traits(Family f) {
       t.stepping = Stepping::controlled;
       t.search = SearchStrategy::none;
       t.peer = true;
+      t.third_party = true;
       break;
     case Family::TimeTransformed:
       t.stepping = Stepping::fictitious;

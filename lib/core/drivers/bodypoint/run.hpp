@@ -217,6 +217,9 @@ struct MethodTraits {
   SearchStrategy search = SearchStrategy::ladder;
   /// A general-purpose peer bodypoint's methods compete with (Boost.Odeint, GSL, Mikkola's logh-bs).
   bool peer = false;
+  /// Another project's code, driven as its users drive it (Boost.Odeint, GSL): a comparison "against a peer"
+  /// names one of these (logh-bs is a peer's algorithm in bodypoint's own code).
+  bool third_party = false;
   /// Its stages follow the motion about a centre exactly (the orbital resolution check is skipped).
   bool orbit_exact = false;
   /// In free flight its drift turns the spin exactly (the spin resolution check is skipped there).
