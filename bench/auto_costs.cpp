@@ -42,23 +42,19 @@ std::vector<std::string> split(const std::string& s) {
   return out;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  std::string scenes = "thesis,close,long,two-centres,three-centres", tols = "1e-4,1e-5,1e-6,1e-7,1e-8,1e-9,1e-10,1e-11,1e-12";
-  for (int i = 1; i + 1 < argc; i += 2) {
-    if (!std::strcmp(argv[i], "--scenes")) scenes = argv[i + 1];
-    else if (!std::strcmp(argv[i], "--tols")) tols = argv[i + 1];
-    else {
-      std::fprintf(stderr, "auto_costs: unknown option %s (--scenes, --tols)\n", argv[i]);
-      return 2;
-    }
-  }
-  struct Cell {
-    double evals = NAN, err = NAN, est = NAN;
-  };
-  std::map<std::pair<std::string, double>, std::map<std::string, Cell>> cells;
+/// One search: its force evaluations, its error against the reference and its estimate (NaN: refused).
+struct Cell {
+  double evals = NAN, err = NAN, est = NAN;
+};
+/// By (TOL text, TOL), by "scene/table".
+using Cells = std::map<std::pair<std::string, double>, std::map<std::string, Cell>>;
+struct Tally {
   int missed = 0, low = 0, delivered = 0;
+};
+
+/// Every table of auto's chosen family searched at every TOL on every scene, each printed as it is made.
+Cells measure(const std::string& scenes, const std::string& tols, Tally& tally) {
+  Cells cells;
   for (const std::string& name : split(scenes)) {
     const NamedScene ns = named_scene(name);
     const Body& body = ns.scene.bodies.front();
@@ -78,9 +74,9 @@ int main(int argc, char** argv) {
           c.evals = static_cast<double>(r.total_force_evals);
           c.err = adaptive::state_distance(r.result.final, ref);
           c.est = r.err_estimate;
-          ++delivered;
-          missed += c.err > tol;
-          low += c.err > kRoundingLevel && c.err > kLowEstimate * c.est;
+          ++tally.delivered;
+          tally.missed += c.err > tol;
+          tally.low += c.err > kRoundingLevel && c.err > kLowEstimate * c.est;
         } catch (const Error& e) {
           std::printf("%-13s %6s %-12s refused: %s\n", name.c_str(), t.c_str(), m->name.c_str(), e.what());
         }
@@ -91,39 +87,57 @@ int main(int argc, char** argv) {
       }
     }
   }
+  return cells;
+}
+
+/// A table's geometric mean over the scenes of its search's evaluations over the cheapest table's at one TOL;
+/// NaN where it was refused on a scene another table delivered.
+double mean_over_cheapest(const std::map<std::string, Cell>& row, const std::string& scenes, const std::string& table) {
+  double log_sum = 0.0;
+  int n = 0;
+  for (const std::string& name : split(scenes)) {
+    double best = INFINITY;
+    for (const std::string& other : kTables) {
+      const auto it = row.find(name + "/" + other);
+      if (it != row.end() && !std::isnan(it->second.evals)) best = std::min(best, it->second.evals);
+    }
+    if (std::isinf(best)) continue;  // no table delivered TOL on this scene
+    const auto it = row.find(name + "/" + table);
+    if (it == row.end() || std::isnan(it->second.evals)) return NAN;
+    log_sum += std::log(it->second.evals / best);
+    ++n;
+  }
+  return n > 0 ? std::exp(log_sum / n) : NAN;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string scenes = "thesis,close,long,two-centres,three-centres", tols = "1e-4,1e-5,1e-6,1e-7,1e-8,1e-9,1e-10,1e-11,1e-12";
+  for (int i = 1; i + 1 < argc; i += 2) {
+    if (!std::strcmp(argv[i], "--scenes")) scenes = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--tols")) tols = argv[i + 1];
+    else {
+      std::fprintf(stderr, "auto_costs: unknown option %s (--scenes, --tols)\n", argv[i]);
+      return 2;
+    }
+  }
+  Tally tally;
+  Cells cells = measure(scenes, tols, tally);
   std::printf("\nper TOL, each table's geometric mean over the scenes of its search's force evaluations over the "
               "cheapest table's (-: refused on a scene)\n%6s", "TOL");
   for (const std::string& table : kTables) std::printf(" %7s", table.c_str());
   std::printf("\n");
   for (const std::string& t : split(tols)) {
-    const double tol = std::stod(t);
     std::printf("%6s", t.c_str());
     for (const std::string& table : kTables) {
-      double log_sum = 0.0;
-      int n = 0;
-      bool all = true;
-      for (const std::string& name : split(scenes)) {
-        double best = INFINITY;
-        for (const std::string& other : kTables) {
-          const auto& row = cells[{t, tol}];
-          const auto it = row.find(name + "/" + other);
-          if (it != row.end() && !std::isnan(it->second.evals)) best = std::min(best, it->second.evals);
-        }
-        if (std::isinf(best)) continue;  // no table delivered TOL on this scene
-        const auto it = cells[{t, tol}].find(name + "/" + table);
-        if (it == cells[{t, tol}].end() || std::isnan(it->second.evals)) {
-          all = false;
-          continue;
-        }
-        log_sum += std::log(it->second.evals / best);
-        ++n;
-      }
-      if (all && n > 0) std::printf(" %7.2f", std::exp(log_sum / n));
-      else std::printf(" %7s", "-");
+      const double mean = mean_over_cheapest(cells[{t, std::stod(t)}], scenes, table);
+      if (std::isnan(mean)) std::printf(" %7s", "-");
+      else std::printf(" %7.2f", mean);
     }
     std::printf("\n");
   }
   std::printf("\n%d searches delivered: %d missed TOL, %d estimates more than %.0fx below an error above %.0e\n",
-              delivered, missed, low, kLowEstimate, kRoundingLevel);
+              tally.delivered, tally.missed, tally.low, kLowEstimate, kRoundingLevel);
   return 0;
 }

@@ -33,17 +33,11 @@ def rows(path):
         return list(csv.DictReader(l for l in f if not l.startswith("#")))
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("results", help="a paper build's results directory (work_precision.csv, methods.csv)")
-    ap.add_argument("--family", default="logh", help="logh or ttl (three-centres attracts: ttl only)")
-    ap.add_argument("--cap", type=float, default=0.2, help="the largest fictitious step the model predicts")
-    ap.add_argument("--reference", default="close", help="the scene the error constants are fitted on")
-    ap.add_argument("--ratios", action="store_true", help="print k_m / k_verlet per scene and their geometric mean")
-    a = ap.parse_args()
-    meth = {r["method"]: r for r in rows(os.path.join(a.results, "methods.csv"))}
+def load(results, family):
+    """The catalogue's rows, the work-precision ladders by (scene, method), and the family's candidates."""
+    meth = {r["method"]: r for r in rows(os.path.join(results, "methods.csv"))}
     ladders = defaultdict(list)
-    for r in rows(os.path.join(a.results, "work_precision.csv")):
+    for r in rows(os.path.join(results, "work_precision.csv")):
         try:
             h, e = float(r["h"]), float(r["err_rel"])
         except ValueError:
@@ -52,53 +46,74 @@ def main():
             ladders[(r["scene"], r["method"])].append((h, e, int(r["force_evals"])))
     for k in ladders:
         ladders[k].sort(reverse=True)
-    cands = [m for m, r in meth.items() if m.startswith(a.family + "-") and r["advance"] == "fictitious"
+    cands = [m for m, r in meth.items() if m.startswith(family + "-") and r["advance"] == "fictitious"
              and int(r["order"]) > 0]
+    return meth, ladders, cands
 
-    def constant(scene, m):
-        p = int(meth[m]["order"])
-        ks = [e / h ** p for h, e, _ in ladders.get((scene, m), []) if FIT_RANGE[0] < e < FIT_RANGE[1]]
-        return statistics.median(ks) if ks else None
 
-    def actual(scene, m, tol):
-        pts = ladders.get((scene, m), [])
-        for i, (_, e, n) in enumerate(pts):
-            if e <= tol and (i + 1 >= len(pts) or pts[i + 1][1] <= tol):
-                return n
-        return None
+def constant(meth, ladders, scene, m):
+    """The error constant k of e = k h^p, fitted on the ladder's points in FIT_RANGE."""
+    p = int(meth[m]["order"])
+    ks = [e / h ** p for h, e, _ in ladders.get((scene, m), []) if FIT_RANGE[0] < e < FIT_RANGE[1]]
+    return statistics.median(ks) if ks else None
 
-    verlet = a.family + "-verlet"
-    if a.ratios:
-        print(f"{'method':12s} " + " ".join(f"{s:>13s}" for s in SCENES) + "  geometric mean")
-        for m in sorted(cands):
-            per = {s: k / v for s in SCENES if (k := constant(s, m)) and (v := constant(s, verlet))}
-            mean = math.exp(statistics.fmean(math.log(x) for x in per.values())) if per else float("nan")
-            print(f"{m:12s} " + " ".join(f"{per[s]:13.3g}" if s in per else f"{'-':>13s}" for s in SCENES) + f"  {mean:.3g}")
-        return
-    k_ref = {m: constant(a.reference, m) for m in cands}
+
+def actual(ladders, scene, m, tol):
+    """The evaluations of the ladder's coarsest point delivering TOL whose next finer one does too."""
+    pts = ladders.get((scene, m), [])
+    for i, (_, e, n) in enumerate(pts):
+        if e <= tol and (i + 1 >= len(pts) or pts[i + 1][1] <= tol):
+            return n
+    return None
+
+
+def print_ratios(meth, ladders, cands, verlet):
+    print(f"{'method':12s} " + " ".join(f"{s:>13s}" for s in SCENES) + "  geometric mean")
+    for m in sorted(cands):
+        per = {s: k / v for s in SCENES
+               if (k := constant(meth, ladders, s, m)) and (v := constant(meth, ladders, s, verlet))}
+        mean = math.exp(statistics.fmean(math.log(x) for x in per.values())) if per else float("nan")
+        print(f"{m:12s} " + " ".join(f"{per[s]:13.3g}" if s in per else f"{'-':>13s}" for s in SCENES) + f"  {mean:.3g}")
+
+
+def compare(meth, ladders, cands, verlet, a):
+    """Per scene and TOL, the model's pick against the family's cheapest; the ratios."""
+    k_ref = {m: constant(meth, ladders, a.reference, m) for m in cands}
     ratios = []
     for scene in SCENES:
-        k_v = constant(scene, verlet)
+        k_v = constant(meth, ladders, scene, verlet)
         if k_v is None or not k_ref.get(verlet):
             continue
         amp = k_v / k_ref[verlet]
         for tol in TOLS:
-            predicted = []
-            for m in cands:
-                if not k_ref[m]:
-                    continue
-                p, s = int(meth[m]["order"]), int(meth[m]["evals_per_step"])
-                ds = min(a.cap, (AIM * tol / (amp * k_ref[m])) ** (1.0 / p))
-                predicted.append((s / ds, m))
-            best = min(((n, m) for m in cands if (n := actual(scene, m, tol))), default=None)
+            predicted = [(int(meth[m]["evals_per_step"]) / min(a.cap, (AIM * tol / (amp * k_ref[m])) ** (1.0 / int(meth[m]["order"]))), m)
+                         for m in cands if k_ref[m]]
+            best = min(((n, m) for m in cands if (n := actual(ladders, scene, m, tol))), default=None)
             if not predicted or not best:
                 continue
             pick = min(predicted)[1]
-            n = actual(scene, pick, tol)
+            n = actual(ladders, scene, pick, tol)
             ratio = n / best[0] if n else float("nan")
             if n:
                 ratios.append(ratio)
             print(f"{scene:13s} {tol:7.0e}  picks {pick:12s} {n or '-':>8}  best {best[1]:12s} {best[0]:>8}  {ratio:.2f}x")
+    return ratios
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("results", help="a paper build's results directory (work_precision.csv, methods.csv)")
+    ap.add_argument("--family", default="logh", help="logh or ttl (three-centres attracts: ttl only)")
+    ap.add_argument("--cap", type=float, default=0.2, help="the largest fictitious step the model predicts")
+    ap.add_argument("--reference", default="close", help="the scene the error constants are fitted on")
+    ap.add_argument("--ratios", action="store_true", help="print k_m / k_verlet per scene and their geometric mean")
+    a = ap.parse_args()
+    meth, ladders, cands = load(a.results, a.family)
+    verlet = a.family + "-verlet"
+    if a.ratios:
+        print_ratios(meth, ladders, cands, verlet)
+        return
+    ratios = compare(meth, ladders, cands, verlet, a)
     if ratios:
         print(f"{len(ratios)} cases: picked over best {min(ratios):.2f}-{max(ratios):.2f}x, "
               f"median {statistics.median(ratios):.2f}x")

@@ -54,6 +54,85 @@ def reference(scene, times, h=1e-3, flip_at=None):
     return out
 
 
+class Tally:
+    """The ratios estimate / error of the comparable states, the low cases, the companion's price."""
+
+    def __init__(self):
+        self.ratios, self.low, self.costs = [], [], []
+
+    def record(self, case, est, err, ref_err, s):
+        line = f"{case:44s} est {est:9.2e} err {err:9.2e} ref {ref_err:7.0e}"
+        if err > COMPARABLE and err > 100 * ref_err:
+            q = est / err
+            self.ratios.append(q)
+            if q < 1 / LOW:
+                self.low.append(case)
+                line += "  LOW"
+        self.costs.append(s.error["force_evals"] / max(1, s.force_evals))
+        print(line)
+        sys.stdout.flush()
+
+    def summary(self):
+        q = sorted(self.ratios)
+        print(f"\n{len(q)} states with an error above {COMPARABLE:g}: estimate / error median {statistics.median(q):.2f}, "
+              f"10th percentile {q[len(q) // 10]:.2f}, 90th {q[(9 * len(q)) // 10]:.2f}; more than {LOW:g}x low: {len(self.low)}")
+        for c in self.low:
+            print("  low:", c)
+        print(f"companion's force evaluations over the run's: median {statistics.median(self.costs):.2f}")
+
+
+def segments(tally, name, scene, m, tol, T):
+    """The span in 1, 7 and 25 segments, the estimate read after each (7) or at the end."""
+    for nseg in (1, 7, 25):
+        times = list(np.linspace(0, T, nseg + 1)[1:])
+        try:
+            s = bp.Stepper(scene, m, tol=tol, t_end=T)
+        except bp.Error as e:
+            print(f"{name} {m} {tol:.0e}: refused ({str(e)[:70]})")
+            return
+        ref, ref2 = reference(scene, times), reference(scene, times, 5e-4)
+        for t, rf, rf2 in zip(times, ref, ref2):
+            s.advance_to(t)
+            if t == times[-1] or nseg == 7:
+                tally.record(f"{name} {m} {tol:.0e} {nseg} segments t={t:.3g}", s.error["estimate"],
+                             relerr(s.state, rf), relerr({k: rf2[k] for k in "Rv"}, rf), s)
+
+
+def out_and_back(tally, name, scene, m, tol, T):
+    """Forwards and back in one stepper, and as two with the first one's error carried."""
+    start = {k: np.array(scene.bodies[0][k]) for k in "Rv"}
+    try:
+        s = bp.Stepper(scene, m, tol=tol, t_end=T)
+        s.advance_to(T)
+        s.advance_to(0)
+        tally.record(f"{name} {m} {tol:.0e} out and back", s.error["estimate"], relerr(s.state, start), 0, s)
+        s1 = bp.Stepper(scene, m, tol=tol, t_end=T)
+        s1.advance_to(T)
+        body = dict(scene.bodies[0])
+        body.update({k: s1.state[k] for k in "Rvw"})
+        s2 = bp.Stepper(bp.Scene(centres=scene.centres, bodies=[body]), m, tol=tol, t_end=-T)
+        s2.carry_error(s1.error)
+        s2.advance_to(-T)
+        tally.record(f"{name} {m} {tol:.0e} two steppers", s2.error["estimate"], relerr(s2.state, start), 0, s2)
+    except bp.Error as e:
+        print(f"{name} {m} {tol:.0e} back: refused ({str(e)[:70]})")
+
+
+def flipped(tally, name, scene, m, tol, T):
+    """A write w = -w half way (apply)."""
+    try:
+        s = bp.Stepper(scene, m, tol=tol, t_end=T)
+    except bp.Error:
+        return
+    s.advance_to(T / 2)
+    s.apply(lambda x: {"w": -np.array(x["w"])})
+    s.advance_to(T)
+    ref = reference(scene, [T], flip_at=T / 2)[0]
+    ref2 = reference(scene, [T], 5e-4, flip_at=T / 2)[0]
+    tally.record(f"{name} {m} {tol:.0e} w = -w at {T / 2:g}", s.error["estimate"], relerr(s.state, ref),
+                 relerr({k: ref2[k] for k in "Rv"}, ref), s)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="auto and rk4 at tol 1e-6 and 1e-9 only")
@@ -61,73 +140,15 @@ def main():
     methods = ["auto", "rk4"] if args.quick else ["auto", "lp-y4", "rk4", "ttl-y4", "kep-y4"]
     tols = [1e-6, 1e-9] if args.quick else [1e-6, 1e-8, 1e-10]
     T = 25.0
-    ratios, low, costs = [], [], []
-
-    def record(case, est, err, ref_err, s):
-        line = f"{case:44s} est {est:9.2e} err {err:9.2e} ref {ref_err:7.0e}"
-        if err > COMPARABLE and err > 100 * ref_err:
-            q = est / err
-            ratios.append(q)
-            if q < 1 / LOW:
-                low.append(case)
-                line += "  LOW"
-        costs.append(s.error["force_evals"] / max(1, s.force_evals))
-        print(line)
-        sys.stdout.flush()
-
+    tally = Tally()
     for name, scene in scenes().items():
-        start = {k: np.array(scene.bodies[0][k]) for k in "Rv"}
         for m in methods:
             for tol in tols:
-                for nseg in (1, 7, 25):
-                    times = list(np.linspace(0, T, nseg + 1)[1:])
-                    try:
-                        s = bp.Stepper(scene, m, tol=tol, t_end=T)
-                    except bp.Error as e:
-                        print(f"{name} {m} {tol:.0e}: refused ({str(e)[:70]})")
-                        break
-                    ref, ref2 = reference(scene, times), reference(scene, times, 5e-4)
-                    for t, rf, rf2 in zip(times, ref, ref2):
-                        s.advance_to(t)
-                        if t == times[-1] or nseg == 7:
-                            record(f"{name} {m} {tol:.0e} {nseg} segments t={t:.3g}", s.error["estimate"],
-                                   relerr(s.state, rf), relerr({k: rf2[k] for k in "Rv"}, rf), s)
-                # forwards and back in one stepper, and as two with the error carried
-                try:
-                    s = bp.Stepper(scene, m, tol=tol, t_end=T)
-                    s.advance_to(T)
-                    s.advance_to(0)
-                    record(f"{name} {m} {tol:.0e} out and back", s.error["estimate"], relerr(s.state, start), 0, s)
-                    s1 = bp.Stepper(scene, m, tol=tol, t_end=T)
-                    s1.advance_to(T)
-                    body = dict(scene.bodies[0])
-                    body.update({k: s1.state[k] for k in "Rvw"})
-                    s2 = bp.Stepper(bp.Scene(centres=scene.centres, bodies=[body]), m, tol=tol, t_end=-T)
-                    s2.carry_error(s1.error)
-                    s2.advance_to(-T)
-                    record(f"{name} {m} {tol:.0e} two steppers", s2.error["estimate"], relerr(s2.state, start), 0, s2)
-                except bp.Error as e:
-                    print(f"{name} {m} {tol:.0e} back: refused ({str(e)[:70]})")
-            # w = -w half way
+                segments(tally, name, scene, m, tol, T)
+                out_and_back(tally, name, scene, m, tol, T)
             for tol in tols:
-                try:
-                    s = bp.Stepper(scene, m, tol=tol, t_end=T)
-                except bp.Error:
-                    continue
-                s.advance_to(T / 2)
-                s.apply(lambda x: {"w": -np.array(x["w"])})
-                s.advance_to(T)
-                ref = reference(scene, [T], flip_at=T / 2)[0]
-                ref2 = reference(scene, [T], 5e-4, flip_at=T / 2)[0]
-                record(f"{name} {m} {tol:.0e} w = -w at {T / 2:g}", s.error["estimate"], relerr(s.state, ref),
-                       relerr({k: ref2[k] for k in "Rv"}, ref), s)
-
-    q = sorted(ratios)
-    print(f"\n{len(q)} states with an error above {COMPARABLE:g}: estimate / error median {statistics.median(q):.2f}, "
-          f"10th percentile {q[len(q) // 10]:.2f}, 90th {q[(9 * len(q)) // 10]:.2f}; more than {LOW:g}x low: {len(low)}")
-    for c in low:
-        print("  low:", c)
-    print(f"companion's force evaluations over the run's: median {statistics.median(costs):.2f}")
+                flipped(tally, name, scene, m, tol, T)
+    tally.summary()
 
 
 if __name__ == "__main__":
