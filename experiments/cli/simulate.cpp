@@ -61,10 +61,14 @@ std::string error_line(const ErrorEstimate& e) {
   return line + ")";
 }
 
+/// An event's error as printed: the number, or why there is none.
+std::string error_text(double error) { return std::isfinite(error) ? fmt(error) : std::string("not known"); }
+
 void print_encounter(const std::vector<Event>& events, const BodyResult& run, const std::optional<Encounter>& e) {
   for (const EventHit& h : run.events)
     std::cout << "  event " << events[h.event].label() << ": t = " << fmt(h.t) << ", r = " << fmt(h.r)
-              << ", R = " << json_vec(h.s.R) << "\n";
+              << ", R = " << json_vec(h.s.R) << " (errors: " << error_text(h.t_error) << " in t, " << error_text(h.r_error)
+              << " in r, " << error_text(h.state_error) << " of the state)\n";
   if (run.run.stopped) std::cout << "  the run stopped at event " << events[run.events.back().event].label() << "\n";
   if (!e) return;
   const Scattering& sc = e->scattering;
@@ -83,7 +87,9 @@ void print_encounter(const std::vector<Event>& events, const BodyResult& run, co
               << e->start_distance_basis << (std::isfinite(e->start_distance_error) ? ")" : "") << "\n"
               << "    the deflection's total error (the run's, the asymptotes' and the start distance's): "
               << (std::isfinite(e->deflection_error) ? fmt(e->deflection_error) : "not known") << "\n";
-  if (std::isfinite(e->r_min)) std::cout << "    closest approach r_min = " << fmt(e->r_min) << " at t_min = " << fmt(e->t_min) << "\n";
+  if (std::isfinite(e->r_min))
+    std::cout << "    closest approach r_min = " << fmt(e->r_min) << " (error " << error_text(e->r_min_error) << ") at t_min = "
+              << fmt(e->t_min) << " (error " << error_text(e->t_min_error) << ")\n";
   else std::cout << "    no closest approach within the run (the distance has no minimum between its ends)\n";
   std::cout << "    K1 turned " << fmt(sc.K1_turn) << " rad, the spin K2 " << fmt(sc.spin_turn) << " rad; K1: "
             << json_vec(sc.K1_start) << " -> " << json_vec(sc.K1_end) << "\n";

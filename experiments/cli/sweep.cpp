@@ -120,6 +120,23 @@ std::string body_names(const SweepSpec& spec) {
   return join(names, ", ");
 }
 
+/// The header's words on an encounter sweep's columns (SweepSpec::scattering).
+std::string scattering_columns() {
+  return "; r_min,t_min = the closest approach to any centre (located on the method's steps), r_min_error,t_min_error ="
+         " their estimated errors (the same event on companion runs at 2h and 4h; NaN: not known);"
+         " deflection, out_of_plane = angles between the incoming and outgoing asymptotes (rad);"
+         " b_in = impact parameter of the incoming asymptote, v_inf_in = speed at infinity on it (of the guiding centre"
+         " for B != 0);"
+         " time_delay = against free motion, Coulomb logarithm removed; asymptote_error = the"
+         " asymptotes' model error in the deflection (estimated from half the start distance);"
+         " start_distance_error, time_delay_error = what the start distance L leaves against L ->"
+         " infinity (the point again from 2L); deflection_error = the deflection's total; start_distance_force_evals = what that run from 2L cost;"
+         " a run that ended before the body left is outcome incomplete, without them;"
+         " K1_turn, spin_turn ="
+         " angles K1 and K2 turned over the run (rad); K1x,K1y,K1z = final K1;"
+         " asymptotes = kepler | guiding-centre | none: why (docs/physics.md, Scattering)";
+}
+
 std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& command) {
   std::string varied;
   bool sweeps_h = false;
@@ -164,20 +181,7 @@ std::vector<std::string> sweep_header(const SweepSpec& spec, const std::string& 
               " err_estimate = estimated relative error of the final state, max(|dR|/|R|, |dv|/|v|) (NaN: none),"
               " estimate_force_evals = its companion run's cost, err_basis = how it was estimated or why there is"
               " none; warning = a flag the estimate overruled" +
-              std::string(spec.scattering
-                              ? "; r_min,t_min = the closest approach to any centre (located on the method's steps);"
-                                " deflection, out_of_plane = angles between the incoming and outgoing asymptotes (rad);"
-                                " b_in = impact parameter of the incoming asymptote, v_inf_in = speed at infinity on it (of the guiding centre"
-                                " for B != 0);"
-                                " time_delay = against free motion, Coulomb logarithm removed; asymptote_error = the"
-                                " asymptotes' model error in the deflection (estimated from half the start distance);"
-                                " start_distance_error, time_delay_error = what the start distance L leaves against L ->"
-                                " infinity (the point again from 2L); deflection_error = the deflection's total; start_distance_force_evals = what that run from 2L cost;"
-                                " a run that ended before the body left is outcome incomplete, without them;"
-                                " K1_turn, spin_turn ="
-                                " angles K1 and K2 turned over the run (rad); K1x,K1y,K1z = final K1;"
-                                " asymptotes = kepler | guiding-centre | none: why (docs/physics.md, Scattering)"
-                              : "") +
+              (spec.scattering ? scattering_columns() : std::string()) +
               "; steps, t_end = the run's steps and end time; vx,vy,vz, wx,wy,wz = final velocity and angular velocity"};
 }
 

@@ -147,6 +147,8 @@ Encounter measure_encounter(const Body& body, const std::vector<Centre>& centres
   if (const EventHit* nearest = nearest_approach(hits, events)) {
     e.r_min = nearest->r;
     e.t_min = nearest->t;
+    e.r_min_error = nearest->r_error;
+    e.t_min_error = nearest->t_error;
   }
   e.reason = unfinished(body, centres, run);
   const bool finished = e.reason.empty();
@@ -251,7 +253,9 @@ EncounterResult encounter_twice_as_far(const Scene& far, double tol, const Optio
                            &detail::choose_method_for(body, far.centres, a.tol, nullptr) == near->method
                        ? near->accuracy->h_chosen
                        : 0.0;
-    EncounterResult r = encounter_at(body, far.centres, nullptr, a, options, true);
+    Options o = options;
+    o.estimate_events = false;  // its observables are what the limit needs, not its closest approach's error
+    EncounterResult r = encounter_at(body, far.centres, nullptr, a, o, true);
     if (r.run.outcome != Outcome::failed || r.run.reason.find("out of reach") == std::string::npos ||
         a.tol * kLooser > kLoosest)
       return r;

@@ -19,6 +19,11 @@ using Rerun = std::function<BodyResult(const Body& body, const Advance& how, con
 /// estimate, a companion run's (bodypoint.hpp, ErrorEstimate), or why the run has none.
 void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Advance& how,
                     const Options& options, const Rerun& rerun);
+/// Sets the errors of r's located events (EventHit::t_error, r_error, state_error) from one companion run at
+/// twice the step (far-ip, KS: at 1/1.25 of it) that locates the same events, its evaluations the events';
+/// nothing where r has no estimate or no step to scale (estimate/events.cpp).
+void estimate_event_errors(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Advance& how,
+                           const Options& options, const Rerun& rerun);
 
 /// The coarse companion of a run by step: up to twice its step (h, or ds with the same time-step
 /// constant; a fixed-step run of an odd number of steps: half as many rounded up, at the step that lands

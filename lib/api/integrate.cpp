@@ -453,9 +453,11 @@ BodyResult integrate_estimated(const Body& body, const std::vector<Centre>& cent
 BodyResult integrate_forwards(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
                               const Advance& how, const Options& options) {
   BodyResult r = integrate_valid_body(body, centres, method, how, options);
-  detail::estimate_error(r, body, centres, how, options, [&](const Body& from, const Advance& a, const Options& o) {
+  const detail::Rerun rerun = [&](const Body& from, const Advance& a, const Options& o) {
     return integrate_valid_body(from, centres, r.method, a, o);
-  });
+  };
+  detail::estimate_error(r, body, centres, how, options, rerun);
+  detail::estimate_event_errors(r, body, centres, how, options, rerun);
   detail::settle(r.outcome, r.reason, r.warnings, r.error, options.max_error, options.max_energy_error,
                  detail::final_energy_error(body, centres, r.run.final));
   return r;

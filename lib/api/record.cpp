@@ -137,6 +137,7 @@ const Value* Record::find(std::string_view key) const {
 Record event_record(const EventHit& h, const std::vector<Event>& events) {
   Record e;
   e.text("event", events[h.event].label()).number("t", h.t).number("r", h.r);
+  e.number("t_error", h.t_error).number("r_error", h.r_error).number("state_error", h.state_error);
   return e.vector("R", h.s.R).vector("v", h.s.v).vector("w", h.s.w);
 }
 
@@ -180,7 +181,8 @@ Record encounter_record(const Encounter& e) {
   out.note("start_distance_basis", e.start_distance_basis).count("start_distance_force_evals", e.start_distance_force_evals);
   out.number("deflection_error", e.deflection_error);
   if (sc.in) out.vector("direction_in", sc.in->direction).vector("direction_out", sc.out->direction);
-  out.number("r_min", e.r_min).number("t_min", e.t_min).number("K1_turn", sc.K1_turn).number("spin_turn", sc.spin_turn);
+  out.number("r_min", e.r_min).number("t_min", e.t_min).number("r_min_error", e.r_min_error).number("t_min_error", e.t_min_error);
+  out.number("K1_turn", sc.K1_turn).number("spin_turn", sc.spin_turn);
   out.vector("K1_start", sc.K1_start).vector("K1_end", sc.K1_end).vector("K2_start", sc.K2_start).vector("K2_end", sc.K2_end);
   out.number("E_start", sc.E_start).number("E_end", sc.E_end);
   if (sc.has_K2Q) out.vector("K2Q_start", sc.K2Q_start).vector("K2Q_end", sc.K2Q_end);
@@ -202,7 +204,8 @@ Record sweep_record(const SweepSpec& spec, const SweepRow& r) {
   out.note("err_basis", r.error.basis).note("warning", join(r.warnings, "; "));
   if (spec.scattering) {  // NaN where there is no value (no minimum, no asymptotes, a run that did not finish)
     const Scattering sc = r.scattering ? *r.scattering : Scattering{};
-    out.number("r_min", r.r_min).number("t_min", r.t_min).number("deflection", sc.deflection);
+    out.number("r_min", r.r_min).number("t_min", r.t_min).number("r_min_error", r.r_min_error).number("t_min_error", r.t_min_error);
+    out.number("deflection", sc.deflection);
     out.number("out_of_plane", sc.out_of_plane).number("b_in", sc.b).number("v_inf_in", sc.v_inf);
     out.number("time_delay", sc.time_delay).number("asymptote_error", r.asymptote_error);
     out.number("start_distance_error", r.start_distance_error).number("time_delay_error", r.time_delay_error);

@@ -345,6 +345,8 @@ SweepRow encounter_row(SweepRow row, const MethodInfo* method, const Scene& scen
     row.start_distance_force_evals = add_row_start_distance(e, spec, row.point, body, r);
   row.r_min = e.r_min;
   row.t_min = e.t_min;
+  row.r_min_error = e.r_min_error;
+  row.t_min_error = e.t_min_error;
   row.asymptote_error = e.asymptote_error;
   row.start_distance_error = e.start_distance_error;
   row.time_delay_error = e.time_delay_error;

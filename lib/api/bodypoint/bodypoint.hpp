@@ -107,6 +107,13 @@ struct EventHit {
   double t = 0.0;
   State s;
   double r = 0.0;  ///< |R - c| to the event's centre (plane: to the scene's first centre); "r" in JSON and Python too
+  /// The estimated errors of t, r and the state (relative, as the run's err_estimate) from the same events
+  /// located on a companion run (estimate/events.cpp); NaN where not known (no estimate of the run, a
+  /// step-size-controlled method, a companion that hit the event another number of times, a Stepper's
+  /// segment).
+  double t_error = std::numeric_limits<double>::quiet_NaN();
+  double r_error = std::numeric_limits<double>::quiet_NaN();
+  double state_error = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Every centre's closest approach (Kind::closest_approach for centres 0 .. n-1), as events.
@@ -131,6 +138,9 @@ struct Options : RunOptions {
   /// Estimate the error of a run asked for by step with a companion run (ErrorEstimate; it costs about
   /// half the run). Off: BodyResult::error says the run has none. The accuracy mode always has one.
   bool estimate_error = true;
+  /// Estimate the located events' errors (EventHit::t_error, r_error, state_error) with one companion run
+  /// at twice the step that locates them too (about half the run); off, or without estimate_error: NaN.
+  bool estimate_events = true;
   /// A run whose estimated relative error (BodyResult::error) exceeds this bound ends Outcome::inaccurate
   /// (> 0; infinity: no bound).
   double max_error = kDefaultMaxError;
@@ -277,6 +287,7 @@ struct Encounter {
   /// delay only when ok.
   Scattering scattering;
   double r_min = Scattering::kNaN, t_min = Scattering::kNaN;  ///< the closest approach (to any centre)
+  double r_min_error = Scattering::kNaN, t_min_error = Scattering::kNaN;  ///< theirs (EventHit's r_error, t_error)
   /// Estimated error of the deflection that the asymptotes' model leaves at the run's distances (the
   /// guiding centre is a Kepler particle only far away): the change of the deflection between the
   /// asymptotes taken at the run's ends and at half the start distance, over 2^p - 1 with p =

@@ -126,6 +126,7 @@ struct SweepRow {
   /// asymptotes' model error in the deflection (Encounter::asymptote_error).
   std::optional<Scattering> scattering;
   double r_min = Scattering::kNaN, t_min = Scattering::kNaN, asymptote_error = Scattering::kNaN;
+  double r_min_error = Scattering::kNaN, t_min_error = Scattering::kNaN;  ///< Encounter's
   /// The start distance's part of the deflection's and the time delay's error, and the deflection's total
   /// error (Encounter's fields of the same names).
   double start_distance_error = Scattering::kNaN, time_delay_error = Scattering::kNaN, deflection_error = Scattering::kNaN;

@@ -4,6 +4,7 @@
 //   estimate/fine.cpp      the fine companions at h/2, h/4, ... and what they confirm of a flagged run
 //   estimate/rounding.cpp  the rounding draws at the scene's rounding level
 //   estimate/settle.cpp    what a run's flags make of its estimate
+//   estimate/events.cpp    the located events' errors, from companions that locate them too
 // Each tuned constant's measurement: docs/measurements.md, "Tuned constants". Internal to the API.
 #pragma once
 
