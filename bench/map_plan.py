@@ -59,8 +59,9 @@ def cheapest(named, tol):
 
 
 def cost(r):
-    """A row's every force evaluation: its search, and an encounter's run from twice its start distance."""
-    return int(r["search_force_evals"]) + int(r.get("start_distance_force_evals") or 0)
+    """A row's every force evaluation: its search, an encounter's run from twice its start distance and its events
+    (a build before the events' column counted them nowhere)."""
+    return sum(int(r.get(k) or 0) for k in ("search_force_evals", "start_distance_force_evals", "event_force_evals"))
 
 
 def summary(rows, tol, cheapest_sum):

@@ -131,6 +131,7 @@ std::string scattering_columns() {
          " asymptotes' model error in the deflection (estimated from half the start distance);"
          " start_distance_error, time_delay_error = what the start distance L leaves against L ->"
          " infinity (the point again from 2L); deflection_error = the deflection's total; start_distance_force_evals = what that run from 2L cost;"
+         " event_force_evals = what locating the events and their errors cost;"
          " a run that ended before the body left is outcome incomplete, without them;"
          " K1_turn, spin_turn ="
          " angles K1 and K2 turned over the run (rad); K1x,K1y,K1z = final K1;"

@@ -210,6 +210,7 @@ Record sweep_record(const SweepSpec& spec, const SweepRow& r) {
     out.number("time_delay", sc.time_delay).number("asymptote_error", r.asymptote_error);
     out.number("start_distance_error", r.start_distance_error).number("time_delay_error", r.time_delay_error);
     out.number("deflection_error", r.deflection_error).count("start_distance_force_evals", r.start_distance_force_evals);
+    out.count("event_force_evals", r.event_force_evals);
     out.number("K1_turn", r.scattering ? sc.K1_turn : nan).number("spin_turn", r.scattering ? sc.spin_turn : nan);
     out.number("K1x", sc.K1_end.x()).number("K1y", sc.K1_end.y()).number("K1z", sc.K1_end.z());
     out.note("asymptotes", r.scattering ? sc.asymptotes : std::string("none: the run did not finish"));

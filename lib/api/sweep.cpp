@@ -64,6 +64,7 @@ SweepRow result_row(SweepRow row, BodyResult r) {
   row.error = std::move(r.error);
   row.warnings = std::move(r.warnings);
   row.accuracy = r.accuracy;
+  row.event_force_evals = r.event_force_evals;
   return row;
 }
 

@@ -131,6 +131,7 @@ struct SweepRow {
   /// error (Encounter's fields of the same names).
   double start_distance_error = Scattering::kNaN, time_delay_error = Scattering::kNaN, deflection_error = Scattering::kNaN;
   long start_distance_force_evals = 0;  ///< the row's encounter from twice its start distance cost these
+  long event_force_evals = 0;  ///< locating the row's events and their errors cost these (BodyResult's)
   std::optional<AccuracyReport> accuracy;  ///< with SweepSpec::accuracy: what the search chose and cost
 };
 
