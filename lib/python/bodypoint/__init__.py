@@ -351,18 +351,20 @@ def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, accuracy=None
     is swept as the thesis's parameters. ``methods``: names, a list of
     names separated by commas, "fixed" (every fixed-step method but the Kepler split) or "all", as
     ``bodypoint sweep --methods`` takes them, and "auto": the accuracy mode chooses each row's method
-    (column chosen), at ``accuracy``, or listed alone without it at ``tol``. ``base``: fixed scene parameters, and fixed asymptotic data (b, v_inf,
+    (column chosen), at ``accuracy``, or listed alone without it at ``tol``; auto's rows share one plan, each
+    starting at the step of its nearest pilot row (err_basis names it; docs/physics.md, "A map at an accuracy"). ``base``: fixed scene parameters, and fixed asymptotic data (b, v_inf,
     arrival_phase: solved for at every point, a column each, as ``bodypoint sweep --b``); ``force_law`` as
     thesis_scene()'s. Steps of h: ``steps`` of them, or to ``t_end``; ``tol``: the step-size-controlled
     peers' tolerance per step. ``accuracy``: the accuracy mode, every other method delivering this
-    relative error of the final state at ``t_end`` (its step searched per row: columns h_chosen,
+    relative error of the final state at ``t_end`` (its step searched per row: columns h_chosen, omega_c,
     search_force_evals). ``threads``: every core unless
     given (0 too, as on the command line). The columns are those of ``bodypoint sweep``'s CSV (docs/guide.md): one per axis, method,
     max_rel_dE, max_rel_dK2sq, max_abs_dK2Q, Rx..Rz, force_evals, wall_s, outcome (an Outcome's name),
     reason, err_estimate, estimate_force_evals,
-    err_basis, warning; with ``scattering=True`` the encounter's (r_min, t_min, deflection,
-    out_of_plane, b_in, v_inf_in, time_delay, asymptote_error, K1_turn, spin_turn, K1x..K1z,
-    asymptotes); then steps, t_end, vx..vz, wx..wz. One row per (grid point, method), grid point major.
+    err_basis, warning; with ``scattering=True`` the encounter's (r_min, t_min, r_min_error, t_min_error,
+    deflection, out_of_plane, b_in, v_inf_in, time_delay, asymptote_error, start_distance_error,
+    time_delay_error, deflection_error, start_distance_force_evals, event_force_evals, K1_turn, spin_turn,
+    K1x..K1z, asymptotes); then steps, t_end, vx..vz, wx..wz. One row per (grid point, method), grid point major.
     ``progress``: a line on stderr, rewritten as rows finish (rows done, elapsed, time left), for calls
     longer than a second; None (the default) shows it where stderr is a terminal or in a Jupyter
     notebook, not in a script whose stderr is a file or pipe, nor under CI; True or False decide.
