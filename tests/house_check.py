@@ -53,9 +53,9 @@ CATCH_SITES = {
     "experiments/cli/sweep.cpp": 2,
     "experiments/studies/work_precision.cpp": 1,
     "lib/api/integrate.cpp": 1,  # a run's Error as its outcome
-    "lib/api/sweep.cpp": 4,  # a row's point named; a worker's error carried to the caller
+    "lib/api/sweep.cpp": 3,  # a row's point named; a worker's error carried to the caller
     "lib/core/model/bodypoint/scene_file.cpp": 5,  # toml++'s errors with the file's line
-    "lib/core/model/bodypoint/threads.hpp": 1,
+    "lib/core/model/bodypoint/threads.hpp": 2,  # parallel_for: a call's error carried to the caller
     "lib/python/module.cpp": 5,  # Python's exceptions
 }
 

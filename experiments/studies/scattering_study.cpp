@@ -25,9 +25,7 @@
 #include "sweep.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <functional>
 #include <iostream>
 #include <limits>
 #include <numbers>
@@ -142,16 +140,6 @@ Point run_point(const Series& s, double b, double psi) {
 }
 
 double rutherford(double A, double mu, double v_inf, double b) { return 2.0 * std::atan(std::abs(A) / (mu * v_inf * v_inf * b)); }
-
-/// Runs f(i) for i < n on `threads` threads.
-void parallel_for(std::size_t n, unsigned threads, const std::function<void(std::size_t)>& f) {
-  std::atomic<std::size_t> next{0};
-  auto worker = [&] {
-    for (std::size_t i; (i = next++) < n;) f(i);
-  };
-  const WorkerThreads pool(std::max(1u, threads) - 1, worker);  // joined before the caller reads
-  worker();
-}
 
 /// The study's grid: per series its phases, per phase every b.
 struct Grid {

@@ -611,23 +611,7 @@ MapPlan plan_map(const SweepSpec& spec, unsigned threads) {
   }
   for (std::size_t& p : pilots) p = p * spec.methods.size() + auto_column(spec);
   std::vector<SweepRow> rows(pilots.size());
-  std::atomic<std::size_t> next{0};
-  std::mutex mutex;
-  std::exception_ptr error;
-  auto worker = [&] {
-    try {
-      for (std::size_t k; (k = next++) < pilots.size();) rows[k] = run_sweep_unit_rows(spec, {pilots[k]}).front();
-    } catch (...) {
-      const std::lock_guard<std::mutex> lock(mutex);
-      if (!error) error = std::current_exception();
-      next = pilots.size();
-    }
-  };
-  {
-    const WorkerThreads pool(static_cast<unsigned>(std::min<std::size_t>(std::max(threads, 1u), pilots.size())) - 1, worker);
-    worker();
-  }
-  if (error) std::rethrow_exception(error);
+  parallel_for(pilots.size(), threads, [&](std::size_t k) { rows[k] = run_sweep_unit_rows(spec, {pilots[k]}).front(); });
   for (std::size_t k = 0; k < pilots.size(); ++k) {
     const SweepRow& row = rows[k];
     MapPlan::Step step{row.method, 0.0};

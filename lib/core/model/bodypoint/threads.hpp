@@ -6,6 +6,9 @@
 #include "bodypoint/model.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <exception>
+#include <mutex>
 #include <string>
 #include <system_error>
 #include <thread>
@@ -51,5 +54,29 @@ class WorkerThreads {
  private:
   std::vector<std::thread> pool_;
 };
+
+/// Runs f(i) for every i < n on up to `threads` threads (this one among them), each taking the next i. The
+/// first exception a call throws stops the handing out and is rethrown once the running calls have finished.
+template <class F>
+void parallel_for(std::size_t n, unsigned threads, F&& f) {
+  std::atomic<std::size_t> next{0};
+  std::mutex mutex;  // the first error
+  std::exception_ptr error;
+  auto worker = [&] {
+    try {
+      for (std::size_t i; (i = next++) < n;) f(i);
+    } catch (...) {
+      const std::lock_guard<std::mutex> lock(mutex);
+      if (!error) error = std::current_exception();
+      next = n;
+    }
+  };
+  {
+    const WorkerThreads pool(static_cast<unsigned>(std::min<std::size_t>(std::max(threads, 1u), std::max<std::size_t>(n, 1))) - 1,
+                             worker);
+    worker();
+  }
+  if (error) std::rethrow_exception(error);
+}
 
 }  // namespace bodypoint
