@@ -14,6 +14,18 @@
 namespace bodypoint::detail {
 namespace {
 
+/// Why a run by step gets no estimate from companions ("" where it gets one): not asked for, a run that
+/// did not end (failed, stopped), a run its sink ended early.
+std::string why_no_companion(const BodyResult& r, const Options& options) {
+  if (!options.estimate_error) return "not asked for (estimate_error off)";
+  if (r.outcome != Outcome::ok && r.outcome != Outcome::unresolved && r.outcome != Outcome::inaccurate)
+    return "the run ended " + std::string(outcome_name(r.outcome));
+  if (r.run.stopped && !stopped_by_event(r, options)) return "the run was ended early by its sink";
+  return "";
+}
+
+}  // namespace
+
 /// What a companion observes: the invariants if the run tracked them (a run that observes no step merges
 /// adjacent sub-steps, which changes its rounding: a sweep's vector lanes, which observe, then agree with
 /// it bit for bit), the run's stop events, with the run's time-step constant (a pair compared by
@@ -34,18 +46,6 @@ Options companion_options(const Body& body, const std::vector<Centre>& centres, 
     if (ev.stop) o.events.push_back(ev);
   return o;
 }
-
-/// Why a run by step gets no estimate from companions ("" where it gets one): not asked for, a run that
-/// did not end (failed, stopped), a run its sink ended early.
-std::string why_no_companion(const BodyResult& r, const Options& options) {
-  if (!options.estimate_error) return "not asked for (estimate_error off)";
-  if (r.outcome != Outcome::ok && r.outcome != Outcome::unresolved && r.outcome != Outcome::inaccurate)
-    return "the run ended " + std::string(outcome_name(r.outcome));
-  if (r.run.stopped && !stopped_by_event(r, options)) return "the run was ended early by its sink";
-  return "";
-}
-
-}  // namespace
 
 /// Where the method's flow is exact (the Kepler split on a material point about one Coulomb centre),
 /// two runs differ by rounding alone, which no step refines: their whole difference is the estimate, not

@@ -104,18 +104,6 @@ double quantity_error(double d1, double d2, int p, double scale, double final_fa
   return std::max(d1 * std::max(richardson, final_factor), kEventRounding * scale);
 }
 
-Options event_companion_options(const Body& body, const std::vector<Centre>& centres, const RunStep& step,
-                                const Options& options) {
-  Options o;
-  o.track_invariants = false;
-  o.estimate_error = false;
-  o.max_energy_error = std::numeric_limits<double>::infinity();
-  o.max_error = std::numeric_limits<double>::infinity();
-  o.cancel = options.cancel;
-  o.events = options.events;
-  o.omega_c = step.omega_c < 0.0 && step.fictitious ? adaptive::automatic_omega_c(body, centres, step.h) : step.omega_c;
-  return o;
-}
 
 }  // namespace
 
@@ -125,7 +113,12 @@ void estimate_event_errors(BodyResult& r, const Body& body, const std::vector<Ce
   const std::optional<RunStep> step = run_step(r, how, options);
   if (!step) return;
   const int p = adaptive::effective_order(*r.method, body);
-  const Options o = event_companion_options(body, centres, *step, options);
+  // A companion as the estimate's (companion_options) that locates every event and tracks no invariant, with the
+  // constant c the run had (the accuracy mode's delivered one).
+  Options o = companion_options(body, centres, how, options);
+  o.events = options.events;
+  o.track_invariants = false;
+  if (step->omega_c >= 0.0) o.omega_c = step->omega_c;
   // Order p: companions at 2h and 4h (three quarters of a run), a quantity's error trusted where the three
   // fall as order p. Without an order (far-ip, KS): one at h/1.25, as their searches pair them.
   const BodyResult x = rerun(body, scaled(*step, p > 0 ? kEventRatio : 1.0 / kFinerRatio), o);

@@ -42,6 +42,9 @@ inline int fixed_order(const MethodInfo& m, const Body& body) { return std::max(
 /// Where the method's flow is exact (the Kepler split on a material point about one Coulomb centre), two runs
 /// differ by rounding alone: their whole difference is the estimate (estimate.cpp).
 bool flow_is_exact(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres);
+/// What a companion of the run asked as `how` observes: the invariants if the run tracked them, the run's stop
+/// events, its time-step constant c; no samples, no bounds, no estimate of its own (estimate.cpp).
+Options companion_options(const Body& body, const std::vector<Centre>& centres, const Advance& how, const Options& options);
 /// Whether the run r ended at one of its stop events.
 bool stopped_by_event(const BodyResult& r, const Options& options);
 /// Whether a companion ended as the run did (finite, at the same stop event).
