@@ -1,8 +1,7 @@
-// bodypoint: the error of a run's located events (estimate.hpp, estimate_event_errors). One companion run
-// locates the same events; in the asymptotic regime every smooth quantity of a run (an event's time, its
-// distance, its state) errs by the same multiple of what the pair differs by in it, so each hit's error is its
-// difference from the companion's times the larger of Richardson's factor and the final state's estimate over
-// the final states' difference (which carries the estimate's rounding draws and margins to the events).
+// bodypoint: the errors of a run's located events (estimate.hpp, estimate_event_errors). Companions at 2h and 4h
+// locate the same events; in the asymptotic regime every smooth quantity of a run (an event's time, its distance,
+// its state) errs by the same multiple of what the pair differs by in it, so a quantity whose three values fall as
+// an order gets Richardson's error at that order, at least the final state's estimate over its pair's difference.
 #include "parts.hpp"
 
 #include "bodypoint/adaptive/methods.hpp"
@@ -63,10 +62,6 @@ std::map<std::pair<std::size_t, int>, const EventHit*> by_occurrence(const std::
   return out;
 }
 
-}  // namespace
-
-namespace {
-
 /// A hit's quantities that get an error: its time, its distance, its state (relative).
 std::array<double, 3> differences(const EventHit& a, const EventHit& b) {
   return {std::abs(a.t - b.t), std::abs(a.r - b.r), adaptive::state_distance(a.s, b.s)};
@@ -103,7 +98,6 @@ double quantity_error(double d1, double d2, int p, double scale, double final_fa
   const double richardson = 1.0 / (std::pow(kEventRatio, std::min<double>(q, p)) - 1.0);
   return std::max(d1 * std::max(richardson, final_factor), kEventRounding * scale);
 }
-
 
 }  // namespace
 
