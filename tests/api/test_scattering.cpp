@@ -662,6 +662,30 @@ TEST(Encounter, AnEncounterGivenByBTakesK1AsItsMomentumAtInfinity) {
   EXPECT_EQ(with_asymptotic_data(SceneParams{}, Scattering::kNaN, Scattering::kNaN, 1.0).start.K1, 5.0);
 }
 
+/// A spinning body's time delay is its trajectory's, wherever its legs are cut: the same encounter from L = 800 and
+/// from its own state where the guiding centre is back in at r = 200 (a long-double reference state; each run cut
+/// at its start distance on the way out). While each leg's time to infinity was its state's Kepler hyperbola's
+/// (one mass mu = |K1|/u for the whole leg) the two differed by 5.1e-5 (table 3.1, b = 3, arrival phase 1, TOL
+/// 1e-10); with the averaged flight to infinity (scattering.cpp, SpinLeg) by 2.5e-7. This bound is 4x above that
+/// and 50x below the hyperbola's.
+constexpr double kDelayCut = 1e-6;
+
+TEST(Encounter, ASpinningBodysTimeDelayDoesNotDependOnWhereItsLegsAreCut) {
+  SceneParams p;
+  p.start.L = 800.0;
+  p = with_asymptotic_data(p, 3.0, Scattering::kNaN, 1.0);
+  const Scene s = thesis_scene(p);
+  const Body& body = s.bodies.front();
+  const EncounterResult far = encounter(body, s.centres, nullptr, 1e-10);
+  ASSERT_EQ(far.encounter.outcome, Outcome::ok) << far.encounter.reason;
+  const double t_in = (800.0 - 200.0) / far.encounter.scattering.v_inf;  // G near r = 200 on the way in
+  Body near = body;
+  near.s0 = reference_state(body, s.centres, t_in, 1e-18L);
+  const EncounterResult cut = encounter(near, s.centres, nullptr, 1e-10);
+  ASSERT_EQ(cut.encounter.outcome, Outcome::ok) << cut.encounter.reason;
+  EXPECT_NEAR(cut.encounter.scattering.time_delay, far.encounter.scattering.time_delay, kDelayCut);
+}
+
 /// An accuracy run with a stop event plans for the stop: asked for t_end = 1e5 and stopped at the departure
 /// (at t ~ 57), it searched its step over the whole 1e5 (34-164 million evaluations, issue #79); planned for
 /// the stop its whole cost is within this factor of the same encounter asked to its default end, two free

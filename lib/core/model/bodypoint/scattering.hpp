@@ -69,7 +69,8 @@ struct Scattering {
   /// -2 kappa/(mu v_inf^3)(1 + ln e) (the run's own timing error aside): free motion along the
   /// asymptotes takes that much longer than the orbit once the logarithm (kappa/(mu v_inf^3)) ln(2r/a)
   /// per leg (a = |kappa|/(mu v_inf^2)), which grows without bound in any Coulomb field, is removed.
-  /// For B != 0: the guiding centre's delay, the spin's part included. docs/physics.md, "Scattering".
+  /// For B != 0: the guiding centre's delay, the spin's part included, each leg carried from its cut to
+  /// infinity by the averaged flight, not the hyperbola (whose one mass leaves O(1/r)). docs/physics.md, "Time delay".
   double time_delay = kNaN;
 
   static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
