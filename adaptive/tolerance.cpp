@@ -13,12 +13,6 @@
 
 namespace bodypoint::adaptive {
 
-int effective_order(const MethodInfo& m, const Body& b) {
-  // The thesis's schemes freeze the gyroscopic term: first order for B != 0 (README, findings).
-  if (m.traits.frozen_gyroscopic_term && b.p.B != 0.0) return 1;
-  return m.order;
-}
-
 double state_distance(const State& a, const State& b) {
   auto rel = [](const Vec3& x, const Vec3& y) {
     const double n = y.norm();

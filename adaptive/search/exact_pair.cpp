@@ -24,7 +24,7 @@ constexpr double kFarStartShift = std::numeric_limits<double>::epsilon();
 }  // namespace
 
 Level Search::exact_flow() {
-  double h = initial_step(m_, b_, c_, t_end_);
+  double h = search_first_step(m_, b_, c_, t_end_);
   const bool far = m_.traits.search == SearchStrategy::field_pair;
   const Body moved = start_moved(kFarStartShift), rounded = start_moved(-kStartShift);
   double best = std::numeric_limits<double>::infinity();

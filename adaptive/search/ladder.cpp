@@ -71,7 +71,7 @@ constexpr double kVerifyRatio = 1.25;
 /// run, never delivered (docs/measurements.md, "Limits, measured": a pilot pair's estimate alone was 25x low;
 /// the coarser may be, bounded by finer runs: pilot_answer).
 Level Search::pilot(Level& coarse) {
-  double h = initial_step(m_, b_, c_, t_end_);
+  double h = search_first_step(m_, b_, c_, t_end_);
   for (int k = 0;; ++k) {
     Attempt<Level> pair = attempt([&] {
       coarse = run_at(h, h, tol_ >= kProbeBelowTol);  // it may be the answer (pilot_answer)

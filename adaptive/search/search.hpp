@@ -74,13 +74,9 @@ struct Level {
   Advance how;                      ///< what it ran, for that run again
 };
 
-/// The period of the body's spin about its orbit (infinite for B = 0).
-double spin_orbit_period(const Body& b);
 /// The way of advancing time at step h: fictitious steps ds = h to t_end for time-transformed methods,
 /// otherwise the fixed steps of at most h that land on t_end.
 Advance step_advance(const MethodInfo& m, double h, double t_end, double dt_out);
-/// The first, coarse step of a search.
-double initial_step(const MethodInfo& m, const Body& b, const std::vector<Centre>& centres, double t_end);
 
 /// One search: its runs, what they measured so far, and the run it delivers.
 class Search {

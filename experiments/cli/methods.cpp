@@ -18,11 +18,7 @@ void print_markdown_table() {
   std::cout << "| method | family | order | stages | evals/step | description |\n|---|---|---|---|---|---|\n";
   for (const MethodInfo& m : methods())
     std::cout << "| `" << m.name << "` | " << m.traits.family_name << " | " << (m.order ? std::to_string(m.order) : "var")
-              << " | " << (is_step_controlled(m) || m.traits.cost_set_by_field ? "-" : std::to_string(m.stages)) << " | "
-              << (is_step_controlled(m) ? "adaptive"
-                  : m.traits.cost_set_by_field ? "points x sweeps"  // far_field.hpp: set by the step and the field
-                                                 : std::to_string(m.evals_per_step))
-              << " | " << m.description << " |\n";
+              << " | " << stages_text(m) << " | " << evals_per_step_text(m) << " | " << m.description << " |\n";
 }
 
 /// One row per method for scripts (paper/ reads the families from it): method, family (family_key),
@@ -32,7 +28,7 @@ void print_csv() {
   for (const MethodInfo& m : methods()) {
     CsvLine row;
     row.text(m.name).text(std::string(m.traits.family_key)).count(m.order).count(m.stages).count(m.evals_per_step);
-    row.text(is_step_controlled(m) ? "controlled" : is_time_transformed(m) ? "fictitious" : "fixed");
+    row.text(std::string(stepping_name(m)));
     row.quoted(std::string(m.traits.family_name));
     std::cout << row.str() << "\n";
   }
@@ -40,12 +36,11 @@ void print_csv() {
 
 void print_table() {
   std::cout << std::left << std::setw(16) << "method" << std::setw(8) << "order" << std::setw(8)
-            << "stages" << std::setw(14) << "evals/step" << "description\n";
+            << "stages" << std::setw(17) << "evals/step" << "description\n";
   for (const MethodInfo& m : methods())
     std::cout << std::left << std::setw(16) << m.name << std::setw(8)
-              << (m.order ? std::to_string(m.order) : "var") << std::setw(8)
-              << (is_step_controlled(m) ? "-" : std::to_string(m.stages)) << std::setw(14)
-              << (is_step_controlled(m) ? "adaptive" : std::to_string(m.evals_per_step)) << m.description << "\n";
+              << (m.order ? std::to_string(m.order) : "var") << std::setw(8) << stages_text(m) << std::setw(17)
+              << evals_per_step_text(m) << m.description << "\n";
 }
 
 }  // namespace

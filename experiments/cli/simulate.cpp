@@ -44,8 +44,8 @@ std::string search_line(const BodyResult& b) {
   std::ostringstream os;
   os << "method=" << b.method->name;
   if (b.accuracy)
-    os << (is_time_transformed(*b.method) ? " ds=" : " h=") << fmt(b.accuracy->h_chosen)
-       << (b.method->traits.takes_omega_c ? " omega_c=" + fmt(b.accuracy->omega_c) : std::string()) << " search: " << b.accuracy->runs
+    os << " " << step_name(*b.method) << "=" << fmt(b.accuracy->h_chosen)
+       << (takes_time_step_constant(*b.method) ? " omega_c=" + fmt(b.accuracy->omega_c) : std::string()) << " search: " << b.accuracy->runs
        << " runs (the delivered one included), " << b.accuracy->force_evals << " force evaluations";
   return os.str();
 }
@@ -424,7 +424,7 @@ void report_body(const SimulatedBody& body, const std::string& name) {
               << " (relative) of the start: the way out's error taken back and the way back's own, composed (a symmetric "
                  "method's cancel in part); the run's estimated error "
               << run.error.value << "; the way back alone, from the final state with the same step"
-              << (run.method->traits.takes_omega_c ? " and omega_c" : "") << ", is off by its own estimate "
+              << (takes_time_step_constant(*run.method) ? " and omega_c" : "") << ", is off by its own estimate "
               << body.reversal->back_estimate << " (" << body.reversal->force_evals << " force evaluations)\n"
               << std::defaultfloat;
 }

@@ -199,10 +199,7 @@ constexpr double kOwnOverAuto = 4.0;
 
 /// One rung of an own ladder: `m` at step h (fixed steps landing on t_end, or the fictitious step ds with
 /// its automatic constant c), as a user would run `--method m --h h --no-error-estimate`.
-Advance own_advance(const MethodInfo& m, double h, double t_end) {
-  if (is_time_transformed(m)) return FictitiousSteps{h, EndTime{t_end}};
-  return fixed_steps_to(t_end, h);
-}
+Advance own_advance(const MethodInfo& m, double h, double t_end) { return advance_to(m, h, t_end); }
 
 /// bodypoint's own configurations, untimed: every own method that takes the scene at a fixed or
 /// fictitious step (not the peers; not far-ip, whose step is set by the field), from kOwnFirstStep down

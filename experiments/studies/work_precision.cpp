@@ -310,7 +310,7 @@ void write_rows(std::ostream& os, const std::vector<Row>& rows, const std::strin
 std::string config_of(const Row& r) {
   std::ostringstream c;
   c << std::setprecision(3);
-  if (r.h > 0) c << (is_time_transformed(method_or_throw(r.method)) ? "ds=" : "h=") << r.h;
+  if (r.h > 0) c << step_name(method_or_throw(r.method)) << "=" << r.h;
   else c << "tol=" << r.tol;
   return c.str();
 }

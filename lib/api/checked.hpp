@@ -28,10 +28,6 @@ StepRequest with_default_end(StepRequest request, const MethodInfo* method);
 /// Throws Error unless max_error is a number > 0 (infinity: no bound).
 void check_error_bound(double max_error);
 
-/// Whether `method` takes a time-step constant c (RunOptions::omega_c): the time-transformed methods
-/// logh-* and ttl-*, not ks (regularised, exact in its fictitious time).
-bool takes_time_step_constant(const MethodInfo& method);
-
 /// Every part of a request checked once, each with one message naming the quantity: the scene
 /// (validate), then what check_run checks. The one check integrate(), integrate_body() and a Stepper make.
 void check_request(const Scene& scene, const MethodInfo* method, const Advance& how, const Options& options);

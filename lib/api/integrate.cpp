@@ -148,7 +148,7 @@ InvariantStats cut_at(RunResult& run, const EventHit& hit, const Body& body, con
 detail::Advancer advancer(const BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Advance& how,
                           const Options& options) {
   const MethodInfo& m = *r.method;
-  double step = 0.0, tol = 0.0, c = options.omega_c;
+  double step = 0.0, h0 = kControlledFirstStep, c = options.omega_c;  // step: h, ds or tol (advance_to)
   if (r.accuracy) {
     step = r.accuracy->h_chosen;
     c = r.accuracy->omega_c;
@@ -158,21 +158,18 @@ detail::Advancer advancer(const BodyResult& r, const Body& body, const std::vect
     step = fictitious->ds;
     if (c < 0.0) c = adaptive::automatic_omega_c(body, centres, step);
   } else if (const auto* controlled = std::get_if<ControlledSteps>(&how)) {
-    step = controlled->h0;
-    tol = controlled->tol;
+    step = controlled->tol;
+    h0 = controlled->h0;
   }
-  return [&m, body, &centres, step, tol, c, cancel = options.cancel](const State& s, double tau, long& evals) {
+  return [&m, body, &centres, step, h0, c, cancel = options.cancel](const State& s, double tau, long& evals) {
     Body from = body;
     from.s0 = s;
     Options sub;
     sub.track_invariants = false;
     sub.omega_c = c;
     sub.cancel = cancel;
-    Advance a;
-    if (is_time_transformed(m)) a = FictitiousSteps{step, EndTime{tau}};
-    else if (is_step_controlled(m)) a = ControlledSteps{std::min(step, tau), tau, tol};
-    else a = fixed_steps_to(tau, step);  // one step of tau inside a step; steps <= h across output times
-    const BodyResult x = integrate_valid_body(from, centres, &m, a, sub);
+    // A fixed step: one step of tau inside a step; steps <= h across output times.
+    const BodyResult x = integrate_valid_body(from, centres, &m, advance_to(m, step, tau, h0), sub);
     evals += x.run.force_evals;
     if (!ran(x.outcome)) {
       constexpr double nan = std::numeric_limits<double>::quiet_NaN();
@@ -489,10 +486,6 @@ void detail::check_run(const std::vector<Centre>& centres, const MethodInfo* met
   detail::validate_events(options.events, centres);
 }
 
-bool takes_time_step_constant(const MethodInfo& method) {
-  return method.traits.takes_omega_c;
-}
-
 void check_time_step_constant(double omega_c, const MethodInfo* method, bool accuracy) {
   require_non_negative(omega_c, "the time-step constant omega_c");
   if (accuracy) throw Error("the accuracy mode chooses the time-step constant omega_c itself: do not give it");
@@ -588,19 +581,13 @@ constexpr double kDrawTolerance = 10.0 * adaptive::kProbeBelowTol;
 
 /// A Stepper's segment of `span` (> 0) forwards: the step, fictitious step or tolerance per step it
 /// was built with.
-Advance segment_of(const MethodInfo& method, double step, double span) {
-  if (is_time_transformed(method)) return FictitiousSteps{step, EndTime{span}};
-  if (is_step_controlled(method)) return ControlledSteps{std::min(1e-3, span), span, step};
-  return fixed_steps_to(span, step);
-}
+Advance segment_of(const MethodInfo& method, double step, double span) { return advance_to(method, step, span); }
 
 /// A Stepper's request (its scene, its way of advancing time, its options), checked once, when it is
 /// built: a segment (advance_to) is valid by construction and runs unchecked.
 const MethodInfo& checked_request(const MethodInfo& method, const Body& body, const std::vector<Centre>& centres,
                                   double step, const Options& options) {
-  require_positive(step, is_time_transformed(method) ? "the fictitious step ds"
-                         : is_step_controlled(method)  ? "the tolerance per step tol"
-                                                       : "the step h");
+  require_positive(step, step_quantity(method));
   check_request(Scene{centres, {body}}, &method, segment_of(method, step, 1.0), options);
   return method;
 }

@@ -150,7 +150,7 @@ Record body_record(const BodyResult& r, const Advance& how, const std::vector<Ev
   if (const auto* a = r.accuracy ? &*r.accuracy : nullptr) {
     out.number("tol", a->tol).number("h_chosen", a->h_chosen);
     // The time-step constant the search delivered with ds: the run is reproduced only with both (--omega-c).
-    if (r.method && r.method->traits.takes_omega_c) out.number("omega_c", a->omega_c);
+    if (r.method && takes_time_step_constant(*r.method)) out.number("omega_c", a->omega_c);
     out.count("search_runs", a->runs);
     out.count("search_force_evals", a->force_evals).number("search_wall_s", a->wall_s);
   }
@@ -218,7 +218,7 @@ Record sweep_record(const SweepSpec& spec, const SweepRow& r) {
   out.count("steps", r.result.steps).number("t_end", r.result.t_end);
   if (spec.accuracy) {  // the accuracy mode's choice and cost (the row's own run is its delivered one)
     out.number("h_chosen", r.accuracy ? r.accuracy->h_chosen : nan);
-    out.number("omega_c", r.accuracy && r.method && r.method->traits.takes_omega_c ? r.accuracy->omega_c : nan);
+    out.number("omega_c", r.accuracy && r.method ? time_step_constant_of(*r.method, r.accuracy->omega_c) : nan);
     out.count("search_force_evals", r.accuracy ? r.accuracy->force_evals : 0);
     if (has_auto(spec)) out.text("chosen", r.automatic && r.method ? std::string(r.method->name) : std::string());
   }

@@ -616,7 +616,7 @@ MapPlan plan_map(const SweepSpec& spec, unsigned threads) {
     const SweepRow& row = rows[k];
     MapPlan::Step step{row.method, 0.0};
     if (row.outcome == Outcome::ok && row.method && row.accuracy && row.accuracy->err_estimate > 0.0 && row.accuracy->h_chosen > 0.0) {
-      const double order = adaptive::effective_order(*row.method, point_scene(spec, row.point).bodies.front());
+      const double order = effective_order(*row.method, point_scene(spec, row.point).bodies.front());
       const double aim = adaptive::kTargetShare * *spec.accuracy / row.accuracy->err_estimate;
       step.first_step = row.accuracy->h_chosen * (order > 0.0 ? std::clamp(std::pow(aim, 1.0 / order), 1.0, kPlanMaxGain) : 1.0);
     }

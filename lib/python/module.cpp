@@ -691,7 +691,7 @@ struct PyStepper {
     d["t_end"] = stepper.accuracy_t_end();
     d["err_estimate"] = a.err_estimate;
     d["h_chosen"] = a.h_chosen;
-    if (stepper.method().traits.takes_omega_c) d["omega_c"] = a.omega_c;
+    if (takes_time_step_constant(stepper.method())) d["omega_c"] = a.omega_c;
     d["basis"] = a.basis;
     d["force_evals"] = a.force_evals;
     return d;

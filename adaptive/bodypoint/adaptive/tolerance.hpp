@@ -85,10 +85,6 @@ ToleranceResult search_step(const MethodInfo& method, const Body& body, const st
 /// method with a known order, or ks.
 void check_searchable(const MethodInfo& method);
 
-/// The order p of `m`'s error on `body`: the method's, but 1 for the thesis's schemes with B != 0 (they
-/// freeze the gyroscopic term); 0 for a method without a fixed order.
-int effective_order(const MethodInfo& m, const Body& body);
-
 /// Relative distance of two final states: max(|dR|/|R_b|, |dv|/|v_b|).
 double state_distance(const State& a, const State& b);
 

@@ -106,7 +106,7 @@ void estimate_event_errors(BodyResult& r, const Body& body, const std::vector<Ce
   if (r.events.empty() || !options.estimate_events || !r.method || !ran(r.outcome) || !r.error.known()) return;
   const std::optional<RunStep> step = run_step(r, how, options);
   if (!step) return;
-  const int p = adaptive::effective_order(*r.method, body);
+  const int p = effective_order(*r.method, body);
   // A companion as the estimate's (companion_options) that locates every event and tracks no invariant, with the
   // constant c the run had (the accuracy mode's delivered one).
   Options o = companion_options(body, centres, how, options);

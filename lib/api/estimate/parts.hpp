@@ -37,7 +37,7 @@ inline constexpr const char* kExactFlowBasis = "the method's flow is exact on th
 inline std::string order_text(int p) { return "order " + std::to_string(p); }
 /// The order the estimate assumes: at least 1 (a method without a fixed order is taken as first order,
 /// which makes its estimate twice the difference).
-inline int fixed_order(const MethodInfo& m, const Body& body) { return std::max(1, adaptive::effective_order(m, body)); }
+inline int fixed_order(const MethodInfo& m, const Body& body) { return std::max(1, effective_order(m, body)); }
 
 /// Where the method's flow is exact (the Kepler split on a material point about one Coulomb centre), two runs
 /// differ by rounding alone: their whole difference is the estimate (estimate.cpp).

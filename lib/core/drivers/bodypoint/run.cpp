@@ -26,6 +26,8 @@
 #include <functional>
 #include <iterator>
 #include <limits>
+#include <numbers>
+#include <string>
 #include <string_view>
 #include <type_traits>
 #include <variant>
@@ -242,12 +244,52 @@ constexpr bool one_row_per_family_in_order() {
 }
 static_assert(one_row_per_family_in_order(), "kFamilyNames: one row per Family, in the enum's order");
 
+/// far-ip's first step turns the spin by at most this many turns (docs/measurements.md, "Tuned constants").
+constexpr double kFarFieldTurns = 1.0;
+
+double spin_orbit_period(const Body& b) {
+  const double rate = std::abs(b.p.B) * to_momenta(b.p, b.s0).K1.norm() / b.p.D();
+  return rate > 0.0 ? 2.0 * std::numbers::pi / rate : std::numeric_limits<double>::infinity();
+}
+
+/// A fixed step: a sixteenth of the run, at most one turn of the spin about K1.
+double fixed_first_step(const Body& b, const std::vector<Centre>&, double t_end) {
+  return std::min(t_end / 16.0, spin_orbit_period(b));
+}
+
+/// A time transformation's ds: dt = ds r/|A| near a centre advances the orbit by ds v/|A| radians, one a step.
+double fictitious_first_step(const Body& b, const std::vector<Centre>& centres, double) {
+  const double v = b.s0.v.norm();
+  double a = 0.0;
+  for (const Centre& c : centres) a += std::abs(c.A);
+  return (v > 0.0 && a > 0.0) ? a / v : 0.1;
+}
+
+/// KS's fictitious time: one sub-step of the exact flow (sqrt(2 |h|) ds = 1, ks.hpp).
+double regularised_first_step(const Body& b, const std::vector<Centre>& centres, double) {
+  const double mu = centres.front().A / b.p.m;
+  const double h = 0.5 * b.s0.v.squaredNorm() - mu / (b.s0.R - centres.front().c).norm();
+  return h != 0.0 ? 1.0 / std::sqrt(2.0 * std::abs(h)) : 1.0;
+}
+
+/// far-ip's step is set by the field's slow scale (far_field.hpp): the time the guiding centre takes to cover
+/// its least distance to the nearest centre, at most kFarFieldTurns turns of the spin; a step too long for the
+/// field is refused and halved.
+double far_field_first_step(const Body& b, const std::vector<Centre>& centres, double t_end) {
+  const Helix helix = helix_of(b.p, to_momenta(b.p, b.s0));
+  double r = std::numeric_limits<double>::infinity();
+  for (const Centre& c : centres) r = std::min(r, path_distance(helix, c.c, t_end));
+  const double v = helix.velocity.norm();
+  return std::min({t_end, v > 0.0 ? r / v : t_end, kFarFieldTurns * spin_orbit_period(b)});
+}
+
 }  // namespace
 
 MethodTraits catalogue_traits(Family f) {
   MethodTraits t;
   t.family_name = kFamilyNames[static_cast<std::size_t>(f)].name;
   t.family_key = kFamilyNames[static_cast<std::size_t>(f)].key;
+  t.first_step = fixed_first_step;
   switch (f) {
     case Family::Thesis:
       t.frozen_gyroscopic_term = true;
@@ -277,12 +319,14 @@ MethodTraits catalogue_traits(Family f) {
       t.stepping = Stepping::fictitious;
       t.free_flight_spin_exact = true;
       t.takes_omega_c = true;
+      t.first_step = fictitious_first_step;
       break;
     case Family::Regularised:
       t.stepping = Stepping::fictitious;
       t.search = SearchStrategy::exact_pair;
       t.orbit_exact = true;
       t.exact_in_fictitious_time = true;
+      t.first_step = regularised_first_step;
       break;
     case Family::Extrapolated:
       t.stepping = Stepping::controlled;
@@ -294,9 +338,56 @@ MethodTraits catalogue_traits(Family f) {
       t.search = SearchStrategy::field_pair;
       t.macro_steps = true;
       t.cost_set_by_field = true;
+      t.first_step = far_field_first_step;
       break;
   }
   return t;
+}
+
+Advance advance_to(const MethodInfo& m, double step, double end, double h0) {
+  switch (m.traits.stepping) {
+    case Stepping::fictitious: return FictitiousSteps{step, EndTime{end}};
+    case Stepping::controlled: return ControlledSteps{std::min(h0, end), end, step};
+    case Stepping::fixed: break;
+  }
+  return fixed_steps_to(end, step);
+}
+
+std::string_view step_name(const MethodInfo& m) {
+  return is_step_controlled(m) ? "tol" : is_time_transformed(m) ? "ds" : "h";
+}
+
+std::string_view step_quantity(const MethodInfo& m) {
+  return is_step_controlled(m) ? "the tolerance per step tol" : is_time_transformed(m) ? "the fictitious step ds" : "the step h";
+}
+
+std::string_view stepping_name(const MethodInfo& m) {
+  return is_step_controlled(m) ? "controlled" : is_time_transformed(m) ? "fictitious" : "fixed";
+}
+
+bool takes_time_step_constant(const MethodInfo& m) { return m.traits.takes_omega_c; }
+
+double time_step_constant_of(const MethodInfo& m, double c) {
+  return takes_time_step_constant(m) ? c : std::numeric_limits<double>::quiet_NaN();
+}
+
+int effective_order(const MethodInfo& m, const Body& b) {
+  if (m.traits.frozen_gyroscopic_term && b.p.B != 0.0) return 1;  // the gyroscopic term frozen (README, findings)
+  return m.order;
+}
+
+std::string stages_text(const MethodInfo& m) {
+  return is_step_controlled(m) || m.traits.cost_set_by_field ? "-" : std::to_string(m.stages);
+}
+
+std::string evals_per_step_text(const MethodInfo& m) {
+  return is_step_controlled(m)          ? "adaptive"
+         : m.traits.cost_set_by_field ? "points x sweeps"  // far_field.hpp: set by the step and the field
+                                        : std::to_string(m.evals_per_step);
+}
+
+double search_first_step(const MethodInfo& m, const Body& b, const std::vector<Centre>& centres, double t_end) {
+  return m.traits.first_step(b, centres, t_end);
 }
 
 Checks checks_for(const MethodInfo& m, const std::vector<Centre>& centres, double max_energy_error) {

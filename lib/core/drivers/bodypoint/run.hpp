@@ -237,6 +237,8 @@ struct MethodTraits {
   bool in_fixed_set = false;
   /// Its cost per step is set by the step and the field, not by a number of stages (far-ip: points x sweeps).
   bool cost_set_by_field = false;
+  /// Where the accuracy mode's search starts on a body for a run to t_end: its first, coarse step (h or ds).
+  double (*first_step)(const Body& b, const std::vector<Centre>& centres, double t_end) = nullptr;
 };
 
 struct MethodInfo {
@@ -268,6 +270,35 @@ std::string refusal(const MethodInfo& m, const Body& body, const std::vector<Cen
 inline bool is_step_controlled(const MethodInfo& m) { return m.traits.stepping == Stepping::controlled; }
 /// True for methods with a fixed fictitious step (FictitiousSteps): time-transformed and regularised.
 inline bool is_time_transformed(const MethodInfo& m) { return m.traits.stepping == Stepping::fictitious; }
+
+// --- a method's behaviour, asked of its row (callers do not switch on its kind or family) ---------------
+
+/// The first trial step of a controlled method's own step-size control where the caller has none.
+inline constexpr double kControlledFirstStep = 1e-3;
+/// A run of `m` to the time `end` (> 0) at its step: the largest fixed step <= step that lands on end, the
+/// fictitious step ds = step to that time, or the tolerance per step tol = step (its control starting at
+/// min(h0, end)).
+Advance advance_to(const MethodInfo& m, double step, double end, double h0 = kControlledFirstStep);
+/// The name of what its step is: "h", "ds" or "tol"; the same as a message names the quantity ("the step h",
+/// "the fictitious step ds", "the tolerance per step tol"); its way of advancing time in one word ("fixed",
+/// "fictitious", "controlled").
+std::string_view step_name(const MethodInfo& m);
+std::string_view step_quantity(const MethodInfo& m);
+std::string_view stepping_name(const MethodInfo& m);
+/// Whether its fictitious time is transformed with a time-step constant c (Options::omega_c): a run of it is
+/// reproduced only with both ds and c. The constant of a run delivered with c, or NaN for a method without one.
+bool takes_time_step_constant(const MethodInfo& m);
+double time_step_constant_of(const MethodInfo& m, double c);
+/// Its order on this body: the thesis's schemes freeze the gyroscopic term, first order for B != 0; 0 for a
+/// method without a fixed order.
+int effective_order(const MethodInfo& m, const Body& b);
+/// Its stages and its force evaluations per step as the method tables print them ("-" and "adaptive" for a
+/// controlled method, "points x sweeps" for one whose cost the step and the field set).
+std::string stages_text(const MethodInfo& m);
+std::string evals_per_step_text(const MethodInfo& m);
+/// Where the accuracy mode's search starts for `m` on this body (its first, coarse step: h, or ds), for a run to
+/// t_end (catalogue_traits sets each family's rule; docs/measurements.md, "Tuned constants").
+double search_first_step(const MethodInfo& m, const Body& b, const std::vector<Centre>& centres, double t_end);
 
 /// How a run ended.
 enum class Outcome {
