@@ -20,6 +20,7 @@
 #include "bodypoint/observables.hpp"
 #include "cli.hpp"
 #include "errata.hpp"
+#include "long_time.hpp"
 #include "orders.hpp"
 #include "rows_file.hpp"
 #include "scattering_study.hpp"
@@ -360,12 +361,14 @@ void study_stress(const StudyContext& c) {
 
 void study_scattering(const StudyContext& c) { write_scattering_study(c.dir, c.quick, c.threads); }
 
+void study_long_time(const StudyContext& c) { write_long_time_study(c.dir, c.quick); }
+
 const std::vector<std::pair<std::string, void (*)(const StudyContext&)>>& recipes() {
   static const std::vector<std::pair<std::string, void (*)(const StudyContext&)>> r = {
       {"d", study_d},         {"L", study_L},          {"h", study_h},         {"Kx", study_Kx},
       {"timing", study_timing}, {"evals", study_evals}, {"appendix", study_appendix}, {"errata", study_errata}, {"orders", study_orders},
       {"published", study_published}, {"stress", study_stress}, {"dL-map", study_dL_map},
-      {"scattering", study_scattering}};
+      {"scattering", study_scattering}, {"long-time", study_long_time}};
   return r;
 }
 
@@ -379,8 +382,9 @@ int cmd_study(int argc, char** argv) {
   po::options_description desc("bodypoint study");
   desc.add_options()
       ("name", defaulted(&which), "recipe: d, L, h, Kx, timing, evals, appendix, errata, orders, published (chapter 4 with the thesis code's force "
-       "law), all (these), stress (hostile scenes), dL-map (the (d, L) stability map) or scattering "
-       "(the deflection function theta(b) against Rutherford's, spinning bodies, cross-sections)")
+       "law), all (these), stress (hostile scenes), dL-map (the (d, L) stability map), scattering "
+       "(the deflection function theta(b) against Rutherford's, spinning bodies, cross-sections) or long-time "
+       "(bound orbits over 10^5 periods: invariants and phase errors)")
       ("results", defaulted(&results), "folder for the CSVs (created if missing)")
       ("quick", po::bool_switch(&quick), "coarser grids, same recipes (under two minutes on 2 cores)")
       ("threads", po::value(&threads)->default_value(0), "worker threads for the sweeps (0: all cores)")
@@ -388,7 +392,7 @@ int cmd_study(int argc, char** argv) {
       ("no-simd", po::bool_switch(&c.no_simd), "sweeps run every trajectory alone, not in batches of vector lanes (same numbers, slower)");
   po::variables_map vm;
   if (!parse(argc, argv, desc, vm,
-             "usage: bodypoint study [--name d|L|h|Kx|timing|evals|appendix|errata|orders|published|all|stress|dL-map|scattering] [--results DIR] [--quick]\n"
+             "usage: bodypoint study [--name d|L|h|Kx|timing|evals|appendix|errata|orders|published|all|stress|dL-map|scattering|long-time] [--results DIR] [--quick]\n"
              "Regenerates the thesis's studies for its methods and ours side by side."))
     return 0;
   c.dir = results;
@@ -402,7 +406,9 @@ int cmd_study(int argc, char** argv) {
   fs::create_directories(c.dir, ec);
   if (ec || !fs::is_directory(c.dir)) throw Error("cannot create results folder '" + results + "'");
   for (const auto& [name, fn] : recipes())
-    if ((which == "all" && name != "stress" && name != "dL-map" && name != "scattering") || which == name) fn(c);
+    if ((which == "all" && name != "stress" && name != "dL-map" && name != "scattering" && name != "long-time") ||
+        which == name)
+      fn(c);
   return 0;
 }
 

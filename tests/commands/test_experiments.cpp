@@ -247,6 +247,71 @@ TEST(Study, QuickRecipesWriteEveryCsv) {
   fs::remove_all(dir);
 }
 
+/// Issue #83 (M3): over 10 .. 1000 periods of three bound orbits (study --name long-time --quick) the
+/// splittings keep their energy error bounded and |K2|^2 at the rounding while RK4 and the step-size-
+/// controlled peers drift; on the Kepler ellipse the splittings' phase error grows linearly, the peers'
+/// quadratically (Hairer, Lubich, Wanner, Geometric Numerical Integration, sec. X.3).
+/// A bounded error's largest value over 1000 periods against over 100: the same up to this factor (a
+/// drift is 10x).
+constexpr double kBoundedGrowth = 2.0;
+/// What the rounding adds to an energy error over 300,000 steps (a random walk of 1e-16 per step is
+/// 5e-14; the exact Kepler flows' measured growth 9e-14).
+constexpr double kRoundingDrift = 1e-12;
+/// |K2|^2 of an exact Lie-Poisson flow: the rounding of 300,000 steps (measured 3e-15).
+constexpr double kCasimirRounding = 1e-13;
+/// A drift's growth over one decade of periods: linear is 10x (measured 9.9-10.1x), taken at half that.
+constexpr double kLinearDecade = 5.0;
+/// The phase error's growth over a decade: linear 10x (a splitting), quadratic 100x (the peers, measured
+/// 100x); told apart at 30x.
+constexpr double kPhaseSplit = 30.0;
+
+TEST(Study, LongTimeSplittingsStayBoundedWhereThePeersDrift) {
+  const fs::path dir = test::temp_path("bp_long_time");
+  fs::remove_all(dir);
+  const Result r = run_cli("study --quick --name long-time --results " + dir.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream f(dir / "long_time.csv");
+  std::stringstream ss;
+  ss << f.rdbuf();
+  // scene, method -> periods -> (max_rel_dE, rel_dK2sq, phase_err)
+  struct Cells {
+    double max_dE, dK2sq, phase;
+  };
+  std::map<std::pair<std::string, std::string>, std::map<long, Cells>> rows;
+  const auto cell = [](const std::vector<std::string>& row, std::size_t i) {
+    return i < row.size() && !row[i].empty() ? std::stod(row[i]) : std::nan("");
+  };
+  for (const auto& row : csv_rows(ss.str())) {
+    ASSERT_GE(row.size(), 14u);
+    EXPECT_EQ(row[13], "ok") << row[0] << " " << row[1];
+    rows[{row[0], row[1]}][std::lround(std::stod(row[5]))] = {cell(row, 7), cell(row, 8), cell(row, 11)};
+  }
+  for (const std::string scene : {"kepler", "spinning", "two-centres"}) {
+    for (const std::string m : {"lp-y4", "ttl-y4", "kep-y4"}) {
+      const auto& by = rows[{scene, m}];
+      ASSERT_TRUE(by.contains(100) && by.contains(1000)) << scene << " " << m;
+      EXPECT_LE(by.at(1000).max_dE, kBoundedGrowth * by.at(100).max_dE + kRoundingDrift) << scene << " " << m;
+      if (scene != "kepler") {
+        EXPECT_LT(by.at(1000).dK2sq, kCasimirRounding) << scene << " " << m;
+      }
+    }
+    for (const std::string m : {"rk4", "gsl-rk8pd", "odeint-rkf78"}) {
+      const auto& by = rows[{scene, m}];
+      ASSERT_TRUE(by.contains(100) && by.contains(1000)) << scene << " " << m;
+      EXPECT_GT(by.at(1000).max_dE, kLinearDecade * by.at(100).max_dE) << scene << " " << m;
+      if (scene != "kepler") {
+        EXPECT_GT(by.at(1000).dK2sq, kCasimirRounding) << scene << " " << m;
+      }
+    }
+  }
+  const auto kepler_phase = [&](const std::string& m) {
+    return rows[{"kepler", m}].at(1000).phase / rows[{"kepler", m}].at(100).phase;
+  };
+  for (const std::string m : {"lp-y4", "ttl-y4"}) EXPECT_LT(kepler_phase(m), kPhaseSplit) << m;
+  for (const std::string m : {"gsl-rk8pd", "odeint-rkf78"}) EXPECT_GT(kepler_phase(m), kPhaseSplit) << m;
+  fs::remove_all(dir);
+}
+
 /// Issue #22: the material point's deflection agrees with Rutherford's to 1e-10 over b = 1e-3 .. 1e3.
 constexpr double kRutherfordRel = 1e-10;
 
