@@ -8,7 +8,7 @@
 #                             unfinished step (the full build takes hours: it can be run in sittings)
 #
 # Steps: bodypoint study (d, L, h, Kx sweeps, timing, force evaluations, appendix 1, errata, the sweeps
-# as published, stress, the (d, L) map, scattering), bodypoint work-precision (ladders and --by-tol),
+# as published, stress, the (d, L) map, scattering, long-time), bodypoint work-precision (ladders and --by-tol),
 # bench/far_field.py (where the steps go, the far field's resonances), gsl_peer (GSL as bodypoint
 # drives it against a plain C program), bench_steps (cost per step), bench_batch (sweep
 # throughput per core),
@@ -104,6 +104,7 @@ q=()
 step study "$bin" study "${q[@]}" --resume --results "$results"
 step stress "$bin" study "${q[@]}" --name stress --results "$results"
 step scattering "$bin" study "${q[@]}" --name scattering --results "$results"
+step long-time "$bin" study "${q[@]}" --name long-time --results "$results"
 # The (d, L) stability map (thesis resolution in the full build), timed: its wall time is a number of
 # the paper.
 # One run (a study of minutes is not repeated), so its time is judged by the share of the cores other

@@ -37,7 +37,7 @@ NAMES = re.compile(r"\\(cmd|texttt|cite|citet|citep|ref|label|eqref|includegraph
 NUMBER = re.compile(r"(?<![A-Za-z\\_^{])\d+(\.\d+)?")
 MAX_OVERFULL_PT = 10.0
 SECTIONS = ["Introduction", "The model and its corrected equations", "Errata", "Methods", "Chapter 4 reproduced",
-            "Close encounters", "Work against precision", "Numerical stability", "Scattering of a spinning body",
+            "Close encounters", "Work against precision", "Numerical stability", "Long-time behaviour", "Scattering of a spinning body",
             "Conclusions"]
 
 

@@ -6,7 +6,7 @@ usage: make_figures.py [--only scattering] RESULTS_DIR FIGURES_DIR
 Reads (all written by paper/build.sh through `bodypoint study`, `bodypoint work-precision`):
   {d,L,h,Kx}_sweep.csv and published_{d,L,h,Kx}_sweep.csv, timing.csv, appendix1/index.csv and
   appendix1/P1.*.csv, work_precision.csv, by_tol.csv, far_field_resonances.csv (bench/far_field.py), and
-  dL_map.csv and scattering.csv when present
+  dL_map.csv, scattering.csv and long_time.csv when present
 Writes fig_*.pdf and figures.md (which thesis figure each one stands for). Nothing here computes
 physics: it only draws what the drivers measured.
 """
@@ -389,6 +389,39 @@ def far_field_figure(res, figs, listing):
          width=0.55)
 
 
+def long_time_figure(res, figs, listing):
+    """Bound orbits over many periods (study --name long-time): the largest energy error so far on the
+    Kepler ellipse and on the two-centre orbit, |K2|^2 of the spinning body, the Kepler ellipse's phase
+    error. Skipped when the study was not run."""
+    path = os.path.join(res, "long_time.csv")
+    if not os.path.exists(path):
+        return
+    rows = read_csv(path)
+    methods = [m for m in dict.fromkeys(r["method"] for r in rows) if m != "lp-kl8"]
+    colours = dict(zip(methods, PANEL_COLOURS))
+    panels = [("kepler", "max_rel_dE", "Kepler ellipse: energy", r"max $|\Delta E/E|$ so far"),
+              ("two-centres", "max_rel_dE", "two centres: energy", r"max $|\Delta E/E|$ so far"),
+              ("spinning", "rel_dK2sq", r"spinning body: $|K_2|^2$", r"$|\Delta |K_2|^2| / |K_2|^2$"),
+              ("kepler", "phase_err", "Kepler ellipse: phase", "mean anomaly error [rad]")]
+    fig, axes = plt.subplots(2, 2, figsize=(WIDE, 4.6))
+    for ax, (scene, column, title, ylabel) in zip(axes.flat, panels):
+        for m in methods:
+            rs = [r for r in rows if r["scene"] == scene and r["method"] == m]
+            ax.plot([num(r["periods"]) for r in rs], [capped(num(r[column])) for r in rs], ".-", color=colours[m],
+                    label=m, markersize=3, linewidth=0.8)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_title(title)
+        ax.set_ylabel(ylabel)
+    for ax in axes[1]:
+        ax.set_xlabel("periods")
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=len(methods), bbox_to_anchor=(0.5, -0.04))
+    fig.tight_layout(rect=(0, 0.05, 1, 1))
+    save(fig, os.path.join(figs, "fig_long_time.pdf"), listing,
+         "bound orbits over many periods: energy, |K2|^2 and phase errors against time")
+
+
 def map_figure(res, figs, listing):
     """The (d, L) stability map (bodypoint study --name dL-map): one heat map of log10 max relative
     energy deviation per fixed-step method; cells whose run is not ok (diverged, collision) in black."""
@@ -509,6 +542,7 @@ def main():
     far_field_figure(res, figs, listing)
     map_figure(res, figs, listing)
     scattering_figure(res, figs, listing)
+    long_time_figure(res, figs, listing)
     with open(os.path.join(figs, "lost.csv"), "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["what", "why"])
