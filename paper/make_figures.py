@@ -294,7 +294,7 @@ def reference_errors(path):
     out = {}
     with open(path) as f:
         for line in f:
-            m = re.match(r"# reference (\S+): .* \(relative (\S+)\)", line)
+            m = re.match(r"# reference (\S+): .* \(relative ([^,)\s]+)", line)
             if m:
                 out[m.group(1)] = float(m.group(2))
     return out
@@ -337,7 +337,7 @@ def work_precision_figures(res, figs, listing):
             ax.axhspan(ax.get_ylim()[0], unresolved[scene], color="0.88", zorder=0, linewidth=0)
         place_labels(ax, labels)
         ax.set_xlabel("run time [ms]")
-        ax.set_ylabel("final-position error |dR|/|R|")
+        ax.set_ylabel("final-state error max(|dR|/|R|, |dv|/|v|)")
         ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2, frameon=False)  # off the labels
         save(fig, os.path.join(figs, f"fig_wp_{scene}.pdf"), listing, f"work-precision on scene {scene}", width=0.49)
 

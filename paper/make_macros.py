@@ -761,7 +761,7 @@ def reference_errors(res):
     """{scene: relative error of its long-double reference}, as work-precision estimated it."""
     _, header = read_csv(os.path.join(res, "work_precision.csv"))
     return {m.group(1): float(m.group(2)) for line in header
-            for m in [re.match(r"# reference (\S+): .* \(relative (\S+)\)", line)] if m}
+            for m in [re.match(r"# reference (\S+): .* \(relative ([^,)\s]+)", line)] if m}
 
 
 THIRD_PARTY = ("Boost.Odeint", "GSL")  # peers nobody here wrote (logh-bs is our own extrapolation code)
