@@ -319,26 +319,47 @@ std::string config_of(const Row& r) {
   return c.str();
 }
 
-/// The cheapest configuration of ours and of the peers reaching `target` on a scene, counting a row
-/// only when the next finer configuration (the next row of its ladder) reaches it too, so that a
-/// lucky cancellation at one step does not count. The exact regularised flow (ks) has one configuration.
-/// Chosen by what does not depend on the machine: the fewest force evaluations (equal counts: the faster,
-/// faster_pick); its time is then printed, or "flagged" where it does not count.
+/// Whether rows[i] reaches `target` on `scene` and counts: only when the next finer configuration (the next row
+/// of its ladder) reaches it too, so that a lucky cancellation at one step does not count. The exact regularised
+/// flow (ks) has one configuration.
+bool counts_at(const std::vector<Row>& rows, std::size_t i, const std::string& scene, double target) {
+  const Row& r = rows[i];
+  if (r.scene != scene || !(r.err_rel <= target)) return false;
+  if (method_or_throw(r.method).traits.exact_in_fictitious_time) return true;
+  const Row* next = i + 1 < rows.size() ? &rows[i + 1] : nullptr;
+  return next && next->scene == r.scene && next->method == r.method && next->err_rel <= target;
+}
+
+/// The cheapest configuration of ours and of the peers reaching `target` on a scene (counts_at). Chosen by
+/// what does not depend on the machine: the fewest force evaluations (equal counts: the first by name, and the
+/// summary names the others, tied_with); its time is then printed, or "flagged" where it does not count.
 std::pair<const Row*, const Row*> best_at(const std::vector<Row>& rows, const std::string& scene, double target) {
   const Row* ours = nullptr;
   const Row* peer = nullptr;
   for (std::size_t i = 0; i < rows.size(); ++i) {
+    if (!counts_at(rows, i, scene, target)) continue;
     const Row& r = rows[i];
-    if (r.scene != scene || !(r.err_rel <= target)) continue;
-    const bool exact = method_or_throw(r.method).traits.exact_in_fictitious_time;
-    const Row* next = i + 1 < rows.size() ? &rows[i + 1] : nullptr;
-    if (!exact && !(next && next->scene == r.scene && next->method == r.method && next->err_rel <= target)) continue;
     const Row*& slot = is_peer(method_or_throw(r.method)) ? peer : ours;
-    if (!slot || r.force_evals < slot->force_evals ||
-        (r.force_evals == slot->force_evals && faster_pick(r.time, &slot->time)))
+    if (!slot || r.force_evals < slot->force_evals || (r.force_evals == slot->force_evals && r.method < slot->method))
       slot = &r;
   }
   return {ours, peer};
+}
+
+/// The other methods on best's side that reach `target` with exactly its force evaluations: a tie the name
+/// broke, which a reader should see (logH and TTL of one repelling centre can make the same count).
+std::string tied_with(const std::vector<Row>& rows, const Row& best, double target) {
+  std::string names;
+  const bool peer = is_peer(method_or_throw(best.method));
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const Row& r = rows[i];
+    if (&r == &best || r.method == best.method || r.force_evals != best.force_evals ||
+        is_peer(method_or_throw(r.method)) != peer || !counts_at(rows, i, best.scene, target) ||
+        names.find(r.method) != std::string::npos)
+      continue;
+    names += (names.empty() ? " (tied: " : ", ") + r.method;
+  }
+  return names.empty() ? names : names + ")";
 }
 
 std::string summary_table(const std::vector<NamedScene>& scenes, const std::vector<Row>& rows) {
@@ -351,7 +372,7 @@ std::string summary_table(const std::vector<NamedScene>& scenes, const std::vect
       sum << "| " << ns.name << " | " << std::setprecision(0) << std::scientific << target << std::defaultfloat
           << std::setprecision(3) << " | ";
       for (const Row* r : {ours, peer}) {
-        if (r) sum << r->method << " | " << config_of(*r) << " | " << r->force_evals << " | " << time_cell(r->time) << " | ";
+        if (r) sum << r->method << tied_with(rows, *r, target) << " | " << config_of(*r) << " | " << r->force_evals << " | " << time_cell(r->time) << " | ";
         else sum << "- | - | - | - | ";
       }
       sum << ratio_cell(ours ? &ours->time : nullptr, peer ? &peer->time : nullptr) << " |\n";
