@@ -23,6 +23,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker  # noqa: E402
 
 plt.rcParams.update({"font.size": 8, "axes.titlesize": 8, "legend.fontsize": 7, "xtick.labelsize": 7,
                      "ytick.labelsize": 7, "figure.dpi": 100, "pdf.fonttype": 42, "savefig.bbox": "tight"})
@@ -217,7 +218,7 @@ def timing_figure(res, figs, listing):
                         linestyle="--" if m.startswith("thesis-") else "-")
         ax.set_xlabel("number of steps n")
         ax.set_title(title)
-        ax.legend(ncol=1, loc="upper center", bbox_to_anchor=(0.5, -0.22), frameon=False)
+        ax.legend(ncol=1, loc="upper left", frameon=False)  # the lines rise to the right: the upper left is empty
     axes[0].set_ylabel("median run time [ms]")
     fig.tight_layout()
     save(fig, os.path.join(figs, "fig_timing.pdf"), listing, "thesis fig. 4.12-4.13: run time against n", width=0.67)
@@ -342,6 +343,15 @@ def work_precision_figures(res, figs, listing):
         save(fig, os.path.join(figs, f"fig_wp_{scene}.pdf"), listing, f"work-precision on scene {scene}", width=0.49)
 
 
+def tol_ticks(ax, tols):
+    """A tick at every requested TOL, labelled at most five times (the ends and every other between)."""
+    ax.xaxis.set_minor_locator(matplotlib.ticker.NullLocator())
+    ax.set_xticks(tols)
+    every = 1 if len(tols) <= 5 else 2
+    ax.set_xticklabels([f"$10^{{{round(math.log10(t))}}}$" if i % every == 0 or i == len(tols) - 1 else ""
+                        for i, t in enumerate(tols)])
+
+
 def by_tol_figure(res, figs, listing):
     rows = read_csv(os.path.join(res, "by_tol.csv"))
     scenes = scenes_of(rows)
@@ -357,6 +367,7 @@ def by_tol_figure(res, figs, listing):
         ax.plot([lo, hi], [lo, hi], color="grey", linewidth=0.5)
         ax.set_xscale("log")
         ax.set_yscale("log")
+        tol_ticks(ax, sorted({num(r["tol"]) for r in sr}))
         ax.set_title(scene)
         ax.set_xlabel("requested TOL")
     axes[0][0].set_ylabel("delivered error")
@@ -383,7 +394,7 @@ def far_field_figure(res, figs, listing):
     ax.set_yscale("log")
     ax.set_xscale("log")  # the splittings below a few radians per step, far-ip up to a hundred
     ax.set_xlabel("spin angle per step [rad]")
-    ax.set_ylabel("relative error at t = 80")
+    ax.set_ylabel("final-state error max(|dR|/|R|, |dv|/|v|)")
     ax.legend(loc="lower right")
     save(fig, os.path.join(figs, "fig_far_field.pdf"), listing, "far pass: error against the spin angle per step",
          width=0.55)
@@ -509,10 +520,13 @@ def scattering_figure(res, figs, listing):
             ax.set_yscale("log")
             ax.set_xlabel(xl)
             ax.set_ylabel(yl)
-        handles, labels = axes[0].get_legend_handles_labels()
-        axes[2].legend(handles, labels, loc="upper left", frameon=False)
-        axes[1].legend(loc="lower left", frameon=False)
-    fig.tight_layout()
+        handles, labels = axes[1].get_legend_handles_labels()
+        if title == "material point":  # two lines: inside, where the curves are not
+            axes[2].legend(*axes[0].get_legend_handles_labels(), loc="upper left", frameon=False)
+            axes[1].legend(loc="lower left", frameon=False)
+        else:  # every series: below the figure, off the curves
+            fig.legend(handles, labels, loc="lower center", ncol=4, frameon=False, bbox_to_anchor=(0.5, 0.0))
+    fig.tight_layout(rect=(0, 0.08, 1, 1))
     save(fig, os.path.join(figs, "fig_scattering.pdf"), listing,
          "scattering: deflection function, differential cross-section and closest approach per series")
 

@@ -717,6 +717,11 @@ def latex_cell(c):
     m = re.fullmatch(r"(.+) \((\d+) evals\)", c)
     if m:
         return f"\\shortstack[l]{{{latex_cell(m.group(1))}\\\\{count(int(m.group(2)))} ev.}}"
+    # A pick tied in force evaluations with other methods ("logh-mcl8 (tied: ttl-mcl8)"): the others on a
+    # second line.
+    m = re.fullmatch(r"(\S+) \(tied: (.+)\)", c)
+    if m:
+        return f"\\shortstack[l]{{{latex_cell(m.group(1))}\\\\= {', '.join(tt(x) for x in m.group(2).split(', '))}}}"
     c = c.replace("_", "\\_").replace("%", "\\%")
     if re.fullmatch(r"[a-z][a-z0-9-]*[a-z0-9]", c) and "-" in c:
         return tt(c)
@@ -792,6 +797,16 @@ def third_party_speedup(res, M):
     M.add("SpeedupCloseThirdPair", speedup_phrase(parts), math_mode=False)
 
 
+def method_words(cell):
+    """A summary's method cell in the text: "none" for "-", a tie as "a (tied with b)"."""
+    if cell == "-":
+        return "none"
+    m = re.fullmatch(r"(\S+) \(tied: (.+)\)", cell)
+    if m:
+        return f"{tt(m.group(1))} (tied with {', '.join(tt(x) for x in m.group(2).split(', '))})"
+    return tt(cell)
+
+
 def speedup_table(res, out, M):
     head, body = md_table(os.path.join(res, "work_precision_summary.md"))
     parts = {}
@@ -810,8 +825,8 @@ def speedup_table(res, out, M):
             key = f"{camel(scene)}{target_word(target)}"
             M.add(f"Speedup{key}", sp.rstrip("x") if sp.endswith("x") else "n/a")
             parts[key] = (sp, num(evals), num(pevals))
-            M.add(f"Best{key}", tt(best) if best != "-" else "none", math_mode=False)
-            M.add(f"BestPeer{key}", tt(peer) if peer != "-" else "none", math_mode=False)
+            M.add(f"Best{key}", method_words(best), math_mode=False)
+            M.add(f"BestPeer{key}", method_words(peer), math_mode=False)
     body = [row for row in body if row not in unresolved]
     M.add("NumSpeedupRows", count(len(body)))
     if all(not row[10].endswith("x") for row in body):
@@ -870,7 +885,7 @@ def close_table(res, out, M):
                 else:
                     cfg = f"{'ds' if has_fictitious_step(m) else 'h'}={num(best['h']):.3g}"
                 evals = int(num(best["force_evals"]))
-                names = tt(m) + (f" (tied: {', '.join(tt(x) for x in tied)})" if tied else "")
+                names = latex_cell(f"{m} (tied: {', '.join(tied)})") if tied else tt(m)
                 f.write(f"{power} & {fam} & {names} & {cfg} & {count(evals)} & {t} \\\\\n")
                 M.add(f"CloseEvals{camel(fam)}{target_word(target)}", count(evals))
             if i + 1 < len(targets):
