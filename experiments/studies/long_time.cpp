@@ -32,9 +32,8 @@ constexpr double kStepsPerPeriod = 100.0;
 constexpr double kReferenceStepsPerPeriod = 400.0;
 /// The tolerance per step of the step-size-controlled peers: their energy drift shows within the span.
 constexpr double kPeerTolerance = 1e-9;
-/// Output times per decade of periods, from 10 periods to 10^3 (quick) or 10^5.
+/// Output times per decade of periods, from kLongTimeFirstPeriods to 10^3 (quick) or 10^5 (or --periods).
 constexpr int kTimesPerDecade = 4;
-constexpr double kFirstPeriods = 10.0;
 constexpr double kQuickPeriods = 1e3, kFullPeriods = 1e5;
 
 /// The orbit: a = 1 about A = 1 (m = 1, period 2 pi), e = 0.5, from its periapsis. The spinning bodies turn at
@@ -86,14 +85,15 @@ const std::vector<LongMethod>& long_methods() {
   return m;
 }
 
-std::vector<double> output_times(double period, bool quick) {
+/// Log-spaced times from kLongTimeFirstPeriods to `last` periods, `last` itself the final one.
+std::vector<double> output_times(double period, double last) {
   std::vector<double> t;
-  const double last = quick ? kQuickPeriods : kFullPeriods;
   for (int k = 0;; ++k) {
-    const double periods = kFirstPeriods * std::pow(10.0, static_cast<double>(k) / kTimesPerDecade);
-    if (periods > last * (1.0 + 1e-12)) break;
+    const double periods = kLongTimeFirstPeriods * std::pow(10.0, static_cast<double>(k) / kTimesPerDecade);
+    if (periods > last * (1.0 - 1e-12)) break;
     t.push_back(periods * period);
   }
+  t.push_back(last * period);
   return t;
 }
 
@@ -177,16 +177,19 @@ std::vector<State> run_method(std::ostream& csv, const LongScene& ls, const Long
 
 }  // namespace
 
-void write_long_time_study(const std::filesystem::path& dir, bool quick) {
+void write_long_time_study(const std::filesystem::path& dir, bool quick, double periods) {
+  if (periods == 0.0) periods = quick ? kQuickPeriods : kFullPeriods;
+  if (!std::isfinite(periods) || periods < kLongTimeFirstPeriods)
+    throw Error("--periods must be a finite number >= " + fmt(kLongTimeFirstPeriods) + ", got " + fmt(periods));
   AtomicFile f((dir / "long_time.csv").string());
   std::ostream& csv = f.stream();
   csv << "scene,method,step_name,step,t,periods,rel_dE,max_rel_dE,rel_dK2sq,abs_dK2Q,err,phase_err,force_evals,outcome\n"
-      << "# bodypoint study --name long-time" << (quick ? " --quick" : "") << ": err = max(|dR|/|R|, |dv|/|v|) against lp-kl8 at "
+      << "# bodypoint study --name long-time" << (quick ? " --quick" : "") << " (" << fmt(periods) << " periods): err = max(|dR|/|R|, |dv|/|v|) against lp-kl8 at "
       << kReferenceStepsPerPeriod << " steps per period (empty in its own rows); phase_err = |M - n t| of the "
       << "Kepler ellipse, M unwrapped along the run (kepler only); max_rel_dE the largest over every step up to t; "
       << "abs_dK2Q with one centre only\n";
   for (const LongScene& ls : scenes()) {
-    const std::vector<double> times = output_times(ls.period, quick);
+    const std::vector<double> times = output_times(ls.period, periods);
     const std::vector<State> ref = run_method(csv, ls, {"lp-kl8", kReferenceStepsPerPeriod}, times, {});
     for (const LongMethod& lm : long_methods()) run_method(csv, ls, lm, times, ref);
   }

@@ -268,6 +268,11 @@ constexpr double kPhaseSplit = 30.0;
 TEST(Study, LongTimeSplittingsStayBoundedWhereThePeersDrift) {
   const fs::path dir = test::temp_path("bp_long_time");
   fs::remove_all(dir);
+  for (const char* bad : {"--periods 5", "--periods nan", "--periods -1e5"}) {
+    const Result b = run_cli("study --name long-time " + std::string(bad) + " --results " + dir.string());
+    EXPECT_NE(b.code, 0) << bad;
+    EXPECT_NE(b.err.find("--periods"), std::string::npos) << b.err;
+  }
   const Result r = run_cli("study --quick --name long-time --results " + dir.string());
   ASSERT_EQ(r.code, 0) << r.err;
   std::ifstream f(dir / "long_time.csv");
