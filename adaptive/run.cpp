@@ -351,6 +351,7 @@ MethodInfo transformed_row(std::string_view prefix, std::string_view family, Sce
   MethodInfo m{std::string(prefix) + std::string(E::tag), Family::TimeTransformed, T::order, s, s,
                sp::describe<T>(family), &run_time_transformed<K, sp::ops_of<T>>, check};
   m.table = E::tag;
+  m.symmetric = sp::ops_of<T>.symmetric();
   return m;
 }
 

@@ -645,6 +645,31 @@ def lost_column(M, what, flags):
     M.ledger.lost(what, f"{sum(1 for f in flags if f)} of {len(flags)} times flagged" + (f" ({words})" if words else ""))
 
 
+def geometry_latex(text):
+    """The catalogue's geometry text ("|K2|^2 exact, K2Q with one centre", "B != 0") in LaTeX."""
+    math = {"|K2|^2": "$|\\vect K_2|^2$", "K2Q": "$\\vect K_{2Q}$", "!=": "$\\ne$"}
+    parts = re.split(r"(\|K2\|\^2|K2Q|!=)", text)
+    return "".join(math.get(p, latex_text(p)) for p in parts)
+
+
+def geometry_tables(res, out):
+    """From the catalogue (methods.csv): tab_families, what each family's flows preserve, and
+    tab_compositions, each composition table's order, stages, symmetry and citation."""
+    rows, _ = read_csv(os.path.join(res, "methods.csv"))
+    with open(os.path.join(out, "tab_families.tex"), "w") as f:
+        for name in dict.fromkeys(r["family_name"] for r in rows):
+            geometry = next(r["geometry"] for r in rows if r["family_name"] == name).split("; ")[0]
+            f.write(f"{name} & {geometry_latex(geometry)} \\\\\n")
+    tables = {}
+    for r in rows:
+        if r["table"] and r["table"] not in tables:
+            tables[r["table"]] = r
+    with open(os.path.join(out, "tab_compositions.tex"), "w") as f:
+        for tag, r in tables.items():
+            symmetric = "yes" if r["geometry"].endswith("; symmetric") else "no"
+            f.write(f"{tt(tag)} & {r['order']} & {r['stages']} & {symmetric} & {latex_text(r['reference'])} \\\\\n")
+
+
 def methods_table(res, out, M):
     rows, _ = read_csv(os.path.join(res, "force_evals.csv"))
     # Thesis table 4.1 against the catalogue: which of its seven counts are ours, which differ.
@@ -1654,6 +1679,7 @@ def main():
     errata(res, M)
     sweeps(res, M)
     methods_table(res, out, M)
+    geometry_tables(res, out)
     claims_table(res, out, M)
     java_agreement(M)
     harness(res, M)

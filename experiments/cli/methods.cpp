@@ -24,12 +24,15 @@ void print_markdown_table() {
 /// One row per method for scripts (paper/ reads the families from it): method, family (family_key),
 /// order (0: variable), stages, force evaluations per step, how it advances time, and the family's name.
 void print_csv() {
-  std::cout << "method,family,order,stages,evals_per_step,advance,family_name\n";
+  std::cout << "method,family,order,stages,evals_per_step,advance,family_name,geometry,table,reference\n";
   for (const MethodInfo& m : methods()) {
     CsvLine row;
     row.text(m.name).text(std::string(m.traits.family_key)).count(m.order).count(m.stages).count(m.evals_per_step);
     row.text(std::string(stepping_name(m)));
-    row.quoted(std::string(m.traits.family_name));
+    row.quoted(std::string(m.traits.family_name)).quoted(geometry_text(m)).text(m.table);
+    // The table's citation: what the description names in brackets ("... [Yoshida 1990; thesis eq. 2.9]").
+    const std::size_t open = m.description.rfind(" ["), close = m.description.rfind(']');
+    row.quoted(open != std::string::npos && close > open ? m.description.substr(open + 2, close - open - 2) : "");
     std::cout << row.str() << "\n";
   }
 }
@@ -49,7 +52,8 @@ int cmd_methods(int argc, char** argv) {
   po::options_description desc("bodypoint methods");
   bool markdown = false, csv = false;
   desc.add_options()("markdown", po::bool_switch(&markdown), "print the table as Markdown (README's Methods section)")(
-      "csv", po::bool_switch(&csv), "print one CSV row per method (method, family, order, stages, evals_per_step, advance, family_name)");
+      "csv", po::bool_switch(&csv), "print one CSV row per method (method, family, order, stages, evals_per_step, advance, family_name, geometry, "
+          "table, reference)");
   po::variables_map vm;
   if (!parse(argc, argv, desc, vm, "usage: bodypoint methods [--markdown | --csv]\nLists every integration method.")) return 0;
   if (markdown && csv) throw Error("give --markdown or --csv, not both");

@@ -122,6 +122,49 @@ TEST(Tables, OrderConditionResidualsVanishUpToTheClaimedOrder) {
   EXPECT_GE(checked, kTablesWhenListed);
 }
 
+/// Whether a table's step is its own adjoint, S(-h) S(h) = I, by the series: every degree 1 .. p + 1 of the
+/// product vanishes to the coefficients' rounding (a table of order p that is not symmetric differs from its
+/// adjoint at degree p + 1). Returns that verdict, checking that a non-vanishing degree stands clear of it.
+template <std::size_t N>
+bool symmetric_by_series(const Table<N>& t, std::size_t p, bool nystrom, const char* name) {
+  const auto [A, B] = test_split(nystrom);
+  const std::size_t K = p + 1;
+  Table<N> back = t;  // S(-h): every coefficient negated
+  for (std::size_t i = 0; i < N; ++i) back.a[i] = -t.a[i], back.b[i] = -t.b[i];
+  const Series m = times(composition(back, A, B, K, false), composition(t, A, B, K, false));
+  const Mat Aa = A.cwiseAbs(), Ba = B.cwiseAbs();
+  const Series scale = times(composition(t, Aa, Ba, K, true), composition(t, Aa, Ba, K, true));
+  long double worst = 0.0L, rounding = 0.0L;
+  for (std::size_t k = 1; k <= K; ++k) {
+    worst = std::max(worst, m[k].cwiseAbs().maxCoeff());
+    rounding = std::max(rounding, kRoundingFactor * scale[k].maxCoeff());
+  }
+  if (worst > rounding) {
+    EXPECT_GT(worst, kNonZeroFactor * rounding) << name << ": neither symmetric nor clearly not";
+  }
+  return worst <= rounding;
+}
+
+// The catalogue's symmetry of a step (its sub-flows read the same backwards: OpSequence::symmetric, the
+// paper's table of compositions) is the algebraic one: S(-h) S(h) = I. Euler and Ruth 3 are the tables that
+// are not symmetric.
+TEST(Tables, SymmetryOfEveryTableIsItsAdjointsEquality) {
+  int not_symmetric = 0;
+  for_each(AllTables{}, [&not_symmetric]<class E>() {
+    using T = typename E::type;
+    const bool by_series = symmetric_by_series(T::table, static_cast<std::size_t>(T::order), is_nystrom<T>(),
+                                               std::string(T::tag).c_str());
+    EXPECT_EQ(ops_of<T>.symmetric(), by_series) << T::tag;
+    not_symmetric += by_series ? 0 : 1;
+  });
+  EXPECT_EQ(not_symmetric, 2);  // euler and ruth3
+  for (const MethodInfo& m : methods()) {
+    if (!m.table.empty()) {
+      EXPECT_EQ(m.symmetric, m.table != "euler" && m.table != "ruth3") << m.name;
+    }
+  }
+}
+
 TEST(Tables, DerivedMiddleWeightsMatchPublishedOnes) {
   EXPECT_NEAR(kahan_li6_weights[4], kahan_li6_middle, kPublishedTol);
   EXPECT_NEAR(kahan_li8_weights[8], kahan_li8_middle, kPublishedTol);

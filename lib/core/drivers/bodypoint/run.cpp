@@ -80,9 +80,11 @@ MethodInfo thesis_row(int batch_kernel) {
     }
   }();
   const int k = static_cast<int>(seq.kicks());
-  return {"thesis-" + std::string(E::tag), Family::Thesis, T::order, k, k,
-          sp::describe<T>("thesis, frozen gyroscopic term"),
-          &run_splitting<sp::ThesisKernel, seq, slip>, nullptr, batch_kernel};
+  MethodInfo m{"thesis-" + std::string(E::tag), Family::Thesis, T::order, k, k,
+               sp::describe<T>("thesis, frozen gyroscopic term"),
+               &run_splitting<sp::ThesisKernel, seq, slip>, nullptr, batch_kernel};
+  m.symmetric = sp::ops_of<T>.symmetric();
+  return m;
 }
 
 /// The row of an exact Lie-Poisson method from its entry in LiePoissonTables (catalogue.hpp).
@@ -95,6 +97,7 @@ MethodInfo lie_row(int batch_kernel) {
                sp::describe<T>("exact Lie-Poisson"),
                &run_splitting<sp::LiePoissonKernel, seq>, nullptr, batch_kernel};
   m.table = E::tag;
+  m.symmetric = seq.symmetric();
   return m;
 }
 
@@ -122,6 +125,7 @@ MethodInfo kepler_row() {
                sp::describe<T>("Kepler split (a stage is a Kepler solve about the first centre)"),
                &run_kepler_split<T>, &kepler_split_check};
   m.table = E::tag;
+  m.symmetric = sp::ops_of<T>.symmetric();
   return m;
 }
 
@@ -224,18 +228,29 @@ namespace {
 struct FamilyNames {
   Family family;
   std::string_view name, key;
+  std::string_view geometry;  ///< what its flows preserve (MethodTraits::geometry)
 };
 constexpr FamilyNames kFamilyNames[] = {
-    {Family::Thesis, "thesis drift/kick", "thesis"},
-    {Family::LiePoisson, "exact Lie-Poisson", "lie-poisson"},
-    {Family::KeplerSplit, "Kepler split", "kepler-split"},
-    {Family::Odeint, "Boost.Odeint fixed step", "odeint"},
-    {Family::OdeintAdaptive, "Boost.Odeint adaptive", "odeint-adaptive"},
-    {Family::Gsl, "GSL adaptive", "gsl"},
-    {Family::TimeTransformed, "time-transformed", "time-transformed"},
-    {Family::Regularised, "regularised", "regularised"},
-    {Family::Extrapolated, "logH extrapolated", "extrapolated"},
-    {Family::FarField, "far-field collocation", "far-field"},
+    {Family::Thesis, "thesis drift/kick", "thesis",
+     "not symplectic for B != 0 (the frozen gyroscopic term)"},
+    {Family::LiePoisson, "exact Lie-Poisson", "lie-poisson",
+     "Poisson (symplectic), |K2|^2 exact, K2Q with one centre"},
+    {Family::KeplerSplit, "Kepler split", "kepler-split",
+     "Poisson (symplectic), |K2|^2 exact, K2Q with one centre"},
+    {Family::Odeint, "Boost.Odeint fixed step", "odeint",
+     "none"},
+    {Family::OdeintAdaptive, "Boost.Odeint adaptive", "odeint-adaptive",
+     "none"},
+    {Family::Gsl, "GSL adaptive", "gsl",
+     "none"},
+    {Family::TimeTransformed, "time-transformed", "time-transformed",
+     "symplectic in the extended phase space, |K2|^2 exact, K2Q with one centre"},
+    {Family::Regularised, "regularised", "regularised",
+     "exact flow (material point, one centre)"},
+    {Family::Extrapolated, "logH extrapolated", "extrapolated",
+     "none (an extrapolated symmetric leapfrog)"},
+    {Family::FarField, "far-field collocation", "far-field",
+     "none (a collocation)"},
 };
 constexpr bool one_row_per_family_in_order() {
   for (std::size_t i = 0; i < std::size(kFamilyNames); ++i)
@@ -285,10 +300,17 @@ double far_field_first_step(const Body& b, const std::vector<Centre>& centres, d
 
 }  // namespace
 
+std::string geometry_text(const MethodInfo& m) {
+  std::string g(m.traits.geometry);
+  if (!m.table.empty() || m.family == Family::Thesis) g += m.symmetric ? "; symmetric" : "; not symmetric";
+  return g;
+}
+
 MethodTraits catalogue_traits(Family f) {
   MethodTraits t;
   t.family_name = kFamilyNames[static_cast<std::size_t>(f)].name;
   t.family_key = kFamilyNames[static_cast<std::size_t>(f)].key;
+  t.geometry = kFamilyNames[static_cast<std::size_t>(f)].geometry;
   t.first_step = fixed_first_step;
   switch (f) {
     case Family::Thesis:

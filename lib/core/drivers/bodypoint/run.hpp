@@ -237,6 +237,8 @@ struct MethodTraits {
   bool in_fixed_set = false;
   /// Its cost per step is set by the step and the field, not by a number of stages (far-ip: points x sweeps).
   bool cost_set_by_field = false;
+  /// What the family's flows preserve (geometry_text adds a splitting's symmetry).
+  std::string_view geometry;
   /// Where the accuracy mode's search starts on a body for a run to t_end: its first, coarse step (h or ds).
   double (*first_step)(const Body& b, const std::vector<Centre>& centres, double t_end) = nullptr;
 };
@@ -259,7 +261,14 @@ struct MethodInfo {
   /// The composition table a splitting method applies (its tag: "y4", "kl6", ...; the part of its name
   /// after the family's prefix); empty for the others. Asked by `auto` (methods.hpp: method_of).
   std::string table = {};
+  /// A splitting whose step is its own adjoint (its sub-flows read the same backwards: composition.hpp);
+  /// false for every other method.
+  bool symmetric = false;
 };
+
+/// What a method preserves, in words (`bodypoint methods --csv`, the paper's table of families): its family's
+/// geometric property and, for a splitting, whether its step is symmetric.
+std::string geometry_text(const MethodInfo& m);
 
 /// Why `m` refuses the scene (empty: it accepts it). `run` throws this reason; sweeps, studies,
 /// benchmarks and tests ask it instead of knowing which family assumes what.

@@ -139,6 +139,17 @@ struct OpSequence {
   [[nodiscard]] constexpr std::size_t kicks_merged() const {
     return fsal() && ops[0].part == Part::kick ? kicks() - 1 : kicks();
   }
+  /// Whether the step is its own adjoint, S(-h) S(h) = id (time-symmetric): its sub-flows read the same
+  /// backwards, each coefficient to a relative 1e-12 (the tables' decimal digits and the triple jump's roots).
+  [[nodiscard]] constexpr bool symmetric() const {
+    for (std::size_t i = 0; i < size / 2; ++i) {
+      const Op& x = ops[i];
+      const Op& y = ops[size - 1 - i];
+      const double d = x.c - y.c, scale = (x.c < 0.0 ? -x.c : x.c) + 1e-300;
+      if (x.part != y.part || (d < 0.0 ? -d : d) > 1e-12 * scale) return false;
+    }
+    return true;
+  }
   /// Appends c of part p, merged into the last sub-flow when it is of the same part; zeros skipped.
   constexpr void push(Part p, double c) {
     if (c == 0.0) return;
