@@ -1222,6 +1222,36 @@ def estimate_branches(res, out, M):
     M.add("BranchUnder", count(totals["under"]))
     tols = sorted({num(r["tol"]) for r in rows}, reverse=True)
     M.add("BranchTols", ", ".join(power_of_ten(t) for t in tols), math_mode=False)
+    branch_outliers(rows, M)
+
+
+def branch_outliers(rows, M):
+    """Where the branches' estimates are more than 3 times off (issue #83 M4), beside the rounding level the
+    accuracy mode measured on the same scene (a refusal's "differ by X": runs that differ only in rounding),
+    which bounds what such an error can be and below which every TOL is refused."""
+    level = {}
+    for r in rows:
+        m = re.search(r"differ by ([0-9.e+-]+)", r.get("reason", ""))
+        if m:
+            level[r["scene"]] = max(level.get(r["scene"], 0.0), float(m.group(1)))
+    parts = []
+    for r in rows:
+        if r["outcome"] != "ok" or not r["err"] or num(r["err"]) <= 1e-13 or num(r["err_estimate"]) <= 0:
+            continue
+        if num(r["err"]) / num(r["err_estimate"]) > 3:
+            where = (f"where runs that differ only in rounding differ by ${sci(level[r['scene']])}$"
+                     if r["scene"] in level else "where the scene's rounding level was not measured")
+            parts.append(f"{tt(r['method'])} at TOL {power_of_ten(num(r['tol']))} ({r['scene']}) erred "
+                         f"${sci(num(r['err']))}$ with an estimate of ${sci(num(r['err_estimate']))}$, {where}")
+    high = [r for r in rows if r["outcome"] == "ok" and r["err"] and num(r["err"]) > 1e-13
+            and num(r["err_estimate"]) > 3 * num(r["err"])]
+    if high:
+        parts.append(f"the {count(len(high))} estimates more than 3 times high are at errors of at most "
+                     f"${sci(max(num(r['err']) for r in high))}$ and estimates of at most "
+                     f"${sci(max(num(r['err_estimate']) for r in high))}$"
+                     + (f", against rounding levels of ${sci(min(level.values()))}$ to ${sci(max(level.values()))}$ "
+                        "measured on these scenes" if level else ""))
+    M.add("BranchOutliersText", "; ".join(parts) if parts else "no estimate is more than 3 times off", math_mode=False)
 
 
 # The far pass's error is smooth in the step below this spin angle per step (radians): the largest
