@@ -327,6 +327,12 @@ const TolRow* oracle_for(const std::vector<TolRow>& rows, const TolRow& a) {
 /// Both times of a comparison count (stopwatch.hpp's flag).
 bool counts(const TolRow& a, const TolRow& b) { return a.time.flag().empty() && b.time.flag().empty(); }
 
+/// auto's whole call against another's time; a refused TOL has no run to compare, and its cell says so (not
+/// "flagged", which speaks of a time).
+std::string auto_ratio(const TolRow& a, const Timing& other) {
+  return a.refusal.empty() ? ratio_cell(&a.time, &other) : std::string("refused");
+}
+
 /// auto's delivered run alone, in ms, flagged with the whole call's timing.
 std::string delivered_cell(const TolRow& a) {
   if (!(a.delivered_wall_s > 0.0)) return "-";
@@ -443,7 +449,7 @@ void write_tol_summary(std::ostream& summary, const std::vector<TolRow>& rows, s
             << (a.met ? "yes" : a.refusal.empty() ? "**no**" : "refused") << " | "
             << (a.refusal.empty() ? time_cell(a.time) : "-") << " | ";
     if (best) {
-      const std::string ratio = ratio_cell(&a.time, &best->time);
+      const std::string ratio = auto_ratio(a, best->time);
       ++compared;
       faster3 += counts(a, *best) && best->time.wall_s >= 3.0 * a.time.wall_s ? 1 : 0;
       summary << best->method << " (" << best->force_evals << " evals) | " << time_cell(best->time) << " | " << ratio << " | ";
@@ -456,7 +462,7 @@ void write_tol_summary(std::ostream& summary, const std::vector<TolRow>& rows, s
       oracle3 += counts(a, *oracle) && oracle->time.wall_s >= 3.0 * a.time.wall_s ? 1 : 0;
       summary << oracle->method << " tol=" << sci(oracle->tol, 1) << " (" << oracle->force_evals << " evals) | "
               << time_cell(oracle->time) << " | "
-              << ratio_cell(&a.time, &oracle->time) << " | " << delivered_cell(a) << " | ";
+              << auto_ratio(a, oracle->time) << " | " << delivered_cell(a) << " | ";
       if (a.delivered_wall_s > 0.0 && a.time.flag().empty() && oracle->time.flag().empty())
         summary << std::setprecision(3) << oracle->time.wall_s / a.delivered_wall_s << "x | ";
       else
