@@ -1223,6 +1223,24 @@ def estimate_branches(res, out, M):
     tols = sorted({num(r["tol"]) for r in rows}, reverse=True)
     M.add("BranchTols", ", ".join(power_of_ten(t) for t in tols), math_mode=False)
     branch_outliers(rows, M)
+    far_ip_against_auto(rows, M)
+
+
+def far_ip_against_auto(rows, M):
+    """far-ip's whole call under --tol against auto's on the same far passes (the branches' "far-ip" and "lp
+    far field" rows), in force evaluations (search and delivered run): per TOL the median and range of the
+    ratio (a far-ip evaluation is the force with its Jacobian; the times are bench/several_centres.py's)."""
+    def whole(r):
+        return num(r["force_evals"]) + num(r["search_force_evals"])
+    auto = {(r["scene"], r["tol"]): r for r in rows if r["branch"] == "lp far field" and r["outcome"] == "ok"}
+    parts = []
+    for tol in sorted({r["tol"] for r in rows}, key=float, reverse=True):
+        ratios = [whole(r) / whole(auto[r["scene"], tol]) for r in rows
+                  if r["branch"] == "far-ip" and r["outcome"] == "ok" and r["tol"] == tol and (r["scene"], tol) in auto]
+        if ratios:
+            parts.append(f"${sci(statistics.median(ratios))}$ (${sci(min(ratios))}$ to ${sci(max(ratios))}$) at "
+                         f"{power_of_ten(float(tol))}")
+    M.add("FarIpVsAutoEvals", ", ".join(parts) if parts else "not measured in this copy", math_mode=False)
 
 
 def branch_outliers(rows, M):
