@@ -17,6 +17,7 @@ import re
 import sys
 
 from catalogue import families, family, load as load_catalogue
+import map_rule
 import timing_rule
 
 import matplotlib
@@ -438,8 +439,9 @@ def long_time_figure(res, figs, listing):
 
 
 def map_figure(res, figs, listing):
-    """The (d, L) stability map (bodypoint study --name dL-map): one heat map of log10 max relative
-    energy deviation per fixed-step method; cells whose run is not ok (diverged, collision) in black."""
+    """The (d, L) stability map (bodypoint study --name dL-map): a heat map of log10 max relative energy
+    deviation per fixed-step method whose map is not uniform (map_rule.py; the others are rows of the paper's
+    table); cells whose run is not ok (diverged, collision) in black."""
     path = os.path.join(res, "dL_map.csv")
     if not os.path.exists(path):
         return
@@ -447,8 +449,11 @@ def map_figure(res, figs, listing):
     ds = sorted({num(r["d"]) for r in rows})
     Ls = sorted({num(r["L"]) for r in rows})
     groups = by_method(rows)
-    methods = list(groups)
-    cols = 6
+    # A uniform map is a row of the paper's table (map_rule.py), not a panel.
+    methods = [m for m in groups if not map_rule.uniform(groups[m])]
+    if not methods:
+        return
+    cols = min(6, len(methods))
     nrows = (len(methods) + cols - 1) // cols
     fig, axes = plt.subplots(nrows, cols, figsize=(WIDE, 1.25 * nrows + 0.5), sharex=True, sharey=True, squeeze=False)
     cmap = plt.get_cmap("viridis").copy()
@@ -469,8 +474,9 @@ def map_figure(res, figs, listing):
         ax.set_xlabel("d")
     for ax in axes[:, 0]:
         ax.set_ylabel("L")
-    fig.colorbar(image, ax=axes, shrink=0.6, label="log10 max relative energy deviation (black: not ok)")
-    save(fig, os.path.join(figs, "fig_dL_map.pdf"), listing, "the (d, L) stability map, one panel per fixed-step method")
+    fig.colorbar(image, ax=axes, shrink=0.9, label="log10 max |dE/E|")  # black: not ok (the caption says so)
+    save(fig, os.path.join(figs, "fig_dL_map.pdf"), listing,
+         "the (d, L) stability map, a panel per fixed-step method whose map is not uniform")
 
 
 def scattering_figure(res, figs, listing):

@@ -16,6 +16,7 @@ import statistics
 import sys
 
 from catalogue import family, has_fictitious_step, load as load_catalogue
+import map_rule
 import timing_rule
 
 THESIS_SEVEN = ["thesis-euler", "thesis-verlet", "thesis-ruth3", "thesis-fr4", "thesis-y6", "rk4", "ab4"]
@@ -1451,7 +1452,26 @@ def appendix(res, M):
             M.add("AppendixPThreeD", sci(num(r["m"]) * num(r["J"]) - num(r["B"]) ** 2))
 
 
-def ensembles(res, M):
+def map_table(rows, methods, out, M):
+    """tab_map: per method of the (d, L) map its median and largest log10 max relative energy deviation, its
+    share below 1e-10 and its runs not ok; whether it has a panel in fig_dL_map (map_rule.py)."""
+    panels = 0
+    with open(os.path.join(out, "tab_map.tex"), "w") as f:
+        for m in methods:
+            rs = [r for r in rows if r["method"] == m]
+            logs = map_rule.log_deviations(rs)
+            good = sum(1 for r in rs if r["outcome"] == "ok" and num(r["max_rel_dE"]) < 1e-10)
+            uniform = map_rule.uniform(rs)
+            panels += 0 if uniform else 1
+            cells = [tt(m), f"${statistics.median(logs):.1f}$" if logs else "--", f"${max(logs):.1f}$" if logs else "--",
+                     f"${100.0 * good / len(rs):.0f}$", count(sum(1 for r in rs if r["outcome"] != "ok")),
+                     "" if uniform else "yes"]
+            f.write(" & ".join(cells) + " \\\\\n")
+    M.add("MapPanels", count(panels))
+    M.add("MapUniformDecades", f"{map_rule.UNIFORM_DECADES:g}")
+
+
+def ensembles(res, out, M):
     """The (d, L) map (study --name dL-map, timed by build.sh) and the batch throughput (bench_batch)."""
     rows, _ = read_csv(os.path.join(res, "dL_map.csv"))
     methods = list(dict.fromkeys(r["method"] for r in rows))
@@ -1484,6 +1504,7 @@ def ensembles(res, M):
     M.add("MapShareThesis", sci(share(lambda m: m.startswith("thesis-")), 3))
     M.add("MapShareRk", sci(share(lambda m: m in ("rk4", "ab4")), 3))
     M.add("MapNotOk", count(sum(1 for r in rows if r["outcome"] != "ok")))
+    map_table(rows, methods, out, M)
     # bench_batch: items_per_second of the scalar loop and of each width, per method; a speed-up only
     # between two times that count under the timing rule.
     bench = timing_rule.benchmark(os.path.join(res, "bench_batch.csv"), M.rule)
@@ -1743,7 +1764,7 @@ def main():
     far_field(res, out, M)
     stress(res, out, M)
     appendix(res, M)
-    ensembles(res, M)
+    ensembles(res, out, M)
     scattering(res, M)
     long_time(res, out, M)
     contention(res, figs, M)
