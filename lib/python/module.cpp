@@ -778,6 +778,9 @@ void bind_scenes(py::module_& mod) {
       d["stages"] = m.stages;
       d["evals_per_step"] = m.evals_per_step;
       d["description"] = m.description;
+      d["geometry"] = geometry_text(m);  // what its flows preserve (methods --csv's column)
+      d["symmetric"] = m.symmetric;
+      d["table"] = m.table;
       l.append(d);
     }
     return l;

@@ -43,6 +43,11 @@ def test_methods_are_the_catalogue():
     rows = list(csv.DictReader(io.StringIO(cli("methods", "--csv"))))
     assert [m["name"] for m in bp.methods()] == [r["method"] for r in rows]
     assert {m["family"] for m in bp.methods()} == {r["family"] for r in rows}
+    # What a method preserves and its table: the command line's columns, one catalogue.
+    assert [(m["geometry"], m["table"]) for m in bp.methods()] == [(r["geometry"], r["table"]) for r in rows]
+    assert [m["name"] for m in bp.methods() if m["table"] and not m["symmetric"]] == [
+        p + t for p in ("lp-", "kep-", "logh-", "ttl-") for t in ("euler", "ruth3")
+        if p + t in {r["method"] for r in rows}]
 
 
 def assert_same_fields(got, want):

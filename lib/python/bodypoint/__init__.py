@@ -170,7 +170,9 @@ def _scene_toml(centres, bodies):
 
 
 def methods():
-    """Every method of the catalogue: dicts with name, family, order, stages, evals_per_step, description."""
+    """Every method of the catalogue: dicts with name, family, order, stages, evals_per_step, description,
+    geometry (what its flows preserve, as `bodypoint methods --csv`), symmetric (a splitting whose step is its
+    own adjoint) and table (a splitting's composition table, "" otherwise)."""
     return _core._methods()
 
 
