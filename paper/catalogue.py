@@ -17,6 +17,7 @@ PAPER_FAMILY = {
     "regularised": "KS",
     "odeint-adaptive": "Boost.Odeint",
     "gsl": "GSL",
+    "sundials": "SUNDIALS",
     "extrapolated": "logH+BS",
 }
 

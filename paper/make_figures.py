@@ -34,8 +34,8 @@ THESIS_SEVEN = ["thesis-euler", "thesis-verlet", "thesis-ruth3", "thesis-fr4", "
 # adds is drawn after them in the next free colour (family_colours).
 FAMILIES = [("thesis's seven", "tab:red"), ("Lie-Poisson", "tab:blue"), ("time-transformed", "tab:green"),
             ("KS", "tab:purple"), ("Kepler split", "tab:cyan"), ("Boost.Odeint", "tab:orange"), ("GSL", "tab:brown"),
-            ("logH+BS", "tab:pink")]
-SPARE_COLOURS = ["tab:olive", "tab:gray", "black", "gold", "navy"]
+            ("logH+BS", "tab:pink"), ("SUNDIALS", "navy")]
+SPARE_COLOURS = ["tab:olive", "tab:gray", "black", "gold"]
 
 
 def family_colours():
@@ -414,7 +414,7 @@ def long_time_figure(res, figs, listing):
         return
     rows = read_csv(path)
     methods = [m for m in dict.fromkeys(r["method"] for r in rows) if m != "lp-kl8"]
-    colours = dict(zip(methods, PANEL_COLOURS))
+    colours = dict(zip(methods, PANEL_COLOURS + ["navy", "tab:olive", "tab:cyan"]))  # GSL, SUNDIALS: optional
     panels = [("kepler", "max_rel_dE", "Kepler ellipse: energy", r"max $|\Delta E/E|$ so far"),
               ("two-centres", "max_rel_dE", "two centres: energy", r"max $|\Delta E/E|$ so far"),
               ("spinning", "rel_dK2sq", r"spinning body: $|K_2|^2$", r"$|\Delta |K_2|^2| / |K_2|^2$"),
@@ -432,8 +432,8 @@ def long_time_figure(res, figs, listing):
     for ax in axes[1]:
         ax.set_xlabel("periods")
     handles, labels = axes[0][0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=len(methods), bbox_to_anchor=(0.5, -0.04))
-    fig.tight_layout(rect=(0, 0.05, 1, 1))
+    fig.legend(handles, labels, loc="lower center", ncol=min(len(methods), 4), bbox_to_anchor=(0.5, -0.06))
+    fig.tight_layout(rect=(0, 0.07, 1, 1))
     save(fig, os.path.join(figs, "fig_long_time.pdf"), listing,
          "bound orbits over many periods: energy, |K2|^2 and phase errors against time")
 

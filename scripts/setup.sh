@@ -21,7 +21,7 @@ esac
 # The library, the command line and the Python module (pybind11 on Debian's python3, numpy arrays;
 # pandas, which docs/guide.md's sweeps use; python3-venv and python3-pip for `pip install .`).
 packages=(cmake ninja-build g++ git libeigen3-dev libboost-dev libboost-program-options-dev
-          libtomlplusplus-dev libgsl-dev python3-numpy python3-dev pybind11-dev python3-pandas python3-venv python3-pip)
+          libtomlplusplus-dev libgsl-dev libsundials-dev python3-numpy python3-dev pybind11-dev python3-pandas python3-venv python3-pip)
 if ((!minimal)); then
   # Tests and benchmarks (GoogleTest, Google Benchmark, pytest), the figures (matplotlib) and:
   packages+=(libgtest-dev libbenchmark-dev python3-pytest python3-matplotlib

@@ -73,15 +73,17 @@ std::vector<LongScene> scenes() {
 }
 
 /// The methods and their steps (h, ds or the tolerance per step): the exact splitting, the time-transformed
-/// leapfrog for attracting centres, the Kepler split, RK4, and two step-size-controlled peers.
+/// leapfrog for attracting centres, the Kepler split, RK4, and the step-size-controlled peers.
 struct LongMethod {
   std::string name;
   double per_period;  ///< steps per period (0: a tolerance per step)
 };
-const std::vector<LongMethod>& long_methods() {
-  static const std::vector<LongMethod> m = {{"lp-y4", kStepsPerPeriod}, {"ttl-y4", kStepsPerPeriod},
-                                            {"kep-y4", kStepsPerPeriod}, {"rk4", kStepsPerPeriod},
-                                            {"gsl-rk8pd", 0.0},          {"odeint-rkf78", 0.0}};
+/// The peers that this build has (GSL and SUNDIALS are optional).
+std::vector<LongMethod> long_methods() {
+  std::vector<LongMethod> m;
+  for (const char* name : {"lp-y4", "ttl-y4", "kep-y4", "rk4"}) m.push_back({name, kStepsPerPeriod});
+  for (const char* name : {"gsl-rk8pd", "odeint-rkf78", "cvode-adams"})
+    if (find_method(name)) m.push_back({name, 0.0});
   return m;
 }
 

@@ -364,7 +364,7 @@ std::string tied_with(const std::vector<Row>& rows, const Row& best, double targ
 
 std::string summary_table(const std::vector<NamedScene>& scenes, const std::vector<Row>& rows) {
   std::ostringstream sum;
-  sum << "| scene | target err_rel | best bodypoint method | config | force evals | time [ms] | best peer (Boost.Odeint, GSL, logh-bs) | config | force evals | time [ms] | speed-up |\n"
+  sum << "| scene | target err_rel | best bodypoint method | config | force evals | time [ms] | best peer (Boost.Odeint, GSL, SUNDIALS, logh-bs) | config | force evals | time [ms] | speed-up |\n"
       << "|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const NamedScene& ns : scenes)
     for (double target : {1e-4, 1e-7, 1e-10, 1e-13}) {

@@ -318,10 +318,14 @@ TEST(Cli, DivergedRunIsAnErrorNotANumber) {
 }
 
 // README's table of methods is `bodypoint methods --markdown`, so a table added to the catalogue
-// (or a family's list) cannot be left out of the docs. GSL's peers are rows only in builds with GSL.
+// (or a family's list) cannot be left out of the docs. GSL's and SUNDIALS's peers are rows only in builds
+// with them.
 TEST(Cli, ReadmeMethodTableIsGenerated) {
 #ifndef BODYPOINT_HAVE_GSL
   GTEST_SKIP() << "built without GSL: the README lists gsl-rk8pd and gsl-rkf45";
+#endif
+#ifndef BODYPOINT_HAVE_SUNDIALS
+  GTEST_SKIP() << "built without SUNDIALS: the README lists cvode-adams";
 #endif
   std::ifstream in(std::string(BODYPOINT_SOURCE_DIR) + "/README.md");
   std::stringstream ss;

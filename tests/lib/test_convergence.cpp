@@ -96,6 +96,7 @@ bool measured_here(Family f, double B) {
     // Peers with their own step control: their order is theirs, not a claim of this project.
     case Family::OdeintAdaptive:
     case Family::Gsl:
+    case Family::Sundials:
     case Family::Extrapolated: return false;
     // Spectral in its step (its error is its points' resolution, not C h^p): tests/lib/test_far_field.cpp.
     case Family::FarField: return false;

@@ -13,6 +13,7 @@
 #include "bodypoint/rk/run_odeint.hpp"
 #ifdef BODYPOINT_HAVE_GSL
 #include "bodypoint/rk/run_gsl.hpp"
+#include "bodypoint/rk/run_sundials.hpp"
 #endif
 #include "bodypoint/splitting/catalogue.hpp"
 #include "bodypoint/splitting/kepler_split.hpp"
@@ -190,6 +191,12 @@ std::vector<MethodInfo> make_rows() {
       {"gsl-rkf45", Family::Gsl, 5, 6, 6, "GSL Runge-Kutta-Fehlberg 4(5) with step-size control (gsl_odeiv2_step_rkf45); a tolerance per step",
        &run_gsl_rkf45},
 #endif
+#ifdef BODYPOINT_HAVE_SUNDIALS
+      {"cvode-adams", Family::Sundials, 0, 0, 0,
+       "SUNDIALS CVODE variable-order Adams-Moulton (1-12) with fixed-point iteration and step-size control; a "
+       "tolerance per step (rtol = atol)",
+       &run_cvode_adams},
+#endif
   };
   std::size_t table = 0;
   sp::for_each(sp::ThesisTables{}, [&]<class E>() { all.push_back(thesis_row<E>(sp::batch_thesis_kernel(table++))); });
@@ -251,11 +258,13 @@ constexpr FamilyNames kFamilyNames[] = {
      "none (an extrapolated symmetric leapfrog)"},
     {Family::FarField, "far-field collocation", "far-field",
      "none (a collocation)"},
+    {Family::Sundials, "SUNDIALS CVODE", "sundials",
+     "none"},
 };
 constexpr bool one_row_per_family_in_order() {
   for (std::size_t i = 0; i < std::size(kFamilyNames); ++i)
     if (static_cast<std::size_t>(kFamilyNames[i].family) != i) return false;
-  return std::size(kFamilyNames) == static_cast<std::size_t>(Family::FarField) + 1;
+  return std::size(kFamilyNames) == static_cast<std::size_t>(Family::Sundials) + 1;
 }
 static_assert(one_row_per_family_in_order(), "kFamilyNames: one row per Family, in the enum's order");
 
@@ -332,6 +341,7 @@ MethodTraits catalogue_traits(Family f) {
       break;
     case Family::OdeintAdaptive:
     case Family::Gsl:
+    case Family::Sundials:
       t.stepping = Stepping::controlled;
       t.search = SearchStrategy::none;
       t.peer = true;

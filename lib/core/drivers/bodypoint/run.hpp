@@ -91,7 +91,7 @@ struct RunResult {
 /// a peer, as Mikkola's codes integrate);
 /// FarField: Chebyshev-Picard collocation in the interaction picture of the exact drift, a step set by
 /// the field's slow scale rather than by the spin (far-ip, far_field.hpp).
-enum class Family { Thesis, LiePoisson, KeplerSplit, Odeint, OdeintAdaptive, Gsl, TimeTransformed, Regularised, Extrapolated, FarField };
+enum class Family { Thesis, LiePoisson, KeplerSplit, Odeint, OdeintAdaptive, Gsl, TimeTransformed, Regularised, Extrapolated, FarField, Sundials };
 
 /// The three ways of advancing time, one driver each, and the accuracy mode that searches the step of
 /// one of them:
