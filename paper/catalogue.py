@@ -31,6 +31,11 @@ def load(results):
             _rows[row["method"]] = row
 
 
+def rows():
+    """The catalogue's rows (methods.csv as DictReader read them), in its order."""
+    return list(_rows.values())
+
+
 def _paper_name(row):
     return PAPER_FAMILY.get(row["family"], row["family_name"])
 

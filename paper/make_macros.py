@@ -15,7 +15,7 @@ import re
 import statistics
 import sys
 
-from catalogue import family, has_fictitious_step, load as load_catalogue
+from catalogue import family, has_fictitious_step, load as load_catalogue, rows as catalogue_rows
 import map_rule
 import timing_rule
 
@@ -654,9 +654,9 @@ def geometry_latex(text):
 
 
 def geometry_tables(res, out):
-    """From the catalogue (methods.csv): tab_families, what each family's flows preserve, and
+    """From the catalogue (methods.csv, as catalogue.py loaded it): tab_families, what each family's flows preserve, and
     tab_compositions, each composition table's order, stages, symmetry and citation."""
-    rows, _ = read_csv(os.path.join(res, "methods.csv"))
+    rows = catalogue_rows()
     with open(os.path.join(out, "tab_families.tex"), "w") as f:
         for name in dict.fromkeys(r["family_name"] for r in rows):
             geometry = next(r["geometry"] for r in rows if r["family_name"] == name).split("; ")[0]
@@ -808,12 +808,8 @@ def third_party_speedup(res, M):
     rows = [r for r in rows if r["scene"] == "close"]
     parts = []
     for target in (1e-7, 1e-10):
-        def cheapest(keep):
-            ok = [r for r in rows if keep(family(r["method"])) and num(r["err_rel"]) <= target
-                  and (r["method"] == "ks" or next_rung_reaches(rows, r, target))]
-            return min(ok, key=lambda r: (num(r["force_evals"]), r["method"])) if ok else None
-        own = cheapest(lambda fam: fam not in THIRD_PARTY and fam != "logH+BS")
-        peer = cheapest(lambda fam: fam in THIRD_PARTY)
+        own, _ = cheapest_reaching(rows, target, lambda fam: fam not in THIRD_PARTY and fam != "logH+BS")
+        peer, _ = cheapest_reaching(rows, target, lambda fam: fam in THIRD_PARTY)
         if own is None or peer is None:
             parts.append(("-", 0.0, 0.0))
             continue
@@ -878,6 +874,20 @@ def next_rung_reaches(rows, r, target):
     return bool(nxt and nxt["scene"] == r["scene"] and nxt["method"] == r["method"] and num(nxt["err_rel"]) <= target)
 
 
+def cheapest_reaching(rows, target, keep):
+    """The cheapest configuration of the families `keep` accepts reaching `target` (err_rel), and the other
+    methods tied with it. Chosen by what does not depend on the machine: the fewest force evaluations,
+    counting a configuration only when the next finer rung of its ladder reaches the target too (ks: one
+    configuration); equal counts: the first by name (not the faster), the others returned to be named.
+    (None, []) when none reaches it."""
+    ok = [r for r in rows if keep(family(r["method"])) and num(r["err_rel"]) <= target
+          and (r["method"] == "ks" or next_rung_reaches(rows, r, target))]
+    if not ok:
+        return None, []
+    best = min(ok, key=lambda r: (num(r["force_evals"]), r["method"]))
+    return best, sorted({r["method"] for r in ok if r["force_evals"] == best["force_evals"]} - {best["method"]})
+
+
 def close_table(res, out, M):
     """Cheapest configuration of each family reaching each target on the close encounter."""
     rows, _ = read_csv(os.path.join(res, "work_precision.csv"))
@@ -888,22 +898,11 @@ def close_table(res, out, M):
         for i, target in enumerate(targets):
             power = f"$10^{{{int(math.log10(float(target)))}}}$"
             for fam in families:
-                ok = [r for r in rows if family(r["method"]) == fam and num(r["err_rel"]) <= float(target)]
-                if not ok:
+                best, tied = cheapest_reaching(rows, float(target), lambda x: x == fam)
+                if best is None:
                     f.write(f"{power} & {fam} & none & & & \\\\\n")
                     M.add(f"CloseEvals{camel(fam)}{target_word(target)}", "none reaching it", math_mode=False)
                     continue
-                # By what does not depend on the machine: the fewest force evaluations, counting a
-                # configuration only when the next finer rung of its ladder reaches the target too.
-                ok = [r for r in ok if r["method"] == "ks" or next_rung_reaches(rows, r, float(target))]
-                if not ok:
-                    f.write(f"{power} & {fam} & none & & & \\\\\n")
-                    M.add(f"CloseEvals{camel(fam)}{target_word(target)}", "none reaching it", math_mode=False)
-                    continue
-                # Equal counts: the first by name (not the faster: the pick must not depend on the machine),
-                # the others named beside it.
-                best = min(ok, key=lambda r: (num(r["force_evals"]), r["method"]))
-                tied = sorted({r["method"] for r in ok if r["force_evals"] == best["force_evals"]} - {best["method"]})
                 t = "\\emph{flagged}" if best["flag"] else f"{num(best['wall_s']) * 1e3:.3g}"
                 m = best["method"]
                 if best["tol"]:

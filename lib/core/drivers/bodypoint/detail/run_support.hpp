@@ -182,7 +182,21 @@ struct StepStats {
   }
 };
 
-/// The one driver of step-size-controlled runs (Boost.Odeint's controlled steppers, GSL's evolve):
+/// How controlled_loop words the failures of a C library's stepper (GSL, SUNDIALS), each message prefixed with
+/// the library's name: `Library::name` ("gsl", "cvode").
+template <class Library>
+struct LibrarySays {
+  static std::string stalled(double t, double /*taken*/) {
+    return std::string(Library::name) + ": the step size collapsed at t = " + std::to_string(t) +
+           " (tolerance too tight?)";
+  }
+  static std::string too_many(double /*t*/, double /*t_end*/) {
+    return std::string(Library::name) + ": more than 2e8 steps before t_end";
+  }
+  static std::string collapsed(double t) { return stalled(t, 0.0); }
+};
+
+/// The one driver of step-size-controlled runs (Boost.Odeint's controlled steppers, GSL's evolve, CVODE):
 /// from t = 0 with first trial step h0 to exactly t_end. `try_step(x, t, dt)` attempts one step from
 /// t and says whether it was accepted, leaving t and dt as its controller does (it lands on t_end
 /// itself). The driver refuses accepted steps that do not move t (they would repeat forever), caps

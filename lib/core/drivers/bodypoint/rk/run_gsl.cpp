@@ -38,14 +38,11 @@ struct GslDeleter {
   void operator()(gsl_odeiv2_evolve* e) const { gsl_odeiv2_evolve_free(e); }
 };
 
-/// How the controlled-step driver words GSL's failures.
-struct GslSays {
-  static std::string stalled(double t, double /*taken*/) {
-    return "gsl: the step size collapsed at t = " + std::to_string(t) + " (tolerance too tight?)";
-  }
-  static std::string too_many(double /*t*/, double /*t_end*/) { return "gsl: more than 2e8 steps before t_end"; }
-  static std::string collapsed(double t) { return stalled(t, 0.0); }
+/// How the controlled-step driver words GSL's failures ("gsl: ...").
+struct Gsl {
+  static constexpr const char* name = "gsl";
 };
+using GslSays = detail::LibrarySays<Gsl>;
 
 RunResult run_gsl(const gsl_odeiv2_step_type* type, const Body& body, const std::vector<Centre>& centres,
                   const Advance& how, const RunOptions& options) {

@@ -17,7 +17,6 @@
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
 #include <algorithm>
-#include <memory>
 #include <string>
 #include <type_traits>
 
@@ -51,14 +50,11 @@ struct Sundials {  // owns the context, the vector, the solver and CVODE's memor
   }
 };
 
-/// How the controlled-step driver words CVODE's failures.
-struct CvodeSays {
-  static std::string stalled(double t, double /*taken*/) {
-    return "cvode: the step size collapsed at t = " + std::to_string(t) + " (tolerance too tight?)";
-  }
-  static std::string too_many(double /*t*/, double /*t_end*/) { return "cvode: more than 2e8 steps before t_end"; }
-  static std::string collapsed(double t) { return stalled(t, 0.0); }
+/// How the controlled-step driver words CVODE's failures ("cvode: ...").
+struct Cvode {
+  static constexpr const char* name = "cvode";
 };
+using CvodeSays = detail::LibrarySays<Cvode>;
 
 void check(int flag, const char* what) {
   if (flag < 0) throw Error(std::string("cvode: ") + what + " failed (flag " + std::to_string(flag) + ")");
