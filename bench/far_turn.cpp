@@ -1,0 +1,103 @@
+// far_turn: the far leg by one turn of the spin a step (splitting/far_turn.hpp) against the exact
+// splitting at steps of a fraction of a radian (docs/measurements.md, "An encounter at infinity").
+//
+// Each row: a scene given by b = 3 and arrival phase 1 (table 3.1's parameters with the row's changes),
+// started at L, run by the far leg (Kahan-Li 6 with a turn for each kick, steps eta r/|v|) until a step
+// ends within r_stop of the nearest centre, against lp-kl8 at h = 0.004 and 0.002 over the same time
+// (the reference; its two runs' difference is printed as its own error). Error: max(|dR|/|R|, |dv|/|v|),
+// the estimates' norm; the columns "share 0" and "share 1" end the leg with no quiver correction and with
+// the first-order theory's full one (kQuiverShare is 0.5).
+#include "bodypoint/field.hpp"
+#include "bodypoint/scattering.hpp"
+#include "bodypoint/splitting/catalogue.hpp"
+#include "bodypoint/splitting/far_turn.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace {
+
+using namespace bodypoint;
+namespace sp = bodypoint::splitting;
+
+double norm_error(const State& a, const State& ref) {
+  return std::max((a.R - ref.R).norm() / ref.R.norm(), (a.v - ref.v).norm() / ref.v.norm());
+}
+
+template <class Field>
+State reference(const Body& b, const Field& f, double t, double h, long* evals) {
+  sp::LiePoissonKernel<Field, true> k(b.p, f);
+  sp::LieState x = k.initial_state(b.s0);
+  const long n = std::lround(std::ceil(t / h));
+  const double step = t / static_cast<double>(n);
+  constexpr auto& seq = sp::ops_of<sp::KahanLi8>;
+  for (long i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < seq.size; ++j) {
+      if (seq.ops[j].part == sp::Part::kick) k.kick(x, seq.ops[j].c * step);
+      else k.drift(x, seq.ops[j].c * step);
+    }
+  *evals = k.evals;
+  return k.to_physical(x);
+}
+
+struct Leg {
+  State end;
+  sp::FarLeg leg;
+  long evals;
+};
+template <class Field>
+Leg leg(const Body& b, const Field& f, double eta, double r_stop, double share, double t_span) {
+  sp::FarTurnKernel<Field> k(b.p, f);
+  k.quiver_share = share;
+  sp::LieState x = k.initial_state(b.s0);
+  const sp::FarLeg l = sp::far_leg<sp::ops_of<sp::KahanLi6>>(k, x, t_span, eta, r_stop);
+  return {k.to_physical(x), l, k.evals()};
+}
+
+template <class Field>
+void row(const char* name, const Body& b, const Field& f, double L, double r_stop, double eta) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const Leg main = leg(b, f, eta, r_stop, sp::kQuiverShare, inf);
+  const double t = main.leg.t;
+  long ref_evals = 0, ref2_evals = 0;
+  const State ref = reference(b, f, t, 0.002, &ref2_evals);
+  const State coarse = reference(b, f, t, 0.004, &ref_evals);
+  const double e0 = norm_error(leg(b, f, eta, r_stop, 0.0, t).end, ref);
+  const double e1 = norm_error(leg(b, f, eta, r_stop, 1.0, t).end, ref);
+  std::printf("%-26s %6.0f %6.0f %5.2f %6ld %7ld %9.2e %9.2e %9.2e %9.2e %9ld\n", name, L,
+              sp::nearest_centre(f, main.end.R), eta, main.leg.steps, main.evals, norm_error(main.end, ref), e0, e1,
+              norm_error(coarse, ref), ref2_evals);
+}
+
+Body body(SceneParams s, double L) {
+  s.start.L = L;
+  return thesis_scene(with_asymptotic_data(s, 3.0, std::numeric_limits<double>::quiet_NaN(), 1.0)).bodies[0];
+}
+
+}  // namespace
+
+int main() {
+  std::printf("%-26s %6s %6s %5s %6s %7s %9s %9s %9s %9s %9s\n", "scene", "L", "r_end", "eta", "steps", "evals",
+              "error", "share 0", "share 1", "ref err", "ref evals");
+  const SceneParams thesis;
+  const OriginCentre one{thesis.A};
+  for (double L : {3200.0, 12800.0})
+    for (double r_stop : {400.0, 800.0}) row("table 3.1", body(thesis, L), one, L, r_stop, 0.1);
+  row("table 3.1, eta 0.05", body(thesis, 3200.0), one, 3200.0, 400.0, 0.05);
+  row("table 3.1, eta 0.2", body(thesis, 3200.0), one, 3200.0, 400.0, 0.2);
+  SceneParams s = thesis;
+  s.B = 0.3;
+  row("B = 0.3", body(s, 3200.0), OriginCentre{s.A}, 3200.0, 400.0, 0.1);
+  s = thesis;
+  s.B = 0.9;
+  row("B = 0.9", body(s, 3200.0), OriginCentre{s.A}, 3200.0, 400.0, 0.1);
+  s = thesis;
+  s.start.Kx = 4.0;
+  s.A = -1.0;
+  row("Kx = 4, A = -1", body(s, 3200.0), OriginCentre{s.A}, 3200.0, 400.0, 0.1);
+  // Two repelling centres 4 apart across the path, their total charge table 3.1's.
+  const CentreList two{{Centre{Vec3(0.0, 2.0, 0.0), -1.0}, Centre{Vec3(0.0, -2.0, 0.0), -1.0}}};
+  row("two centres (A = -1 each)", body(thesis, 3200.0), two, 3200.0, 400.0, 0.1);
+  return 0;
+}
