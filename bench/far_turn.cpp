@@ -5,8 +5,10 @@
 // started at L, run by the far leg (Kahan-Li 6 with a turn for each kick, steps eta r/|v|) until a step
 // ends within r_stop of the nearest centre, against lp-kl8 at h = 0.004 and 0.002 over the same time
 // (the reference; its two runs' difference is printed as its own error). Error: max(|dR|/|R|, |dv|/|v|),
-// the estimates' norm; the columns "share 0" and "share 1" end the leg with no quiver correction and with
-// the first-order theory's full one (kQuiverShare is 0.5).
+// the estimates' norm; orbit: max(|dG|/|G|, |dK1|/|K1|), the guiding centre's orbit without the helix's
+// phase; quiver: the size of the leg's two quiver corrections (FarLeg::quiver); the columns "share 0" and
+// "share 1" end the leg with no quiver correction and with the first-order theory's full one (kQuiverShare
+// is 0.5).
 #include "bodypoint/field.hpp"
 #include "bodypoint/scattering.hpp"
 #include "bodypoint/splitting/catalogue.hpp"
@@ -23,6 +25,12 @@ namespace sp = bodypoint::splitting;
 
 double norm_error(const State& a, const State& ref) {
   return std::max((a.R - ref.R).norm() / ref.R.norm(), (a.v - ref.v).norm() / ref.v.norm());
+}
+/// The orbit's error, without the helix's phase: max(|dG|/|G|, |dK1|/|K1|) (G the guiding centre).
+double orbit_error(const BodyPoint& p, const State& a, const State& ref) {
+  const Momenta qa = to_momenta(p, a), qr = to_momenta(p, ref);
+  const Vec3 Ga = a.R + qa.K1.cross(qa.K2) / qa.K1.squaredNorm(), Gr = ref.R + qr.K1.cross(qr.K2) / qr.K1.squaredNorm();
+  return std::max((Ga - Gr).norm() / Gr.norm(), (qa.K1 - qr.K1).norm() / qr.K1.norm());
 }
 
 template <class Field>
@@ -51,7 +59,7 @@ Leg leg(const Body& b, const Field& f, double eta, double r_stop, double share, 
   sp::FarTurnKernel<Field> k(b.p, f);
   k.quiver_share = share;
   sp::LieState x = k.initial_state(b.s0);
-  const sp::FarLeg l = sp::far_leg<sp::ops_of<sp::KahanLi6>>(k, x, t_span, eta, r_stop);
+  const sp::FarLeg l = sp::far_leg<sp::ops_of<sp::KahanLi6>>(k, x, t_span, eta, sp::LegStop{Vec3::Zero(), r_stop, false});
   return {k.to_physical(x), l, k.evals()};
 }
 
@@ -65,9 +73,9 @@ void row(const char* name, const Body& b, const Field& f, double L, double r_sto
   const State coarse = reference(b, f, t, 0.004, &ref_evals);
   const double e0 = norm_error(leg(b, f, eta, r_stop, 0.0, t).end, ref);
   const double e1 = norm_error(leg(b, f, eta, r_stop, 1.0, t).end, ref);
-  std::printf("%-26s %6.0f %6.0f %5.2f %6ld %7ld %9.2e %9.2e %9.2e %9.2e %9ld\n", name, L,
-              sp::nearest_centre(f, main.end.R), eta, main.leg.steps, main.evals, norm_error(main.end, ref), e0, e1,
-              norm_error(coarse, ref), ref2_evals);
+  std::printf("%-26s %6.0f %6.0f %5.2f %6ld %7ld %9.2e %9.2e %9.2e %9.2e %9.2e %9.2e %9ld\n", name, L,
+              sp::nearest_centre(f, main.end.R), eta, main.leg.steps, main.evals, norm_error(main.end, ref),
+              orbit_error(b.p, main.end, ref), main.leg.quiver, e0, e1, norm_error(coarse, ref), ref2_evals);
 }
 
 Body body(SceneParams s, double L) {
@@ -78,24 +86,25 @@ Body body(SceneParams s, double L) {
 }  // namespace
 
 int main() {
-  std::printf("%-26s %6s %6s %5s %6s %7s %9s %9s %9s %9s %9s\n", "scene", "L", "r_end", "eta", "steps", "evals",
-              "error", "share 0", "share 1", "ref err", "ref evals");
+  std::printf("%-26s %6s %6s %5s %6s %7s %9s %9s %9s %9s %9s %9s %9s\n", "scene", "L", "r_end", "eta", "steps", "evals",
+              "error", "orbit", "quiver", "share 0", "share 1", "ref err", "ref evals");
   const SceneParams thesis;
   const OriginCentre one{thesis.A};
   for (double L : {3200.0, 12800.0})
     for (double r_stop : {400.0, 800.0}) row("table 3.1", body(thesis, L), one, L, r_stop, 0.1);
+  for (double r_stop : {100.0, 200.0}) row("table 3.1", body(thesis, 3200.0), one, 3200.0, r_stop, 0.1);
   row("table 3.1, eta 0.05", body(thesis, 3200.0), one, 3200.0, 400.0, 0.05);
   row("table 3.1, eta 0.2", body(thesis, 3200.0), one, 3200.0, 400.0, 0.2);
   SceneParams s = thesis;
   s.B = 0.3;
-  row("B = 0.3", body(s, 3200.0), OriginCentre{s.A}, 3200.0, 400.0, 0.1);
+  for (double r_stop : {200.0, 400.0}) row("B = 0.3", body(s, 3200.0), OriginCentre{s.A}, 3200.0, r_stop, 0.1);
   s = thesis;
   s.B = 0.9;
-  row("B = 0.9", body(s, 3200.0), OriginCentre{s.A}, 3200.0, 400.0, 0.1);
+  for (double r_stop : {200.0, 400.0}) row("B = 0.9", body(s, 3200.0), OriginCentre{s.A}, 3200.0, r_stop, 0.1);
   s = thesis;
   s.start.Kx = 4.0;
   s.A = -1.0;
-  row("Kx = 4, A = -1", body(s, 3200.0), OriginCentre{s.A}, 3200.0, 400.0, 0.1);
+  for (double r_stop : {200.0, 400.0}) row("Kx = 4, A = -1", body(s, 3200.0), OriginCentre{s.A}, 3200.0, r_stop, 0.1);
   // Two repelling centres 4 apart across the path, their total charge table 3.1's.
   const CentreList two{{Centre{Vec3(0.0, 2.0, 0.0), -1.0}, Centre{Vec3(0.0, -2.0, 0.0), -1.0}}};
   row("two centres (A = -1 each)", body(thesis, 3200.0), two, 3200.0, 400.0, 0.1);

@@ -55,7 +55,7 @@ BodyResult run_body(const RunPlan& plan, const Body& body, const std::vector<Cen
   options.events = events;
   options.sink = sink;
   detail::check_run(centres, plan.method, how, options);  // the scene was checked where it was made (make_scene)
-  BodyResult r = detail::integrate_checked(body, centres, plan.method, how, options);
+  BodyResult r = detail::integrate_encounter_checked(body, centres, plan.method, how, options);
   if (!ran(r.outcome)) throw Error(r.reason);
   return r;
 }

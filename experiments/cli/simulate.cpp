@@ -258,7 +258,7 @@ long add_start_distance_of(Encounter& e, const po::variables_map& vm, const Scen
                            const Body& body, const BodyResult& near) {
   std::function<Expected<Scene>()> far;
   if (!vm.count("scene")) far = [&] { return thesis_scene_twice_as_far(so.params, so.b, so.v_inf, so.arrival_phase); };
-  return add_start_distance(e, body, far, plan.search ? std::optional<double>(plan.tol) : std::nullopt, near.error.value,
+  return add_start_distance(e, body, far, plan.search ? std::optional<double>(plan.tol) : std::nullopt, near.error.for_orbit(),
                             "the scene file gives states, not the thesis's start distance L", {},
                             !vm.count("scene") && answers_at_limit(so.b, so.v_inf), &near);
 }

@@ -128,7 +128,7 @@ Point run_point(const Series& s, double b, double psi) {
     return p;
   }
   p.force_evals += add_start_distance(
-      r.encounter, body, [&] { return thesis_scene_twice_as_far(params, b, kNaN, arrival); }, p.tol, r.run.error.value, "", o,
+      r.encounter, body, [&] { return thesis_scene_twice_as_far(params, b, kNaN, arrival); }, p.tol, r.run.error.for_orbit(), "", o,
       answers_at_limit(b, kNaN), &r.run);
   p.sc = r.encounter.scattering;
   p.asymptote_error = r.encounter.asymptote_error;

@@ -45,4 +45,10 @@ void check_run(const std::vector<Centre>& centres, const MethodInfo* method, con
 BodyResult integrate_checked(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
                              const Advance& how, const Options& options);
 
+/// integrate_checked for an encounter run to its departure (the events of encounter_options): where auto
+/// runs it, the body spins and starts far enough out, its far field is crossed by legs of one turn of the
+/// spin a step (far_legs.cpp) and the run between them is auto's; otherwise integrate_checked.
+BodyResult integrate_encounter_checked(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
+                                       const Advance& how, const Options& options);
+
 }  // namespace bodypoint::detail

@@ -3,6 +3,7 @@
 #include "bodypoint/io.hpp"
 #include "bodypoint/scattering.hpp"
 #include "bodypoint/detail/model_parts.hpp"
+#include "checked.hpp"
 #include "choice.hpp"
 #include "encounter_parts.hpp"
 #include "events.hpp"
@@ -195,7 +196,7 @@ void add_start_distance_error(Encounter& at_L, const EncounterResult* at_2L, boo
     // The value at the limit, 2 x(2L) - x(L); the far run's errors count twice in it.
     const Encounter& far = at_2L->encounter;
     Scattering& sc = at_L.scattering;
-    const double far_error = (std::isfinite(at_2L->run.error.value) ? at_2L->run.error.value : 0.0) +
+    const double far_error = (std::isfinite(at_2L->run.error.for_orbit()) ? at_2L->run.error.for_orbit() : 0.0) +
                              (std::isfinite(far.asymptote_error) ? far.asymptote_error : 0.0);
     // x at the limit, and its error without the far run's: kLimitFactor |x(L) - x(2L)|.
     const auto to_limit = [](double& x, double x_far) {
@@ -212,7 +213,7 @@ void add_start_distance_error(Encounter& at_L, const EncounterResult* at_2L, boo
   } else {
     // x(L) = x_inf + c/L: x(L) - x_inf = 2 (x(L) - x(2L)), with a margin; the far run's own error counts.
     const Scattering& far = at_2L->encounter.scattering;
-    const double far_error = std::isfinite(at_2L->run.error.value) ? at_2L->run.error.value : 0.0;
+    const double far_error = std::isfinite(at_2L->run.error.for_orbit()) ? at_2L->run.error.for_orbit() : 0.0;
     at_L.start_distance_error = kStartDistanceFactor * (std::abs(at_L.scattering.deflection - far.deflection) + far_error);
     at_L.time_delay_error = kStartDistanceFactor * std::abs(at_L.scattering.time_delay - far.time_delay);
     at_L.out_of_plane_start_error = kStartDistanceFactor * (std::abs(at_L.scattering.out_of_plane - far.out_of_plane) + far_error);
@@ -230,7 +231,8 @@ namespace {
 EncounterResult encounter_at(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method, Accuracy a,
                              Options options, bool to_departure) {
   const Options o = encounter_options(body, centres, std::move(options), to_departure);
-  EncounterResult r{integrate_body(body, centres, method, a, o), {}, o.events};
+  check_request(Scene{centres, {body}}, method, a, o);
+  EncounterResult r{detail::integrate_encounter_checked(body, centres, method, a, o), {}, o.events};
   if (r.run.outcome != Outcome::ok) {
     r.encounter.outcome = r.run.outcome;
     r.encounter.reason = r.run.reason;

@@ -328,7 +328,7 @@ long add_row_start_distance(Encounter& e, const SweepSpec& spec, const std::vect
   Options o;
   o.track_invariants = false;
   o.cancel = spec.cancel;
-  return add_start_distance(e, body, far, spec.accuracy, near.error.value, "a scene file's body has no thesis start distance to double", o,
+  return add_start_distance(e, body, far, spec.accuracy, near.error.for_orbit(), "a scene file's body has no thesis start distance to double", o,
                             d && answers_at_limit(d->b, d->v_inf), &near);
 }
 

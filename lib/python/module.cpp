@@ -568,7 +568,7 @@ py::dict encounter_py(const Scene& scene, const std::string& method, double tol,
     if (far_scene) far = [&far_scene] { return *far_scene; };
     {
       py::gil_scoped_release free;
-      r.run.encounter_force_evals = add_start_distance(r.encounter, body, far, tol, r.run.error.value,
+      r.run.encounter_force_evals = add_start_distance(r.encounter, body, far, tol, r.run.error.for_orbit(),
                          "the scene gives states, not the thesis's start distance L (thesis_scene() does)", o, at_limit, &r.run);
     }
     stop.raise();

@@ -706,5 +706,77 @@ TEST(Encounter, AnAccuracyRunStoppedByAnEventPlansForTheStopNotTheSpan) {
   EXPECT_NEAR(far.run.t_end, near.run.run.t_end, 1e-6 * near.run.run.t_end);
 }
 
+
+// --- Issue #79: a far field crossed by legs of one turn of the spin a step (far_legs.cpp) ---
+
+/// Table 3.1's parameters (with `p`'s changes) given by b = 3 and arrival phase 1, started at L.
+Scene arriving_from(double L, SceneParams p = {}) {
+  p.start.L = L;
+  return thesis_scene(with_asymptotic_data(p, 3.0, Scattering::kNaN, 1.0));
+}
+
+/// The reference of an encounter with legs: the same start by logh-kl6 named (no legs), at this tol.
+constexpr double kLegsReferenceTol = 1e-9;
+
+/// An encounter with legs and its reference without: the deflection within the legs' stated error (the run's
+/// orbit and the asymptotes') plus the reference's own.
+void expect_legs_meet_their_reference(const Scene& s, double tol) {
+  const Body& body = s.bodies.front();
+  const EncounterResult legs = encounter(body, s.centres, nullptr, tol);
+  ASSERT_EQ(legs.encounter.outcome, Outcome::ok) << legs.encounter.reason;
+  EXPECT_NE(legs.run.chosen.find("far legs"), std::string::npos) << legs.run.chosen;
+  const EncounterResult ref = encounter(body, s.centres, find_method("logh-kl6"), kLegsReferenceTol);
+  ASSERT_EQ(ref.encounter.outcome, Outcome::ok) << ref.encounter.reason;
+  EXPECT_EQ(ref.run.chosen.find("far legs"), std::string::npos);
+  const double stated = legs.run.error.for_orbit() + legs.encounter.asymptote_error;
+  const double ref_error = ref.run.error.value + ref.encounter.asymptote_error;
+  const double off = std::abs(legs.encounter.scattering.deflection - ref.encounter.scattering.deflection);
+  EXPECT_LE(off, stated + ref_error) << "tol " << tol << ": " << legs.encounter.scattering.deflection << " against "
+                                     << ref.encounter.scattering.deflection;
+  // The legs cost a small share of the run without them.
+  EXPECT_LT(legs.run.total_force_evals(), ref.run.total_force_evals());
+}
+
+TEST(Encounter, AFarStartIsCrossedByLegsWithinTheirStatedError) {
+  expect_legs_meet_their_reference(arriving_from(3200.0), 1e-6);
+  expect_legs_meet_their_reference(arriving_from(3200.0), 1e-8);
+  SceneParams slow;
+  slow.B = 0.3;
+  slow.start.Kx = 4.0;
+  expect_legs_meet_their_reference(arriving_from(1600.0, slow), 1e-6);
+}
+
+TEST(Encounter, LegsCrossTheFarFieldOfSeveralCentres) {
+  Scene s = arriving_from(3200.0);
+  s.centres = {Centre{Vec3(0.0, 0.5, 0.0), -1.0}, Centre{Vec3(0.0, -0.5, 0.0), -1.0}};
+  expect_legs_meet_their_reference(s, 1e-6);
+}
+
+/// 16x the start distance adds ln(16)/0.1 steps of the legs (about 28 steps of 36 evaluations, at two steps
+/// each, in and out): a few thousand evaluations on the encounter's 10,000-20,000; a run capped by the spin
+/// would cost about 16x.
+constexpr double kLogGrowth = 1.5;
+
+TEST(Encounter, WithLegsItsCostGrowsLikeTheLogarithmOfTheStartDistance) {
+  const auto cost = [](double L) {
+    const Scene s = arriving_from(L);
+    const EncounterResult e = encounter(s.bodies.front(), s.centres, nullptr, 1e-6);
+    EXPECT_EQ(e.encounter.outcome, Outcome::ok) << e.encounter.reason;
+    return static_cast<double>(e.run.total_force_evals());
+  };
+  const double near = cost(3200.0), far = cost(51200.0);
+  EXPECT_LT(far, kLogGrowth * near) << near << " -> " << far;
+}
+
+TEST(Encounter, LegsLeaveACallersOwnEventsToTheRunWithout) {
+  const Scene s = arriving_from(3200.0);
+  Options o;
+  o.events.push_back(Event{Event::Kind::radius, 0, 100.0});
+  const EncounterResult e = encounter(s.bodies.front(), s.centres, nullptr, 1e-6, Scattering::kNaN, o);
+  ASSERT_EQ(e.encounter.outcome, Outcome::ok) << e.encounter.reason;
+  EXPECT_EQ(e.run.chosen.find("far legs"), std::string::npos);
+  EXPECT_TRUE(std::any_of(e.run.events.begin(), e.run.events.end(), [](const EventHit& h) { return h.event == 0; }));
+}
+
 }  // namespace
 }  // namespace bodypoint

@@ -188,7 +188,13 @@ struct ErrorEstimate {
   /// Where the run was flagged unresolved: a second companion one level finer showed the error falling
   /// as the step's order says, so the estimate may overrule the flag (the accuracy mode: always).
   bool confirmed = false;
+  /// The estimate of what an encounter's observables read from the final state, the guiding centre's
+  /// orbit (its position and K1) without the helix's phase, where it differs from `value`: a run whose far
+  /// field was crossed by legs of one turn of the spin a step knows the phase along its path less well
+  /// than the orbit. NaN: `value`.
+  double orbit = std::numeric_limits<double>::quiet_NaN();
   [[nodiscard]] bool known() const { return !std::isnan(value); }
+  [[nodiscard]] double for_orbit() const { return std::isnan(orbit) ? value : orbit; }
 };
 
 /// What the accuracy mode did to deliver its tolerance (Accuracy).

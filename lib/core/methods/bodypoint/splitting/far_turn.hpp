@@ -109,32 +109,95 @@ struct FarTurnKernel {
   }
 };
 
-/// What a leg did: its time, steps and why it ended.
+/// Where a leg ends: once the guiding centre G = R + K1 x K2/|K1|^2 is within `r` of `about` (coming
+/// in), or `beyond` it (going out). The last steps are shortened to land there (kLandSlack).
+struct LegStop {
+  Vec3 about = Vec3::Zero();
+  double r = 0.0;
+  bool beyond = false;
+};
+/// A leg has reached its stop within this share of the distance. A landing step aims at the stop by
+/// the guiding centre's rate and misses it by what the force bends the path over the step (1e-4 at
+/// r = 1600 on table 3.1, outwards: 1e-7 of it); the next one, forwards or back, lands within rounding.
+inline constexpr double kLandSlack = 1e-11;
+/// Landing steps before a leg gives up (two suffice where the force is weak enough for a leg).
+inline constexpr int kMaxLandings = 6;
+
+/// What a leg did.
 struct FarLeg {
   double t = 0.0;
   long steps = 0;
-  bool reached_radius = false;  ///< ended at r <= r_stop, before t_span
+  bool reached = false;  ///< ended at its stop (LegStop), not at t_span
+  /// Why the leg stopped short, in one line (the state is then where it stopped, and real); empty when it
+  /// did not: a turn too long for the slow scale (kMinTurns), a guiding centre that moves away from its
+  /// stop, no landing within kMaxLandings steps.
+  std::string refused;
+  /// The size of the two quiver corrections, max(|dR|/|R|, |dv|/|v|) each, summed: what a leg's model
+  /// error is measured against (docs/measurements.md, "An encounter at infinity").
+  double quiver = 0.0;
 };
 
+namespace detail {
+/// The guiding centre's distance from `about` and its rate of change (the guiding centre moves at
+/// (J |K1| - B K2.u)/D along u = K1/|K1| during a drift).
+template <class Field>
+void guiding_distance(const FarTurnKernel<Field>& k, const LieState& x, const Vec3& about, double& g, double& rate) {
+  const Vec3 R = x.R - x.R_err, K1 = x.K1 - x.K1_err;
+  const double K1sq = K1.squaredNorm(), K1n = std::sqrt(K1sq);
+  const Vec3 d = R + K1.cross(x.K2) / K1sq - about;
+  const Vec3 u = K1 / K1n;
+  const double speed = (k.lp.p.J * K1n - k.lp.p.B * x.K2.dot(u)) / k.lp.p.D();
+  g = d.norm();
+  rate = speed * u.dot(d) / g;
+}
+inline double relative_change(const State& a, const State& b) {
+  return std::max((a.R - b.R).norm() / b.R.norm(), (a.v - b.v).norm() / b.v.norm());
+}
+}  // namespace detail
+
 /// The far leg: the table's steps h = eta r/|v| (r: the nearest centre) with E for its kicks, from a
-/// real state for the time t_span or until a step ends within r_stop of a centre, the state real again
-/// at its end. Error where a turn is too long for the slow scale (kMinTurns).
+/// real state for the time t_span or until its stop, the state real again at its end. It stops short,
+/// saying why (FarLeg::refused), where a turn is too long for the slow scale (kMinTurns), where the
+/// guiding centre moves away from its stop (a leg coming in that the field turns back before it, one
+/// going out that turns in), or where it cannot land.
 template <const auto& Seq, class Field>
-FarLeg far_leg(FarTurnKernel<Field>& k, LieState& x, double t_span, double eta, double r_stop) {
+FarLeg far_leg(FarTurnKernel<Field>& k, LieState& x, double t_span, double eta, const LegStop& stop) {
   using Onto = typename FarTurnKernel<Field>::Onto;
   FarLeg leg;
-  k.quiver(x, Onto::averaged);
-  while (leg.t < t_span) {
-    const double r = nearest_centre(k.lp.field, x.R - x.R_err);
-    if (r <= r_stop) {
-      leg.reached_radius = true;
+  const auto corrected = [&](Onto to) {
+    const State before = k.to_physical(x);
+    k.quiver(x, to);
+    leg.quiver += detail::relative_change(k.to_physical(x), before);
+  };
+  corrected(Onto::averaged);
+  for (int landings = 0; leg.t < t_span;) {
+    double g = 0.0, rate = 0.0;
+    detail::guiding_distance(k, x, stop.about, g, rate);
+    if (std::abs(g - stop.r) <= kLandSlack * stop.r) {
+      leg.reached = true;
       break;
     }
+    const bool passed = stop.beyond ? g > stop.r : g < stop.r;
+    const double r = nearest_centre(k.lp.field, x.R - x.R_err);
     const double v = k.to_physical(x).v.norm();
-    if (k.period(x) * v * kMinTurns > r)
-      throw Error("far leg: the spin turns " + std::to_string(r / (k.period(x) * v)) + " times while the body crosses " +
-                  "its distance to the nearest centre (at least " + std::to_string(kMinTurns) + " for one turn a step)");
-    const double h = std::min(eta * r / v, t_span - leg.t);
+    if (!passed && (stop.beyond ? rate <= 0.0 : rate >= 0.0))
+      leg.refused = "the guiding centre moves away from its stop at distance " + std::to_string(stop.r) + " (at " +
+                    std::to_string(g) + ")";
+    else if (k.period(x) * v * kMinTurns > r)
+      leg.refused = "the spin turns " + std::to_string(r / (k.period(x) * v)) + " times while the body crosses its " +
+                    "distance to the nearest centre (at least " + std::to_string(kMinTurns) + " for one turn a step)";
+    if (!leg.refused.empty()) break;
+    // A step that would cross the stop lands on it by the guiding centre's rate (its path's curvature and
+    // the force bend it by less than a step's change of the rate); one that has crossed it steps back.
+    double h = (stop.r - g) / rate;
+    if (!passed && h > eta * r / v) {
+      h = eta * r / v;
+    } else if (++landings > kMaxLandings) {
+      leg.refused = "no landing on its stop at distance " + std::to_string(stop.r) + " in " + std::to_string(kMaxLandings) +
+                    " steps (at " + std::to_string(g) + ")";
+      break;
+    }
+    h = std::min(h, t_span - leg.t);
     for (std::size_t j = 0; j < Seq.size; ++j) {
       if (Seq.ops[j].part == Part::kick) k.kick(x, Seq.ops[j].c * h);
       else k.drift(x, Seq.ops[j].c * h);
@@ -142,7 +205,7 @@ FarLeg far_leg(FarTurnKernel<Field>& k, LieState& x, double t_span, double eta, 
     leg.t += h;
     ++leg.steps;
   }
-  k.quiver(x, Onto::real);
+  corrected(Onto::real);
   return leg;
 }
 

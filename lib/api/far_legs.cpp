@@ -1,0 +1,254 @@
+// bodypoint: an encounter whose far field is crossed by legs of one turn of the spin a step
+// (splitting/far_turn.hpp; docs/physics.md, "The far field by one turn a step").
+//
+// A spinning body that starts far from the centres crosses, in auto's run, a far field whose steps are
+// capped by the spin: the cost grows like the start distance L. Where the encounter allows it, the run
+// is three: a far leg from the start to the hand-off distance r_h, auto's run from there to its
+// departure through r_h (its search, estimate and events as always), and a far leg out to the start
+// distance. Each leg is run at two steps; the finer is delivered, and its error is what the two differ
+// by plus a share of the quiver corrections it made (the averaged model's error). The legs land on
+// half the start distance on the way (the asymptotes' error estimate reads the states there).
+#include "bodypoint/bodypoint.hpp"
+#include "bodypoint/adaptive/tolerance.hpp"
+#include "bodypoint/io.hpp"
+#include "bodypoint/scattering.hpp"
+#include "bodypoint/splitting/catalogue.hpp"
+#include "bodypoint/splitting/far_turn.hpp"
+#include "checked.hpp"
+#include "encounter_parts.hpp"
+#include "events.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace bodypoint::detail {
+namespace {
+
+namespace sp = splitting;
+
+/// A leg's steps are this share of r/|v| (its companion's half of it): Kahan-Li 6 with a turn for each
+/// kick errs 1.5e-9 from L = 12800 to r = 400 on table 3.1, what the averaged model leaves (bench/far_turn).
+constexpr double kLegEta = 0.1;
+/// The leg's model error against its quiver corrections' size, on the scenes of bench/far_turn.cpp
+/// (docs/measurements.md, "An encounter at infinity"): the state's at most 1/86 of it, the orbit's (the
+/// guiding centre and K1, what the observables read) at most 1/196. Bounds about twice those.
+constexpr double kModelShare = 1.0 / 50.0;
+constexpr double kOrbitModelShare = 1.0 / 100.0;
+/// The share of TOL the legs' orbit may take; auto's run between them is asked for the rest.
+constexpr double kLegShare = 0.5;
+/// The hand-off is at least this many turns of the spin while the body crosses it (the leg's
+/// own bound is splitting::kMinTurns; the model's error grows faster than 1/r^2 below about 100 on
+/// table 3.1, 15 turns at r = 136) ...
+constexpr double kHandOffTurns = 15.0;
+/// ... and this many times the encounter's own scale (its straight path's distance from the centre, or
+/// the distance where the potential is the kinetic energy).
+constexpr double kHandOffScale = 8.0;
+/// Legs are used where the start is at least this far beyond the hand-off: nearer, the run from the
+/// start costs little more than the legs and their companions.
+constexpr double kLegGain = 2.0;
+
+struct Plan {
+  double r0 = 0.0;       ///< the start distance of the guiding centre from `about`
+  double r_hand = 0.0;   ///< where auto's run takes over, and hands back
+  Vec3 about = Vec3::Zero();
+  std::size_t arrival = 0, departure = 0, stop = 0;  ///< their indices in the events
+};
+
+/// The index of the event (kind, value, stop), or -1.
+long find_event(const std::vector<Event>& events, Event::Kind kind, double value, bool stop) {
+  for (std::size_t i = 0; i < events.size(); ++i)
+    if (events[i].kind == kind && events[i].value == value && events[i].stop == stop) return static_cast<long>(i);
+  return -1;
+}
+
+/// Whether this run is an encounter to its departure that legs can serve, and where they hand off.
+std::optional<Plan> plan_legs(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
+                              const Advance& how, const Options& options) {
+  const auto* a = std::get_if<Accuracy>(&how);
+  if (method || !a || options.sink || body.p.B == 0.0 || !(a->t_end > 0.0)) return std::nullopt;
+  for (const Centre& c : centres)
+    if (c.law != ForceLaw::coulomb) return std::nullopt;
+  const std::optional<Centre> far = far_field_centre(centres);
+  if (!far || far->A == 0.0) return std::nullopt;
+  Plan plan;
+  plan.about = far->c;
+  plan.r0 = (guiding_centre(body.p, body.s0) - plan.about).norm();
+  const double half = 0.5 * plan.r0;
+  const long arrival = find_event(options.events, Event::Kind::arrival, half, false);
+  const long departure = find_event(options.events, Event::Kind::departure, half, false);
+  const long stop = find_event(options.events, Event::Kind::departure, 0.0, true);
+  if (arrival < 0 || departure < 0 || stop < 0) return std::nullopt;
+  // The encounter's own events and nothing else (a caller's radius, plane or arrival has no leg to fall on).
+  for (std::size_t i = 0; i < options.events.size(); ++i) {
+    const Event& e = options.events[i];
+    const bool own = e.kind == Event::Kind::closest_approach ? !e.stop
+                                                              : static_cast<long>(i) == arrival ||
+                                                                    static_cast<long>(i) == departure || static_cast<long>(i) == stop;
+    if (!own) return std::nullopt;
+  }
+  plan.arrival = static_cast<std::size_t>(arrival);
+  plan.departure = static_cast<std::size_t>(departure);
+  plan.stop = static_cast<std::size_t>(stop);
+  // The hand-off: the turns, the encounter's scale, and the model's error within its share of TOL. The
+  // quiver's size at r is about |A| rho/(r^2 |K1| |v|) (docs/physics.md), the model's error kModelShare of it.
+  // The body's speed at any orientation of its spin far out, (J |K1| + |B| |K2|)/D (a back-scattered body
+  // leaves faster than it came: K1 turns against K2).
+  const Momenta q = to_momenta(body.p, body.s0);
+  const double K1 = q.K1.norm(), v = (body.p.J * K1 + std::abs(body.p.B) * q.K2.norm()) / body.p.D();
+  if (!(K1 > 0.0) || !(body.s0.v.norm() > 0.0)) return std::nullopt;
+  const Vec3 u = q.K1 / K1;
+  if ((guiding_centre(body.p, body.s0) - plan.about).dot(u) >= 0.0) return std::nullopt;  // not coming in
+  const double rho = q.K2.cross(u).norm() / K1;
+  const double period = 2.0 * M_PI * body.p.D() / (std::abs(body.p.B) * K1);
+  const double line = (guiding_centre(body.p, body.s0) - plan.about).cross(u).norm();
+  const double speed = body.s0.v.norm();  // the model's and the encounter's scales take the speed it has
+  const double coulomb = 2.0 * std::abs(far->A) / (K1 * speed);
+  const double model = std::sqrt(std::abs(far->A) * rho * kOrbitModelShare / (K1 * speed * 0.5 * kLegShare * a->tol));
+  plan.r_hand = std::max({kHandOffTurns * period * v, kHandOffScale * std::max(line, coulomb), model});
+  if (plan.r0 < kLegGain * plan.r_hand) return std::nullopt;
+  return plan;
+}
+
+/// max(|dG|/|G|, |dK1|/|K1|): how far apart two states' orbits are (the guiding centre G and K1), whatever
+/// the helix's phase. A leg knows its time along the path to about 1e-7 where it starts at r = 570 on table
+/// 3.1 (the landing times of legs at 22 steps eta between 0.03 and 0.12 scatter by that much), so the
+/// phase of the helix at its end to 5e-7 rad, while its orbit agrees to 1e-10 (docs/measurements.md).
+double orbit_distance(const BodyPoint& p, const State& a, const State& b) {
+  const Vec3 Ga = guiding_centre(p, a), Gb = guiding_centre(p, b);
+  const Vec3 Ka = to_momenta(p, a).K1, Kb = to_momenta(p, b).K1;
+  return std::max((Ga - Gb).norm() / Gb.norm(), (Ka - Kb).norm() / Kb.norm());
+}
+
+/// One leg at kLegEta and at half of it: the finer's state, and its error.
+struct Leg {
+  State end;
+  std::string refused;  ///< FarLeg::refused of either run
+  double t = 0.0, error = 0.0, orbit_error = 0.0;
+  long steps = 0, evals = 0;
+};
+Leg leg(const Body& body, const std::vector<Centre>& centres, const State& start, const sp::LegStop& stop) {
+  Leg out;
+  State coarse;
+  for (const double eta : {kLegEta, 0.5 * kLegEta}) {
+    sp::FarTurnKernel<CentreList> k(body.p, CentreList{centres});
+    sp::LieState x = k.initial_state(start);
+    const sp::FarLeg l = sp::far_leg<sp::ops_of<sp::KahanLi6>>(k, x, std::numeric_limits<double>::infinity(), eta, stop);
+    out.evals += k.evals();
+    out.end = k.to_physical(x);
+    if (!l.refused.empty()) {
+      out.refused = l.refused;
+      return out;
+    }
+    if (eta == kLegEta) {
+      coarse = out.end;
+      continue;
+    }
+    out.t = l.t;
+    out.steps = l.steps;
+    out.error = adaptive::state_distance(coarse, out.end) + kModelShare * l.quiver;
+    out.orbit_error = orbit_distance(body.p, coarse, out.end) + kOrbitModelShare * l.quiver;
+  }
+  return out;
+}
+
+EventHit hit_at(std::size_t event, double t, const State& s, const Vec3& centre) {
+  EventHit h;
+  h.event = event;
+  h.t = t;
+  h.s = s;
+  h.r = (s.R - centre).norm();
+  return h;
+}
+
+/// The four legs of an encounter: in to half the start distance and on to the hand-off, out to half the
+/// start distance and on to the start distance.
+struct Legs {
+  Leg in_half, in, out_half, out;
+  [[nodiscard]] long evals() const { return in_half.evals + in.evals + out_half.evals + out.evals; }
+};
+
+/// auto's run `r` between the legs made the run of the whole encounter: its hits on the encounter's own
+/// events (the near run's closest approaches, the half distance's, the end), its time, cost and errors.
+void join(BodyResult& r, const Legs& g, const Plan& plan, const Options& options, const Options& near_options,
+          const Vec3& centre, double tol) {
+  const double t_in = g.in_half.t + g.in.t;
+  std::vector<EventHit> hits{hit_at(plan.arrival, g.in_half.t, g.in_half.end, centre)};
+  for (EventHit h : r.events) {
+    const Event& e = near_options.events[h.event];
+    if (e.kind != Event::Kind::closest_approach) continue;
+    for (std::size_t k = 0; k < options.events.size(); ++k)
+      if (options.events[k].kind == e.kind && options.events[k].centre == e.centre) h.event = k;
+    h.t += t_in;
+    hits.push_back(h);
+  }
+  const double t_out_half = t_in + r.run.t_end + g.out_half.t, t_end = t_out_half + g.out.t;
+  hits.push_back(hit_at(plan.departure, t_out_half, g.out_half.end, centre));
+  hits.push_back(hit_at(plan.stop, t_end, g.out.end, centre));
+  const double error = g.in_half.error + g.in.error + g.out_half.error + g.out.error;
+  const double orbit = g.in_half.orbit_error + g.in.orbit_error + g.out_half.orbit_error + g.out.orbit_error;
+  r.events = std::move(hits);
+  r.run.final = g.out.end;
+  r.run.t_end = t_end;
+  r.run.steps += g.in_half.steps + g.in.steps + g.out_half.steps + g.out.steps;
+  r.run.force_evals += g.evals();
+  r.error.orbit = r.error.value + orbit;
+  r.error.value += error;
+  if (r.accuracy) r.accuracy->err_estimate = r.error.value;
+  const std::string legs = "far legs of one turn of the spin a step beyond r = " + fmt(plan.r_hand) + " (" +
+                           std::to_string(g.in_half.steps + g.in.steps) + " steps in, " +
+                           std::to_string(g.out_half.steps + g.out.steps) + " out, " + std::to_string(g.evals()) +
+                           " force evaluations with their companions, estimated error " + fmt(error) + ", " + fmt(orbit) +
+                           " of the orbit without the helix's phase; the invariants are the run's between them)";
+  r.error.basis += "; " + legs;
+  r.chosen += r.chosen.empty() ? legs : "; " + legs;
+  if (r.error.value > tol)
+    r.warnings.push_back("the final state's error " + fmt(r.error.value) + " is above tol " + fmt(tol) +
+                         ": the far legs know the helix's phase along the path less well than the orbit (" +
+                         fmt(r.error.orbit) + "), which the encounter's observables read; a state at tol wants a named method");
+}
+
+/// The run of `plan`: the legs and auto's run between them, as one run of the whole encounter. Where a leg
+/// stops short (far_leg's reasons) the encounter is auto's run without legs, the legs' work counted in it.
+BodyResult run_with_legs(const Body& body, const std::vector<Centre>& centres, const Accuracy& a, const Options& options,
+                         const Plan& plan) {
+  const auto without = [&](long spent) {
+    BodyResult plain = integrate_checked(body, centres, nullptr, a, options);
+    plain.run.force_evals += spent;
+    return plain;
+  };
+  Legs g;
+  g.in_half = leg(body, centres, body.s0, {plan.about, 0.5 * plan.r0, false});
+  if (!g.in_half.refused.empty()) return without(g.evals());
+  g.in = leg(body, centres, g.in_half.end, {plan.about, plan.r_hand, false});
+  if (!g.in.refused.empty()) return without(g.evals());
+  const Body near{body.p, g.in.end, body.name};
+  Options near_options = options;
+  near_options.events.clear();
+  near_options = encounter_options(near, centres, near_options, true);
+  BodyResult r = integrate_checked(near, centres, nullptr,
+                                   Accuracy{(1.0 - kLegShare) * a.tol, encounter_span(near, centres), 0.0, a.first_step},
+                                   near_options);
+  if (r.outcome != Outcome::ok || !r.run.stopped) {  // refused, failed or unfinished: said at its own times
+    r.run.force_evals += g.evals();
+    return r;
+  }
+  g.out_half = leg(body, centres, r.run.final, {plan.about, 0.5 * plan.r0, true});
+  if (g.out_half.refused.empty()) g.out = leg(body, centres, g.out_half.end, {plan.about, plan.r0, true});
+  if (!g.out_half.refused.empty() || !g.out.refused.empty()) return without(g.evals() + r.total_force_evals());
+  join(r, g, plan, options, near_options, centres[options.events[plan.arrival].centre].c, a.tol);
+  return r;
+}
+
+}  // namespace
+
+BodyResult integrate_encounter_checked(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
+                                       const Advance& how, const Options& options) {
+  if (const std::optional<Plan> plan = plan_legs(body, centres, method, how, options))
+    return run_with_legs(body, centres, std::get<Accuracy>(how), options, *plan);
+  return integrate_checked(body, centres, method, how, options);
+}
+
+}  // namespace bodypoint::detail
