@@ -541,6 +541,32 @@ def scattering_figure(res, figs, listing):
          "scattering: deflection function, differential cross-section and closest approach per series")
 
 
+def l_cost_figure(res, figs, listing):
+    """bodypoint study --name L (L_cost.csv): what an encounter at its limit L -> infinity costs against its
+    start distance, auto at tol 1e-8 with every evaluation of the answer (its run from 2L included), the runs
+    with far legs marked, beside the thesis's fixed step's evaluations to the same departure."""
+    path = os.path.join(res, "L_cost.csv")
+    if not os.path.exists(path):
+        return
+    rows = [r for r in read_csv(path) if r["failure"] == ""]
+    fig, ax = plt.subplots(figsize=(WIDE / 2, 2.4))
+    ls = [num(r["L"]) for r in rows]
+    ax.plot(ls, [num(r["fixed_step_evals"]) for r in rows], ".-", color="tab:red", markersize=3, linewidth=0.8,
+            label=r"thesis's step $h = 10^{-4}$")
+    ax.plot(ls, [num(r["force_evals"]) for r in rows], ".-", color="tab:blue", markersize=3, linewidth=0.8,
+            label=r"auto, tol $10^{-8}$, whole call")
+    legs = [r for r in rows if r["far_legs"] == "1"]
+    ax.plot([num(r["L"]) for r in legs], [num(r["force_evals"]) for r in legs], "o", color="tab:blue", markersize=4,
+            markerfacecolor="none", label="with far legs")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("start distance $L$")
+    ax.set_ylabel("force evaluations")
+    ax.legend(loc="upper left", frameon=False)
+    save(fig, os.path.join(figs, "fig_L_cost.pdf"), listing, "an encounter's cost against its start distance",
+         width=0.55)
+
+
 def main():
     args = sys.argv[1:]
     only = None
@@ -566,6 +592,7 @@ def main():
     far_field_figure(res, figs, listing)
     map_figure(res, figs, listing)
     scattering_figure(res, figs, listing)
+    l_cost_figure(res, figs, listing)
     long_time_figure(res, figs, listing)
     with open(os.path.join(figs, "lost.csv"), "w", newline="") as f:
         w = csv.writer(f)

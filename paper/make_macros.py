@@ -1631,6 +1631,32 @@ def scattering(res, M):
     M.add("ScatDelayZeroMax", sci(max(delays0), 2))
 
 
+def l_cost(res, M):
+    """bodypoint study --name L (L_cost.csv): an encounter's whole cost against its start distance, with and
+    without far legs, beside the thesis's fixed step's; how far apart its deflections at the limit are."""
+    path = os.path.join(res, "L_cost.csv")
+    if not os.path.exists(path):
+        return
+    rows, _ = read_csv(path)
+    ok = [r for r in rows if r["failure"] == ""]
+    legs = [r for r in ok if r["far_legs"] == "1"]
+    last = max(ok, key=lambda r: num(r["L"]))
+    M.add("LCostLMin", count(round(min(num(r["L"]) for r in ok))))
+    M.add("LCostLMax", sci(num(last["L"])))
+    M.add("LCostAtMax", count(int(last["force_evals"])))
+    M.add("LCostFixedAtMax", sci(num(last["fixed_step_evals"])))
+    without = [r for r in ok if r["far_legs"] == "0"]
+    top = max(without, key=lambda r: num(r["L"]))
+    M.add("LCostNoLegsL", count(round(num(top["L"]))))
+    M.add("LCostNoLegs", count(int(top["force_evals"])))
+    if legs:
+        M.add("LCostLegsFrom", count(round(min(num(r["L"]) for r in legs))))
+        M.add("LCostLegsSpread", f"{max(num(r['force_evals']) for r in legs) / min(num(r['force_evals']) for r in legs):.2f}")
+    thetas = [num(r["deflection"]) for r in ok]
+    M.add("LCostThetaSpread", sci(max(thetas) - min(thetas), 1))
+    M.add("LCostErrMax", sci(max(num(r["deflection_error"]) for r in ok), 1))
+
+
 def latex_text(text):
     """Plain text (a CPU's or a compiler's name) safe inside a LaTeX paragraph."""
     for a, b in [("\\", "\\textbackslash{}"), ("&", "\\&"), ("%", "\\%"), ("$", "\\$"), ("#", "\\#"),
@@ -1771,6 +1797,7 @@ def main():
     appendix(res, M)
     ensembles(res, out, M)
     scattering(res, M)
+    l_cost(res, M)
     long_time(res, out, M)
     contention(res, figs, M)
     M.write(os.path.join(out, "macros.tex"))

@@ -14,6 +14,7 @@
 //                               grid's range) and in psi, summed over every branch of b(theta), with its
 //                               quadrature error, beside Rutherford's for the guiding centre's mass |K1|/u
 //   scattering_summary.csv      one row per series
+// and, for `study --name L`, L_cost.csv (write_L_cost).
 #include "process.hpp"
 #include "scattering_study.hpp"
 
@@ -447,6 +448,69 @@ void write_scattering_study(const std::filesystem::path& dir, bool quick, unsign
   xs.commit();
   std::cerr << "wrote " << (dir / "scattering.csv").string() << ", scattering_summary.csv, scattering_rainbows.csv and "
             << "scattering_cross_section.csv (" << g.points.size() << " runs on the grid)\n";
+}
+
+namespace {
+
+/// The L cost study's accuracy: the (#79) TOL, where a run from L = 200 costs about 47,000
+/// evaluations with its start distance's run.
+constexpr double kLCostTol = 1e-8;
+/// The thesis's step (table 3.1) and its cheapest method's evaluations a step (symplectic Euler: one).
+constexpr double kThesisStep = 1e-4;
+
+/// One start distance of the L cost study: the encounter by auto to its departure and its start
+/// distance's run (observables at the limit), every evaluation counted.
+struct LCost {
+  double L = 0.0, t_end = kNaN, deflection = kNaN, deflection_error = kNaN;
+  long force_evals = 0;
+  bool legs = false;
+  std::string failure;
+};
+
+LCost l_cost(double L) {
+  LCost c;
+  c.L = L;
+  SceneParams p;
+  p.start.L = L;
+  const SceneParams solved = with_asymptotic_data(p, 3.0, kNaN, 1.0);
+  const Scene scene = thesis_scene(solved);
+  const Body& body = scene.bodies.front();
+  Options o;
+  o.track_invariants = false;
+  EncounterResult r = encounter(body, scene.centres, nullptr, kLCostTol, kNaN, o);
+  c.force_evals = r.run.total_force_evals();
+  c.legs = r.run.chosen.find("far legs") != std::string::npos;
+  if (r.encounter.outcome != Outcome::ok) {
+    c.failure = r.encounter.reason;
+    return c;
+  }
+  c.force_evals += add_start_distance(
+      r.encounter, body, [&] { return thesis_scene_twice_as_far(solved, 3.0, kNaN, 1.0); }, kLCostTol,
+      r.run.error.for_orbit(), "", o, true, &r.run);
+  c.t_end = r.run.run.t_end;
+  c.deflection = r.encounter.scattering.deflection;
+  c.deflection_error = r.encounter.deflection_error;
+  return c;
+}
+
+}  // namespace
+
+void write_L_cost(const std::filesystem::path& dir, bool quick) {
+  AtomicFile f((dir / "L_cost.csv").string());
+  f.stream() << "# bodypoint study" << (quick ? " --quick" : "") << " --name L: table 3.1 given by b = 3 and arrival phase 1, "
+             << "started at L, run to its departure by auto at tol " << fmt(kLCostTol)
+             << " with its observables at the limit L -> infinity (its run from 2L counted); fixed_step_evals: the thesis's "
+             << "step h = " << fmt(kThesisStep) << " to the same departure, one evaluation a step\n"
+             << "L,force_evals,far_legs,t_end,deflection,deflection_error,fixed_step_evals,failure\n";
+  for (const double L : log_range(50.0, 1e5, quick ? 7 : 19)) {
+    const LCost c = l_cost(L);
+    CsvLine line;
+    line.num(c.L).count(c.force_evals).count(c.legs ? 1 : 0).num(c.t_end).num(c.deflection).num(c.deflection_error);
+    line.count(std::isfinite(c.t_end) ? std::lround(c.t_end / kThesisStep) : 0).quoted(c.failure);
+    f.stream() << line.str() << '\n';
+  }
+  f.commit();
+  std::cerr << "wrote " << (dir / "L_cost.csv").string() << "\n";
 }
 
 }  // namespace bodypoint::cli

@@ -99,6 +99,7 @@ void study_L(const StudyContext& c) {
   s.base.start.d = 50;
   s.axes[0].values = c.quick ? linear_range(5, 1000, 199) : linear_range(5, 1000, 5);
   write_sweep(c, "L_sweep.csv", s, "fig. 4.3-4.4: L = 5..1000 step 5, d = 50, h = 1e-4, n = 250000");
+  write_L_cost(c.dir, c.quick);
 }
 
 void study_h(const StudyContext& c) {

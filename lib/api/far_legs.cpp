@@ -32,11 +32,21 @@ namespace sp = splitting;
 /// A leg's steps are this share of r/|v| (its companion's half of it): Kahan-Li 6 with a turn for each
 /// kick errs 1.5e-9 from L = 12800 to r = 400 on table 3.1, what the averaged model leaves (bench/far_turn).
 constexpr double kLegEta = 0.1;
-/// The leg's model error against its quiver corrections' size, on the scenes of bench/far_turn.cpp
-/// (docs/measurements.md, "An encounter at infinity"): the state's at most 1/86 of it, the orbit's (the
-/// guiding centre and K1, what the observables read) at most 1/196. Bounds about twice those.
+/// The leg's model error against its quiver corrections' size in the state, on the scenes of
+/// bench/far_turn.cpp (docs/measurements.md, "An encounter at infinity"): at most 1/86 of it; a bound about
+/// twice that. A leg going out is off in the outgoing asymptote's direction by this share of its
+/// correction's effect on it too.
 constexpr double kModelShare = 1.0 / 50.0;
-constexpr double kOrbitModelShare = 1.0 / 100.0;
+/// Across K1 the correction leaves up to 1.6 times what it moved: the guiding centre's offset across K1
+/// from L = 3200 to r = 200 .. 800 with b = 0.3, 1, 3, 10 is 0.32 .. 1.6 of the correction's, and at most
+/// 0.9 of the quiver's size there, |A| rho/(r^2 |K1| Omega) (Omega = |B| |K1|/D). A leg coming in is taken
+/// to be off in the incoming asymptote by this many times its correction's effect on it.
+constexpr double kAcrossModelShare = 2.0;
+/// A leg coming in moves the incoming asymptote's impact parameter b, which the encounter turns into the
+/// deflection by dtheta/db, Rutherford's 2a/(a^2 + b^2) (a = |A|/(|K1| v), sin(theta)/b) for a point mass;
+/// this many times that (b = 1 on table 3.1: 3.2e-7 across moved the deflection by 2.2e-8, 0.069 of it, where
+/// sin(theta)/b is 0.090).
+constexpr double kSensitivity = 1.5;
 /// The share of TOL the legs' orbit may take; auto's run between them is asked for the rest.
 constexpr double kLegShare = 0.5;
 /// The hand-off is at least this many turns of the spin while the body crosses it (the leg's
@@ -92,9 +102,10 @@ std::optional<Plan> plan_legs(const Body& body, const std::vector<Centre>& centr
   plan.arrival = static_cast<std::size_t>(arrival);
   plan.departure = static_cast<std::size_t>(departure);
   plan.stop = static_cast<std::size_t>(stop);
-  // The hand-off: the turns, the encounter's scale, and the model's error within its share of TOL. The
-  // quiver's size at r is about |A| rho/(r^2 |K1| |v|) (docs/physics.md), the model's error kModelShare of it.
-  // The body's speed at any orientation of its spin far out, (J |K1| + |B| |K2|)/D (a back-scattered body
+  // The hand-off: the turns, the encounter's scale, and the model's error in the deflection within its share
+  // of TOL: an offset across K1 of at most the quiver's size |A| rho/(r^2 |K1| Omega), turned into the
+  // deflection by kSensitivity dtheta/db (Rutherford's, from the straight path's distance). The turns take
+  // the body's speed at any orientation of its spin far out, (J |K1| + |B| |K2|)/D (a back-scattered body
   // leaves faster than it came: K1 turns against K2).
   const Momenta q = to_momenta(body.p, body.s0);
   const double K1 = q.K1.norm(), v = (body.p.J * K1 + std::abs(body.p.B) * q.K2.norm()) / body.p.D();
@@ -106,32 +117,23 @@ std::optional<Plan> plan_legs(const Body& body, const std::vector<Centre>& centr
   const double line = (guiding_centre(body.p, body.s0) - plan.about).cross(u).norm();
   const double speed = body.s0.v.norm();  // the model's and the encounter's scales take the speed it has
   const double coulomb = 2.0 * std::abs(far->A) / (K1 * speed);
-  const double model = std::sqrt(std::abs(far->A) * rho * kOrbitModelShare / (K1 * speed * 0.5 * kLegShare * a->tol));
+  const double ruth = std::abs(far->A) / (K1 * speed), per_b = kSensitivity * 2.0 * ruth / (ruth * ruth + line * line);
+  const double omega = std::abs(body.p.B) * K1 / body.p.D();
+  const double model = std::sqrt(per_b * std::abs(far->A) * rho / (K1 * omega * 0.5 * kLegShare * a->tol));
   plan.r_hand = std::max({kHandOffTurns * period * v, kHandOffScale * std::max(line, coulomb), model});
   if (plan.r0 < kLegGain * plan.r_hand) return std::nullopt;
   return plan;
 }
 
-/// max(|dG|/|G|, |dK1|/|K1|): how far apart two states' orbits are (the guiding centre G and K1), whatever
-/// the helix's phase. A leg knows its time along the path to about 1e-7 where it starts at r = 570 on table
-/// 3.1 (the landing times of legs at 22 steps eta between 0.03 and 0.12 scatter by that much), so the
-/// phase of the helix at its end to 5e-7 rad, while its orbit agrees to 1e-10 (docs/measurements.md).
-double orbit_distance(const BodyPoint& p, const State& a, const State& b) {
-  const Vec3 Ga = guiding_centre(p, a), Gb = guiding_centre(p, b);
-  const Vec3 Ka = to_momenta(p, a).K1, Kb = to_momenta(p, b).K1;
-  return std::max((Ga - Gb).norm() / Gb.norm(), (Ka - Kb).norm() / Kb.norm());
-}
-
 /// One leg at kLegEta and at half of it: the finer's state, and its error.
 struct Leg {
-  State end;
+  State end, coarse, averaged;  ///< the finer run's end, the coarser's, the finer's before its quiver correction
   std::string refused;  ///< FarLeg::refused of either run
-  double t = 0.0, error = 0.0, orbit_error = 0.0;
+  double t = 0.0, error = 0.0;
   long steps = 0, evals = 0;
 };
 Leg leg(const Body& body, const std::vector<Centre>& centres, const State& start, const sp::LegStop& stop) {
   Leg out;
-  State coarse;
   for (const double eta : {kLegEta, 0.5 * kLegEta}) {
     sp::FarTurnKernel<CentreList> k(body.p, CentreList{centres});
     sp::LieState x = k.initial_state(start);
@@ -143,13 +145,13 @@ Leg leg(const Body& body, const std::vector<Centre>& centres, const State& start
       return out;
     }
     if (eta == kLegEta) {
-      coarse = out.end;
+      out.coarse = out.end;
       continue;
     }
     out.t = l.t;
     out.steps = l.steps;
-    out.error = adaptive::state_distance(coarse, out.end) + kModelShare * l.quiver;
-    out.orbit_error = orbit_distance(body.p, coarse, out.end) + kOrbitModelShare * l.quiver;
+    out.averaged = l.averaged_end;
+    out.error = adaptive::state_distance(out.coarse, out.end) + kModelShare * l.quiver;
   }
   return out;
 }
@@ -170,10 +172,40 @@ struct Legs {
   [[nodiscard]] long evals() const { return in_half.evals + in.evals + out_half.evals + out.evals; }
 };
 
+/// What the legs' errors make of the deflection (rad). A leg going out moves the outgoing asymptote: the
+/// deflection from the start to its end against to its coarser run's end, and kModelShare of that to its end
+/// before the quiver correction (the averaged model's error). A leg coming in moves the incoming asymptote:
+/// the same differences of the deflection from its end to the end of auto's run `near_end`, and of the guiding
+/// centre's offset across K1 (the impact parameter's) turned into the deflection by kSensitivity sin(theta)/b,
+/// the model's kAcrossModelShare times its correction's.
+double deflection_error(const Body& body, const std::vector<Centre>& centres, const Legs& g, const State& near_end) {
+  const auto in_of = [&](const State& s) { return scattering(body.p, centres, s, near_end); };
+  const Scattering at = in_of(g.in.end);
+  const double per_b = kSensitivity * std::abs(std::sin(at.deflection)) / at.b;
+  // The guiding centre's offset across K1: what moves the path (b read from K2Q does not see it: every
+  // sub-flow, the quiver's turn included, keeps K2Q).
+  const auto across = [&](const State& x, const State& y) {
+    const Vec3 u = to_momenta(body.p, x).K1.normalized();
+    return (guiding_centre(body.p, x) - guiding_centre(body.p, y)).cross(u).norm();
+  };
+  const auto in_part = [&](const Leg& l, const State& other) {
+    return std::abs(in_of(l.end).deflection - in_of(other).deflection) + per_b * across(l.end, other);
+  };
+  const auto out_part = [&](const Leg& l, const State& other) {
+    return std::abs(scattering(body.p, centres, body.s0, l.end).deflection -
+                    scattering(body.p, centres, body.s0, other).deflection);
+  };
+  double e = 0.0;
+  for (const Leg* l : {&g.in_half, &g.in}) e += in_part(*l, l->coarse) + kAcrossModelShare * in_part(*l, l->averaged);
+  for (const Leg* l : {&g.out_half, &g.out}) e += out_part(*l, l->coarse) + kModelShare * out_part(*l, l->averaged);
+  return std::isfinite(e) ? e : std::numeric_limits<double>::quiet_NaN();
+}
+
 /// auto's run `r` between the legs made the run of the whole encounter: its hits on the encounter's own
 /// events (the near run's closest approaches, the half distance's, the end), its time, cost and errors.
-void join(BodyResult& r, const Legs& g, const Plan& plan, const Options& options, const Options& near_options,
-          const Vec3& centre, double tol) {
+void join(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Legs& g, const Plan& plan,
+          const Options& options, const Options& near_options, double tol) {
+  const Vec3& centre = centres[options.events[plan.arrival].centre].c;
   const double t_in = g.in_half.t + g.in.t;
   std::vector<EventHit> hits{hit_at(plan.arrival, g.in_half.t, g.in_half.end, centre)};
   for (EventHit h : r.events) {
@@ -188,7 +220,7 @@ void join(BodyResult& r, const Legs& g, const Plan& plan, const Options& options
   hits.push_back(hit_at(plan.departure, t_out_half, g.out_half.end, centre));
   hits.push_back(hit_at(plan.stop, t_end, g.out.end, centre));
   const double error = g.in_half.error + g.in.error + g.out_half.error + g.out.error;
-  const double orbit = g.in_half.orbit_error + g.in.orbit_error + g.out_half.orbit_error + g.out.orbit_error;
+  const double orbit = deflection_error(body, centres, g, r.run.final);
   r.events = std::move(hits);
   r.run.final = g.out.end;
   r.run.t_end = t_end;
@@ -200,14 +232,15 @@ void join(BodyResult& r, const Legs& g, const Plan& plan, const Options& options
   const std::string legs = "far legs of one turn of the spin a step beyond r = " + fmt(plan.r_hand) + " (" +
                            std::to_string(g.in_half.steps + g.in.steps) + " steps in, " +
                            std::to_string(g.out_half.steps + g.out.steps) + " out, " + std::to_string(g.evals()) +
-                           " force evaluations with their companions, estimated error " + fmt(error) + ", " + fmt(orbit) +
-                           " of the orbit without the helix's phase; the invariants are the run's between them)";
+                           " force evaluations with their companions, estimated error " + fmt(error) + ", in the deflection " +
+                           fmt(orbit) + "; the invariants are the run's between them)";
   r.error.basis += "; " + legs;
   r.chosen += r.chosen.empty() ? legs : "; " + legs;
   if (r.error.value > tol)
     r.warnings.push_back("the final state's error " + fmt(r.error.value) + " is above tol " + fmt(tol) +
-                         ": the far legs know the helix's phase along the path less well than the orbit (" +
-                         fmt(r.error.orbit) + "), which the encounter's observables read; a state at tol wants a named method");
+                         ": the far legs know the helix's phase along the path less well than the orbit, which the "
+                         "encounter's observables read (their error in the deflection with the run's " + fmt(r.error.orbit) +
+                         "); a state at tol wants a named method");
 }
 
 /// The run of `plan`: the legs and auto's run between them, as one run of the whole encounter. Where a leg
@@ -238,7 +271,7 @@ BodyResult run_with_legs(const Body& body, const std::vector<Centre>& centres, c
   g.out_half = leg(body, centres, r.run.final, {plan.about, 0.5 * plan.r0, true});
   if (g.out_half.refused.empty()) g.out = leg(body, centres, g.out_half.end, {plan.about, plan.r0, true});
   if (!g.out_half.refused.empty() || !g.out.refused.empty()) return without(g.evals() + r.total_force_evals());
-  join(r, g, plan, options, near_options, centres[options.events[plan.arrival].centre].c, a.tol);
+  join(r, body, centres, g, plan, options, near_options, a.tol);
   return r;
 }
 

@@ -332,14 +332,15 @@ long add_row_start_distance(Encounter& e, const SweepSpec& spec, const std::vect
                             d && answers_at_limit(d->b, d->v_inf), &near);
 }
 
-/// The row of a run with its encounter (SweepSpec::scattering): integrate_checked with the encounter's
-/// events (encounter_options: it stops at the departure, the sweep's end the latest), measured by
-/// measure_encounter; an encounter that did not finish by the end is the row's outcome (incomplete).
+/// The row of a run with its encounter (SweepSpec::scattering): integrate_encounter_checked (far legs where
+/// auto runs it) with the encounter's events (encounter_options: it stops at the departure, the sweep's end
+/// the latest), measured by measure_encounter; an encounter that did not finish by the end is the row's
+/// outcome (incomplete).
 SweepRow encounter_row(SweepRow row, const MethodInfo* method, const Scene& scene, const Advance& how,
                        const SweepSpec& spec) {
   const Body& body = scene.bodies.front();
   const Options options = encounter_options(body, scene.centres, sweep_options(spec), true);
-  BodyResult r = detail::integrate_checked(body, scene.centres, method, how, options);  // checked by validate_sweep
+  BodyResult r = detail::integrate_encounter_checked(body, scene.centres, method, how, options);  // checked by validate_sweep
   if (!ran(r.outcome)) return result_row(std::move(row), std::move(r));
   Encounter e = measure_encounter(body, scene.centres, r.run, r.events, options.events);
   if (e.outcome == Outcome::ok && r.outcome == Outcome::ok)

@@ -135,6 +135,8 @@ struct FarLeg {
   /// The size of the two quiver corrections, max(|dR|/|R|, |dv|/|v|) each, summed: what a leg's model
   /// error is measured against (docs/measurements.md, "An encounter at infinity").
   double quiver = 0.0;
+  /// The end state before its quiver correction (on the averaged motion).
+  State averaged_end;
 };
 
 namespace detail {
@@ -205,6 +207,7 @@ FarLeg far_leg(FarTurnKernel<Field>& k, LieState& x, double t_span, double eta, 
     leg.t += h;
     ++leg.steps;
   }
+  leg.averaged_end = k.to_physical(x);
   corrected(Onto::real);
   return leg;
 }
