@@ -37,11 +37,14 @@ constexpr double kLegEta = 0.1;
 /// twice that. A leg going out is off in the outgoing asymptote's direction by this share of its
 /// correction's effect on it too.
 constexpr double kModelShare = 1.0 / 50.0;
-/// Across K1 the correction leaves up to 1.6 times what it moved: the guiding centre's offset across K1
-/// from L = 3200 to r = 200 .. 800 with b = 0.3, 1, 3, 10 is 0.32 .. 1.6 of the correction's, and at most
-/// 0.9 of the quiver's size there, |A| rho/(r^2 |K1| Omega) (Omega = |B| |K1|/D). A leg coming in is taken
-/// to be off in the incoming asymptote by this many times its correction's effect on it.
-constexpr double kAcrossModelShare = 2.0;
+/// Across K1 the averaged model leaves the guiding centre off by up to 2.1 times what the quiver correction
+/// moved it, and by up to 1.14 times the quiver's size |A| rho/(r^2 |K1| Omega) (Omega = |B| |K1|/D): 0.32 ..
+/// 2.1 and 0.2 .. 1.14 on bench/far_turn.cpp's scenes (b = 0.3 .. 10, B = 0.3 .. 0.9, r = 200 .. 800; it
+/// moves with the step's phases: b = 1 at r = 400 and 403, 7.1e-8 and 3.2e-7). A leg coming in is taken to
+/// be off in the incoming asymptote by this many times its correction's effect on it, and the hand-off is
+/// planned for kAcrossQuiver times the quiver's size.
+constexpr double kAcrossModelShare = 3.0;
+constexpr double kAcrossQuiver = 1.5;
 /// A leg coming in moves the incoming asymptote's impact parameter b, which the encounter turns into the
 /// deflection by dtheta/db, Rutherford's 2a/(a^2 + b^2) (a = |A|/(|K1| v), sin(theta)/b) for a point mass;
 /// this many times that (b = 1 on table 3.1: 3.2e-7 across moved the deflection by 2.2e-8, 0.069 of it, where
@@ -103,7 +106,7 @@ std::optional<Plan> plan_legs(const Body& body, const std::vector<Centre>& centr
   plan.departure = static_cast<std::size_t>(departure);
   plan.stop = static_cast<std::size_t>(stop);
   // The hand-off: the turns, the encounter's scale, and the model's error in the deflection within its share
-  // of TOL: an offset across K1 of at most the quiver's size |A| rho/(r^2 |K1| Omega), turned into the
+  // of TOL: an offset across K1 of kAcrossQuiver the quiver's size |A| rho/(r^2 |K1| Omega), turned into the
   // deflection by kSensitivity dtheta/db (Rutherford's, from the straight path's distance). The turns take
   // the body's speed at any orientation of its spin far out, (J |K1| + |B| |K2|)/D (a back-scattered body
   // leaves faster than it came: K1 turns against K2).
@@ -119,7 +122,7 @@ std::optional<Plan> plan_legs(const Body& body, const std::vector<Centre>& centr
   const double coulomb = 2.0 * std::abs(far->A) / (K1 * speed);
   const double ruth = std::abs(far->A) / (K1 * speed), per_b = kSensitivity * 2.0 * ruth / (ruth * ruth + line * line);
   const double omega = std::abs(body.p.B) * K1 / body.p.D();
-  const double model = std::sqrt(per_b * std::abs(far->A) * rho / (K1 * omega * 0.5 * kLegShare * a->tol));
+  const double model = std::sqrt(kAcrossQuiver * per_b * std::abs(far->A) * rho / (K1 * omega * 0.5 * kLegShare * a->tol));
   plan.r_hand = std::max({kHandOffTurns * period * v, kHandOffScale * std::max(line, coulomb), model});
   if (plan.r0 < kLegGain * plan.r_hand) return std::nullopt;
   return plan;
