@@ -13,14 +13,6 @@
 
 namespace bodypoint::adaptive {
 
-double state_distance(const State& a, const State& b) {
-  auto rel = [](const Vec3& x, const Vec3& y) {
-    const double n = y.norm();
-    return n > 0.0 ? (x - y).norm() / n : (x - y).norm();
-  };
-  return std::max(rel(a.R, b.R), rel(a.v, b.v));
-}
-
 void check_tolerance(double tol) {
   require_positive(tol, "the tolerance tol");
   if (tol < kMinTolerance)

@@ -28,9 +28,6 @@ namespace {
 using namespace bodypoint;
 namespace sp = bodypoint::splitting;
 
-double norm_error(const State& a, const State& ref) {
-  return std::max((a.R - ref.R).norm() / ref.R.norm(), (a.v - ref.v).norm() / ref.v.norm());
-}
 /// The guiding centre G = R + K1 x K2/|K1|^2 of a state.
 Vec3 guiding(const BodyPoint& p, const State& s) {
   const Momenta q = to_momenta(p, s);
@@ -79,12 +76,12 @@ void row(const char* name, const Body& b, const std::vector<Centre>& centres, do
   long ref_evals = 0, ref2_evals = 0;
   const State ref = reference(b, centres, t, 0.002, &ref2_evals);
   const State coarse = reference(b, centres, t, 0.004, &ref_evals);
-  const double e0 = norm_error(leg(b, f, eta, r_stop, 0.0, t).end, ref);
-  const double e1 = norm_error(leg(b, f, eta, r_stop, 1.0, t).end, ref);
+  const double e0 = state_distance(leg(b, f, eta, r_stop, 0.0, t).end, ref);
+  const double e1 = state_distance(leg(b, f, eta, r_stop, 1.0, t).end, ref);
   std::printf("%-26s %6.0f %6.0f %5.2f %6ld %7ld %9.2e %9.2e %9.2e %9.2e %9.2e %9.2e %9.2e %9.2e %9ld\n", name,
-              L, sp::nearest_centre(f, main.end.R), eta, main.leg.steps, main.evals, norm_error(main.end, ref),
+              L, sp::nearest_centre(f, main.end.R), eta, main.leg.steps, main.evals, state_distance(main.end, ref),
               orbit_error(b.p, main.end, ref), across(b.p, main.end, ref), across(b.p, main.leg.averaged_end, main.end),
-              main.leg.quiver, e0, e1, norm_error(coarse, ref), ref2_evals);
+              main.leg.quiver, e0, e1, state_distance(coarse, ref), ref2_evals);
 }
 
 Body body(SceneParams s, double L) {

@@ -9,7 +9,6 @@
 // by plus a share of the quiver corrections it made (the averaged model's error). The legs land on
 // half the start distance on the way (the asymptotes' error estimate reads the states there).
 #include "bodypoint/bodypoint.hpp"
-#include "bodypoint/adaptive/tolerance.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/scattering.hpp"
 #include "bodypoint/splitting/catalogue.hpp"
@@ -88,7 +87,8 @@ std::optional<Plan> plan_legs(const Body& body, const std::vector<Centre>& centr
   if (!far || far->A == 0.0) return std::nullopt;
   Plan plan;
   plan.about = far->c;
-  plan.r0 = (guiding_centre(body.p, body.s0) - plan.about).norm();
+  const Vec3 from = guiding_centre(body.p, body.s0) - plan.about;  // the guiding centre from the far-field centre
+  plan.r0 = from.norm();
   const double half = 0.5 * plan.r0;
   const long arrival = find_event(options.events, Event::Kind::arrival, half, false);
   const long departure = find_event(options.events, Event::Kind::departure, half, false);
@@ -114,10 +114,10 @@ std::optional<Plan> plan_legs(const Body& body, const std::vector<Centre>& centr
   const double K1 = q.K1.norm(), v = (body.p.J * K1 + std::abs(body.p.B) * q.K2.norm()) / body.p.D();
   if (!(K1 > 0.0) || !(body.s0.v.norm() > 0.0)) return std::nullopt;
   const Vec3 u = q.K1 / K1;
-  if ((guiding_centre(body.p, body.s0) - plan.about).dot(u) >= 0.0) return std::nullopt;  // not coming in
+  if (from.dot(u) >= 0.0) return std::nullopt;  // not coming in
   const double rho = q.K2.cross(u).norm() / K1;
   const double period = 2.0 * M_PI * body.p.D() / (std::abs(body.p.B) * K1);
-  const double line = (guiding_centre(body.p, body.s0) - plan.about).cross(u).norm();
+  const double line = from.cross(u).norm();
   const double speed = body.s0.v.norm();  // the model's and the encounter's scales take the speed it has
   const double coulomb = 2.0 * std::abs(far->A) / (K1 * speed);
   const double ruth = std::abs(far->A) / (K1 * speed), per_b = kSensitivity * 2.0 * ruth / (ruth * ruth + line * line);
@@ -154,7 +154,7 @@ Leg leg(const Body& body, const std::vector<Centre>& centres, const State& start
     out.t = l.t;
     out.steps = l.steps;
     out.averaged = l.averaged_end;
-    out.error = adaptive::state_distance(out.coarse, out.end) + kModelShare * l.quiver;
+    out.error = state_distance(out.coarse, out.end) + kModelShare * l.quiver;
   }
   return out;
 }

@@ -175,10 +175,6 @@ State exact(const Body& b, double t, long* evals) {
   return r.run.final;
 }
 
-double norm_error(const State& a, const State& ref) {
-  return std::max((a.R - ref.R).norm() / ref.R.norm(), (a.v - ref.v).norm() / ref.v.norm());
-}
-
 }  // namespace far_turn
 
 TEST(FarTurn, ALegOfOneTurnAStepMeetsTheExactSplittingAtAThousandthOfItsCost) {
@@ -187,11 +183,11 @@ TEST(FarTurn, ALegOfOneTurnAStepMeetsTheExactSplittingAtAThousandthOfItsCost) {
   ASSERT_TRUE(run.leg.reached);
   long exact_evals = 0;
   const State ref = far_turn::exact(b, run.leg.t, &exact_evals);
-  const double error = far_turn::norm_error(run.end, ref);
+  const double error = state_distance(run.end, ref);
   EXPECT_LT(error, far_turn::kLegError);
   EXPECT_LT(run.evals * 1000, exact_evals) << run.evals << " evaluations against " << exact_evals;
   // The quiver correction is what brings the leg there.
-  const double uncorrected = far_turn::norm_error(far_turn::leg(b, 800.0, 0.0).end, ref);
+  const double uncorrected = state_distance(far_turn::leg(b, 800.0, 0.0).end, ref);
   EXPECT_GT(uncorrected, far_turn::kCorrectionGain * error) << uncorrected << " against " << error;
 }
 

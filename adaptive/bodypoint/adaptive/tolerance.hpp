@@ -85,8 +85,8 @@ ToleranceResult search_step(const MethodInfo& method, const Body& body, const st
 /// method with a known order, or ks.
 void check_searchable(const MethodInfo& method);
 
-/// Relative distance of two final states: max(|dR|/|R_b|, |dv|/|v_b|).
-double state_distance(const State& a, const State& b);
+/// Relative distance of two final states: max(|dR|/|R_b|, |dv|/|v_b|) (the model's, model.hpp).
+using bodypoint::state_distance;
 
 /// Throws Error unless tol is a finite number in [kMinTolerance, 1).
 void check_tolerance(double tol);

@@ -93,6 +93,16 @@ struct State {
 /// Whether every component of the state is a finite number.
 inline bool is_finite(const State& s) { return s.R.allFinite() && s.v.allFinite() && s.w.allFinite(); }
 
+/// Relative distance of two states, max(|dR|/|R_b|, |dv|/|v_b|) (a part of b that is zero: its absolute
+/// distance): the norm of every estimate, --tol and the far legs' corrections.
+inline double state_distance(const State& a, const State& b) {
+  const auto rel = [](const Vec3& x, const Vec3& y) {
+    const double n = y.norm();
+    return n > 0.0 ? (x - y).norm() / n : (x - y).norm();
+  };
+  return std::max(rel(a.R, b.R), rel(a.v, b.v));
+}
+
 /// Time reversal (docs/physics.md, "Time reversal"): the equations keep their form under t -> -t,
 /// v -> -v, w -> -w (the kinetic energy is quadratic in the velocities, the potential depends on R
 /// alone), so a run backwards in time is the forward run of the reversed state, reversed again.

@@ -152,9 +152,6 @@ void guiding_distance(const FarTurnKernel<Field>& k, const LieState& x, const Ve
   g = d.norm();
   rate = speed * u.dot(d) / g;
 }
-inline double relative_change(const State& a, const State& b) {
-  return std::max((a.R - b.R).norm() / b.R.norm(), (a.v - b.v).norm() / b.v.norm());
-}
 }  // namespace detail
 
 /// The far leg: the table's steps h = eta r/|v| (r: the nearest centre) with E for its kicks, from a
@@ -169,7 +166,7 @@ FarLeg far_leg(FarTurnKernel<Field>& k, LieState& x, double t_span, double eta, 
   const auto corrected = [&](Onto to) {
     const State before = k.to_physical(x);
     k.quiver(x, to);
-    leg.quiver += detail::relative_change(k.to_physical(x), before);
+    leg.quiver += state_distance(k.to_physical(x), before);
   };
   corrected(Onto::averaged);
   for (int landings = 0; leg.t < t_span;) {
@@ -200,10 +197,8 @@ FarLeg far_leg(FarTurnKernel<Field>& k, LieState& x, double t_span, double eta, 
       break;
     }
     h = std::min(h, t_span - leg.t);
-    for (std::size_t j = 0; j < Seq.size; ++j) {
-      if (Seq.ops[j].part == Part::kick) k.kick(x, Seq.ops[j].c * h);
-      else k.drift(x, Seq.ops[j].c * h);
-    }
+    NullObserver none;
+    integrate<Seq>(k, x, h, 1, none);  // one step of the table (composition.hpp), a turn for each kick
     leg.t += h;
     ++leg.steps;
   }
