@@ -10,6 +10,7 @@
 // made by side steps from the state before the crossing step (one step of the same table in physical
 // time; for ks the exact advance), without touching the main integration.
 #include "bodypoint/adaptive/methods.hpp"
+#include "bodypoint/accuracy.hpp"
 
 #include "bodypoint/adaptive/extrapolated.hpp"
 #include "bodypoint/adaptive/ks.hpp"
@@ -57,31 +58,6 @@ void check_progress(long steps, double t_prev, double t, double t_end, long cap)
 }
 
 using detail::StepStats;
-
-/// Far from every centre the spin-orbit angle per step may be this many times the orbital angle per
-/// step at closest approach (see automatic_omega_c).
-constexpr double kSpinToOrbitStepRatio = 16.0;
-/// The spin-orbit angle of one whole step far from every centre stays below this (radians).
-constexpr double kMaxSpinAngle = 2.0;
-
-}  // namespace
-
-// c = max(sum|A| Omega_so / (k v0), Omega_so ds / kMaxSpinAngle): far from every centre a step turns the
-// spin by k times the orbital angle per step at closest approach, and never by more than 2 rad
-// (docs/physics.md, "The time-step constant c", gives the rule's reasons and measurements).
-double automatic_omega_c(const Body& body, const std::vector<Centre>& centres, double ds) {
-  const BodyPoint& p = body.p;
-  if (p.B == 0.0) return 0.0;
-  const Momenta q = to_momenta(p, body.s0);
-  const double spin_rate = std::abs(p.B) * q.K1.norm() / p.D();
-  const double speed = body.s0.v.norm();
-  double strength = 0.0;
-  for (const Centre& c : centres) strength += std::abs(c.A);
-  if (!(speed > 0.0) || !(spin_rate > 0.0)) return 0.0;
-  return std::max(strength * spin_rate / (kSpinToOrbitStepRatio * speed), spin_rate * std::abs(ds) / kMaxSpinAngle);
-}
-
-namespace {
 
 /// From `from` (whose time is below target), the state at exactly `target`: a fictitious step ds'
 /// with advance(ds') = target - from.time(), where the whole step ds reaches t_full >= target (known

@@ -13,14 +13,6 @@
 
 namespace bodypoint::adaptive {
 
-void check_tolerance(double tol) {
-  require_positive(tol, "the tolerance tol");
-  if (tol < kMinTolerance)
-    throw Error("tol below 1e-13 cannot be delivered in double precision (the round-off of a run is "
-                "1e-15..1e-13 relative)");
-  if (!(tol < 1.0)) throw Error("tol must be below 1 (it is a relative error of the final state)");
-}
-
 void check_searchable(const MethodInfo& method) {
   if (is_step_controlled(method))
     throw Error(std::string(method.name) + " controls its own step: give it a tolerance per step, not the accuracy mode's "

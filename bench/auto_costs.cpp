@@ -72,7 +72,7 @@ Cells measure(const std::string& scenes, const std::string& tols, Tally& tally) 
           const adaptive::ToleranceResult r =
               adaptive::search_step(*m, body, centres, Accuracy{tol, ns.t_end}, RunOptions{}, auto_verifies(centres));
           c.evals = static_cast<double>(r.total_force_evals);
-          c.err = adaptive::state_distance(r.result.final, ref);
+          c.err = bodypoint::state_distance(r.result.final, ref);
           c.est = r.err_estimate;
           ++tally.delivered;
           tally.missed += c.err > tol;

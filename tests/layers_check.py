@@ -6,7 +6,11 @@ Floors, from the ground up (docs/developers.md, "Architecture"):
 Every `#include "..."` of a project file is resolved the way the build resolves it: first beside the
 file, then in the include roots (each floor's), and the header found must sit on the file's floor or
 below. An include that resolves to nothing in the tree is a system or third-party header and is
-skipped. Usage: layers_check.py SOURCE_DIR. Prints each violation and exits 1 when there is one.
+skipped. The public API (floor 5) reaches the adaptive layer through one seam: only the files of SEAM
+include its headers (the registry of its methods, and the search behind the accuracy mode), and the commands
+and studies (experiments/) include none: they run on the public API. State arithmetic,
+Richardson's rule and the accuracy mode's limits sit in the core (bodypoint/accuracy.hpp, model.hpp).
+Usage: layers_check.py SOURCE_DIR. Prints each violation and exits 1 when there is one.
 """
 import pathlib
 import re
@@ -24,6 +28,8 @@ FLOORS = [  # (folder, floor); the longest matching folder decides a file's floo
 # Where the build looks for "bodypoint/...", "search.hpp", "cli.hpp": each floor's include roots.
 ROOTS = ["lib/core/model", "lib/core/methods", "lib/core/drivers", "adaptive", "lib/api",
          "experiments/cli", "experiments/studies"]
+# The lib/api files that include an adaptive/ header (issue #82 item 3: at most two).
+SEAM = {"lib/api/methods.cpp", "lib/api/integrate.cpp"}
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 
 
@@ -64,6 +70,8 @@ def main():
                 theirs = floor_of(target.relative_to(src).as_posix())
                 if theirs is None:
                     problems.append(f"{rel}: includes {name}, which is outside every floor")
+                elif theirs[0] == "adaptive" and own[0] in ("lib/api", "experiments") and rel not in SEAM:
+                    problems.append(f"{rel} includes {name} from adaptive/: only {sorted(SEAM)} may (the seam)")
                 elif theirs[1] > own[1] or (theirs[1] == own[1] and theirs[0] != own[0] and own[1] == 6):
                     problems.append(f"{rel} (floor {own[1]}, {own[0]}) includes {name} from {theirs[0]} (floor {theirs[1]})")
     for p in problems:

@@ -2,7 +2,7 @@
 //
 // Runs that share one time-step constant c (time-transformed methods; a pair compared by Richardson must be
 // one method) form a ladder, coarse to fine; each new run's error is estimated from the run before it,
-// est = |x_a - x_b|/((h_a/h_b)^p - 1) (richardson.hpp), and the estimate is trusted when the error behaves
+// est = |x_a - x_b|/((h_a/h_b)^p - 1) (accuracy.hpp), and the estimate is trusted when the error behaves
 // like C h^p there: the three last runs fit an order between p - kOrderSlack and p + kOrderExcess, or (a
 // ladder of two) the estimate is what the coarser runs predicted for it, within kAgree.
 // 1. Pilot pair: runs at a coarse step h0 (start.cpp) and h0/2, with the c of h0. A run the method refuses
@@ -23,7 +23,7 @@
 #include "search.hpp"
 
 #include "bodypoint/adaptive/methods.hpp"
-#include "bodypoint/adaptive/richardson.hpp"
+#include "bodypoint/accuracy.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -305,9 +305,9 @@ bool Search::verified_at(std::vector<Level>& rungs, double h_c, double current) 
   return false;
 }
 
-/// The order with which three runs of the ladder converge (richardson.hpp, observed_order).
+/// The order with which three runs of the ladder converge (accuracy.hpp, observed_order).
 double Search::observed_order(const Level& l1, const Level& l2, const Level& l3) const {
-  return adaptive::observed_order(state_distance(l1.run.final, l2.run.final), state_distance(l2.run.final, l3.run.final),
+  return bodypoint::observed_order(state_distance(l1.run.final, l2.run.final), state_distance(l2.run.final, l3.run.final),
                                   l1.h / l3.h, l2.h / l3.h);
 }
 

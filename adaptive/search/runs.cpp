@@ -4,6 +4,7 @@
 #include "search.hpp"
 
 #include "bodypoint/adaptive/methods.hpp"
+#include "bodypoint/accuracy.hpp"
 #include "bodypoint/detail/run_parts.hpp"
 
 #include <algorithm>

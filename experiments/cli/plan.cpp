@@ -1,6 +1,6 @@
 // The command line's run plan: what --method, --tol and the step options ask for (plan_run), and one
 // body's run through the library (run_body), shared by simulate and view.
-#include "bodypoint/adaptive/tolerance.hpp"
+#include "bodypoint/accuracy.hpp"
 #include "bodypoint/methods.hpp"
 #include "cli.hpp"
 #include "checked.hpp"

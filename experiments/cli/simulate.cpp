@@ -1,7 +1,6 @@
 // `bodypoint simulate`: one method on one scene; readable summary, --json, or a trajectory CSV.
 #include "process.hpp"
-#include "bodypoint/adaptive/methods.hpp"
-#include "bodypoint/adaptive/tolerance.hpp"
+#include "bodypoint/accuracy.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
 #include "bodypoint/observables.hpp"
@@ -278,7 +277,7 @@ struct SimulatedBody {
   std::optional<Reversal> reversal;
   /// With the reference: |R - R_ref| and the relative error as --tol measures it, max(|dR|/|R_ref|, |dv|/|v_ref|).
   [[nodiscard]] double err_R() const { return (run.run.final.R - reference->R).norm(); }
-  [[nodiscard]] double err_rel() const { return adaptive::state_distance(run.run.final, *reference); }
+  [[nodiscard]] double err_rel() const { return bodypoint::state_distance(run.run.final, *reference); }
 };
 
 /// The run `fwd` of `body` taken back from its final state to its start time by the same method, step and
@@ -299,12 +298,12 @@ Reversal run_back(const RunPlan& plan, const BodyResult& fwd, const Body& body, 
   } else {
     if (fwd.run.stopped) throw Error("--reversibility takes a run to its end time, not one a --stop-at event ended");
     how = is_backward(plan.how) ? forwards(plan.how) : backwards(plan.how);
-    if (constant && options.omega_c < 0.0) options.omega_c = adaptive::automatic_omega_c(body, centres, planned_step(plan));
+    if (constant && options.omega_c < 0.0) options.omega_c = bodypoint::automatic_omega_c(body, centres, planned_step(plan));
   }
   const BodyResult back = integrate_body(there, centres, &m, how, options);
   if (!ran(back.outcome))
     throw Error("body '" + body.name + "': the way back failed: " + back.reason);
-  return {adaptive::state_distance(back.run.final, body.s0), back.error.value, back.total_force_evals()};
+  return {bodypoint::state_distance(back.run.final, body.s0), back.error.value, back.total_force_evals()};
 }
 
 /// One body: budget, run (with the progress bar), health, and the reference state when asked for.

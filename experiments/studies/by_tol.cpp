@@ -15,7 +15,8 @@
 #include "cli.hpp"
 #include "stopwatch.hpp"
 
-#include "bodypoint/adaptive/tolerance.hpp"
+#include "bodypoint/accuracy.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
 #include "bodypoint/reference.hpp"
@@ -95,12 +96,15 @@ TolRow measure_auto(const NamedScene& ns, const State& ref, double tol) {
   row.method = std::string(m.name);
   row.h = r.accuracy->h_chosen;
   row.err_estimate = r.accuracy->err_estimate;
-  row.err = adaptive::state_distance(r.run.final, ref);
+  row.err = bodypoint::state_distance(r.run.final, ref);
   row.met = row.err <= tol;
   row.delivered_samples = std::make_shared<std::vector<double>>();
-  row.run = [&m, body, centres = ns.scene.centres, accuracy, samples = row.delivered_samples] {
-    const adaptive::ToleranceResult x = adaptive::run_to_tolerance(m, body, centres, accuracy, unobserved(), auto_verifies(centres));
-    samples->push_back(x.result.wall_s);
+  // The delivered run again, through the public API: the method auto chose at its step and time-step constant.
+  Options delivered = unobserved();
+  if (takes_time_step_constant(m)) delivered.omega_c = r.accuracy->omega_c;
+  row.run = [&m, body, centres = ns.scene.centres, how = advance_to(m, row.h, ns.t_end), delivered,
+             samples = row.delivered_samples] {
+    samples->push_back(integrate_body(body, centres, &m, how, delivered).run.wall_s);
   };
   row.force_evals = r.accuracy->force_evals;
   row.delivered_force_evals = r.run.force_evals;
@@ -125,7 +129,7 @@ TolRow measure_peer(const NamedScene& ns, const std::string& name, const State& 
   }
   const RunResult& r = x.run;
   row.run = [&m, body, centres = ns.scene.centres, how] { run_or_throw(m, body, centres, how, unobserved()); };
-  row.err = adaptive::state_distance(r.final, ref);
+  row.err = bodypoint::state_distance(r.final, ref);
   if (!std::isfinite(row.err)) row.err = std::numeric_limits<double>::infinity();
   row.met = row.err <= tol;
   row.force_evals = r.force_evals;
@@ -230,7 +234,7 @@ void measure_own_ladders(const NamedScene& ns, const State& ref, double smallest
         ++failures;
         continue;
       }
-      r.err = adaptive::state_distance(x.run.final, ref);
+      r.err = bodypoint::state_distance(x.run.final, ref);
       r.force_evals = std::max(x.run.force_evals, x.run.steps);  // ks counts its exact steps
       if (!std::isfinite(r.err)) r.err = std::numeric_limits<double>::infinity();
       r.run = [&m, body, centres = ns.scene.centres, how] { run_or_throw(m, body, centres, how, unobserved()); };

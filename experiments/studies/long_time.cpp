@@ -6,7 +6,7 @@
 // a reference run (the tool's error norm), and on the Kepler ellipse the mean anomaly against Kepler's n t.
 #include "long_time.hpp"
 
-#include "bodypoint/adaptive/tolerance.hpp"
+#include "bodypoint/accuracy.hpp"
 #include "bodypoint/bodypoint.hpp"
 #include "bodypoint/invariants.hpp"
 #include "bodypoint/io.hpp"
@@ -165,7 +165,7 @@ std::vector<State> run_method(std::ostream& csv, const LongScene& ls, const Long
     row.num(std::abs(now.E - start.E) / std::abs(start.E)).num(max_dE);
     row.num_if(start.K2sq > 0.0, std::abs(now.K2sq - start.K2sq) / start.K2sq);  // none without a spin
     row.num_if(ls.scene.centres.size() == 1, (now.K2Q - start.K2Q).norm());
-    row.num_if(!ref.empty(), ref.empty() ? 0.0 : adaptive::state_distance(s.state(), ref[i]));
+    row.num_if(!ref.empty(), ref.empty() ? 0.0 : bodypoint::state_distance(s.state(), ref[i]));
     row.num_if(ls.kepler, phase.error(times[i]));
     row.count(s.force_evals()).text(std::string(outcome_name(o)));
     csv << row.str() << '\n';

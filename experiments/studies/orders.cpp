@@ -12,7 +12,7 @@
 
 #include "cli.hpp"
 
-#include "bodypoint/adaptive/tolerance.hpp"
+#include "bodypoint/accuracy.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
 #include "bodypoint/order_fit.hpp"
@@ -60,7 +60,7 @@ double error_at(const MethodInfo& m, const Probe& p, double h) {
   }
   const BodyResult r = run_unestimated(m, p.scene.bodies.front(), p.scene.centres, how, o);
   if (!ran(r.outcome)) return std::numeric_limits<double>::infinity();  // a step too large for this encounter (logH's E - T + c <= 0)
-  return adaptive::state_distance(r.run.final, p.ref);  // the tool's error norm, max(|dR|/|R|, |dv|/|v|)
+  return bodypoint::state_distance(r.run.final, p.ref);  // the tool's error norm, max(|dR|/|R|, |dv|/|v|)
 }
 
 /// The fitted slope, or NaN when the method does not run on the scene or no ladder start was found.

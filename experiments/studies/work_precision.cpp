@@ -9,7 +9,8 @@
 // under the commands' timing rules (stopwatch.hpp: warm-up, repeats interleaved across all of them,
 // wall and CPU time, median and spread, a flag where the time does not count).
 #include "process.hpp"
-#include "bodypoint/adaptive/tolerance.hpp"
+#include "bodypoint/accuracy.hpp"
+#include "bodypoint/detail/run_parts.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
 #include "bodypoint/reference.hpp"
@@ -90,7 +91,7 @@ std::optional<Row> measure(const NamedScene& ns, const MethodInfo& m, const Body
   row.err_R = (r.final.R - ref.R).norm();
   if (!std::isfinite(row.err_R)) row.err_R = std::numeric_limits<double>::infinity();
   // The tool's one error norm (ErrorEstimate, --tol): max(|dR|/|R|, |dv|/|v|) of the final state.
-  row.err_rel = adaptive::state_distance(r.final, ref);
+  row.err_rel = bodypoint::state_distance(r.final, ref);
   if (!std::isfinite(row.err_rel)) row.err_rel = std::numeric_limits<double>::infinity();
   row.max_rel_dE = ri.invariants ? ri.invariants->max_rel_dE : 0.0;
   row.force_evals = r.force_evals;
@@ -169,7 +170,7 @@ State reference_of(const NamedScene& ns, std::ostringstream& refs) {
   const FixedSteps check_steps{ns.t_end / static_cast<double>(steps), steps};
   const State split = run_or_throw(method_or_throw("lp-ss10"), body, ns.scene.centres, check_steps, unobserved()).final;
   const double ref_err = std::max((ref.R - loose.R).norm(), (ref.R - split.R).norm());
-  const double ref_rel = std::max(adaptive::state_distance(loose, ref), adaptive::state_distance(split, ref));
+  const double ref_rel = std::max(bodypoint::state_distance(loose, ref), bodypoint::state_distance(split, ref));
   std::ostringstream line;
   line << "reference " << ns.name << ": odeint rkf78 long double tol 1e-18, t_end " << fmt(ns.t_end)
        << ", |R_ref| = " << fmt(ref.R.norm()) << ", estimated error " << std::setprecision(2) << std::scientific
@@ -418,7 +419,7 @@ int cmd_work_precision(int argc, char** argv) {
     const std::vector<double> tols = parse_numbers(a.tols, "--tols");
     for (double tol : tols) {
       try {
-        adaptive::check_tolerance(tol);
+        bodypoint::check_tolerance(tol);
       } catch (const Error& e) {
         throw Error("--tols: " + std::string(e.what()));
       }

@@ -3,8 +3,7 @@
 
 #include "choice.hpp"
 
-#include "bodypoint/adaptive/methods.hpp"
-#include "bodypoint/adaptive/tolerance.hpp"
+#include "bodypoint/accuracy.hpp"
 #include "bodypoint/field.hpp"
 #include "bodypoint/detail/model_parts.hpp"
 #include "bodypoint/detail/run_support.hpp"
@@ -69,7 +68,7 @@ constexpr double kFarFraction = 0.1;
 bool auto_verifies(const std::vector<Centre>& centres) { return centres.size() > 1; }
 
 const MethodInfo& choose_method(const Body& body, const std::vector<Centre>& centres, double tol, std::string* why) {
-  adaptive::check_tolerance(tol);
+  check_tolerance(tol);
   return detail::choose_method_for(body, centres, tol, why);
 }
 
@@ -83,7 +82,7 @@ const MethodInfo& detail::choose_method_for(const Body& body, const std::vector<
   const Helix helix = helix_of(body.p, to_momenta(body.p, body.s0));
   for (const Centre& c : centres)
     potential_at_closest += std::abs(c.A) / std::max(path_distance(helix, c.c, std::numeric_limits<double>::infinity()), 1e-300);
-  const double c = adaptive::automatic_omega_c(body, centres, 0.0);
+  const double c = automatic_omega_c(body, centres, 0.0);
   // What each branch needs is asked of the catalogue: the regularised flow where it accepts the scene (a
   // material point, one centre), the Lie-Poisson splitting far from every centre, else the first
   // time-transformed method of the table that accepts the scene (logH before TTL: logH refuses attraction).

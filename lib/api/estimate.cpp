@@ -3,7 +3,7 @@
 // concern per file: estimate/parts.hpp.
 #include "estimate/parts.hpp"
 
-#include "bodypoint/adaptive/methods.hpp"
+#include "bodypoint/accuracy.hpp"
 #include "bodypoint/field.hpp"
 #include "bodypoint/detail/model_parts.hpp"
 
@@ -40,7 +40,7 @@ Options companion_options(const Body& body, const std::vector<Centre>& centres, 
   o.omega_c = options.omega_c;
   o.cancel = options.cancel;
   if (const auto* f = std::get_if<FictitiousSteps>(&how); f && o.omega_c < 0.0)
-    o.omega_c = adaptive::automatic_omega_c(body, centres, f->ds);
+    o.omega_c = bodypoint::automatic_omega_c(body, centres, f->ds);
   // A run cut at a stop event is compared with its companion cut at the same event.
   for (const Event& ev : options.events)
     if (ev.stop) o.events.push_back(ev);
@@ -84,10 +84,10 @@ void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& 
   if (estimated_by_coarse(r, body, centres, how, options, o, rerun, coarse_side)) return;
   const std::optional<FineCompanion> f = finer_companion(r, body, how, options, o, rerun);
   if (!f) return;
-  e.value = f->c.factor * adaptive::state_distance(r.run.final, f->x.run.final);
+  e.value = f->c.factor * bodypoint::state_distance(r.run.final, f->x.run.final);
   e.basis = f->c.basis;
   if (flow_is_exact(*r.method, body, centres)) {
-    e.value = std::max(e.value, adaptive::state_distance(r.run.final, f->x.run.final));
+    e.value = std::max(e.value, bodypoint::state_distance(r.run.final, f->x.run.final));
     e.basis += "; " + std::string(kExactFlowBasis);
   }
   add_rounding_draws(e, r, options, o, rerun_draws(body, [&how](int k) { return off_grid(how, k); }, o, rerun),

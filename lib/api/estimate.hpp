@@ -45,7 +45,7 @@ constexpr double kCoarseEnergyBound = kDefaultMaxEnergyError;
 /// ratio at most max_ratio (coarse_ratio_limit), nullopt below kMinCoarseRatio.
 std::optional<CoarseCompanion> coarse_companion(const MethodInfo& m, const Advance& how, long run_steps, double max_ratio);
 /// `how` with its steps off its own grid (k fixed steps more; a fictitious step longer by a relative
-/// k adaptive::kProbeShift; a controlled run as it is): a draw of the rounding whose steps land nowhere the
+/// k bodypoint::kProbeShift; a controlled run as it is): a draw of the rounding whose steps land nowhere the
 /// first's do. Repeats at the same step share the rounding of every point they share (ttl-kl8, ds = 0.02
 /// on a bound spinning orbit: coarse runs from starts moved either way 2e-13 and 1.5e-12 from a run
 /// 1.1e-11 off; off the grid, 1.2e-11).

@@ -156,7 +156,7 @@ detail::Advancer advancer(const BodyResult& r, const Body& body, const std::vect
     step = fixed->h;
   } else if (const auto* fictitious = std::get_if<FictitiousSteps>(&how)) {
     step = fictitious->ds;
-    if (c < 0.0) c = adaptive::automatic_omega_c(body, centres, step);
+    if (c < 0.0) c = automatic_omega_c(body, centres, step);
   } else if (const auto* controlled = std::get_if<ControlledSteps>(&how)) {
     step = controlled->tol;
     h0 = controlled->h0;
@@ -393,7 +393,7 @@ BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& cen
   r.method = method;
   if (accuracy && non_coulomb(centres)) {
     r.outcome = Outcome::refused;
-    r.reason = adaptive::kNeedsCoulomb;
+    r.reason = bodypoint::kNeedsCoulomb;
     return r;
   }
   if (!method) r.method = &detail::choose_method_for(body, centres, accuracy->tol, &r.chosen);
@@ -473,7 +473,7 @@ void detail::check_run(const std::vector<Centre>& centres, const MethodInfo* met
     throw Error("the fictitious step ds must be > 0 (a run backwards has a negative end time), got " + fmt(f->ds));
   check(forwards(how));  // a run backwards is checked as the forward run it makes (integrate_estimated)
   if (const auto* accuracy = std::get_if<Accuracy>(&how)) {
-    adaptive::check_tolerance(accuracy->tol);
+    check_tolerance(accuracy->tol);
     if (method) adaptive::check_searchable(*method);
   } else if (!method) {
     throw Error("only the accuracy mode chooses a method by itself; name one");
@@ -577,7 +577,7 @@ namespace {
 /// A stepper asked for a tolerance at or below this has a draw of the rounding beside its companion: a chain's
 /// error can fall a decade below the tolerance (a leg back cancelling the way out's), where the companion pair
 /// alone can agree by chance (rk4 at tol 1e-10 forwards and back on a spinning pass: 4.7e-11 off, read 1.4e-11).
-constexpr double kDrawTolerance = 10.0 * adaptive::kProbeBelowTol;
+constexpr double kDrawTolerance = 10.0 * bodypoint::kProbeBelowTol;
 
 /// A Stepper's segment of `span` (> 0) forwards: the step, fictitious step or tolerance per step it
 /// was built with.
@@ -603,7 +603,7 @@ Stepper::Stepper(Checked, const MethodInfo& method, const Body& body, const std:
   // The time-step constant of a time-transformed method is fixed once, from the starting state, so
   // that every segment integrates the same transformed system.
   if (is_time_transformed(method) && options_.omega_c < 0.0)
-    options_.omega_c = adaptive::automatic_omega_c(body_, centres_, step_);
+    options_.omega_c = automatic_omega_c(body_, centres_, step_);
   // A segment has no error estimate of its own (a companion per segment would compare segments that
   // start from one state, not the runs).
   options_.estimate_error = false;
@@ -672,7 +672,7 @@ ErrorEstimate Stepper::error() const {
     e.basis = twin_.none;
     return e;
   }
-  e.value = twin_.factor * adaptive::state_distance(body_.s0, twin_.s);
+  e.value = twin_.factor * bodypoint::state_distance(body_.s0, twin_.s);
   e.basis = twin_.basis + ", beside every segment and write (the chain's error at t = " + fmt(t_) + ")";
   if (twin_.draw && detail::at_rounding_level(e)) {
     detail::add_rounding_spread(e, body_.s0, *twin_.draw, 0, 0.0, detail::kRepeatRoundingDraw);

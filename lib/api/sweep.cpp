@@ -1,7 +1,7 @@
 // bodypoint: sweeps and grids (sweep.hpp).
 #include "bodypoint/sweep.hpp"
 
-#include "bodypoint/adaptive/tolerance.hpp"
+#include "bodypoint/accuracy.hpp"
 #include "bodypoint/batch.hpp"
 #include "bodypoint/threads.hpp"
 #include "bodypoint/io.hpp"
@@ -509,7 +509,7 @@ void validate_sweep_rules(const SweepSpec& spec) {
       throw Error(unknown_name("parameter", a.param, sweep_parameters()));
   }
   if (spec.accuracy) {
-    adaptive::check_tolerance(*spec.accuracy);
+    check_tolerance(*spec.accuracy);
     if (!(spec.t_end > 0.0) && !spec.scattering)
       throw Error("the accuracy mode delivers its tolerance at an end time: give t_end");
     for (const Axis& a : spec.axes)
@@ -618,7 +618,7 @@ MapPlan plan_map(const SweepSpec& spec, unsigned threads) {
     MapPlan::Step step{row.method, 0.0};
     if (row.outcome == Outcome::ok && row.method && row.accuracy && row.accuracy->err_estimate > 0.0 && row.accuracy->h_chosen > 0.0) {
       const double order = effective_order(*row.method, point_scene(spec, row.point).bodies.front());
-      const double aim = adaptive::kTargetShare * *spec.accuracy / row.accuracy->err_estimate;
+      const double aim = bodypoint::kTargetShare * *spec.accuracy / row.accuracy->err_estimate;
       step.first_step = row.accuracy->h_chosen * (order > 0.0 ? std::clamp(std::pow(aim, 1.0 / order), 1.0, kPlanMaxGain) : 1.0);
     }
     plan.steps.emplace(pilots[k], step);

@@ -2,6 +2,7 @@
 // logarithmic Hamiltonian, convergence order in the fictitious step, time reversibility, exact end
 // times, stress cases, and the close-encounter targets of issue #4.
 #include "bodypoint/adaptive/ks.hpp"
+#include "bodypoint/accuracy.hpp"
 #include "bodypoint/adaptive/methods.hpp"
 #include "bodypoint/adaptive/time_transformed.hpp"
 #include "bodypoint/detail/monitor.hpp"
@@ -215,12 +216,12 @@ TEST(TimeTransformed, StepShrinksNearTheCentreAndIsBoundedFarAway) {
   for (const char* m : {"logh-y4", "ttl-y4"}) {
     const Body& b = ns.scene.bodies.front();
     const RunResult r = run(method_or_throw(m), b, ns.scene.centres, spec);
-    const double c = adaptive::automatic_omega_c(b, ns.scene.centres, spec.h);
+    const double c = bodypoint::automatic_omega_c(b, ns.scene.centres, spec.h);
     ASSERT_GT(c, 0.0) << "a spinning body has a spin-orbit time scale";
     EXPECT_LE(r.max_step, spec.h / c * (1 + 1e-12)) << m << ": the physical step is at most ds/c";
     EXPECT_GT(r.max_step / r.min_step, kMinBoundedStepRange) << m << " min " << r.min_step << " max " << r.max_step;
     // A material point has no spin time scale: c = 0, and dt/ds = 1/Pi ~ r/|A| follows r.
-    EXPECT_EQ(adaptive::automatic_omega_c(material, ns.scene.centres, spec.h), 0.0);
+    EXPECT_EQ(bodypoint::automatic_omega_c(material, ns.scene.centres, spec.h), 0.0);
     const RunResult rm = run(method_or_throw(m), material, ns.scene.centres, spec);
     EXPECT_GT(rm.max_step / rm.min_step, kMinMaterialStepRange) << m << " min " << rm.min_step << " max " << rm.max_step;
   }

@@ -49,7 +49,7 @@ constexpr double kMaxCostRatio = 3.5;
 // methods.hpp; kVerifyRatio, search/ladder.cpp): 1.25 delivered runs, and a verified search may restart its
 // ladder once more (two-centres at 1e-4, Verlet: the pilot pair, two ladders, the companion: 5.07 runs).
 constexpr double kVerifyRuns = 2.0;
-// Below adaptive::kProbeBelowTol each run about to be delivered is repeated kProbeRuns times with its
+// Below bodypoint::kProbeBelowTol each run about to be delivered is repeated kProbeRuns times with its
 // roundings changed (tolerance.hpp), a delivered run's cost each time; a candidate whose truncation and
 // round-off add up to more than tol allows is refined and probed again. On this grid at most this many
 // candidates are probed (close at 1e-12: two, 6.9x the delivered run in all).
@@ -120,13 +120,13 @@ double rounding_spread(const MethodInfo& m, const Case& c, double h) {
   FlatRun spec;
   spec.t_end = c.t_end;
   spec.steps = 0;
-  spec.omega_c = adaptive::automatic_omega_c(b, c.scene.centres, h);
+  spec.omega_c = bodypoint::automatic_omega_c(b, c.scene.centres, h);
   spec.h = h;
   const State a = run(m, b, c.scene.centres, spec).final;
   double spread = 0.0;
   for (int k = 1; k <= kRoundingTwins; ++k) {
     spec.h = h * (1.0 - k * kRoundingShift);
-    spread = std::max(spread, adaptive::state_distance(a, run(m, b, c.scene.centres, spec).final));
+    spread = std::max(spread, bodypoint::state_distance(a, run(m, b, c.scene.centres, spec).final));
   }
   return spread;
 }
@@ -149,7 +149,7 @@ TEST(Tolerance, AutoDeliversTolWithAnHonestEstimate) {
         // Below the probe's threshold the scene's round-off may be above tol: a refusal that says so is
         // the right answer when it is true.
         const std::string reason = e.what();
-        ASSERT_LT(tol, adaptive::kProbeBelowTol) << c.name << ": " << reason;
+        ASSERT_LT(tol, bodypoint::kProbeBelowTol) << c.name << ": " << reason;
         ASSERT_NE(reason.find("round-off"), std::string::npos) << c.name << ": " << reason;
         ASSERT_TRUE(is_time_transformed(m)) << c.name;
         const double spread = rounding_spread(m, c, 0.25 * coarser_h);
@@ -160,7 +160,7 @@ TEST(Tolerance, AutoDeliversTolWithAnHonestEstimate) {
         continue;
       }
       coarser_h = r.h;
-      const double err = adaptive::state_distance(r.result.final, ref);
+      const double err = bodypoint::state_distance(r.result.final, ref);
       EXPECT_LE(err, tol) << c.name << " tol " << tol << " " << why;
       EXPECT_LE(r.err_estimate, tol) << c.name << " tol " << tol;
       if (err > kComparableError) {
@@ -171,9 +171,9 @@ TEST(Tolerance, AutoDeliversTolWithAnHonestEstimate) {
       const double cost = r.result.force_evals > 0
                               ? static_cast<double>(r.total_force_evals) / static_cast<double>(r.result.force_evals)
                               : static_cast<double>(r.runs);
-      const bool probed = tol < adaptive::kProbeBelowTol && r.result.force_evals > 0;
+      const bool probed = tol < bodypoint::kProbeBelowTol && r.result.force_evals > 0;
       const double verify = auto_verifies(c.scene.centres) ? kVerifyRuns : 0.0;
-      EXPECT_LE(cost, kMaxCostRatio + verify + (probed ? kProbeRounds * adaptive::kProbeRuns : 0)) << c.name << " tol " << tol;
+      EXPECT_LE(cost, kMaxCostRatio + verify + (probed ? kProbeRounds * bodypoint::kProbeRuns : 0)) << c.name << " tol " << tol;
       worst_cost = std::max(worst_cost, cost);
       ++runs;
       within_decade += err >= 0.1 * tol ? 1 : 0;
@@ -200,7 +200,7 @@ TEST(Tolerance, ATripleConvergingFarFasterThanOrderPIsNotTrusted) {
   // The ladder's own rule, unverified: ttl-kl6, auto's table at 1e-7 when this was measured.
   const MethodInfo& m = method_or_throw("ttl-kl6");
   const adaptive::ToleranceResult r = adaptive::run_to_tolerance(m, b, s.centres, Accuracy{kTol, kEnd}, kUnobserved, false);
-  const double err = adaptive::state_distance(r.result.final, reference_state(b, s.centres, kEnd, 1e-18L));
+  const double err = bodypoint::state_distance(r.result.final, reference_state(b, s.centres, kEnd, 1e-18L));
   EXPECT_LE(err, kTol);
   EXPECT_GE(r.err_estimate, err / kEstimateFactor) << m.name << " at ds " << r.h;
   EXPECT_LE(r.err_estimate, kEstimateFactor * err) << m.name << " at ds " << r.h;
@@ -227,7 +227,7 @@ TEST(Tolerance, AutoAboutSeveralCentresDeliversTol) {
       o.track_invariants = false;
       const BodyResult r = integrate_body(b, s.centres, nullptr, Accuracy{tol, kEnd}, o);
       ASSERT_EQ(r.outcome, Outcome::ok) << r.reason;
-      const double err = adaptive::state_distance(r.run.final, ref);
+      const double err = bodypoint::state_distance(r.run.final, ref);
       EXPECT_LE(err, tol) << r.method->name << " d " << d << " tol " << tol;
       EXPECT_GE(r.error.value, err / kEstimateFactor) << r.method->name << " d " << d << " tol " << tol;
     }
@@ -245,7 +245,7 @@ TEST(Tolerance, ThePilotsCoarseRunIsDeliveredWhereFinerRunsBoundIt) {
   constexpr double kTol = 1e-4;
   const adaptive::ToleranceResult r = adaptive::run_to_tolerance(method_or_throw("logh-verlet"), b, ns.scene.centres,
                                                                  Accuracy{kTol, ns.t_end}, kUnobserved, false);
-  const double err = adaptive::state_distance(r.result.final, reference_state(b, ns.scene.centres, ns.t_end));
+  const double err = bodypoint::state_distance(r.result.final, reference_state(b, ns.scene.centres, ns.t_end));
   EXPECT_EQ(r.runs, 3) << "the pilot pair and the ladder's first refinement";
   EXPECT_LE(err, kTol);
   EXPECT_GE(err, kTol / kAskedDigits);
@@ -267,7 +267,7 @@ TEST(Tolerance, AVerifiedAnswerOnARoundedPassIsWithinTolOrRefused) {
     try {
       const adaptive::ToleranceResult r =
           adaptive::run_to_tolerance(method_or_throw("logh-kl8"), b, s.centres, Accuracy{tol, t_end}, kUnobserved);
-      const double err = adaptive::state_distance(r.result.final, ref);
+      const double err = bodypoint::state_distance(r.result.final, ref);
       EXPECT_LE(err, tol) << "estimated " << r.err_estimate;
       EXPECT_GE(r.err_estimate, err / kEstimateFactor);
     } catch (const Error& e) {
@@ -313,7 +313,7 @@ TEST(Tolerance, EveryFamilyAcceptsTol) {
   for (const char* name : {"lp-rkn6", "lp-kl8", "logh-y4", "logh-kl6", "ttl-bm4", "ttl-mcl8"}) {
     const adaptive::ToleranceResult r =
         adaptive::run_to_tolerance(method_or_throw(name), b, ns.scene.centres, Accuracy{tol, ns.t_end}, kUnobserved);
-    EXPECT_LE(adaptive::state_distance(r.result.final, ref), tol) << name;
+    EXPECT_LE(bodypoint::state_distance(r.result.final, ref), tol) << name;
   }
 }
 
@@ -395,7 +395,7 @@ TEST(Tolerance, FarIpDeliversTolWithTheEstimateOfItsPair) {
       try {
         const adaptive::ToleranceResult r =
             adaptive::run_to_tolerance(m, b, c.scene.centres, Accuracy{tol, c.t_end}, kUnobserved);
-        const double err = adaptive::state_distance(r.result.final, ref);
+        const double err = bodypoint::state_distance(r.result.final, ref);
         EXPECT_LE(err, tol) << c.name << " tol " << tol;
         EXPECT_LE(r.err_estimate, tol) << c.name << " tol " << tol;
         if (err > kComparableError) {
@@ -407,7 +407,7 @@ TEST(Tolerance, FarIpDeliversTolWithTheEstimateOfItsPair) {
                     c.name.c_str(), tol, r.h, r.err_estimate, err, r.runs, r.total_force_evals);
       } catch (const Error& e) {
         const std::string reason = e.what();
-        EXPECT_LT(tol, adaptive::kProbeBelowTol) << c.name << ": " << reason;
+        EXPECT_LT(tol, bodypoint::kProbeBelowTol) << c.name << ": " << reason;
         const std::string floor_said = "was at least ";
         const auto at = reason.find(floor_said);
         ASSERT_NE(at, std::string::npos) << c.name << ": " << reason;
@@ -426,7 +426,7 @@ TEST(Tolerance, UnreachableOrInvalidTolIsRefused) {
   const NamedScene ns = named_scene("close");
   const Body& b = ns.scene.bodies.front();
   for (double tol : {0.0, -1e-6, std::nan(""), 1e-20, 2.0})
-    EXPECT_THROW(adaptive::check_tolerance(tol), Error) << tol;
+    EXPECT_THROW(bodypoint::check_tolerance(tol), Error) << tol;
   // An adaptive peer controls its own step: the search refuses it.
   EXPECT_THROW(adaptive::run_to_tolerance(method_or_throw("odeint-rkf78"), b, ns.scene.centres, Accuracy{1e-8, 80.0}, kUnobserved), Error);
 }
@@ -461,14 +461,14 @@ TEST(Tolerance, ARefusalQuotesTheFloorItMet) {
   }
   const State ref = reference_state(b, scene.centres, t_end, 1e-18L);
   const adaptive::ToleranceResult r = adaptive::run_to_tolerance(m, b, scene.centres, Accuracy{kLooser, t_end}, kUnobserved);
-  EXPECT_LE(adaptive::state_distance(r.result.final, ref), kLooser);
+  EXPECT_LE(bodypoint::state_distance(r.result.final, ref), kLooser);
   // Ten times tighter than the floor, a pair at the answer's step and twice it agreed with C h^p by
   // chance and was delivered 38x off (estimate 1.9e-14, error 3.8e-12) until runs differing only in
   // rounding were compared: now refused, or delivered within tol.
   constexpr double kBelowFloor = 1e-13;
   try {
     const adaptive::ToleranceResult below = adaptive::run_to_tolerance(m, b, scene.centres, Accuracy{kBelowFloor, t_end}, kUnobserved);
-    EXPECT_LE(adaptive::state_distance(below.result.final, ref), kBelowFloor) << "delivered below the floor";
+    EXPECT_LE(bodypoint::state_distance(below.result.final, ref), kBelowFloor) << "delivered below the floor";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("out of reach"), std::string::npos) << e.what();
   }

@@ -775,7 +775,7 @@ TEST(ApiSweep, AutoRowsFollowOneMapPlanThatDependsOnTheSweepAlone) {
     const Scene scene = thesis_scene(point_params(s, r.point));
     const BodyResult ref = integrate(scene, "auto", Accuracy{kReferenceTol, s.t_end}).bodies.front();
     ASSERT_TRUE(ref.accuracy.has_value()) << at;
-    EXPECT_LE(adaptive::state_distance(r.result.final, ref.run.final), kTol + ref.accuracy->err_estimate) << at;
+    EXPECT_LE(bodypoint::state_distance(r.result.final, ref.run.final), kTol + ref.accuracy->err_estimate) << at;
     if (plan.pilots.count(r.task)) {  // a pilot is the single run's search
       const BodyResult one = integrate(scene, "auto", Accuracy{kTol, s.t_end}).bodies.front();
       EXPECT_EQ(r.result.final.R, one.run.final.R) << at;

@@ -594,7 +594,7 @@ TEST(Encounter, BelowTheRoundOffFloorTheAccuracyModeRefusesOrDelivers) {
     return;
   }
   const State ref = reference_state(s.bodies.front(), s.centres, e.run.run.t_end, 1e-18L);
-  EXPECT_LE(adaptive::state_distance(e.run.run.final, ref), kTol) << "estimate " << e.run.error.value;
+  EXPECT_LE(bodypoint::state_distance(e.run.run.final, ref), kTol) << "estimate " << e.run.error.value;
 }
 
 TEST(Encounter, ASpinningBodysTimeDelayConverges) {

@@ -11,8 +11,4 @@ namespace bodypoint::adaptive {
 /// logh-*, ttl-* and ks, in listing order.
 std::vector<MethodInfo> methods();
 
-/// The constant c of the time-step function chosen from the scene and the fictitious step ds when
-/// RunOptions::omega_c < 0 (run.cpp says why).
-double automatic_omega_c(const Body& body, const std::vector<Centre>& centres, double ds);
-
 }  // namespace bodypoint::adaptive

@@ -14,43 +14,14 @@
 // `--method auto` (which method for a scene and a tol) is one layer up: bodypoint/methods.hpp.
 #pragma once
 
+#include "bodypoint/accuracy.hpp"
 #include "bodypoint/run.hpp"
 #include "bodypoint/detail/run_parts.hpp"
 
-#include <limits>
 #include <string>
-#include <string_view>
 #include <vector>
 
 namespace bodypoint::adaptive {
-
-/// Requested tolerances below this are refused: runs of 1e3..1e5 steps accumulate a round-off
-/// floor of 1e-15..1e-13 relative (README, round-off floor test), so a smaller error cannot be
-/// delivered, nor estimated, in double precision.
-inline constexpr double kMinTolerance = 1e-13;
-/// A step the search predicts, or a map plans (Accuracy::first_step), aims its estimate at this fraction of
-/// tol: a prediction from a coarser pair is uncertain by a factor of a few, and a miss costs one more run.
-inline constexpr double kTargetShare = 0.3;
-
-/// Below this tolerance a run about to be delivered is repeated kProbeRuns times: with its roundings
-/// changed (all but one), and once from its start moved by a rounding; what they differ by is added to the estimate
-/// (search/rounding.cpp): an encounter amplifies round-off, which Richardson's estimate cannot tell from
-/// truncation. The search then costs that many delivered runs more.
-inline constexpr double kProbeBelowTol = 1e-10;
-inline constexpr int kProbeRuns = 3;
-/// The rounding probe's relative move of the starting state (R scaled by 1 + kStartShift, v by 1 -
-/// kStartShift): a few units in the last place of a double (the rounding of a decimal input such as
-/// Kz = 0.1 is half of one). The run-by-step estimate at the rounding level moves it alike (lib/api/estimate/rounding.cpp).
-inline constexpr double kStartShift = 4.0 * std::numeric_limits<double>::epsilon();
-/// The rounding probe's relative move of a fictitious step (k kProbeShift for its k-th repeat): its
-/// steps then land nowhere the run's do, and its truncation error moves by far less than a tolerance.
-/// The run-by-step estimate's second coarse draw moves its step alike (lib/api/estimate/rounding.cpp, off_grid).
-inline constexpr double kProbeShift = 1e-9;
-
-/// Why the accuracy mode refuses a scene with a centre that does not follow Coulomb's law.
-inline constexpr std::string_view kNeedsCoulomb =
-    "the accuracy mode (tol) assumes Coulomb's law (its error model and time transformations do); run the thesis "
-    "code's force law with a fixed step h";
 
 struct ToleranceResult {
   RunResult result;        ///< the delivered run, with the invariants and samples RunOptions asked for
@@ -84,11 +55,5 @@ ToleranceResult search_step(const MethodInfo& method, const Body& body, const st
 /// Throws Error unless the accuracy mode can search `method`'s step: a fixed-step or time-transformed
 /// method with a known order, or ks.
 void check_searchable(const MethodInfo& method);
-
-/// Relative distance of two final states: max(|dR|/|R_b|, |dv|/|v_b|) (the model's, model.hpp).
-using bodypoint::state_distance;
-
-/// Throws Error unless tol is a finite number in [kMinTolerance, 1).
-void check_tolerance(double tol);
 
 }  // namespace bodypoint::adaptive

@@ -3,7 +3,7 @@
 // the default flags pass it and its estimate is small.
 #include "estimate/parts.hpp"
 
-#include "bodypoint/adaptive/richardson.hpp"
+#include "bodypoint/accuracy.hpp"
 #include "bodypoint/batch.hpp"
 #include "bodypoint/detail/run_parts.hpp"
 
@@ -53,7 +53,7 @@ constexpr double kMinCoarseRatio = 1.25;
 /// cancel near twice the step make it differ by much less (attracting lp-euler at h = 0.01: 9.3e-6 off, its
 /// coarse run at 0.02 1.0e-5 off the same way, read 1.0e-6; bound-orbit lp-rkn4 at h = 0.1: 9.6e-7 off,
 /// read 1.2e-7). A second coarse run, the coarse run's own coarse companion, tells: the order the three
-/// runs observe (adaptive::observed_order) must lie within kObservedOrderSlack of the orders the estimate
+/// runs observe (bodypoint::observed_order) must lie within kObservedOrderSlack of the orders the estimate
 /// assumes (below: the coarse side's order, capped; above: the method's own, which high orders may
 /// show at coarse steps). There it observed 4.5 (order 1) and 8.7 (order 4).
 constexpr double kObservedOrderSlack = 1.0;
@@ -125,7 +125,7 @@ bool coarse_pair_asymptotic(ErrorEstimate& e, const MethodInfo& m, const Body& b
 }  // namespace
 
 double coarse_side_of(const MethodInfo& m, const Body& body, const CoarseCompanion& c, const State& run, const State& coarse) {
-  return adaptive::finer_run_error(adaptive::state_distance(run, coarse), c.ratio, fixed_order(m, body));
+  return bodypoint::finer_run_error(bodypoint::state_distance(run, coarse), c.ratio, fixed_order(m, body));
 }
 
 bool asks_second_coarse(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres, const ErrorEstimate& e) {
@@ -142,7 +142,7 @@ bool sharpened_by_second_coarse(const MethodInfo& m, const Body& body, const std
 bool observed_order_agrees(const MethodInfo& m, const Body& body, const CoarseCompanion& c, const CoarseCompanion& c2,
                            const State& run, const State& coarse, const State& coarser, ErrorEstimate& e) {
   if (!(coarser.R.allFinite() && coarser.v.allFinite())) return false;
-  const double q = adaptive::observed_order(adaptive::state_distance(coarse, coarser), adaptive::state_distance(run, coarse),
+  const double q = bodypoint::observed_order(bodypoint::state_distance(coarse, coarser), bodypoint::state_distance(run, coarse),
                                             c.ratio * c2.ratio, c.ratio);
   const int p = fixed_order(m, body);
   const int assumed = std::min(c.asked < kStepRatio ? kCoarseMaxOrderBelow2 : kCoarseMaxOrder, p);
@@ -157,8 +157,8 @@ bool observed_order_agrees(const MethodInfo& m, const Body& body, const CoarseCo
   // second coarse run at 1.49 times the first's: order 7.68 seen, 3.1e-6 off, read 6.7e-7 at 7.68, 1.35e-6 at 6.68).
   const double taken = std::min(static_cast<double>(p), c2.asked >= kStepRatio ? q : q - kObservedOrderSlack);
   if (taken > assumed) {
-    const double d = adaptive::state_distance(run, coarse);
-    const double sharper = std::max(adaptive::finer_run_error(d, c.ratio, taken), std::min(d, kRoundingLevel));
+    const double d = bodypoint::state_distance(run, coarse);
+    const double sharper = std::max(bodypoint::finer_run_error(d, c.ratio, taken), std::min(d, kRoundingLevel));
     if (sharper < e.value) {
       e.value = sharper;
       e.basis += ", order " + short_number(taken) + " taken";
@@ -277,7 +277,7 @@ std::optional<ErrorEstimate> coarse_estimate(const MethodInfo& m, const Body& bo
                                              const CoarseCompanion& c, const State& run, const State& coarse, long run_steps) {
   if (!(coarse.R.allFinite() && coarse.v.allFinite())) return std::nullopt;
   const int p = std::min(c.asked < kStepRatio ? kCoarseMaxOrderBelow2 : kCoarseMaxOrder, fixed_order(m, body));
-  const double d = adaptive::state_distance(run, coarse);
+  const double d = bodypoint::state_distance(run, coarse);
   ErrorEstimate e;
   const bool h = std::holds_alternative<FixedSteps>(c.how);
   const std::string step = h ? "h" : "ds";
@@ -289,7 +289,7 @@ std::optional<ErrorEstimate> coarse_estimate(const MethodInfo& m, const Body& bo
     e.basis += kExactFlowBasis;
     return e.value <= kCoarseTrusted ? std::optional<ErrorEstimate>(std::move(e)) : std::nullopt;
   }
-  e.value = adaptive::finer_run_error(d, c.ratio, p);
+  e.value = bodypoint::finer_run_error(d, c.ratio, p);
   e.basis += order_text(p) + (p < fixed_order(m, body) ? " (at most " + std::to_string(p) + " on the coarse side)" : "");
   // Where the pair differs by the scene's rounding, that difference is not divided: the run's own
   // rounding is of its size (the two runs' roundings are independent draws, the moved start's growth one more).

@@ -4,7 +4,7 @@
 // an order gets Richardson's error at that order, at least the final state's estimate over its pair's difference.
 #include "parts.hpp"
 
-#include "bodypoint/adaptive/methods.hpp"
+#include "bodypoint/accuracy.hpp"
 
 #include <array>
 #include <cmath>
@@ -22,7 +22,7 @@ constexpr double kFinerRatio = 1.25;
 /// A pair that locates an event at the same double has still erred by its rounding: the errors are at least
 /// this relative part of the time and distance (a few units in the last place, the rounding probes' start
 /// shift), and the state's at least the run's own estimate's share of it.
-constexpr double kEventRounding = adaptive::kStartShift;
+constexpr double kEventRounding = bodypoint::kStartShift;
 
 /// The step of the run r asked as `how`: the accuracy mode's delivered one, or the step by which it ran.
 struct RunStep {
@@ -64,7 +64,7 @@ std::map<std::pair<std::size_t, int>, const EventHit*> by_occurrence(const std::
 
 /// A hit's quantities that get an error: its time, its distance, its state (relative).
 std::array<double, 3> differences(const EventHit& a, const EventHit& b) {
-  return {std::abs(a.t - b.t), std::abs(a.r - b.r), adaptive::state_distance(a.s, b.s)};
+  return {std::abs(a.t - b.t), std::abs(a.r - b.r), bodypoint::state_distance(a.s, b.s)};
 }
 
 /// The hits of `x` paired with r's by occurrence; none where an event is hit another number of times.
@@ -128,7 +128,7 @@ void estimate_event_errors(BodyResult& r, const Body& body, const std::vector<Ce
   // (in the asymptotic regime every smooth quantity errs by the same multiple). Not where the final pair differs
   // at the rounding level: there the estimate is its rounding draws', which say nothing of an earlier event's
   // truncation (lp-y4 h = 0.01 to t = 40: r_min stated 60x its error).
-  const double apart = adaptive::state_distance(r.run.final, x.run.final);
+  const double apart = bodypoint::state_distance(r.run.final, x.run.final);
   const double final_factor = apart > kRoundingLevel ? r.error.value / apart : 0.0;
   const std::vector<const EventHit*> with_x = partners(r.events, x.events);
   const std::vector<const EventHit*> with_y = y ? partners(r.events, y->events) : std::vector<const EventHit*>(r.events.size());

@@ -3,7 +3,7 @@
 // third one level finer that confirm a flagged run's estimate.
 #include "estimate/parts.hpp"
 
-#include "bodypoint/adaptive/richardson.hpp"
+#include "bodypoint/accuracy.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -49,7 +49,7 @@ std::optional<Companion> companion_of(const MethodInfo& m, const Body& body, con
                                       std::string& none) {
   const double ratio = std::pow(kStepRatio, level);
   const int p = fixed_order(m, body);
-  const double richardson = adaptive::coarser_run_error(1.0, ratio, p);  // times what the two runs differ by
+  const double richardson = bodypoint::coarser_run_error(1.0, ratio, p);  // times what the two runs differ by
   const double fall = std::min(kMaxFall, std::pow(kStepRatio, p - kOrderSlack));
   if (const auto* f = std::get_if<FixedSteps>(&how)) {
     if (static_cast<double>(f->steps) * ratio > 1e15) {
@@ -171,9 +171,9 @@ void bound_by_second(ErrorEstimate& e, const MethodInfo& m, const Body& body, lo
                      const State& first, const State& second) {
   const int p = fixed_order(m, body);
   // What the run differs by from the second companion, plus what the first may still be off by.
-  const double near = adaptive::state_distance(run, first);
-  const double further = adaptive::state_distance(first, second);
-  const double bound = adaptive::state_distance(run, second) + further;
+  const double near = bodypoint::state_distance(run, first);
+  const double further = bodypoint::state_distance(first, second);
+  const double bound = bodypoint::state_distance(run, second) + further;
   // A run of a few steps (a time-transformed run whose landing step spans the whole end time) is not in any
   // asymptotic regime (ttl-verlet at ds = 1 on the material pass: 1 step, 2.1e-5 off, estimated 4.0e-6 from a
   // companion of 2 steps; a second of 3 steps is 1.7e-5 from the run). Nor is a pair that agrees by chance
@@ -201,14 +201,14 @@ void confirm(ErrorEstimate& e, double min_fall, const State& run, const State& f
     e.basis += "; a second companion one level finer did not end as the run did";
     return;
   }
-  const double d1 = adaptive::state_distance(run, first), d2 = adaptive::state_distance(first, second);
+  const double d1 = bodypoint::state_distance(run, first), d2 = bodypoint::state_distance(first, second);
   if (d1 >= min_fall * d2) {
     e.confirmed = true;
     e.basis += "; a second companion one level finer confirms it";
     return;
   }
   if (d1 >= kGeometricFall * d2) {
-    const double bound = adaptive::state_distance(run, second) + d2;
+    const double bound = bodypoint::state_distance(run, second) + d2;
     e.value = std::max(e.value, bound);
     e.confirmed = true;
     e.basis += "; a second companion one level finer: the differences fall " + short_number(d1 / d2) +
@@ -231,12 +231,12 @@ void confirm_deeper(ErrorEstimate& e, const State& run, const State& first, cons
     e.basis += "; a third companion did not end as the run did";
     return;
   }
-  const double d2 = adaptive::state_distance(first, second), d3 = adaptive::state_distance(second, third);
+  const double d2 = bodypoint::state_distance(first, second), d3 = bodypoint::state_distance(second, third);
   if (!(d2 >= kGeometricFall * d3)) {
     e.basis += "; nor a third, one level finer again (its differences fall " + short_number(d2 / d3) + "x)";
     return;
   }
-  e.value = std::max(e.value, adaptive::state_distance(run, third) + d3);
+  e.value = std::max(e.value, bodypoint::state_distance(run, third) + d3);
   e.confirmed = true;
   e.basis += "; a third companion one level finer again: the finer differences fall " + short_number(d2 / d3) +
              "x, the estimate at least what the run differs by from the third plus what that may still be off by";
@@ -255,12 +255,12 @@ ErrorEstimate fixed_step_estimate(const MethodInfo& m, const Body& body, const s
   if (!(companion.R.allFinite() && companion.v.allFinite())) {
     e.basis = "the " + e.basis + " did not end as the run did";
   } else if (flow_is_exact(m, body, centres)) {
-    e.value = adaptive::state_distance(run, companion);
+    e.value = bodypoint::state_distance(run, companion);
     e.basis = "companion run at h/2, " + std::string(kExactFlowBasis);
   } else {
     // As integrate()'s companion: its factor times the difference (not the difference over 1 - 2^-p,
     // which rounds otherwise: a sweep's lane and the same run alone were an ulp apart).
-    e.value = adaptive::coarser_run_error(1.0, kStepRatio, p) * adaptive::state_distance(run, companion);
+    e.value = bodypoint::coarser_run_error(1.0, kStepRatio, p) * bodypoint::state_distance(run, companion);
   }
   return e;
 }

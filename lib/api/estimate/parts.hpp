@@ -10,7 +10,7 @@
 
 #include "estimate.hpp"
 
-#include "bodypoint/adaptive/tolerance.hpp"
+#include "bodypoint/accuracy.hpp"
 #include "bodypoint/detail/run_support.hpp"
 
 #include <algorithm>
@@ -25,13 +25,13 @@ namespace bodypoint::detail {
 inline constexpr double kStepRatio = ErrorEstimate::kStepRatio;
 /// A companion difference below kRoundingLevel is at the scene's rounding level, where the pair can agree
 /// by chance (one draw of the rounding each). There the estimate adds what kRoundingDraws - 1 more runs
-/// differ from the run by, off the run's grid (off_grid) from its start moved by adaptive::kStartShift,
+/// differ from the run by, off the run's grid (off_grid) from its start moved by bodypoint::kStartShift,
 /// either way in turn, as the accuracy mode adds its rounding probes below the same level (tolerance.hpp,
 /// kProbeBelowTol): repeats of the run (fine companions), or coarse runs (coarse companion: half a run
 /// each; at fixed steps the companion's twin, its own steps from the start moved the other way, the two
 /// lanes of one batch where the method has a kernel: coarse_lanes), and the sum is taken kRoundingBound
 /// times (ErrorEstimate).
-inline constexpr double kRoundingLevel = adaptive::kProbeBelowTol;
+inline constexpr double kRoundingLevel = bodypoint::kProbeBelowTol;
 inline constexpr const char* kExactFlowBasis = "the method's flow is exact on this scene: they differ by rounding, taken whole";
 
 inline std::string order_text(int p) { return "order " + std::to_string(p); }

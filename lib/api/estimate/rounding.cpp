@@ -41,7 +41,7 @@ Advance off_grid(const Advance& how, int k) {
     return FixedSteps{f->h * static_cast<double>(f->steps) / static_cast<double>(f->steps + k), f->steps + k};
   if (const auto* f = std::get_if<FictitiousSteps>(&how)) {
     FictitiousSteps moved = *f;
-    moved.ds *= 1.0 + k * adaptive::kProbeShift;
+    moved.ds *= 1.0 + k * bodypoint::kProbeShift;
     return moved;
   }
   return how;
@@ -58,8 +58,8 @@ void bound_from_draws(ErrorEstimate& e) {
 bool at_rounding_level(const ErrorEstimate& e) { return e.value < kRoundingLevel; }
 
 State start_moved_by_rounding(State s, double way) {
-  s.R *= 1.0 + way * adaptive::kStartShift;
-  s.v *= 1.0 - way * adaptive::kStartShift;
+  s.R *= 1.0 + way * bodypoint::kStartShift;
+  s.v *= 1.0 - way * bodypoint::kStartShift;
   return s;
 }
 
@@ -68,7 +68,7 @@ void add_rounding_spread(ErrorEstimate& e, const State& run, const State& repeat
   e.force_evals += force_evals;
   e.wall_s += wall_s;
   if (!(repeat.R.allFinite() && repeat.v.allFinite())) return;
-  const double spread = adaptive::state_distance(run, repeat);
+  const double spread = bodypoint::state_distance(run, repeat);
   e.value += spread;
   e.basis += "; plus " + short_number(spread) + " from " + what + " (the estimate is at the scene's rounding level)";
 }

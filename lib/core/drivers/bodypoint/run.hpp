@@ -151,7 +151,7 @@ Advance backwards(Advance how);
 
 /// Every number of `how` checked, each with one message naming the quantity: steps and times finite
 /// and > 0, counts >= 1, dt_out >= 0, a tolerance per step in [1e-15, inf). The accuracy mode's
-/// tolerance is checked by adaptive::check_tolerance, one layer up.
+/// tolerance is checked by check_tolerance (accuracy.hpp).
 void check(const Advance& how);
 
 /// What a run asks for besides the way of advancing time; the API's Options add events and the bound
