@@ -14,7 +14,7 @@
 namespace bodypoint::adaptive {
 
 void check_searchable(const MethodInfo& method) {
-  if (is_step_controlled(method))
+  if (takes_tolerance_per_step(method))
     throw Error(std::string(method.name) + " controls its own step: give it a tolerance per step, not the accuracy mode's "
                 "search (which is for fixed-step and time-transformed methods)");
   if (method.traits.search == SearchStrategy::none || (method.traits.search == SearchStrategy::ladder && method.order == 0))

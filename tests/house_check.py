@@ -28,35 +28,22 @@ CATALOGUE = ("lib/core/drivers/bodypoint/run.cpp", "lib/core/drivers/bodypoint/r
 SINGLE_FAMILY_TRAITS = re.compile(
     r"traits\.(frozen_gyroscopic_term|takes_omega_c|exact_in_fictitious_time|cost_set_by_field)\b"
     r"|SearchStrategy::(field_pair|exact_pair)\b")
-TRAIT_READS = {
+TRAIT_READS = {  # far-ip's search strategy (field_pair): its pair's basis, its search and its ladder's first step
     "adaptive/search/exact_pair.cpp": 1,
     "adaptive/search/runs.cpp": 1,
-    "experiments/studies/by_tol.cpp": 2,
-    "experiments/studies/orders.cpp": 1,
-    "experiments/studies/work_precision.cpp": 3,
-    "lib/api/estimate/coarse.cpp": 1,
-    "lib/api/estimate/fine.cpp": 1,
+    "experiments/studies/work_precision.cpp": 1,
 }
 # A method's kind (is_time_transformed, is_step_controlled) asked outside the catalogue: what the row's functions
-# (advance_to, step_name, step_quantity, stepping_name, search_first_step, ...: run.hpp) do not yet answer.
+# (advance_to, advance_of, step_name, lands_on_output_times, takes_tolerance_per_step, refines_by_step, ...: run.hpp)
+# do not yet answer.
 KIND = re.compile(r"\b(is_time_transformed|is_step_controlled)\s*\(")
 KIND_CHECKS = {
-    "adaptive/search/rounding.cpp": 1,
-    "adaptive/search/start.cpp": 1,
-    "adaptive/tolerance.cpp": 1,
+    "adaptive/search/rounding.cpp": 1,  # the rounding probe moves a fictitious step, or a fixed step's count
     "bench/bench_steps.cpp": 1,
-    "experiments/cli/budget.cpp": 2,
-    "experiments/cli/cli.cpp": 1,
-    "experiments/cli/simulate.cpp": 2,
-    "experiments/studies/by_tol.cpp": 2,
-    "experiments/studies/orders.cpp": 2,
-    "experiments/studies/stress.cpp": 2,
-    "experiments/studies/study.cpp": 2,
-    "experiments/studies/work_precision.cpp": 6,
-    "lib/api/estimate/events.cpp": 1,
-    "lib/api/integrate.cpp": 7,
-    "lib/api/sweep.cpp": 3,
-    "lib/core/drivers/bodypoint/detail/run_parts.hpp": 2,
+    "experiments/cli/simulate.cpp": 1,  # the header names the step ds or h
+    "experiments/studies/stress.cpp": 1,  # a fictitious step 10 fixed steps long
+    "experiments/studies/work_precision.cpp": 2,  # the ladder of each kind
+    "lib/api/integrate.cpp": 1,  # the message names the request's h as ds
 }
 CATCH_SITES = {
     "adaptive/search/search.hpp": 3,  # attempt(): a method's breakdown as a step's answer

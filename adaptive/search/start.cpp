@@ -14,10 +14,10 @@
 namespace bodypoint::adaptive::detail {
 
 Advance step_advance(const MethodInfo& m, double h, double t_end, double dt_out) {
-  if (is_time_transformed(m)) return FictitiousSteps{h, EndTime{t_end}, dt_out};
-  const double n = steps_landing_on(t_end, h);
-  if (!(n <= 1e12)) throw SearchLimit("tol: the step the search needs (" + std::to_string(h) + ") is too small");
-  return FixedSteps{t_end / n, static_cast<long>(n), dt_out};
+  const Advance how = advance_of(m, {.step = h, .end = t_end, .dt_out = dt_out});
+  if (const auto* f = std::get_if<FixedSteps>(&how); f && !(static_cast<double>(f->steps) <= 1e12))
+    throw SearchLimit("tol: the step the search needs (" + std::to_string(h) + ") is too small");
+  return how;
 }
 
 }  // namespace bodypoint::adaptive::detail

@@ -78,11 +78,10 @@ std::optional<WorkEstimate> estimate_work(const MethodInfo& m, const Body& body,
 
 double estimated_seconds(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres, double step,
                          double steps, double runs) {
-  if (!(steps > 0.0) || !(runs > 0.0) || is_step_controlled(m)) return 0.0;
+  if (!(steps > 0.0) || !(runs > 0.0) || takes_tolerance_per_step(m)) return 0.0;
   // A calibration of kCalibrationSteps: asked for as a long run, so that estimate_work measures it.
   constexpr long kAsLong = 2 * kCalibrateAbove;
-  const Advance how = is_time_transformed(m) ? Advance(FictitiousSteps{step, StepCount{kAsLong}})
-                                             : Advance(FixedSteps{step, kAsLong});
+  const Advance how = advance_of(m, {.step = step, .steps = kAsLong});
   Options quiet;
   quiet.track_invariants = false;
   quiet.estimate_error = false;  // the caller counts the runs

@@ -98,7 +98,7 @@ double error_bound(const StepOptions& o) {
 StepRequest step_request(const po::variables_map& vm, const StepOptions& o, const MethodInfo* method, double tol,
                          std::optional<double> end_if_none) {
   StepRequest r;
-  if ((vm.count("tol") && !vm["tol"].defaulted()) || (method && is_step_controlled(*method))) r.tol = tol;
+  if ((vm.count("tol") && !vm["tol"].defaulted()) || (method && takes_tolerance_per_step(*method))) r.tol = tol;
   // A step given is passed on (the accuracy mode refuses it); a default one only where a step is used.
   if (!vm["h"].defaulted() || !searches(method, r)) r.h = o.h;
   if (!vm["steps"].defaulted()) r.steps = o.steps;

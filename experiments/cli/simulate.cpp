@@ -323,7 +323,7 @@ SimulatedBody simulate_body(const SimulateOptions& o, const RunPlan& plan, const
   }
   const BodyResult& br = sb.run;
   if (br.outcome != Outcome::ok) {
-    const std::string smaller = is_step_controlled(*br.method) ? "the tolerance is too loose for this scene (reduce --tol"
+    const std::string smaller = takes_tolerance_per_step(*br.method) ? "the tolerance is too loose for this scene (reduce --tol"
                                                                : "the step is too large for this scene (reduce --h";
     const bool energy = br.run.invariants && br.run.invariants->max_rel_dE > plan.options.max_energy_error;
     throw Error("body '" + body.name + "' (" + std::string(br.method->name) + "): " + br.reason + "; " +

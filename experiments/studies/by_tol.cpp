@@ -72,7 +72,7 @@ constexpr int kLadderStalls = 3;
 std::vector<std::string> peer_names() {
   std::vector<std::string> out;
   for (const MethodInfo& m : methods())
-    if (is_step_controlled(m)) out.emplace_back(m.name);
+    if (takes_tolerance_per_step(m)) out.emplace_back(m.name);
   return out;
 }
 
@@ -213,7 +213,7 @@ void measure_own_ladders(const NamedScene& ns, const State& ref, double smallest
                          std::vector<TolRow>& rows) {
   const Body& body = ns.scene.bodies.front();
   for (const MethodInfo& m : methods()) {
-    if (is_peer(m) || is_step_controlled(m) || m.traits.search == SearchStrategy::field_pair) continue;
+    if (is_peer(m) || !refines_by_step(m)) continue;
     if (!refusal(m, body, ns.scene.centres).empty()) continue;
     int failures = 0, below = 0, stalled = 0;
     double best = std::numeric_limits<double>::infinity();
@@ -228,7 +228,7 @@ void measure_own_ladders(const NamedScene& ns, const State& ref, double smallest
       r.method = m.name;
       r.h = h;
       r.is_own = true;
-      r.method_is_exact = m.traits.exact_in_fictitious_time;
+      r.method_is_exact = is_exact_flow(m);
       const BodyResult x = run_unestimated(m, body, ns.scene.centres, how, unobserved());
       if (!ran(x.outcome)) {
         ++failures;

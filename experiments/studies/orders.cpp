@@ -50,14 +50,9 @@ Probe probe(const NamedScene& ns) {
 
 double error_at(const MethodInfo& m, const Probe& p, double h) {
   Options o = unobserved();
-  Advance how;
-  if (is_time_transformed(m)) {
-    how = FictitiousSteps{h, EndTime{p.t_end}};  // the fictitious step; the run ends exactly at t_end
-    o.omega_c = 0.0;
-  } else {
-    const long steps = std::max(1L, std::lround(p.t_end / h));
-    how = FixedSteps{p.t_end / static_cast<double>(steps), steps};
-  }
+  if (takes_time_step_constant(m)) o.omega_c = 0.0;
+  // A fictitious step ends exactly at t_end; a fixed one is the nearest that lands there.
+  const Advance how = advance_of(m, {.step = h, .end = p.t_end, .grid = FixedGrid::nearest});
   const BodyResult r = run_unestimated(m, p.scene.bodies.front(), p.scene.centres, how, o);
   if (!ran(r.outcome)) return std::numeric_limits<double>::infinity();  // a step too large for this encounter (logH's E - T + c <= 0)
   return bodypoint::state_distance(r.run.final, p.ref);  // the tool's error norm, max(|dR|/|R|, |dv|/|v|)
@@ -89,13 +84,13 @@ void write_orders(std::ostream& csv) {
   const Probe enc_spin = probe(convergence_encounter(0.7)), enc_material = probe(convergence_encounter(0.0));
   const Probe orb_spin = probe(convergence_orbit(0.7)), orb_material = probe(convergence_orbit(0.0));
   for (const MethodInfo& m : methods()) {
-    if (is_step_controlled(m)) continue;  // no step to refine: a tolerance
+    if (takes_tolerance_per_step(m)) continue;  // no step to refine: a tolerance
     // A method that refuses the spinning body (ks) is measured on the material point.
     const bool ks = !refusal(m, enc_spin.scene.bodies.front(), enc_spin.scene.centres).empty();
     std::size_t ue = 0, uo = 0;
     const double enc = measured_order(m, ks ? enc_material : enc_spin, &ue);
-    const double orb = m.traits.frozen_gyroscopic_term ? std::numeric_limits<double>::quiet_NaN()
-                                                   : measured_order(m, ks ? orb_material : orb_spin, &uo);
+    const double orb = keeps_order_with_spin(m) ? measured_order(m, ks ? orb_material : orb_spin, &uo)
+                                                : std::numeric_limits<double>::quiet_NaN();
     csv << CsvLine().text(m.name).count(m.order).num_if(std::isfinite(enc), enc).count(static_cast<long>(ue))
                .num_if(std::isfinite(orb), orb).count(static_cast<long>(uo)).str()
         << '\n';

@@ -120,11 +120,9 @@ StressRow run_case(const StressCase& c, const MethodInfo& m, double max_seconds)
     return row;
   }
   const Body& body = c.scene.bodies.front();
-  Advance how;
-  if (is_step_controlled(m)) how = ControlledSteps{c.h, c.t_end, kDefaultStepTolerance};
   // ds: one fictitious step covers ~10 fixed steps far from a centre
-  else if (is_time_transformed(m)) how = FictitiousSteps{c.h * 10, EndTime{c.t_end}};
-  else how = FixedSteps{c.h, static_cast<long>(std::llround(c.t_end / c.h))};
+  const double step = c.h * (is_time_transformed(m) ? 10.0 : 1.0);
+  const Advance how = advance_of(m, {.step = step, .end = c.t_end, .grid = FixedGrid::nearest});
   const Options options;
   // The scene was checked (cases); the step, its end and the options are the study's own.
   if (const auto e = estimate_work(m, body, c.scene.centres, how, options)) {

@@ -171,9 +171,7 @@ void study_evals(const StudyContext& c) {
   for (const MethodInfo& m : methods()) {
     constexpr double h = 1e-3;
     constexpr long steps = 1000;
-    const Advance how = is_step_controlled(m)  ? Advance(ControlledSteps{h, 1.0, kDefaultStepTolerance})
-                        : is_time_transformed(m) ? Advance(FictitiousSteps{h, StepCount{steps}})
-                                                 : Advance(FixedSteps{h, steps});
+    const Advance how = advance_of(m, {.step = h, .steps = steps});
     const Scene& sc = refusal(m, scene.bodies.front(), scene.centres).empty() ? scene : material_scene;
     const RunResult r = run_or_throw(m, sc.bodies.front(), sc.centres, how, unobserved());
     const auto printed = kThesisTable41.find(m.name);

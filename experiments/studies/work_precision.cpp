@@ -65,17 +65,11 @@ struct Options {
 /// is refused or fails: `why` says why.
 std::optional<Row> measure(const NamedScene& ns, const MethodInfo& m, const Body& body, const State& ref, double h,
                            double tol, std::string& why) {
-  Advance how;
-  double step = h;  // the step of the row: h, or the fictitious step ds
-  if (is_time_transformed(m)) {
-    how = FictitiousSteps{h, EndTime{ns.t_end}};
-  } else if (is_step_controlled(m)) {
-    how = ControlledSteps{1e-3, ns.t_end, tol};
-  } else {
-    const long steps = std::max(1L, std::lround(ns.t_end / h));
-    step = ns.t_end / static_cast<double>(steps);
-    how = FixedSteps{step, steps};
-  }
+  // h: the step or the fictitious step ds (0 for a controlled method: its own first trial step); tol: a
+  // controlled method's tolerance per step (0 for the others).
+  const Advance how = advance_of(m, {.step = h, .end = ns.t_end, .tol = tol, .grid = FixedGrid::nearest});
+  const auto* fixed = std::get_if<FixedSteps>(&how);
+  const double step = fixed ? fixed->h : h;  // the step of the row: h, or the fictitious step ds
   const BodyResult plain = run_unestimated(m, body, ns.scene.centres, how, unobserved());
   if (!ran(plain.outcome)) {
     why = plain.reason;
@@ -86,8 +80,8 @@ std::optional<Row> measure(const NamedScene& ns, const MethodInfo& m, const Body
   Row row;
   row.scene = ns.name;
   row.method = std::string(m.name);
-  row.h = is_step_controlled(m) ? 0.0 : step;  // for time-transformed methods: ds
-  row.tol = is_step_controlled(m) ? tol : 0.0;
+  row.h = step;  // for time-transformed methods: ds; 0 for a controlled method
+  row.tol = tol;  // 0 but for a controlled method
   row.err_R = (r.final.R - ref.R).norm();
   if (!std::isfinite(row.err_R)) row.err_R = std::numeric_limits<double>::infinity();
   // The tool's one error norm (ErrorEstimate, --tol): max(|dR|/|R|, |dv|/|v|) of the final state.
@@ -193,7 +187,7 @@ class Ladder {
         capped_(!is_peer(m) || o.cap_peers) {}
 
   void run() {
-    if (m_.traits.exact_in_fictitious_time) exact();
+    if (is_exact_flow(m_)) exact();
     else if (is_time_transformed(m_)) fictitious();
     else if (is_step_controlled(m_)) tolerances();
     else fixed();
@@ -326,7 +320,7 @@ std::string config_of(const Row& r) {
 bool counts_at(const std::vector<Row>& rows, std::size_t i, const std::string& scene, double target) {
   const Row& r = rows[i];
   if (r.scene != scene || !(r.err_rel <= target)) return false;
-  if (method_or_throw(r.method).traits.exact_in_fictitious_time) return true;
+  if (is_exact_flow(method_or_throw(r.method))) return true;
   const Row* next = i + 1 < rows.size() ? &rows[i + 1] : nullptr;
   return next && next->scene == r.scene && next->method == r.method && next->err_rel <= target;
 }

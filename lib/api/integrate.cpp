@@ -387,7 +387,7 @@ BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& cen
                                 const Advance& how, const Options& options) {
   if (!options.events.empty()) return run_with_events(body, centres, method, how, options);
   const auto* accuracy = std::get_if<Accuracy>(&how);
-  if (!accuracy && options.sink && output_interval(how) > 0.0 && !is_time_transformed(*method))
+  if (!accuracy && options.sink && output_interval(how) > 0.0 && !lands_on_output_times(*method))
     return run_with_output_times(body, centres, *method, how, options);
   BodyResult r;
   r.method = method;
@@ -403,7 +403,7 @@ BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& cen
     return r;
   }
   try {
-    if (accuracy && options.sink && accuracy->dt_out > 0.0 && !is_time_transformed(*r.method))
+    if (accuracy && options.sink && accuracy->dt_out > 0.0 && !lands_on_output_times(*r.method))
       run_accurately_at_output_times(r, body, centres, *accuracy, options);
     else if (accuracy) run_accurately(r, body, centres, *accuracy, options);
     else r.run = r.method->run(body, centres, how, options);
@@ -529,7 +529,7 @@ Result integrate(const Scene& scene, std::string_view method, const Advance& how
 }
 
 bool searches(const MethodInfo* method, const StepRequest& request) {
-  return !method || (request.tol && !is_step_controlled(*method));
+  return !method || (request.tol && !takes_tolerance_per_step(*method));
 }
 
 StepRequest with_default_end(StepRequest r, const MethodInfo* method) {
@@ -554,18 +554,11 @@ Advance advance_for(const MethodInfo* m, const StepRequest& r) {
   const bool back = r.backward || (r.t_end && *r.t_end < 0.0);
   if (back && r.code_loop) throw Error("the thesis code's loop runs forwards only: give a positive end time");
   const std::optional<double> end = r.t_end ? std::optional<double>(std::abs(*r.t_end)) : std::nullopt;
-  Advance how;
-  if (is_step_controlled(*m)) {
-    const double t = end ? *end : h * static_cast<double>(require_count(*r.steps, "the number of steps"));
-    how = ControlledSteps{std::min(h, t), t, r.tol.value_or(kDefaultStepTolerance), r.dt_out};
-  } else if (is_time_transformed(*m)) {
-    how = end ? FictitiousSteps{h, EndTime{*end}, r.dt_out} : FictitiousSteps{h, StepCount{*r.steps}, r.dt_out};
-  } else {
-    FixedSteps f = r.code_loop ? thesis_code_steps(h, r.steps.value_or(0), end.value_or(0.0))
-                   : end       ? fixed_steps_to(*end, h)
-                               : FixedSteps{h, *r.steps};
-    f.dt_out = r.dt_out;
-    how = f;
+  if (!end) require_count(*r.steps, "the number of steps");
+  Advance how = advance_of(*m, {h, end.value_or(0.0), r.steps.value_or(0), r.tol.value_or(kDefaultStepTolerance), r.dt_out});
+  if (auto* f = std::get_if<FixedSteps>(&how); f && r.code_loop) {  // the thesis's loop: its own grid
+    *f = thesis_code_steps(h, r.steps.value_or(0), end.value_or(0.0));
+    f->dt_out = r.dt_out;
   }
   return back ? backwards(how) : how;
 }
@@ -602,7 +595,7 @@ Stepper::Stepper(Checked, const MethodInfo& method, const Body& body, const std:
     : method_(&method), body_(body), centres_(centres), step_(step), options_(std::move(options)) {
   // The time-step constant of a time-transformed method is fixed once, from the starting state, so
   // that every segment integrates the same transformed system.
-  if (is_time_transformed(method) && options_.omega_c < 0.0)
+  if (takes_time_step_constant(method) && options_.omega_c < 0.0)
     options_.omega_c = automatic_omega_c(body_, centres_, step_);
   // A segment has no error estimate of its own (a companion per segment would compare segments that
   // start from one state, not the runs).

@@ -420,10 +420,9 @@ FixedSteps sweep_steps(double h, long steps, double t_end, ForceLaw law) {
 }
 
 Advance to_common_end(const MethodInfo& method, const FixedSteps& f, double tol) {
-  const double t_end = f.h * static_cast<double>(f.steps);
-  if (is_time_transformed(method)) return FictitiousSteps{f.h, EndTime{t_end}};
-  if (is_step_controlled(method)) return ControlledSteps{f.h, t_end, tol};
-  return f;
+  // A fixed-step method keeps the grid it was given; the others run to its end.
+  const Advance how = advance_of(method, {.step = f.h, .end = f.h * static_cast<double>(f.steps), .tol = tol});
+  return std::holds_alternative<FixedSteps>(how) ? Advance(f) : how;
 }
 
 Advance point_advance(const SweepSpec& spec, const MethodInfo& method, const std::vector<double>& point) {
@@ -432,7 +431,7 @@ Advance point_advance(const SweepSpec& spec, const MethodInfo& method, const std
 
 Advance point_advance(const SweepSpec& spec, const MethodInfo* m, const std::vector<double>& point) {
   if (!m && !spec.accuracy) throw Error("method auto needs the accuracy mode (SweepSpec::accuracy: the tolerance to deliver)");
-  if (spec.accuracy && (!m || !is_step_controlled(*m))) {
+  if (spec.accuracy && (!m || !takes_tolerance_per_step(*m))) {
     if (spec.t_end > 0.0 || !spec.scattering) return Accuracy{*spec.accuracy, spec.t_end};
     // An encounter without an end: its span (the departure event stops the run), as simulate takes it.
     const Scene scene = point_scene(spec, point);

@@ -241,11 +241,10 @@ struct Result {
   double wall_s = 0.0;            ///< all bodies' step loops, searches included
 };
 
-/// The defaults of a run asked for by step (the thesis's table 3.1: h = 1e-4, n = 500000) and of a
-/// step-size-controlled method's tolerance per step.
+/// The defaults of a run asked for by step (the thesis's table 3.1: h = 1e-4, n = 500000); a
+/// step-size-controlled method's tolerance per step: kDefaultStepTolerance (run.hpp).
 inline constexpr double kDefaultStep = 1e-4;
 inline constexpr long kDefaultSteps = 500000;
-inline constexpr double kDefaultStepTolerance = 1e-10;
 
 /// A run asked for as the command line and the Python module take it, before the method's kind gives
 /// it a meaning (advance_for): a step, an end (an end time or a number of steps, not both), a tolerance.

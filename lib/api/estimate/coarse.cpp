@@ -259,7 +259,7 @@ std::optional<CoarseCompanion> coarse_companion(const MethodInfo& m, const Advan
     return CoarseCompanion{FixedSteps{f->h * ratio, coarse}, ratio, r, true};
   }
   const auto* f = std::get_if<FictitiousSteps>(&how);
-  if (f == nullptr || f->end.index() != 0 || m.traits.exact_in_fictitious_time) return std::nullopt;
+  if (f == nullptr || f->end.index() != 0 || is_exact_flow(m)) return std::nullopt;
   return CoarseCompanion{FictitiousSteps{f->ds * r, EndTime{f->t_end()}}, r, r, false};
 }
 

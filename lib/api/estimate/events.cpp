@@ -27,19 +27,20 @@ constexpr double kEventRounding = bodypoint::kStartShift;
 /// The step of the run r asked as `how`: the accuracy mode's delivered one, or the step by which it ran.
 struct RunStep {
   double h = 0.0, t_end = 0.0, omega_c = -1.0;
-  bool fictitious = false;
+  const MethodInfo* method = nullptr;
 };
 
 std::optional<RunStep> run_step(const BodyResult& r, const Advance& how, const Options& options) {
   RunStep s;
   s.omega_c = options.omega_c;
+  s.method = r.method;
   if (const auto* a = std::get_if<Accuracy>(&how); a && r.accuracy) {
-    s = RunStep{r.accuracy->h_chosen, a->t_end, r.accuracy->omega_c, is_time_transformed(*r.method)};
+    s = RunStep{r.accuracy->h_chosen, a->t_end, r.accuracy->omega_c, r.method};
   } else if (const auto* f = std::get_if<FixedSteps>(&how)) {
     s.h = f->h;
     s.t_end = f->h * static_cast<double>(f->steps);
   } else if (const auto* x = std::get_if<FictitiousSteps>(&how); x && x->end.index() == 0) {
-    s = RunStep{x->ds, x->t_end(), options.omega_c, true};
+    s = RunStep{x->ds, x->t_end(), options.omega_c, r.method};
   } else {
     return std::nullopt;  // a controlled step, a counted number of fictitious steps
   }
@@ -48,10 +49,7 @@ std::optional<RunStep> run_step(const BodyResult& r, const Advance& how, const O
 
 /// The companion's way of advancing: `ratio` times the step (fixed steps landing on the same end).
 Advance scaled(const RunStep& s, double ratio) {
-  const double h = ratio * s.h;
-  if (s.fictitious) return FictitiousSteps{h, EndTime{s.t_end}};
-  const double n = steps_landing_on(s.t_end, h);
-  return FixedSteps{s.t_end / n, static_cast<long>(n)};
+  return advance_of(*s.method, {.step = ratio * s.h, .end = s.t_end});
 }
 
 /// The k-th hit of each event in `hits`, by (event, k).

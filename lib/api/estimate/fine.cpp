@@ -65,7 +65,7 @@ std::optional<Companion> companion_of(const MethodInfo& m, const Body& body, con
     }
     const FictitiousSteps finer{f->ds / ratio, EndTime{f->t_end()}};
     const std::string at = "companion run at ds/" + short_number(ratio);
-    if (m.traits.exact_in_fictitious_time)  // the runs differ by rounding
+    if (is_exact_flow(m))  // the runs differ by rounding
       return Companion{finer, 1.0, at + " (the KS flow is exact: they differ by rounding and the time equation)", 1.0};
     return Companion{finer, richardson, at + " and the same time-step constant, " + order_text(p), fall};
   }

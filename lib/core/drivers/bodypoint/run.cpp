@@ -385,6 +385,34 @@ Advance advance_to(const MethodInfo& m, double step, double end, double h0) {
   return fixed_steps_to(end, step);
 }
 
+Advance advance_of(const MethodInfo& m, const RunAt& r) {
+  switch (m.traits.stepping) {
+    case Stepping::fictitious:
+      return r.end > 0.0 ? FictitiousSteps{r.step, EndTime{r.end}, r.dt_out} : FictitiousSteps{r.step, StepCount{r.steps}, r.dt_out};
+    case Stepping::controlled: {
+      const double t = r.end > 0.0 ? r.end : r.step * static_cast<double>(r.steps);
+      return ControlledSteps{std::min(r.step > 0.0 ? r.step : kControlledFirstStep, t), t, r.tol, r.dt_out};
+    }
+    case Stepping::fixed: break;
+  }
+  FixedSteps f{r.step, r.steps};
+  if (r.end > 0.0 && r.grid == FixedGrid::landing) f = fixed_steps_to(r.end, r.step);
+  if (r.end > 0.0 && r.grid == FixedGrid::nearest) {
+    const long n = std::max(1L, std::lround(r.end / r.step));
+    f = FixedSteps{r.end / static_cast<double>(n), n};
+  }
+  f.dt_out = r.dt_out;
+  return f;
+}
+
+bool lands_on_output_times(const MethodInfo& m) { return is_time_transformed(m); }
+bool takes_tolerance_per_step(const MethodInfo& m) { return is_step_controlled(m); }
+bool is_exact_flow(const MethodInfo& m) { return m.traits.exact_in_fictitious_time; }
+bool keeps_order_with_spin(const MethodInfo& m) { return !m.traits.frozen_gyroscopic_term; }
+bool refines_by_step(const MethodInfo& m) {
+  return !is_step_controlled(m) && m.traits.search != SearchStrategy::field_pair;
+}
+
 std::string_view step_name(const MethodInfo& m) {
   return is_step_controlled(m) ? "tol" : is_time_transformed(m) ? "ds" : "h";
 }
@@ -566,7 +594,7 @@ void check_takes(const MethodInfo& m, const Advance& how) {
   const bool ok = std::visit(
       [&m](const auto& a) {
         using A = std::decay_t<decltype(a)>;
-        if constexpr (std::is_same_v<A, FixedSteps>) return !has_variable_step(m);
+        if constexpr (std::is_same_v<A, FixedSteps>) return m.traits.stepping == Stepping::fixed;
         else if constexpr (std::is_same_v<A, FictitiousSteps>) return is_time_transformed(m);
         else if constexpr (std::is_same_v<A, ControlledSteps>) return is_step_controlled(m);
         else return false;

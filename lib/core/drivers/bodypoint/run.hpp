@@ -282,12 +282,42 @@ inline bool is_time_transformed(const MethodInfo& m) { return m.traits.stepping 
 
 // --- a method's behaviour, asked of its row (callers do not switch on its kind or family) ---------------
 
-/// The first trial step of a controlled method's own step-size control where the caller has none.
+/// The first trial step of a controlled method's own step-size control where the caller has none, and its
+/// tolerance per step.
 inline constexpr double kControlledFirstStep = 1e-3;
+inline constexpr double kDefaultStepTolerance = 1e-10;
 /// A run of `m` to the time `end` (> 0) at its step: the largest fixed step <= step that lands on end, the
 /// fictitious step ds = step to that time, or the tolerance per step tol = step (its control starting at
 /// min(h0, end)).
 Advance advance_to(const MethodInfo& m, double step, double end, double h0 = kControlledFirstStep);
+/// How a fixed step lands on an end time: the fewest steps <= h (fixed_steps_to), or the count nearest end/h
+/// (the studies' grids, at least one step).
+enum class FixedGrid { landing, nearest };
+/// A run of a given size, whatever the row's kind: `step` is h, ds, or a controlled method's first trial step
+/// (at most the span; 0: kControlledFirstStep), `tol` a controlled method's tolerance per step; to the time `end` (> 0) or, with end 0,
+/// for `steps` steps (a controlled method: to the time steps x step).
+struct RunAt {
+  double step = 0.0;
+  double end = 0.0;
+  long steps = 0;
+  double tol = kDefaultStepTolerance;
+  double dt_out = 0.0;
+  FixedGrid grid = FixedGrid::landing;
+};
+Advance advance_of(const MethodInfo& m, const RunAt& r);
+/// Whether its own driver lands on output times (FictitiousSteps::dt_out): the others' samples at dt_out are
+/// runs from one output time to the next.
+bool lands_on_output_times(const MethodInfo& m);
+/// Whether a tolerance given with it is its tolerance per step (its own control), not an accuracy to deliver.
+bool takes_tolerance_per_step(const MethodInfo& m);
+/// Whether its flow is exact (ks in fictitious time): runs at different steps differ by rounding only, so one
+/// configuration stands for its ladder and a pair of its runs measures rounding, not truncation.
+bool is_exact_flow(const MethodInfo& m);
+/// Whether it keeps its order on a spinning body (the thesis's schemes freeze the gyroscopic term: first order).
+bool keeps_order_with_spin(const MethodInfo& m);
+/// Whether a step the caller chooses and refines (h, or ds) sets its error, so that a ladder of steps converges:
+/// not a controlled method (its tolerance does), nor far-ip (the field sets its steps).
+bool refines_by_step(const MethodInfo& m);
 /// The name of what its step is: "h", "ds" or "tol"; the same as a message names the quantity ("the step h",
 /// "the fictitious step ds", "the tolerance per step tol"); its way of advancing time in one word ("fixed",
 /// "fictitious", "controlled").

@@ -96,8 +96,6 @@ RunResult run(const MethodInfo& method, const Body& body, const std::vector<Cent
 /// True for the peers that bodypoint's own methods compete with: the general-purpose ones (Boost.Odeint,
 /// GSL) and the time-transformed one of Mikkola's codes (logh-bs).
 inline bool is_peer(const MethodInfo& m) { return m.traits.peer; }
-/// True for every method whose physical step varies (step-size-controlled or time-transformed).
-inline bool has_variable_step(const MethodInfo& m) { return is_step_controlled(m) || is_time_transformed(m); }
 /// Throws Error unless `m` takes this way of advancing time (FixedSteps for fixed-step methods,
 /// FictitiousSteps for time-transformed ones, ControlledSteps for step-size-controlled ones; Accuracy
 /// for none: it searches the step of one of the others).
