@@ -12,7 +12,7 @@ import tempfile
 
 sys.path.insert(0, os.path.join(sys.argv[1], "paper"))
 import check_paper  # noqa: E402
-import make_macros  # noqa: E402
+from macros import common, front, stability  # noqa: E402
 import timing_rule  # noqa: E402
 
 FLAG_LINE = ("# flag: why a time does not count (fewer than 5 repeats; wall above CPU by more than 5 %: contended; "
@@ -56,19 +56,19 @@ def check_rules(failures):
         # A parallel run counts where others used at most 5 % of the cores; one of 30 % is contended.
         for others, counts in [(0.01, True), (0.30, False)]:
             scaling_csv(res, others)
-            M = make_macros.Macros(rule)
-            make_macros.scaling_text(res, M)
+            M = common.Macros(rule)
+            stability.scaling_text(res, M)
             text = M.defs["ScalingText"]
             if counts != ("untimed" not in text) or counts != (not M.ledger.lost_items):
                 failures.append(f"others {others}: {text} / lost {M.ledger.lost_items}")
 
         # The stamp: none for a copy that lost nothing; a stamp and the list for one that lost a part.
         for lost in ([], [("figure 6, panel thesis's seven", "84 of 84 times flagged (contended)")]):
-            M = make_macros.Macros(rule)
+            M = common.Macros(rule)
             for what, why in lost:
                 M.ledger.lost(what, why)
             write(res, "timing.csv", "n,method,flag\n")
-            make_macros.contention(res, None, M)
+            front.contention(res, None, M)
             stamped = bool(M.defs["ContendedStamp"]) and "84 of 84" in M.defs["ContendedNotice"]
             if stamped != bool(lost) or (not lost and M.defs["ContendedNotice"]):
                 failures.append(f"lost {lost}: stamp {M.defs['ContendedStamp']!r}, notice {M.defs['ContendedNotice']!r}")
@@ -83,7 +83,7 @@ def check_figure(failures):
     else:
         with tempfile.TemporaryDirectory() as res:
             write(res, "timing.csv", "n,method,median_s,flag\n" + "".join(
-                f'{n},{m},{n * 1e-7},"contended: wall 40 % above CPU"\n' for m in make_macros.THESIS_SEVEN + ["lp-y4"]
+                f'{n},{m},{n * 1e-7},"contended: wall 40 % above CPU"\n' for m in common.THESIS_SEVEN + ["lp-y4"]
                 for n in (20000, 40000)))
             listing = []
             make_figures.timing_figure(res, res, listing)

@@ -1,0 +1,115 @@
+"""Section 'Long-time behaviour': invariants and phase error over many periods."""
+
+import math
+import os
+
+from macros.common import count, finite, num, power_of_ten, read_csv, sci, slope, tt
+
+
+# The long-time study's rows from this many periods on are fitted for a growth exponent (earlier ones
+# hold the first orbits' transient); an energy error below ROUNDING_LEVEL at the end is the rounding's.
+LONG_FIT_FROM = 100.0
+
+
+ROUNDING_LEVEL = 1e-10
+
+
+SPLITTINGS = ("lp-y4", "ttl-y4", "kep-y4")
+
+
+DAGGER = "^\\dagger"  # a scene the method diverged on
+
+
+LONG_SCENES = ("kepler", "two-centres", "spinning")  # the table's order of the energy columns
+
+
+SCENE_WORDS = {"kepler": "the ellipse", "spinning": "the spinning body's ellipse", "two-centres": "the two-centre orbit"}
+
+
+def long_time_series(rows):
+    """The long-time study's (series, last, exponent) readers over its rows that ended ok."""
+    ok = [r for r in rows if r["outcome"] == "ok"]
+
+    def series(scene, m, column):
+        rs = [r for r in ok if r["scene"] == scene and r["method"] == m and num(r[column]) > 0]
+        return [num(r["periods"]) for r in rs], [num(r[column]) for r in rs]
+
+    def last(scene, m, column):
+        _, ys = series(scene, m, column)
+        return ys[-1] if ys else float("nan")
+
+    def exponent(scene, m, column):
+        xs, ys = series(scene, m, column)
+        fit = [(x, y) for x, y in zip(xs, ys) if x >= LONG_FIT_FROM]
+        return slope([x for x, _ in fit], [y for _, y in fit]) if len(fit) >= 3 else float("nan")
+
+    return last, exponent
+
+
+def long_time_table(rows, out, methods):
+    """tab_long_time: per method its step, largest energy error per scene, the energy's growth exponent
+    where its error is the method's (not the rounding's), |K2|^2, the ellipse's phase error and exponent.
+    Returns {method: (energy exponents per scene, |K2|^2, phase exponent)}."""
+    last, exponent = long_time_series(rows)
+    found = {}
+    with open(os.path.join(out, "tab_long_time.tex"), "w") as f:
+        for m in methods:
+            first = next(r for r in rows if r["method"] == m)
+            # Every method runs at the same step per period (the first scene's period is 2 pi) or tolerance.
+            if first["step_name"] == "tol":
+                step = f"tol {power_of_ten(num(first['step']))}"
+            else:
+                step = f"{first['step_name']} $= P/{round(2 * math.pi / num(first['step']))}$"
+            # A scene the method diverged on reads its value at the last time it reached, marked.
+            ended = {r["scene"] for r in rows if r["method"] == m and r["outcome"] != "ok"}
+            energy = [f"${sci(last(sc, m, 'max_rel_dE'))}{DAGGER if sc in ended else ''}$" for sc in LONG_SCENES]
+            exps = [exponent(sc, m, "max_rel_dE") for sc in LONG_SCENES]
+            above = [e for sc, e in zip(LONG_SCENES, exps) if last(sc, m, "max_rel_dE") > ROUNDING_LEVEL]
+            k2 = max(finite(last(sc, m, "rel_dK2sq") for sc in ("spinning", "two-centres")))
+            k2q = max(finite(last(sc, m, "abs_dK2Q") for sc in ("kepler", "spinning")))
+            phase = exponent("kepler", m, "phase_err")
+            cells = [tt(m), step] + energy + [f"${sci(max(finite(above)), 2)}$", f"${sci(k2)}$", f"${sci(k2q)}$",
+                                              f"${sci(last('kepler', m, 'phase_err'))}$", f"${sci(phase, 2)}$"]
+            f.write(" & ".join(cells) + " \\\\\n")
+            found[m] = (exps, k2, phase)
+    return found
+
+
+def long_time(res, out, M):
+    """bodypoint study --name long-time: tab_long_time and the ranges the text quotes."""
+    rows, _ = read_csv(os.path.join(res, "long_time.csv"))
+    last, exponent = long_time_series(rows)
+    methods = [m for m in dict.fromkeys(r["method"] for r in rows) if m != "lp-kl8"]
+    periods = max(num(r["periods"]) for r in rows)
+    M.add("LongPeriods", power_of_ten(periods).strip("$"))
+    M.add("LongFitFrom", sci(LONG_FIT_FROM))
+    first = next(r for r in rows if r["scene"] == "kepler" and r["method"] == "lp-y4")  # its period is 2 pi
+    M.add("LongStepsPerPeriod", count(round(2 * math.pi / num(first["step"]))))
+    ref = next(r for r in rows if r["scene"] == "kepler" and r["method"] == "lp-kl8")
+    M.add("LongRefStepsPerPeriod", count(round(2 * math.pi / num(ref["step"]))))
+    found = long_time_table(rows, out, methods)
+    gone = {}
+    for r in rows:
+        if r["outcome"] != "ok" and r["method"] != "lp-kl8":
+            gone.setdefault(r["method"], []).append(SCENE_WORDS[r["scene"]])
+    parts = [f"{tt(m)} leaves {' and '.join(dict.fromkeys(where))}" for m, where in gone.items()]
+    M.add("LongDivergedText", "; ".join(parts) + " (daggers in the table)" if parts else
+          f"no method leaves its orbit within {power_of_ten(periods)} periods", math_mode=False)
+    split_above = [e for m in SPLITTINGS for sc, e in zip(LONG_SCENES, found[m][0])
+                   if last(sc, m, "max_rel_dE") > ROUNDING_LEVEL]
+    peers = [m for m in methods if m not in SPLITTINGS]
+    M.add("LongSplitEnergyExpMax", f"{max(split_above):.2f}")
+    M.add("LongPeerEnergyExpMin", f"{min(e for m in peers for e in found[m][0]):.2f}")
+    M.add("LongSplitKTwoMax", sci(max(found[m][1] for m in SPLITTINGS)))
+    M.add("LongPeerKTwoMin", sci(min(found[m][1] for m in peers)))
+    leapfrogs, rk = [found[m][2] for m in ("lp-y4", "ttl-y4")], [found[m][2] for m in peers if m != "rk4"]
+    M.add("LongSplitPhaseExpMin", f"{min(leapfrogs):.2f}")
+    M.add("LongSplitPhaseExpMax", f"{max(leapfrogs):.2f}")
+    M.add("LongPeerPhaseExpMin", f"{min(rk):.2f}")
+    M.add("LongPeerPhaseExpMax", f"{max(rk):.2f}")
+    for m, word in (("lp-kl8", "Ref"), ("kep-y4", "Kep")):
+        M.add(f"Long{word}EnergyExp", f"{exponent('kepler', m, 'max_rel_dE'):.2f}")
+        M.add(f"Long{word}PhaseExp", f"{exponent('kepler', m, 'phase_err'):.2f}")
+        M.add(f"Long{word}PhaseEnd", sci(last("kepler", m, "phase_err")))
+    M.add("LongKepEnergyEnd", sci(last("kepler", "kep-y4", "max_rel_dE")))
+    M.add("LongTtlKeplerEnergyEnd", sci(last("kepler", "ttl-y4", "max_rel_dE")))
