@@ -54,8 +54,10 @@ void run_accurately(BodyResult& r, const Body& body, const std::vector<Centre>& 
   r.run = std::move(t.result);
 }
 
-BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
-                                const Advance& how, const Options& options);
+BodyResult run_plain(const Body& body, const std::vector<Centre>& centres, const MethodInfo& m, const Advance& how,
+                     const Options& options);
+BodyResult run_timed(const Body& body, const std::vector<Centre>& centres, const MethodInfo& m, const Advance& how,
+                     const Options& options);
 
 /// Whether an event's first bracket ends the run: a stop event, except the closest approach, which is the
 /// least distance of the whole run (it is cut there afterwards: run_watched).
@@ -169,7 +171,7 @@ detail::Advancer advancer(const BodyResult& r, const Body& body, const std::vect
     sub.omega_c = c;
     sub.cancel = cancel;
     // A fixed step: one step of tau inside a step; steps <= h across output times.
-    const BodyResult x = integrate_valid_body(from, centres, &m, advance_to(m, step, tau, h0), sub);
+    const BodyResult x = run_plain(from, centres, m, advance_to(m, step, tau, h0), sub);
     evals += x.run.force_evals;
     if (!ran(x.outcome)) {
       constexpr double nan = std::numeric_limits<double>::quiet_NaN();
@@ -238,8 +240,8 @@ class OutputTimesSink {
 /// for. A stop event ends a fixed-step, time-transformed or controlled run on the step that brackets
 /// it; the accuracy mode hands its delivered run's states on after its search, so its run is cut at
 /// the event afterwards.
-BodyResult run_watched(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
-                       const Advance& how, const Options& options) {
+BodyResult run_watched(const Body& body, const std::vector<Centre>& centres, const MethodInfo& m, const Advance& how,
+                       const Options& options) {
   const bool accuracy = std::holds_alternative<Accuracy>(how);
   const std::vector<Event> events = detail::resolved(options.events, body.p, centres, body.s0);
   detail::EventWatch watch(events, body.p, centres);
@@ -250,7 +252,7 @@ BodyResult run_watched(const Body& body, const std::vector<Centre>& centres, con
   inner.sink = &sink;
   inner.every = 1;
   inner.inside_steps = true;  // an event between the ends of a step that holds several turns of the spin
-  BodyResult r = integrate_valid_body(body, centres, method, how, inner);
+  BodyResult r = run_timed(body, centres, m, how, inner);
   if (!ran(r.outcome)) return r;
   r.events = detail::locate(watch, events, body.p, centres, advancer(r, body, centres, how, options), r.event_force_evals);
   detail::keep_closest(r.events, events);
@@ -310,7 +312,7 @@ std::optional<double> stop_time(const Body& body, const std::vector<Centre>& cen
   pilot.max_energy_error = std::numeric_limits<double>::infinity();
   for (const Event& e : options.events)
     if (e.stop) pilot.events.push_back(e);
-  const BodyResult r = run_watched(body, centres, find_method("odeint-dopri5"), ControlledSteps{kStopPilotFirstStep, a.t_end, kStopPilotTol}, pilot);
+  const BodyResult r = run_watched(body, centres, *find_method("odeint-dopri5"), ControlledSteps{kStopPilotFirstStep, a.t_end, kStopPilotTol}, pilot);
   evals += r.total_force_evals();
   if (r.outcome != Outcome::ok || !r.run.stopped) return std::nullopt;
   return r.run.t_end;
@@ -320,23 +322,23 @@ std::optional<double> stop_time(const Body& body, const std::vector<Centre>& cen
 /// for (a departure asked with t_end = 1e5 searched its step over all of it): its search runs to
 /// kStopMargin times the stop's time as a pilot finds it; a delivered run that does not reach the stop
 /// there is searched again over the span asked for. Every evaluation is counted as the events'.
-BodyResult run_with_events(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
-                           const Advance& how, const Options& options) {
+BodyResult run_with_events(const Body& body, const std::vector<Centre>& centres, const MethodInfo& m, const Advance& how,
+                           const Options& options) {
   const auto* a = std::get_if<Accuracy>(&how);
   const bool stops = std::any_of(options.events.begin(), options.events.end(), [](const Event& e) { return e.stop; });
   if (!a || !stops || non_coulomb(centres) || !(a->t_end > kPilotAbove * crossing_time(body, centres)))
-    return run_watched(body, centres, method, how, options);
+    return run_watched(body, centres, m, how, options);
   long spent = 0;
   const std::optional<double> t = stop_time(body, centres, *a, options, spent);
   if (t && kPlannedShorter * kStopMargin * *t < a->t_end) {
     Accuracy planned = *a;
     planned.t_end = kStopMargin * *t;
-    BodyResult r = run_watched(body, centres, method, planned, options);
+    BodyResult r = run_watched(body, centres, m, planned, options);
     r.event_force_evals += spent;
     if (!ran(r.outcome) || r.run.stopped) return r;
     spent = r.total_force_evals();
   }
-  BodyResult r = run_watched(body, centres, method, how, options);
+  BodyResult r = run_watched(body, centres, m, how, options);
   r.event_force_evals += spent;
   return r;
 }
@@ -355,7 +357,7 @@ BodyResult run_with_output_times(const Body& body, const std::vector<Centre>& ce
   inner.every = 1;
   Advance plain = how;
   std::visit([](auto& a) { a.dt_out = 0.0; }, plain);
-  BodyResult r = integrate_valid_body(body, centres, &method, plain, inner);
+  BodyResult r = run_plain(body, centres, method, plain, inner);
   if (!ran(r.outcome)) return r;
   outputs.finish();
   r.event_force_evals += outputs.evals();
@@ -382,31 +384,26 @@ void run_accurately_at_output_times(BodyResult& r, const Body& body, const std::
   r.event_force_evals += outputs.evals();
 }
 
-/// integrate_body for a body, centres, `how` and options already checked.
-BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
-                                const Advance& how, const Options& options) {
-  if (!options.events.empty()) return run_with_events(body, centres, method, how, options);
-  const auto* accuracy = std::get_if<Accuracy>(&how);
-  if (!accuracy && options.sink && output_interval(how) > 0.0 && !lands_on_output_times(*method))
-    return run_with_output_times(body, centres, *method, how, options);
+// --- The run pipeline of a checked request, in order (integrate_estimated) ----------------------------------
+//  1. the direction: a run backwards is the forward run of the time-reversed start, reversed back (in_direction);
+//  2. the method: the one named or auto's choice, and its refusal of the scene (resolve_method);
+//  3. the run, observed: its events watched (run_with_events), its output times (run_timed), the accuracy mode's
+//     search or the method's own run (run_plain), each stage calling the next and none an earlier one;
+//  4. its error estimate and its events' errors, from companion runs through stage 3 (estimate.hpp);
+//  5. its outcome settled in the light of the estimate.
+// A Stepper's segments enter at stage 3 with the method its construction resolved and checked (run_estimated).
+
+/// Stage 3's last step: the accuracy mode's search or the method's own run, judged by its flags.
+BodyResult run_plain(const Body& body, const std::vector<Centre>& centres, const MethodInfo& m, const Advance& how,
+                     const Options& options) {
   BodyResult r;
-  r.method = method;
-  if (accuracy && non_coulomb(centres)) {
-    r.outcome = Outcome::refused;
-    r.reason = bodypoint::kNeedsCoulomb;
-    return r;
-  }
-  if (!method) r.method = &detail::choose_method_for(body, centres, accuracy->tol, &r.chosen);
-  if (std::string why = refusal(*r.method, body, centres); !why.empty()) {
-    r.outcome = Outcome::refused;
-    r.reason = std::move(why);
-    return r;
-  }
+  r.method = &m;
+  const auto* accuracy = std::get_if<Accuracy>(&how);
   try {
-    if (accuracy && options.sink && accuracy->dt_out > 0.0 && !lands_on_output_times(*r.method))
+    if (accuracy && options.sink && accuracy->dt_out > 0.0 && !lands_on_output_times(m))
       run_accurately_at_output_times(r, body, centres, *accuracy, options);
     else if (accuracy) run_accurately(r, body, centres, *accuracy, options);
-    else r.run = r.method->run(body, centres, how, options);
+    else r.run = m.run(body, centres, how, options);
   } catch (const Error& e) {
     r.outcome = Outcome::failed;
     r.reason = e.what();
@@ -416,16 +413,62 @@ BodyResult integrate_valid_body(const Body& body, const std::vector<Centre>& cen
   return r;
 }
 
-BodyResult integrate_forwards(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
-                              const Advance& how, const Options& options);
+/// Stage 3 with output times: a fixed-step or controlled run hands its states at t = k dt_out through
+/// OutputTimesSink; the others land on them themselves.
+BodyResult run_timed(const Body& body, const std::vector<Centre>& centres, const MethodInfo& m, const Advance& how,
+                     const Options& options) {
+  if (!std::holds_alternative<Accuracy>(how) && options.sink && output_interval(how) > 0.0 && !lands_on_output_times(m))
+    return run_with_output_times(body, centres, m, how, options);
+  return run_plain(body, centres, m, how, options);
+}
 
-/// A checked request's run, with its error estimate (estimate.hpp) and its outcome in the light of it.
-/// A run backwards in time (is_backward) is the forward run of the time-reversed state (v, w negated),
-/// its states, times and events reversed back: every method runs backwards, a symmetric splitting's
-/// steps being exactly its steps of -h.
-BodyResult integrate_estimated(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
-                               const Advance& how, const Options& options) {
-  if (!is_backward(how)) return integrate_forwards(body, centres, method, how, options);
+/// Stage 3 whole: with events, the watch around the run with output times.
+BodyResult run_observed(const Body& body, const std::vector<Centre>& centres, const MethodInfo& m, const Advance& how,
+                        const Options& options) {
+  if (!options.events.empty()) return run_with_events(body, centres, m, how, options);
+  return run_timed(body, centres, m, how, options);
+}
+
+/// Stage 2: the method named, or auto's choice for this body and tol (r.chosen says why); a refused request
+/// comes back with its outcome and reason (r.method nullptr where auto chose none).
+BodyResult resolve_method(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
+                          const Advance& how) {
+  BodyResult r;
+  r.method = method;
+  const auto* accuracy = std::get_if<Accuracy>(&how);
+  if (accuracy && non_coulomb(centres)) {
+    r.outcome = Outcome::refused;
+    r.reason = bodypoint::kNeedsCoulomb;
+    return r;
+  }
+  if (!method) r.method = &detail::choose_method_for(body, centres, accuracy->tol, &r.chosen);
+  if (std::string why = refusal(*r.method, body, centres); !why.empty()) {
+    r.outcome = Outcome::refused;
+    r.reason = std::move(why);
+  }
+  return r;
+}
+
+/// Stages 3-5 for a method resolved and accepted.
+BodyResult run_estimated(const Body& body, const std::vector<Centre>& centres, const MethodInfo& m, const Advance& how,
+                         const Options& options) {
+  BodyResult r = run_observed(body, centres, m, how, options);
+  const detail::Rerun rerun = [&](const Body& from, const Advance& a, const Options& o) {
+    return run_observed(from, centres, m, a, o);
+  };
+  detail::estimate_error(r, body, centres, how, options, rerun);
+  detail::estimate_event_errors(r, body, centres, how, options, rerun);
+  detail::settle(r.outcome, r.reason, r.warnings, r.error, options.max_error, options.max_energy_error,
+                 detail::final_energy_error(body, centres, r.run.final));
+  return r;
+}
+
+/// Stage 1 around `forwards(body, how, options)`, which runs a forward request: a run backwards in time
+/// (is_backward) is the forward run of the time-reversed state (v, w negated), its states, times and events
+/// reversed back: every method runs backwards, a symmetric splitting's steps being exactly its steps of -h.
+template <class Forwards>
+BodyResult in_direction(const Body& body, const Advance& how, const Options& options, const Forwards& forwards) {
+  if (!is_backward(how)) return forwards(body, how, options);
   Body reversed = body;
   reversed.s0 = time_reversed(body.s0);
   Options o = options;
@@ -437,7 +480,7 @@ BodyResult integrate_estimated(const Body& body, const std::vector<Centre>& cent
     };
     o.sink = &back;
   }
-  BodyResult r = integrate_forwards(reversed, centres, method, forwards(how), o);
+  BodyResult r = forwards(reversed, bodypoint::forwards(how), o);
   r.run.final = time_reversed(r.run.final);
   r.run.t_end = -r.run.t_end;
   for (EventHit& h : r.events) {
@@ -447,17 +490,24 @@ BodyResult integrate_estimated(const Body& body, const std::vector<Centre>& cent
   return r;
 }
 
-BodyResult integrate_forwards(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
-                              const Advance& how, const Options& options) {
-  BodyResult r = integrate_valid_body(body, centres, method, how, options);
-  const detail::Rerun rerun = [&](const Body& from, const Advance& a, const Options& o) {
-    return integrate_valid_body(from, centres, r.method, a, o);
-  };
-  detail::estimate_error(r, body, centres, how, options, rerun);
-  detail::estimate_event_errors(r, body, centres, how, options, rerun);
-  detail::settle(r.outcome, r.reason, r.warnings, r.error, options.max_error, options.max_energy_error,
-                 detail::final_energy_error(body, centres, r.run.final));
-  return r;
+/// A checked request's run: the pipeline's five stages.
+BodyResult integrate_estimated(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
+                               const Advance& how, const Options& options) {
+  return in_direction(body, how, options, [&](const Body& b, const Advance& a, const Options& o) {
+    BodyResult resolved = resolve_method(b, centres, method, a);
+    if (resolved.outcome == Outcome::refused) return resolved;
+    BodyResult r = run_estimated(b, centres, *resolved.method, a, o);
+    r.chosen = std::move(resolved.chosen);
+    return r;
+  });
+}
+
+/// A Stepper's segment: stages 1 and 3-5 for the method its construction resolved and checked.
+BodyResult run_segment(const Body& body, const std::vector<Centre>& centres, const MethodInfo& m, const Advance& how,
+                       const Options& options) {
+  return in_direction(body, how, options, [&](const Body& b, const Advance& a, const Options& o) {
+    return run_estimated(b, centres, m, a, o);
+  });
 }
 
 }  // namespace
@@ -592,7 +642,8 @@ Stepper::Stepper(const MethodInfo& method, Body body, std::vector<Centre> centre
 
 Stepper::Stepper(Checked, const MethodInfo& method, const Body& body, const std::vector<Centre>& centres, double step,
                  Options options)
-    : method_(&method), body_(body), centres_(centres), step_(step), options_(std::move(options)) {
+    : method_(&method), body_(body), centres_(centres), step_(step), options_(std::move(options)),
+      refusal_(refusal(method, body, centres)) {
   // The time-step constant of a time-transformed method is fixed once, from the starting state, so
   // that every segment integrates the same transformed system.
   if (takes_time_step_constant(method) && options_.omega_c < 0.0)
@@ -723,7 +774,7 @@ bool Stepper::advance_companion(double t1, long run_steps, std::string& broke) {
       return true;
     }
     if (level == 1) twin_.factor = c->factor, twin_.basis = c->basis;  // the method may be new (a write planned anew)
-    const BodyResult x = integrate_estimated(b, centres_, method_, t1 < t_ ? backwards(c->how) : c->how, o);
+    const BodyResult x = run_segment(b, centres_, *method_, t1 < t_ ? backwards(c->how) : c->how, o);
     twin_.force_evals += x.run.force_evals;
     if (x.outcome == Outcome::failed && x.reason == kStoppedOnRequest) return false;
     if (detail::companion_broke_down(x) || x.outcome == Outcome::refused) {
@@ -742,7 +793,7 @@ bool Stepper::advance_companion(double t1, long run_steps, std::string& broke) {
   // The draw of the rounding: the segment's own steps off its grid (a repeat, not a finer run).
   b.s0 = *twin_.draw;
   o.carried = twin_.draw_carried;
-  const BodyResult y = integrate_estimated(b, centres_, method_, t1 < t_ ? backwards(detail::off_grid(fwd)) : detail::off_grid(fwd), o);
+  const BodyResult y = run_segment(b, centres_, *method_, t1 < t_ ? backwards(detail::off_grid(fwd)) : detail::off_grid(fwd), o);
   twin_.force_evals += y.run.force_evals;
   if (y.outcome == Outcome::failed && y.reason == kStoppedOnRequest) return false;
   twin_.draw = y.run.final;  // a draw that broke down is not finite: add_rounding_spread leaves it out
@@ -836,13 +887,14 @@ Outcome Stepper::advance_to(double t) {
   if (!(std::isfinite(t) && t != t_))
     throw Error("advance_to needs a finite time other than the current one (" + fmt(t_) + "), got " + fmt(t));
   // A segment starts where the last one ended; a state that is no longer a motion (the last segment
-  // diverged) is not run on.
-  if (!is_finite(body_.s0)) {
-    reason_ = "the stepper's state is not finite (" + (reason_.empty() ? std::string("a segment diverged") : reason_) +
-              "): set_state() a new one";
+  // diverged) is not run on, nor a scene the method refuses (asked once, at construction).
+  if (!refusal_.empty() || !is_finite(body_.s0)) {
+    reason_ = !refusal_.empty() ? refusal_
+                                : "the stepper's state is not finite (" +
+                                      (reason_.empty() ? std::string("a segment diverged") : reason_) + "): set_state() a new one";
     return Outcome::refused;
   }
-  const double span = std::abs(t - t_);  // before t_: backwards in time (integrate_estimated, is_backward)
+  const double span = std::abs(t - t_);  // before t_: backwards in time (in_direction, is_backward)
   Advance how = segment(span);
   if (t < t_) how = backwards(how);
   // Samples carry absolute times (the segment's run starts at 0); a later segment's first sample is
@@ -859,7 +911,7 @@ Outcome Stepper::advance_to(double t) {
     };
     opt.sink = &shifted;
   }
-  const BodyResult r = integrate_estimated(body_, centres_, method_, how, opt);  // checked in the constructor
+  const BodyResult r = run_segment(body_, centres_, *method_, how, opt);  // resolved and checked in the constructor
   if (!ran(r.outcome)) {
     reason_ = r.reason;
     return r.outcome;

@@ -435,6 +435,7 @@ class Stepper {
   double t_ = 0.0;
   long force_evals_ = 0, steps_ = 0;
   std::string reason_;
+  std::string refusal_;  ///< why the method refuses the scene, asked once at construction ("" : it accepts it)
   std::vector<EventHit> events_;
   bool stopped_ = false;
   std::optional<AccuracyReport> accuracy_;
