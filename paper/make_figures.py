@@ -17,6 +17,7 @@ import re
 import sys
 
 from catalogue import families, family, load as load_catalogue
+from macros.common import num
 import map_rule
 import timing_rule
 
@@ -74,13 +75,6 @@ def by_method(rows):
 def scenes_of(rows):
     """The scenes of a driver's CSV in the order it ran them."""
     return list(dict.fromkeys(r["scene"] for r in rows))
-
-
-def num(s):
-    try:
-        return float(s)
-    except (TypeError, ValueError):
-        return float("nan")
 
 
 def capped(v):

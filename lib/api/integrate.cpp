@@ -391,7 +391,7 @@ void run_accurately_at_output_times(BodyResult& r, const Body& body, const std::
 //     search or the method's own run (run_plain), each stage calling the next and none an earlier one;
 //  4. its error estimate and its events' errors, from companion runs through stage 3 (estimate.hpp);
 //  5. its outcome settled in the light of the estimate.
-// A Stepper's segments enter at stage 3 with the method its construction resolved and checked (run_estimated).
+// A Stepper's segments enter at stage 3 with the method its construction resolved and checked (run_segment).
 
 /// Stage 3's last step: the accuracy mode's search or the method's own run, judged by its flags.
 BodyResult run_plain(const Body& body, const std::vector<Centre>& centres, const MethodInfo& m, const Advance& how,

@@ -377,12 +377,9 @@ MethodTraits catalogue_traits(Family f) {
 }
 
 Advance advance_to(const MethodInfo& m, double step, double end, double h0) {
-  switch (m.traits.stepping) {
-    case Stepping::fictitious: return FictitiousSteps{step, EndTime{end}};
-    case Stepping::controlled: return ControlledSteps{std::min(h0, end), end, step};
-    case Stepping::fixed: break;
-  }
-  return fixed_steps_to(end, step);
+  // A controlled method's step is its tolerance per step, its control starting at h0.
+  if (is_step_controlled(m)) return advance_of(m, {.step = h0, .end = end, .tol = step});
+  return advance_of(m, {.step = step, .end = end});
 }
 
 Advance advance_of(const MethodInfo& m, const RunAt& r) {
