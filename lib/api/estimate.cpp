@@ -99,4 +99,12 @@ void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& 
     second_companion(r, body, how, options, o, rerun, *f, check_pair);
 }
 
+void estimate_and_settle(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Advance& how,
+                         const Options& options, const Rerun& rerun) {
+  estimate_error(r, body, centres, how, options, rerun);
+  estimate_event_errors(r, body, centres, how, options, rerun);
+  settle(r.outcome, r.reason, r.warnings, r.error, options.max_error, options.max_energy_error,
+         final_energy_error(body, centres, r.run.final));
+}
+
 }  // namespace bodypoint::detail

@@ -29,17 +29,6 @@ long BodyResult::total_force_evals() const {
 
 namespace {
 
-/// The outcome of a finished run, from its health (run.hpp, assess).
-void judge(BodyResult& r, const std::vector<Centre>& centres, const Options& options) {
-  // A run observed for its events or samples alone has invariants it was not asked for: they are neither
-  // reported nor judged (a Stepper with invariants off and a stop event was refused "unresolved" far out,
-  // where a controlled step at a tolerance per step of 1e-13 turned the spin by 3.6 rad).
-  if (!options.track_invariants) r.run.invariants.reset();
-  Health h = assess(r.run, checks_for(*r.method, centres, options.max_energy_error));
-  r.outcome = h.outcome;
-  r.reason = std::move(h.why);
-}
-
 /// The accuracy mode: the step search, whose delivered run carries the observers.
 void run_accurately(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Accuracy& a,
                     const Options& options) {
@@ -265,7 +254,7 @@ BodyResult run_watched(const Body& body, const std::vector<Centre>& centres, con
   r.events.erase(std::next(stop), r.events.end());  // nothing after the stop happened
   const InvariantStats last = cut_at(r.run, r.events.back(), body, centres);
   watching.finish(&r.events.back(), last.max_rel_dE, last.max_rel_dK2sq, last.max_abs_dK2Q);
-  judge(r, centres, options);
+  detail::judge(r, centres, options);
   return r;
 }
 
@@ -409,7 +398,7 @@ BodyResult run_plain(const Body& body, const std::vector<Centre>& centres, const
     r.reason = e.what();
     return r;
   }
-  judge(r, centres, options);
+  detail::judge(r, centres, options);
   return r;
 }
 
@@ -453,13 +442,10 @@ BodyResult resolve_method(const Body& body, const std::vector<Centre>& centres, 
 BodyResult run_estimated(const Body& body, const std::vector<Centre>& centres, const MethodInfo& m, const Advance& how,
                          const Options& options) {
   BodyResult r = run_observed(body, centres, m, how, options);
-  const detail::Rerun rerun = [&](const Body& from, const Advance& a, const Options& o) {
+  const detail::Rerun rerun{[&](const Body& from, const Advance& a, const Options& o) {
     return run_observed(from, centres, m, a, o);
-  };
-  detail::estimate_error(r, body, centres, how, options, rerun);
-  detail::estimate_event_errors(r, body, centres, how, options, rerun);
-  detail::settle(r.outcome, r.reason, r.warnings, r.error, options.max_error, options.max_energy_error,
-                 detail::final_energy_error(body, centres, r.run.final));
+  }};
+  detail::estimate_and_settle(r, body, centres, how, options, rerun);
   return r;
 }
 

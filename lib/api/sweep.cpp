@@ -23,6 +23,7 @@
 #include <mutex>
 #include <optional>
 #include <thread>
+#include <tuple>
 #include <utility>
 
 namespace bodypoint {
@@ -68,231 +69,89 @@ SweepRow result_row(SweepRow row, BodyResult r) {
   return row;
 }
 
-/// Whether a lane's run ended so that it has an estimate (estimate_error of integrate(): ok, or a flag).
-bool estimable(Outcome o) { return o == Outcome::ok || o == Outcome::unresolved || o == Outcome::inaccurate; }
+/// A batch's companion runs. integrate()'s estimate (estimate_and_settle) runs each lane's companions through
+/// run(); a companion one lane asks for runs as one batch with the same companion of every later lane (the
+/// rows share the method and the step, and their estimates mostly ask alike; earlier lanes are done). A lane
+/// computes the scalar run's bits (batch.hpp) and is judged as integrate() judges a companion, so a batch's
+/// rows are integrate()'s rows, estimates included: one estimate policy, whose companions are lanes here.
+class LaneRuns {
+ public:
+  LaneRuns(const MethodInfo& method, const std::vector<batch::Member>& members, const std::vector<Scene>& scenes,
+           const std::atomic<bool>* cancel)
+      : method_(method), members_(members), scenes_(scenes), cancel_(cancel) {}
 
-/// integrate()'s rounding draws (estimate/rounding.cpp, add_rounding_draws) for a batch's lanes: for each lane with
-/// an estimate in `drawn` (nullptr: none; decided before the draws, as integrate() does),
-/// ErrorEstimate::kRoundingDraws - 1 more batches, the k-th advancing as `how(k)` from starts moved by a
-/// rounding, what each lane's `finals` differs from them by added, the sum then taken as a bound.
-void lane_rounding_draws(const MethodInfo& method, const std::vector<batch::Member>& members,
-                         const std::function<Advance(int)>& how, const std::vector<const State*>& finals,
-                         const std::vector<ErrorEstimate*>& drawn, const std::string& what) {
-  if (std::all_of(drawn.begin(), drawn.end(), [](const ErrorEstimate* e) { return e == nullptr; })) return;
-  std::vector<batch::Member> moved = members;
-  for (int draw = 1; draw < ErrorEstimate::kRoundingDraws; ++draw) {
-    for (std::size_t k = 0; k < members.size(); ++k)
-      moved[k].s0 = detail::start_moved_by_rounding(members[k].s0, detail::rounding_way(draw));
-    const auto other = batch::run(method, moved, std::get<FixedSteps>(how(draw)));
-    for (std::size_t k = 0; k < members.size(); ++k)
-      if (drawn[k] != nullptr)
-        detail::add_rounding_spread(*drawn[k], *finals[k], other[k].final, other[k].force_evals, other[k].wall_s, what);
-  }
-  for (ErrorEstimate* e : drawn)
-    if (e != nullptr) detail::bound_from_draws(*e);
-}
-
-/// As integrate() (estimate/coarse.cpp): the lanes whose trusted coarse estimate asks (asks_second_coarse)
-/// get a second coarse batch, the coarse batch's own coarse companion from the same moved starts; a lane whose
-/// three runs do not observe the order the estimate assumes is left to the fine companions, the batch's cost
-/// counted in `cost` as the coarse batch's is.
-void second_coarse_batch(const MethodInfo& method, const detail::CoarseCompanion& c, const std::vector<batch::Member>& moved,
-                         const std::vector<Scene>& scenes, const std::vector<RunResult>& results,
-                         const std::vector<RunResult>& coarse, std::vector<std::optional<ErrorEstimate>>& out,
-                         std::vector<ErrorEstimate>& cost) {
-  // As integrate(): a lane asks to keep its pair (asks_second_coarse) or to sharpen it (sharpened_by_second_coarse).
-  enum class Second { none, asks, sharpens };
-  std::vector<Second> second(out.size(), Second::none);
-  double max_ratio = ErrorEstimate::kStepRatio;
-  bool any = false;
-  for (std::size_t k = 0; k < out.size(); ++k) {
-    if (!out[k]) continue;
-    const Body& body = scenes[k].bodies.front();
-    second[k] = detail::asks_second_coarse(method, body, scenes[k].centres, *out[k]) ? Second::asks
-                : detail::sharpened_by_second_coarse(method, body, scenes[k].centres, c, *out[k]) ? Second::sharpens
-                                                                                                  : Second::none;
-    if (second[k] != Second::none)
-      any = true, max_ratio = std::min(max_ratio, detail::coarse_ratio_limit(method, scenes[k].centres, coarse[k]));
-  }
-  if (!any) return;
-  const auto c2 = detail::coarse_companion(method, c.how, std::get<FixedSteps>(c.how).steps, max_ratio);
-  if (!c2) return;
-  const auto y = batch::run(method, moved, std::get<FixedSteps>(c2->how));
-  for (std::size_t k = 0; k < out.size(); ++k) {
-    if (second[k] == Second::none) continue;
-    const bool ok = assess(y[k], checks_for(method, scenes[k].centres, detail::kCoarseEnergyBound)).outcome == Outcome::ok;
-    ErrorEstimate trial = *out[k];
-    trial.force_evals += y[k].force_evals;
-    trial.wall_s += y[k].wall_s;
-    if (ok && detail::observed_order_agrees(method, scenes[k].bodies.front(), c, *c2, results[k].final, coarse[k].final,
-                                            y[k].final, trial)) {
-      *out[k] = std::move(trial);
-    } else if (second[k] == Second::sharpens) {  // the capped estimate stands
-      out[k]->force_evals = trial.force_evals, out[k]->wall_s = trial.wall_s;
-    } else {
-      cost[k].force_evals += y[k].force_evals;
-      cost[k].wall_s += y[k].wall_s;
-      out[k].reset();
+  /// Lane k's run from `from` (its start, or its start moved by a rounding either way) as `how`.
+  BodyResult run(std::size_t k, const Body& from, const Advance& how, const Options& o) {
+    const auto* f = std::get_if<FixedSteps>(&how);
+    if (f == nullptr) throw Error("a batch's lanes run by fixed steps");  // their methods' only way (plan_units)
+    const std::optional<double> way = way_of(k, from.s0);
+    if (!way) return lanes(k, k + 1, *f, from.s0, o).front();  // not a start the batch shares: this lane alone
+    const Key key{f->h, f->steps, *way, o.max_energy_error, o.track_invariants};
+    auto found = done_.find(key);
+    if (found == done_.end() || !found->second[k]) {
+      std::vector<std::optional<BodyResult>> lane(members_.size());
+      std::vector<BodyResult> ran = lanes(k, members_.size(), *f, std::nullopt, o, *way);
+      for (std::size_t j = k; j < members_.size(); ++j) lane[j] = std::move(ran[j - k]);
+      found = done_.insert_or_assign(key, std::move(lane)).first;
     }
+    return std::move(*std::exchange(found->second[k], std::nullopt));
   }
-}
 
-/// The lanes' estimates from the coarse companion batch (estimate.hpp, CoarseCompanion), as integrate()
-/// makes them: nullopt for a lane the fine companions decide (flagged, or its coarse estimate not trusted),
-/// whose estimate then counts the coarse lane's cost in `cost` as integrate() does.
-std::vector<std::optional<ErrorEstimate>> coarse_estimates(const MethodInfo& method, const FixedSteps& how,
-                                                           const std::vector<batch::Member>& members,
-                                                           const std::vector<Scene>& scenes,
-                                                           const std::vector<RunResult>& results,
-                                                           const std::vector<Health>& health,
-                                                           std::vector<ErrorEstimate>& cost,
-                                                           std::vector<std::optional<double>>& coarse_side) {
-  std::vector<std::optional<ErrorEstimate>> out(members.size());
-  double max_ratio = ErrorEstimate::kStepRatio;  // one coarse batch: the ratio every lane's steps allow
-  for (std::size_t k = 0; k < members.size(); ++k)
-    max_ratio = std::min(max_ratio, detail::coarse_ratio_limit(method, scenes[k].centres, results[k]));
-  const auto c = detail::coarse_companion(method, how, how.steps, max_ratio);
-  if (!c) return out;
-  std::vector<batch::Member> moved = members;
-  for (batch::Member& m : moved) m.s0 = detail::start_moved_by_rounding(m.s0);
-  const auto coarse = batch::run(method, moved, std::get<FixedSteps>(c->how));
-  for (std::size_t k = 0; k < members.size(); ++k) {
-    cost[k].force_evals = coarse[k].force_evals;
-    cost[k].wall_s = coarse[k].wall_s;
-    if (health[k].outcome != Outcome::ok && health[k].outcome != Outcome::inaccurate) continue;
-    if (assess(coarse[k], checks_for(method, scenes[k].centres, detail::kCoarseEnergyBound)).outcome != Outcome::ok) continue;
-    if (!(coarse[k].final.R.allFinite() && coarse[k].final.v.allFinite())) continue;
-    coarse_side[k] = detail::coarse_side_of(method, scenes[k].bodies.front(), *c, results[k].final, coarse[k].final);
-    out[k] = detail::coarse_estimate(method, scenes[k].bodies.front(), scenes[k].centres, *c, results[k].final,
-                                     coarse[k].final, results[k].steps);
-    if (out[k]) out[k]->force_evals = coarse[k].force_evals, out[k]->wall_s = coarse[k].wall_s;
-  }
-  second_coarse_batch(method, *c, moved, scenes, results, coarse, out, cost);
-  // As integrate(): lanes whose coarse estimate is at the rounding level add more draws of it, coarse
-  // batches off the run's grid.
-  std::vector<const State*> finals(members.size());
-  std::vector<ErrorEstimate*> drawn(members.size(), nullptr);
-  for (std::size_t k = 0; k < members.size(); ++k) {
-    finals[k] = &results[k].final;
-    if (out[k] && detail::at_rounding_level(*out[k])) drawn[k] = &*out[k];
-  }
-  lane_rounding_draws(method, members, [&c](int k) { return detail::coarse_draw(*c, k); }, finals, drawn,
-                      detail::coarse_draw_text(*c));
-  return out;
-}
+ private:
+  using Key = std::tuple<double, long, double, double, bool>;  // h, steps, the rounding's way, energy bound, invariants
 
-/// As integrate(): a batch's flagged lanes that the second companion did not confirm get a third companion,
-/// one level finer again (estimate.hpp, confirm_deeper).
-void confirm_deeper_lanes(std::vector<SweepRow>& rows, const SweepSpec& spec, const MethodInfo& method,
-                          const std::vector<batch::Member>& members, const FixedSteps& how,
-                          const std::vector<std::optional<ErrorEstimate>>& by_coarse,
-                          const std::vector<RunResult>& companions, const std::vector<RunResult>& second) {
-  const auto deeper = [&](std::size_t k) {
-    return spec.estimate_error && !by_coarse[k] && rows[k].outcome == Outcome::unresolved && !rows[k].error.confirmed &&
-           rows[k].error.known();
-  };
-  bool any_deeper = false;
-  for (std::size_t k = 0; k < rows.size(); ++k) any_deeper = any_deeper || deeper(k);
-  if (!any_deeper) return;
-  const auto third = batch::run(method, members, detail::fixed_companion(how, 3));
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    if (!deeper(k)) continue;
-    rows[k].error.force_evals += third[k].force_evals;
-    rows[k].error.wall_s += third[k].wall_s;
-    detail::confirm_deeper(rows[k].error, rows[k].result.final, companions[k].final, second[k].final, third[k].final);
-  }
-}
-
-/// The last steps of a batch's estimates, as integrate() takes them: lanes at the rounding level add draws of
-/// it, a second companion bounds the fine pairs it was asked for, and every lane is settled (flags, bounds).
-void settle_lanes(std::vector<SweepRow>& rows, const SweepSpec& spec, const MethodInfo& method,
-                  const std::vector<batch::Member>& members, const std::vector<Scene>& scenes, const FixedSteps& how,
-                  const std::vector<std::optional<ErrorEstimate>>& by_coarse, const std::vector<std::optional<double>>& coarse_side,
-                  const std::vector<RunResult>& companions, const std::vector<RunResult>& second) {
-  // As integrate(): lanes whose fine estimate is at the rounding level add more draws of it, repeats off
-  // their grid (estimate.hpp).
-  std::vector<const State*> finals(rows.size());
-  std::vector<ErrorEstimate*> drawn(rows.size(), nullptr);
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    finals[k] = &rows[k].result.final;
-    if (spec.estimate_error && !by_coarse[k] && detail::at_rounding_level(rows[k].error)) drawn[k] = &rows[k].error;
-  }
-  lane_rounding_draws(method, members, [&how](int k) { return detail::off_grid(how, k); }, finals, drawn,
-                      detail::kRepeatRoundingDraw);
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    if (!spec.estimate_error || by_coarse[k] || !estimable(rows[k].outcome) || second.empty()) continue;
-    ErrorEstimate& e = rows[k].error;
-    const bool check = detail::checks_fine_pair(method, scenes[k].centres, rows[k].result, coarse_side[k], e.value);
-    if (rows[k].outcome != Outcome::unresolved) {  // a flagged lane counted its second companion above
-      if (!check && how.steps >= detail::kFewSteps) continue;
-      e.force_evals += second[k].force_evals;
-      e.wall_s += second[k].wall_s;
+  /// The way (0, +1, -1) start_moved_by_rounding moved lane k's start to s; nullopt: none of them.
+  std::optional<double> way_of(std::size_t k, const State& s) const {
+    for (const double way : {0.0, 1.0, -1.0}) {
+      const State moved = way == 0.0 ? members_[k].s0 : detail::start_moved_by_rounding(members_[k].s0, way);
+      if (moved.R == s.R && moved.v == s.v && moved.w == s.w) return way;
     }
-    if (second[k].final.R.allFinite() && second[k].final.v.allFinite())
-      detail::bound_by_second(e, method, scenes[k].bodies.front(), how.steps, check, rows[k].result.final,
-                              companions[k].final, second[k].final);
+    return std::nullopt;
   }
-  for (std::size_t k = 0; k < rows.size(); ++k)
-    detail::settle(rows[k].outcome, rows[k].reason, rows[k].warnings, rows[k].error, spec.max_error, spec.max_energy_error,
-                   detail::final_energy_error(scenes[k].bodies.front(), scenes[k].centres, rows[k].result.final));
-}
 
-/// The rows of a batch: its lanes, judged by assess() and, with SweepSpec::estimate_error, by the
-/// estimate from a coarse companion batch or, where that is not trusted, from companion batches at h/2
-/// (and h/4 for flagged lanes): the same kernel and the same rule as integrate() alone (estimate/).
+  /// Lanes [first, last) as `how`, each from `start` or from its own start moved `way`, judged as integrate() judges.
+  std::vector<BodyResult> lanes(std::size_t first, std::size_t last, const FixedSteps& how, const std::optional<State>& start,
+                                const Options& o, double way = 0.0) const {
+    std::vector<batch::Member> moved(members_.begin() + static_cast<long>(first), members_.begin() + static_cast<long>(last));
+    for (batch::Member& m : moved)
+      m.s0 = start ? *start : way == 0.0 ? m.s0 : detail::start_moved_by_rounding(m.s0, way);
+    std::vector<RunResult> runs = batch::run(method_, moved, how, 0, cancel_);
+    std::vector<BodyResult> out(moved.size());
+    for (std::size_t j = 0; j < out.size(); ++j) {
+      out[j].method = &method_;
+      if (runs.empty()) {  // stopped on request
+        out[j].outcome = Outcome::failed;
+        out[j].reason = kStoppedOnRequest;
+        continue;
+      }
+      out[j].run = std::move(runs[j]);
+      detail::judge(out[j], scenes_[first + j].centres, o);
+    }
+    return out;
+  }
+
+  const MethodInfo& method_;
+  const std::vector<batch::Member>& members_;
+  const std::vector<Scene>& scenes_;
+  const std::atomic<bool>* cancel_;
+  std::map<Key, std::vector<std::optional<BodyResult>>> done_;
+};
+
+/// The rows of a batch: its lanes run as one batch, then each estimated and settled by integrate()'s policy
+/// (estimate_and_settle), its companions lanes of batches too (LaneRuns).
 void batch_rows(std::vector<SweepRow>& rows, const SweepSpec& spec, const MethodInfo& method,
                 const std::vector<batch::Member>& members, const std::vector<Scene>& scenes) {
-  const FixedSteps how = std::get<FixedSteps>(point_advance(spec, method, rows.front().point));
-  auto results = batch::run(method, members, how);
-  std::vector<Health> health;
-  for (std::size_t k = 0; k < rows.size(); ++k)
-    health.push_back(assess(results[k], checks_for(method, scenes[k].centres, spec.max_energy_error)));
-  std::vector<std::optional<ErrorEstimate>> by_coarse(rows.size());
-  std::vector<ErrorEstimate> coarse_cost(rows.size());
-  std::vector<std::optional<double>> coarse_side(rows.size());
-  if (spec.estimate_error) by_coarse = coarse_estimates(method, how, members, scenes, results, health, coarse_cost, coarse_side);
-  bool fine = false;
-  for (std::size_t k = 0; k < rows.size(); ++k) fine = fine || (estimable(health[k].outcome) && !by_coarse[k]);
-  std::vector<RunResult> companions, second;
-  if (spec.estimate_error && fine) companions = batch::run(method, members, detail::fixed_companion(how));
-  // As integrate(): a second companion batch confirms the flagged lanes' estimates, bounds a run of a few steps and
-  // checks the fine pairs the coarse side disagrees with (checks_fine_pair; the rounding draws only raise the
-  // estimate it is compared with, so a lane that asks after them asks before).
-  std::vector<ErrorEstimate> by_fine(rows.size());
-  bool any_second = false;
-  for (std::size_t k = 0; spec.estimate_error && k < rows.size(); ++k) {
-    if (by_coarse[k] || !estimable(health[k].outcome)) continue;
-    by_fine[k] =
-        detail::fixed_step_estimate(method, scenes[k].bodies.front(), scenes[k].centres, results[k].final, companions[k].final);
-    any_second = any_second || health[k].outcome == Outcome::unresolved || how.steps < detail::kFewSteps ||
-                 detail::checks_fine_pair(method, scenes[k].centres, results[k], coarse_side[k], by_fine[k].value);
-  }
-  if (any_second) second = batch::run(method, members, detail::fixed_companion(how, 2));
+  const Advance how = point_advance(spec, method, rows.front().point);
+  const Options options = sweep_options(spec);
+  LaneRuns lanes(method, members, scenes, spec.cancel);
   for (std::size_t k = 0; k < rows.size(); ++k) {
-    SweepRow& row = rows[k];
-    Health& h = health[k];
-    row.result = std::move(results[k]);
-    row.outcome = h.outcome;
-    row.reason = std::move(h.why);
-    if (!spec.estimate_error) {
-      row.error.basis = "not asked for (estimate_error off)";
-    } else if (by_coarse[k]) {
-      row.error = std::move(*by_coarse[k]);
-    } else if (estimable(row.outcome)) {
-      row.error = std::move(by_fine[k]);
-      row.error.force_evals = coarse_cost[k].force_evals + companions[k].force_evals;
-      row.error.wall_s = coarse_cost[k].wall_s + companions[k].wall_s;
-      if (row.outcome == Outcome::unresolved) {
-        row.error.force_evals += second[k].force_evals;
-        row.error.wall_s += second[k].wall_s;
-        detail::confirm(row.error, method, scenes[k].bodies.front(), row.result.final, companions[k].final, second[k].final);
-      }
-    } else {
-      row.error.basis = "the run ended " + std::string(outcome_name(row.outcome));
-    }
+    const Body& body = scenes[k].bodies.front();
+    BodyResult r = lanes.run(k, body, how, options);
+    const detail::Rerun rerun{[&lanes, k](const Body& from, const Advance& a, const Options& o) { return lanes.run(k, from, a, o); },
+                              false};
+    detail::estimate_and_settle(r, body, scenes[k].centres, how, options, rerun);
+    rows[k] = result_row(std::move(rows[k]), std::move(r));
   }
-  confirm_deeper_lanes(rows, spec, method, members, how, by_coarse, companions, second);
-  settle_lanes(rows, spec, method, members, scenes, how, by_coarse, coarse_side, companions, second);
 }
 
 /// A grid point's thesis parameters, and the asymptotic data its axes give (NaN: not given), solved in.

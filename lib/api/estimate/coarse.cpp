@@ -96,9 +96,7 @@ std::optional<std::vector<BodyResult>> coarse_lanes(const MethodInfo& m, const B
   for (std::size_t k = 0; k < kDrawLanes; ++k) {
     lanes[k].method = &m;
     lanes[k].run = std::move(runs[k]);
-    Health h = assess(lanes[k].run, checks_for(m, centres, oc.max_energy_error));
-    lanes[k].outcome = h.outcome;
-    lanes[k].reason = std::move(h.why);
+    judge(lanes[k], centres, oc);
   }
   return lanes;
 }
@@ -184,7 +182,8 @@ bool estimated_by_coarse(BodyResult& r, const Body& body, const std::vector<Cent
   oc.track_invariants = true;
   oc.max_energy_error = kCoarseEnergyBound;
   const auto draw = rerun_draws(body, [&c](int k) { return coarse_draw(*c, k); }, oc, rerun);
-  std::optional<std::vector<BodyResult>> lanes = coarse_lanes(*r.method, body, centres, *c, oc);
+  std::optional<std::vector<BodyResult>> lanes =
+      rerun.twin_lanes ? coarse_lanes(*r.method, body, centres, *c, oc) : std::nullopt;
   const BodyResult x = lanes ? std::move(lanes->front()) : draw(0);
   ErrorEstimate& e = r.error;
   e.force_evals += x.total_force_evals();

@@ -191,11 +191,6 @@ void bound_by_second(ErrorEstimate& e, const MethodInfo& m, const Body& body, lo
                    "second companion one level finer differs by from it and from the first";
 }
 
-FixedSteps fixed_companion(const FixedSteps& run, int level) {
-  const double ratio = std::pow(kStepRatio, level);
-  return FixedSteps{run.h / ratio, run.steps * static_cast<long>(ratio)};
-}
-
 void confirm(ErrorEstimate& e, double min_fall, const State& run, const State& first, const State& second) {
   if (!(second.R.allFinite() && second.v.allFinite())) {
     e.basis += "; a second companion one level finer did not end as the run did";
@@ -240,29 +235,6 @@ void confirm_deeper(ErrorEstimate& e, const State& run, const State& first, cons
   e.confirmed = true;
   e.basis += "; a third companion one level finer again: the finer differences fall " + short_number(d2 / d3) +
              "x, the estimate at least what the run differs by from the third plus what that may still be off by";
-}
-
-void confirm(ErrorEstimate& e, const MethodInfo& m, const Body& body, const State& run, const State& first,
-             const State& second) {
-  confirm(e, std::min(kMaxFall, std::pow(kStepRatio, fixed_order(m, body) - kOrderSlack)), run, first, second);
-}
-
-ErrorEstimate fixed_step_estimate(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
-                                  const State& run, const State& companion) {
-  ErrorEstimate e;
-  const int p = fixed_order(m, body);
-  e.basis = fixed_basis(p, kStepRatio);
-  if (!(companion.R.allFinite() && companion.v.allFinite())) {
-    e.basis = "the " + e.basis + " did not end as the run did";
-  } else if (flow_is_exact(m, body, centres)) {
-    e.value = bodypoint::state_distance(run, companion);
-    e.basis = "companion run at h/2, " + std::string(kExactFlowBasis);
-  } else {
-    // As integrate()'s companion: its factor times the difference (not the difference over 1 - 2^-p,
-    // which rounds otherwise: a sweep's lane and the same run alone were an ulp apart).
-    e.value = bodypoint::coarser_run_error(1.0, kStepRatio, p) * bodypoint::state_distance(run, companion);
-  }
-  return e;
 }
 
 bool companion_broke_down(const BodyResult& x) {

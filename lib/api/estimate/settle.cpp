@@ -64,6 +64,16 @@ void settle(Outcome& outcome, std::string& reason, std::vector<std::string>& war
   }
 }
 
+void judge(BodyResult& r, const std::vector<Centre>& centres, const Options& options) {
+  // A run observed for its events or samples alone has invariants it was not asked for: they are neither
+  // reported nor judged (a Stepper with invariants off and a stop event was refused "unresolved" far out,
+  // where a controlled step at a tolerance per step of 1e-13 turned the spin by 3.6 rad).
+  if (!options.track_invariants) r.run.invariants.reset();
+  Health h = assess(r.run, checks_for(*r.method, centres, options.max_energy_error));
+  r.outcome = h.outcome;
+  r.reason = std::move(h.why);
+}
+
 }  // namespace bodypoint::detail
 
 namespace bodypoint {

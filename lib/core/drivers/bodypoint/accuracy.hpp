@@ -50,7 +50,7 @@ double automatic_omega_c(const Body& body, const std::vector<Centre>& centres, d
 
 // Richardson's estimate of a run's error from a companion run of the same method (order p) whose step
 // differs by a factor `ratio` > 1: the one rule behind the accuracy mode's search (adaptive/search/ladder.cpp),
-// the estimate of a run by step and the sweep's vector lanes (lib/api/estimate/). With x(h) = x* + C h^p,
+// the estimate of a run by step (lib/api/estimate/). With x(h) = x* + C h^p,
 // runs at h and h/ratio differ by C h^p (1 - ratio^-p) (docs/physics.md, "Error estimate").
 
 /// The error of the finer of two runs whose final states are `difference` apart: difference / (ratio^p - 1).
