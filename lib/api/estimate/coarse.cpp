@@ -104,14 +104,16 @@ std::optional<std::vector<BodyResult>> coarse_lanes(const MethodInfo& m, const B
 /// The second coarse companion of a pair whose estimate would be trusted: the coarse run's own coarse
 /// companion (within the angles the coarse run's steps allow), from the same moved start; the order the three
 /// runs observe decides (kObservedOrderSlack). True where the pair is kept: the three agree with the order, or
-/// there is no second coarse run to ask (the coarse run too short, its steps at the angles' limit). A second
-/// coarse run that breaks down or ends otherwise says the pair is near the end of its regime: not kept.
+/// the coarse run is too short for a second. A coarse run whose own steps turn the spin or the direction to a
+/// centre as far as the angles allow no second, and a second coarse run that breaks down or ends otherwise, say
+/// the pair is near the end of its regime: not kept (lp-bm4 at h = 0.1 on an attracting pass, 1.0e-11 off: its
+/// coarse run at 2h, no second within the angles, is 4.2e-7 off, and the pair read 2.8e-8).
 bool coarse_pair_asymptotic(ErrorEstimate& e, const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
                             const CoarseCompanion& c, const BodyResult& x, const BodyResult& r, const Options& options,
                             const Options& oc, const Rerun& rerun) {
-  const std::optional<CoarseCompanion> c2 =
-      coarse_companion(m, c.how, x.run.steps, coarse_ratio_limit(m, centres, x.run));
-  if (!c2) return true;
+  const double limit = coarse_ratio_limit(m, centres, x.run);
+  const std::optional<CoarseCompanion> c2 = coarse_companion(m, c.how, x.run.steps, limit);
+  if (!c2) return !(limit < kMinCoarseRatio);
   const BodyResult y = rerun_draws(body, [&c2](int) { return c2->how; }, oc, rerun)(0);
   e.force_evals += y.total_force_evals();
   e.wall_s += y.run.wall_s;
