@@ -26,7 +26,7 @@ PY_DIRS = ("lib", "bench", "paper", "tests")
 CATALOGUE = ("lib/core/drivers/bodypoint/run.cpp", "lib/core/drivers/bodypoint/run.hpp")
 # Traits set for one family only (catalogue_traits, run.cpp): Thesis, TimeTransformed, Regularised, FarField.
 SINGLE_FAMILY_TRAITS = re.compile(
-    r"traits\.(frozen_gyroscopic_term|takes_omega_c|exact_in_fictitious_time|cost_set_by_field)\b"
+    r"traits\.(frozen_gyroscopic_term|takes_omega_c|exact_in_fictitious_time)\b"
     r"|SearchStrategy::(field_pair|exact_pair)\b")
 TRAIT_READS = {  # far-ip's search strategy (field_pair): its pair's basis, its search and its ladder's first step
     "adaptive/search/exact_pair.cpp": 1,

@@ -247,23 +247,15 @@ class Ladder {
       if (stalled >= kPeerStallDecades) break;
     }
   }
-  /// far-ip's step is tens of radians of spin (far_field.hpp): its ladder starts at kFarFieldFirstStep,
-  /// and a step too long for the scene's closest approach (its iteration diverges) is left out.
+  /// Fixed steps halving from 0.5 (far-ip's from kFarFieldFirstStep: its step is tens of radians of spin,
+  /// far_field.hpp); a step the method cannot take on the scene (an iteration that diverges there, as far-ip's
+  /// collocation does) is left out, with a note.
   void fixed() {
     Row r;
     const bool far = m_.traits.search == SearchStrategy::field_pair;
     for (double h = far ? kFarFieldFirstStep : 0.5; ns_.t_end / h * std::max(1, m_.evals_per_step) <= o_.max_evals; h /= 2) {
-      if (far) {
-        if (!try_measure(h, 0, r)) continue;
-        if (!keep(r)) break;
-        continue;
-      }
-      std::string why;
-      std::optional<Row> row = measure(ns_, m_, body_, ref_, h, 0, why);
-      if (!row) throw Error(ns_.name + " " + m_.name + " h=" + fmt(h) + ": " + why);  // a fixed step the ladder needs
-      rows_.push_back(std::move(*row));
-      below_ = rows_.back().err_rel < o_.floor ? below_ + 1 : 0;
-      if (below_ >= 2) break;
+      if (!try_measure(h, 0, r)) continue;
+      if (!keep(r)) break;
     }
   }
 

@@ -316,11 +316,8 @@ std::string geometry_text(const MethodInfo& m) {
 }
 
 MethodTraits catalogue_traits(Family f) {
-  MethodTraits t;
-  t.family_name = kFamilyNames[static_cast<std::size_t>(f)].name;
-  t.family_key = kFamilyNames[static_cast<std::size_t>(f)].key;
-  t.geometry = kFamilyNames[static_cast<std::size_t>(f)].geometry;
-  t.first_step = fixed_first_step;
+  const FamilyNames& names = kFamilyNames[static_cast<std::size_t>(f)];
+  MethodTraits t{.family_name = names.name, .family_key = names.key, .geometry = names.geometry, .first_step = fixed_first_step};
   switch (f) {
     case Family::Thesis:
       t.frozen_gyroscopic_term = true;
@@ -369,7 +366,7 @@ MethodTraits catalogue_traits(Family f) {
     case Family::FarField:
       t.search = SearchStrategy::field_pair;
       t.macro_steps = true;
-      t.cost_set_by_field = true;
+      t.cost_set_by = "points x sweeps";  // far_field.hpp
       t.first_step = far_field_first_step;
       break;
   }
@@ -434,13 +431,13 @@ int effective_order(const MethodInfo& m, const Body& b) {
 }
 
 std::string stages_text(const MethodInfo& m) {
-  return is_step_controlled(m) || m.traits.cost_set_by_field ? "-" : std::to_string(m.stages);
+  return is_step_controlled(m) || !m.traits.cost_set_by.empty() ? "-" : std::to_string(m.stages);
 }
 
 std::string evals_per_step_text(const MethodInfo& m) {
   return is_step_controlled(m)          ? "adaptive"
-         : m.traits.cost_set_by_field ? "points x sweeps"  // far_field.hpp: set by the step and the field
-                                        : std::to_string(m.evals_per_step);
+         : !m.traits.cost_set_by.empty() ? std::string(m.traits.cost_set_by)
+                                          : std::to_string(m.evals_per_step);
 }
 
 double search_first_step(const MethodInfo& m, const Body& b, const std::vector<Centre>& centres, double t_end) {

@@ -235,8 +235,9 @@ struct MethodTraits {
   bool frozen_gyroscopic_term = false;
   /// In the thesis's "fixed" set (`--methods fixed`): a fixed physical step of its own.
   bool in_fixed_set = false;
-  /// Its cost per step is set by the step and the field, not by a number of stages (far-ip: points x sweeps).
-  bool cost_set_by_field = false;
+  /// What sets its cost per step where the step and the field do, not a number of stages, as the method table
+  /// prints it (far-ip: "points x sweeps"); empty: its stages do.
+  std::string_view cost_set_by = {};
   /// What the family's flows preserve (geometry_text adds a splitting's symmetry).
   std::string_view geometry;
   /// Where the accuracy mode's search starts on a body for a run to t_end: its first, coarse step (h or ds).
@@ -332,7 +333,7 @@ double time_step_constant_of(const MethodInfo& m, double c);
 /// method without a fixed order.
 int effective_order(const MethodInfo& m, const Body& b);
 /// Its stages and its force evaluations per step as the method tables print them ("-" and "adaptive" for a
-/// controlled method, "points x sweeps" for one whose cost the step and the field set).
+/// controlled method, what sets it for one whose cost the step and the field set: MethodTraits::cost_set_by).
 std::string stages_text(const MethodInfo& m);
 std::string evals_per_step_text(const MethodInfo& m);
 /// Where the accuracy mode's search starts for `m` on this body (its first, coarse step: h, or ds), for a run to
