@@ -1,10 +1,12 @@
 // bodypoint: the errors of a run's located events (estimate.hpp, estimate_event_errors). Companions at 2h and 4h
 // locate the same events; in the asymptotic regime every smooth quantity of a run (an event's time, its distance,
 // its state) errs by the same multiple of what the pair differs by in it, so a quantity whose three values fall as
-// an order gets Richardson's error at that order, at least the final state's estimate over its pair's difference.
+// an order gets Richardson's error at that order, at least the final state's estimate over its pair's difference;
+// a time whose values observe no order gets the bound its state's error gives (time_error_from_state).
 #include "parts.hpp"
 
 #include "bodypoint/accuracy.hpp"
+#include "bodypoint/field.hpp"
 
 #include <array>
 #include <cmath>
@@ -23,6 +25,7 @@ constexpr double kFinerRatio = 1.25;
 /// this relative part of the time and distance (a few units in the last place, the rounding probes' start
 /// shift), and the state's at least the run's own estimate's share of it.
 constexpr double kEventRounding = bodypoint::kStartShift;
+constexpr double kUnknown = std::numeric_limits<double>::quiet_NaN();
 
 /// The step of the run r asked as `how`: the accuracy mode's delivered one, or the step by which it ran.
 struct RunStep {
@@ -97,6 +100,56 @@ double quantity_error(double d1, double d2, int p, double scale, double final_fa
   return std::max(d1 * std::max(richardson, final_factor), kEventRounding * scale);
 }
 
+/// Where an event time's differences observe no order (the closest approach on table 3.1 under --tol 1e-8: the
+/// times at h and 2h 8.6e-11 and 1.1e-10 off, 4h's out of its regime, -3.6e-8), its error from the state's: a state off by
+/// `state_error` (relative in R and in v, the tool's norm) moves the root of g by at most what g changes by over
+/// g's rate along the motion. For the events whose g reads R and v alone (closest, local minimum, radius, plane);
+/// NaN for departure and arrival, whose guiding centre reads the spin, which the norm does not bound.
+double time_error_from_state(const Event& e, const BodyPoint& p, const std::vector<Centre>& centres, const State& s,
+                             double state_error) {
+  using K = Event::Kind;
+  const double dR = state_error * s.R.norm(), dv = state_error * s.v.norm();
+  double dg = std::numeric_limits<double>::quiet_NaN(), rate = dg;
+  switch (e.kind) {
+    case K::closest_approach:
+    case K::local_minimum: {  // g = (R - c) . v, g' = |v|^2 + (R - c) . dv/dt
+      const Vec3 d = s.R - centres[e.centre].c;
+      const Vec3 a = (p.J * CentreList{centres}.force(s.R) - p.B * p.B * s.w.cross(s.v)) / p.D();
+      dg = s.v.norm() * dR + d.norm() * dv;
+      rate = s.v.squaredNorm() + d.dot(a);
+      break;
+    }
+    case K::radius: {  // g = |R - c| - r, g' = (R - c) . v / |R - c|
+      const Vec3 d = s.R - centres[e.centre].c;
+      dg = dR;
+      rate = d.dot(s.v) / d.norm();
+      break;
+    }
+    case K::plane:  // g = n . R - offset, g' = n . v
+      dg = e.normal.norm() * dR;
+      rate = e.normal.dot(s.v);
+      break;
+    case K::departure:
+    case K::arrival: break;
+  }
+  const double dt = std::abs(dg / rate);
+  return std::isfinite(dt) ? dt : std::numeric_limits<double>::quiet_NaN();
+}
+
+/// The errors the three runs left unknown, from the state's where it is known: a stop event's state is the run's
+/// final state, whose estimate is `final_error`; the time from time_error_from_state; the distance at a time
+/// t_error off from a position state_error off, what it moves by either way.
+void bound_from_state(EventHit& h, const Event& e, const BodyPoint& p, const std::vector<Centre>& centres, double final_error) {
+  if (std::isnan(h.state_error)) h.state_error = final_error;
+  if (!std::isfinite(h.state_error)) return;
+  if (std::isnan(h.t_error))
+    h.t_error = std::max(time_error_from_state(e, p, centres, h.s, h.state_error), kEventRounding * std::abs(h.t));
+  if (std::isnan(h.r_error) && std::isfinite(h.t_error) && !e.about && !centres.empty()) {
+    const Vec3 d = h.s.R - centres[e.kind == Event::Kind::plane ? 0 : e.centre].c;
+    h.r_error = std::max(h.state_error * h.s.R.norm() + std::abs(d.dot(h.s.v)) / d.norm() * h.t_error, kEventRounding * h.r);
+  }
+}
+
 }  // namespace
 
 void estimate_event_errors(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Advance& how,
@@ -130,6 +183,7 @@ void estimate_event_errors(BodyResult& r, const Body& body, const std::vector<Ce
   const double final_factor = apart > kRoundingLevel ? r.error.value / apart : 0.0;
   const std::vector<const EventHit*> with_x = partners(r.events, x.events);
   const std::vector<const EventHit*> with_y = y ? partners(r.events, y->events) : std::vector<const EventHit*>(r.events.size());
+  const bool stopped_here = stopped_by_event(r, options);
   for (std::size_t i = 0; i < r.events.size(); ++i) {
     EventHit& h = r.events[i];
     if (!with_x[i] || (y && !with_y[i])) continue;  // no partner: its errors are not known
@@ -139,6 +193,7 @@ void estimate_event_errors(BodyResult& r, const Body& body, const std::vector<Ce
     for (std::size_t q = 0; q < 3; ++q)
       *out[q] = y ? quantity_error(d1[q], differences(*with_x[i], *with_y[i])[q], p, scale[q], final_factor)
                   : std::max(d1[q] * std::max(1.0, final_factor), kEventRounding * scale[q]);
+    bound_from_state(h, options.events[h.event], body.p, centres, stopped_here && i + 1 == r.events.size() ? r.error.value : kUnknown);
   }
 }
 
