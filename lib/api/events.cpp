@@ -227,17 +227,19 @@ double event_scale(const Event& e, const BodyPoint& p, const std::vector<Centre>
   return 0.0;
 }
 
+/// The body's acceleration dv/dt at s (docs/physics.md, equations of motion: D dv/dt = J F - B^2 (w x v)).
+Vec3 acceleration(const BodyPoint& p, const CentreList& field, const State& s) {
+  return (p.J * field.force(s.R) - p.B * p.B * s.w.cross(s.v)) / p.D();
+}
+
 /// An upper bound on |dg/dt| at state s (before kRateMargin): d/dt (R - c).v = |v|^2 + (R - c).a for an
 /// approach, |v| for a radius, |n||v| for a plane; the guiding centre of an arrival or departure moves
 /// smoothly (0: it hides no root).
 double rate_bound(const Event& e, const BodyPoint& p, const CentreList& field, const State& s) {
   switch (e.kind) {
     case Event::Kind::closest_approach:
-    case Event::Kind::local_minimum: {
-      // docs/physics.md, equations of motion: D dv/dt = J F - B^2 (w x v)
-      const Vec3 a = (p.J * field.force(s.R) - p.B * p.B * s.w.cross(s.v)) / p.D();
-      return s.v.squaredNorm() + (s.R - field.centres[e.centre].c).norm() * a.norm();
-    }
+    case Event::Kind::local_minimum:
+      return s.v.squaredNorm() + (s.R - field.centres[e.centre].c).norm() * acceleration(p, field, s).norm();
     case Event::Kind::radius: return s.v.norm();
     case Event::Kind::plane: return e.normal.norm() * s.v.norm();
     case Event::Kind::departure:
@@ -245,6 +247,28 @@ double rate_bound(const Event& e, const BodyPoint& p, const CentreList& field, c
   }
   return 0.0;
 }
+
+}  // namespace
+
+double event_rate(const Event& e, const BodyPoint& p, const std::vector<Centre>& centres, const State& s) {
+  switch (e.kind) {
+    case Event::Kind::closest_approach:
+    case Event::Kind::local_minimum: {
+      const Vec3 d = s.R - centres[e.centre].c;
+      return s.v.squaredNorm() + d.dot(acceleration(p, CentreList{centres}, s));
+    }
+    case Event::Kind::radius: {
+      const Vec3 d = s.R - centres[e.centre].c;
+      return d.dot(s.v) / d.norm();
+    }
+    case Event::Kind::plane: return e.normal.dot(s.v);
+    case Event::Kind::departure:
+    case Event::Kind::arrival: break;
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+namespace {
 
 /// Whether the span from a to b (dt long) is one that can hide two sign changes (kHiddenSpin, kHiddenTurn).
 bool long_span(const BodyPoint& p, const std::vector<Centre>& centres, const State& a, const State& b, double dt) {

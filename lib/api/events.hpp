@@ -32,6 +32,9 @@ void keep_closest(std::vector<EventHit>& hits, const std::vector<Event>& events)
 
 /// The function whose sign change is the event.
 double event_function(const Event& e, const BodyPoint& p, const std::vector<Centre>& centres, const State& s);
+/// Its rate along the motion, dg/dt at s: |v|^2 + (R - c).dv/dt for an approach, (R - c).v/|R - c| for a radius,
+/// n.v for a plane; NaN for a departure or an arrival (the guiding centre's, not needed).
+double event_rate(const Event& e, const BodyPoint& p, const std::vector<Centre>& centres, const State& s);
 
 class EventWatch {
  public:

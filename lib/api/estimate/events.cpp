@@ -5,8 +5,9 @@
 // a time whose values observe no order gets the bound its state's error gives (time_error_from_state).
 #include "parts.hpp"
 
+#include "events.hpp"
+
 #include "bodypoint/accuracy.hpp"
-#include "bodypoint/field.hpp"
 
 #include <array>
 #include <cmath>
@@ -109,31 +110,17 @@ double time_error_from_state(const Event& e, const BodyPoint& p, const std::vect
                              double state_error) {
   using K = Event::Kind;
   const double dR = state_error * s.R.norm(), dv = state_error * s.v.norm();
-  double dg = std::numeric_limits<double>::quiet_NaN(), rate = dg;
+  double dg = kUnknown;  // at most |grad_R g| dR + |grad_v g| dv
   switch (e.kind) {
     case K::closest_approach:
-    case K::local_minimum: {  // g = (R - c) . v, g' = |v|^2 + (R - c) . dv/dt
-      const Vec3 d = s.R - centres[e.centre].c;
-      const Vec3 a = (p.J * CentreList{centres}.force(s.R) - p.B * p.B * s.w.cross(s.v)) / p.D();
-      dg = s.v.norm() * dR + d.norm() * dv;
-      rate = s.v.squaredNorm() + d.dot(a);
-      break;
-    }
-    case K::radius: {  // g = |R - c| - r, g' = (R - c) . v / |R - c|
-      const Vec3 d = s.R - centres[e.centre].c;
-      dg = dR;
-      rate = d.dot(s.v) / d.norm();
-      break;
-    }
-    case K::plane:  // g = n . R - offset, g' = n . v
-      dg = e.normal.norm() * dR;
-      rate = e.normal.dot(s.v);
-      break;
+    case K::local_minimum: dg = s.v.norm() * dR + (s.R - centres[e.centre].c).norm() * dv; break;  // g = (R - c).v
+    case K::radius: dg = dR; break;                                                                  // g = |R - c| - r
+    case K::plane: dg = e.normal.norm() * dR; break;                                                 // g = n.R - offset
     case K::departure:
     case K::arrival: break;
   }
-  const double dt = std::abs(dg / rate);
-  return std::isfinite(dt) ? dt : std::numeric_limits<double>::quiet_NaN();
+  const double dt = std::abs(dg / event_rate(e, p, centres, s));
+  return std::isfinite(dt) ? dt : kUnknown;
 }
 
 /// The errors the three runs left unknown, from the state's where it is known: a stop event's state is the run's
