@@ -3,6 +3,7 @@
 
 usage: check_paper.py literals paper/bodypoint.tex
        check_paper.py pdf paper/build
+       check_paper.py contended paper/results-quick OUT quick
 
 literals: fails if the body of the .tex types a number that is not a scene parameter or a reference to
           the thesis (every measured figure must come from generated/macros.tex).
@@ -11,9 +12,18 @@ pdf:      fails unless bodypoint.pdf exists with every required section, and the
           states no number as "n/a" (a number it promised and lost: the sentence must say why in
           words), and a copy whose parts lost every time to the timing rules carries the draft stamp
           and its list (make_macros.py's ContendedStamp, ContendedNotice).
+contended: builds in OUT the copy a fully contended machine would make of the results directory (every
+          time flagged, paper/contended_copy.py; MODE quick or full as the results were made) and checks it
+          as `pdf` does, its stamp and list included: the pages a busy machine's build lays out, checked
+          on any machine.
 """
+import os
 import re
+import shutil
+import subprocess
 import sys
+
+import contended_copy
 
 # Inputs, not measurements, that the text may type: the thesis's scene parameters (table 3.1: d = 10,
 # L = 200, B = 0.7; the sweeps' d = 50, T = hn = 25, n = 250000, t = 50; appendix set P1.2's J = 0.2;
@@ -149,10 +159,37 @@ def claims_without_verdict(build):
     return found
 
 
+def contended(results, out, mode):
+    """The worst case of a busy machine's build (every time flagged) made from `results` in `out`, and
+    checked as pdf() checks a build; it must carry the draft stamp and its list."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    contended_copy.flag_every_time(results, os.path.join(out, "results"))
+    for step in [["make_figures.py", os.path.join(out, "results"), os.path.join(out, "figures")],
+                 ["make_macros.py", os.path.join(out, "results"), os.path.join(out, "generated"), mode,
+                  os.path.join(out, "figures")]]:
+        subprocess.run([sys.executable, os.path.join(here, step[0])] + step[1:], check=True, stdout=subprocess.DEVNULL)
+    for name in ["bodypoint.tex", "bodypoint.bib"]:
+        shutil.copy(os.path.join(here, name), out)
+    latex = subprocess.run(["latexmk", "-pdf", "-interaction=nonstopmode", "-halt-on-error", "bodypoint.tex"],
+                           cwd=out, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    if latex.returncode != 0:
+        print(latex.stdout[-3000:])
+        print(f"{out}: LaTeX failed on the contended copy")
+        return 1
+    with open(os.path.join(out, "generated", "macros.tex")) as f:
+        if not re.search(r"\\newcommand\{\\ContendedStamp\}\{\S", f.read()):
+            print(f"{out}: the contended copy has no draft stamp")
+            return 1
+    return pdf(out)
+
+
 def main():
-    if len(sys.argv) != 3 or sys.argv[1] not in ("literals", "pdf"):
+    args = sys.argv[1:]
+    if args[:1] == ["contended"] and len(args) == 4:
+        sys.exit(contended(*args[1:]))
+    if len(args) != 2 or args[0] not in ("literals", "pdf"):
         sys.exit(__doc__)
-    sys.exit(literals(sys.argv[2]) if sys.argv[1] == "literals" else pdf(sys.argv[2]))
+    sys.exit(literals(args[1]) if args[0] == "literals" else pdf(args[1]))
 
 
 if __name__ == "__main__":
