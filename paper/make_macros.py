@@ -25,7 +25,7 @@ from macros.front import build_options, build_time, contention, platform, timing
 from macros.long_time import long_time
 from macros.methods import geometry_tables, methods_table
 from macros.scattering import l_cost, scattering
-from macros.stability import appendix, ensembles, stress
+from macros.stability import appendix, ensembles, map_scale_text, stress
 from macros.work_precision import by_tol, estimate_branches, estimate_cost, estimate_grid, far_field
 
 
@@ -64,6 +64,7 @@ def main():
     stress(res, out, M)
     appendix(res, M)
     ensembles(res, out, M)
+    map_scale_text(res, M)
     scattering(res, M)
     l_cost(res, M)
     long_time(res, out, M)

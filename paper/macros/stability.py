@@ -7,7 +7,7 @@ import statistics
 
 import map_rule
 import timing_rule
-from macros.common import camel, count, latex_text, lost_column, num, read_csv, sci, tt
+from macros.common import camel, count, latex_text, lost_column, num, power_of_ten, read_csv, sci, tt
 
 
 # The statuses of a run that ended with numbers bodypoint does not vouch for (docs/physics.md,
@@ -216,3 +216,39 @@ def scaling_text(res, M):
     M.add("ScalingText", f"{lanes}; {efficiency} (start-up of the processes included{startup})", math_mode=False)
     if not any(ok(m, "simd1") for m in ("simd2", "mpi2", "shards2")):
         lost_column(M, "the parallel efficiencies (section~\\ref{sec:map})", list(flags.values()))
+
+
+def map_scale_text(res, M):
+    """bench/map_at_scale.py: a map of the thesis's scene over (d, B), auto at one TOL on two threads. Its
+    force evaluations and delivered accuracy are printed always; its CPU and wall time per trajectory where
+    the timing rule lets them count (repeats, spread, the share of the cores others used)."""
+    path = os.path.join(res, "map_scale.csv")
+    rows = read_csv(path)[0] if os.path.exists(path) else []
+    if not rows:
+        M.add("MapScaleText", "was not run in this copy", math_mode=False)
+        M.add("MapScaleGrid", "a grid", math_mode=False)
+        return
+    r = rows[0]
+    flag = M.rule.flag(int(num(r["repeats"])), num(r["others_share"]), max(num(r["cpu_spread"]), num(r["wall_spread"])),
+                       process=True)
+    M.ledger.count("the map at an accuracy", [flag])
+    n, threads = int(num(r["rows"])), int(num(r["threads"]))
+    if flag:
+        time_text = f"its times untimed in this copy (flagged: {latex_text(flag)})"
+        M.ledger.lost("the map at an accuracy's time per trajectory (section~\\ref{sec:map})", flag)
+    else:
+        time_text = (f"${sci(num(r['cpu_us_per_trajectory']), 3)}~\\mu$s of CPU time per trajectory "
+                     f"(${sci(num(r['wall_us_per_trajectory']), 3)}~\\mu$s of wall time on {threads} threads; "
+                     f"median of {int(num(r['repeats']))} warm runs, spread ${sci(100 * num(r['cpu_spread']), 2)}\\%$)")
+    refused = n - int(num(r["ok"]))
+    M.add("MapScaleText",
+          f"{count(n)} trajectories at TOL {power_of_ten(num(r['tol']))} cost {time_text} and "
+          f"${sci(num(r['evals_per_trajectory']), 3)}$ force evaluations per trajectory, the search included "
+          f"(${sci(num(r['delivered_evals_per_trajectory']), 3)}$ in the delivered runs); the estimates' median is "
+          f"${sci(num(r['estimate_median']))}$ and the largest ${sci(num(r['estimate_max']))}$ "
+          f"({count(int(num(r['above_tol'])))} above TOL, {count(refused)} {'row' if refused == 1 else 'rows'} refused), and "
+          f"{count(int(num(r['sample'])))} rows checked against long-double references erred at most "
+          f"${sci(num(r['error_max']))}$ (median ${sci(num(r['error_median']))}$)", math_mode=False)
+    M.add("MapScaleGrid", f"$d$ from ${sci(num(r['d_from']))}$ to ${sci(num(r['d_to']))}$ and $B$ from "
+          f"${sci(num(r['B_from']))}$ to ${sci(num(r['B_to']))}$, {count(int(num(r['points'])))} values each, "
+          f"$t = {sci(num(r['t_end']))}$", math_mode=False)
