@@ -28,6 +28,9 @@ MAPS = [
     ("A x d", ["--grid", "A=1:3:1", "--grid", "d=3:12:3"], 1e-6, 40),
     ("K1 x Kz", ["--grid", "K1=3:7:1", "--grid", "Kz=1:5:2"], 1e-10, 60),
     ("encounters b x arrival phase", ["--scattering", "--grid", "b=1:4:1", "--grid", "arrival_phase=0:3:1"], 1e-8, None),
+    # Far passes, whose cost is the far field's spin-limited steps at any step (the 10^4-point map of
+    # bench/map_at_scale.py has most of its rows there).
+    ("far passes d x B", ["--grid", "d=40:100:20", "--grid", "B=0.2:0.9:0.1"], 1e-9, 50),
 ]
 QUICK = [MAPS[0], MAPS[2]]
 NAMED = "logh-verlet,logh-y4,logh-pefrl,logh-bm4,logh-kl6,logh-kl8,lp-y4,lp-kl6"

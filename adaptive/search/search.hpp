@@ -103,6 +103,7 @@ class Search {
   bool first_pair(std::vector<Level>& rungs, double& h_c);
   [[nodiscard]] Error out_of_reach(double d) const;
   bool replanned(std::vector<Level>& rungs, double& h_c);
+  bool coarser_rung_confirms(std::vector<Level>& rungs, double h_c);
   std::optional<Level> pilot_answer(std::vector<Level>& rungs);
   Level ladder();
   double refine(std::vector<Level>& rungs, double& h_c);
