@@ -203,22 +203,14 @@ Level Search::ladder() {
       rungs.front().samples = {};
     }
     const bool from_plan = std::exchange(planned, false);
-    Level& a = rungs[rungs.size() - 2];
-    a.samples = {};  // only the newest run can still be delivered: its predecessors' samples go
-    estimate_ = pair_estimate(a, rungs.back());
-    last_estimate_ = estimate_;
-    const double d = state_distance(a.run.final, rungs.back().run.final);
-    if (from_plan && estimate_ < expected / kAgree && d > kRoundOff) {
-      if (coarser_rung_confirms(rungs, h_c)) {
-        if (deliverable(rungs.back(), h_c, true)) {
-          if (verified(rungs, h_c)) return std::move(rungs.back());
-          verified_finer = true;
-          continue;
-        }
-      } else if (replanned(rungs, h_c)) {
-        planned = true;  // a coarser planned pair, judged as the first was
-        continue;
-      }
+    const std::size_t a = rungs.size() - 2;  // an index: coarser_rung_confirms inserts at the front
+    rungs[a].samples = {};  // only the newest run can still be delivered: its predecessors' samples go
+    last_estimate_ = estimate_ = pair_estimate(rungs[a], rungs.back());
+    const double d = state_distance(rungs[a].run.final, rungs.back().run.final);
+    if (from_plan && estimate_ < expected / kAgree && d > kRoundOff && !coarser_rung_confirms(rungs, h_c) &&
+        replanned(rungs, h_c)) {
+      planned = true;  // far below its target and not confirmed by a coarser run: a coarser planned pair
+      continue;
     }
     if (d <= kRoundOff && estimate_ > kAccept * tol_)
       throw Error("tol " + fmt_tol() + " is below the round-off floor of " + std::string(m_.name) +
