@@ -32,6 +32,9 @@ import sys
 import tempfile
 import time
 
+from estimate_cost import spread  # interquartile range over the median, the paper's timing rule's spread
+from estimate_ladder import distance  # max(|dR|/|R|, |dv|/|v|) against a reference's R_ref, v_ref
+
 # The map's axes: the thesis scene's d (its closest approaches, from a close pass to a far one) and the
 # coupling B (from a nearly material point to a strongly spinning body; D = mJ - B^2 > 0 needs B < 1).
 D_RANGE = (1.0, 100.0)
@@ -69,20 +72,9 @@ def timed(cmd):
     return cpu, t1 - t0, max(others, 0.0)
 
 
-def spread(xs):
-    """Interquartile range over the median, as the paper's timing rule reads it."""
-    if len(xs) < 2:
-        return float("nan")
-    q = statistics.quantiles(xs, n=4, method="inclusive")
-    return (q[2] - q[0]) / statistics.median(xs)
-
-
 def norm_error(row, ref):
-    """The tool's norm of a final state's error: max(|dR|/|R|, |dv|/|v|)."""
-    def rel(a, b):
-        return sum((x - y) ** 2 for x, y in zip(a, b)) ** 0.5 / sum(y * y for y in b) ** 0.5
-    return max(rel([float(row[k]) for k in ("Rx", "Ry", "Rz")], ref["R_ref"]),
-               rel([float(row[k]) for k in ("vx", "vy", "vz")], ref["v_ref"]))
+    """The tool's norm of a sweep row's final state error against `simulate --reference`'s (estimate_ladder.py)."""
+    return distance({"R": [float(row[k]) for k in ("Rx", "Ry", "Rz")], "v": [float(row[k]) for k in ("vx", "vy", "vz")]}, ref)
 
 
 def reference(binary, row):
@@ -122,12 +114,13 @@ def main():
             rows = list(csv.DictReader(line for line in f if not line.startswith("#")))
     tol, n = float(a.tol), len(rows)
     cpu, wall, others = ([t[i] for t in times] for i in range(3))
+    spread_of = lambda xs: spread(xs) if len(xs) > 1 else float("nan")  # noqa: E731  (one repeat: no spread)
     estimates = [float(r["err_estimate"]) for r in rows if r["outcome"] == "ok"]
     checked = sampled_errors(a.binary, rows, a.sample)
     errors = [e for e, _ in checked]
     summary = dict(
         rows=n, tol=a.tol, threads=a.threads, repeats=a.repeats, ok=len(estimates),
-        cpu_s=statistics.median(cpu), cpu_spread=spread(cpu), wall_s=statistics.median(wall), wall_spread=spread(wall),
+        cpu_s=statistics.median(cpu), cpu_spread=spread_of(cpu), wall_s=statistics.median(wall), wall_spread=spread_of(wall),
         others_share=statistics.median(others),
         cpu_us_per_trajectory=1e6 * statistics.median(cpu) / n, wall_us_per_trajectory=1e6 * statistics.median(wall) / n,
         evals_per_trajectory=sum(int(r["search_force_evals"]) for r in rows) / n,
