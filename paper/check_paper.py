@@ -136,7 +136,7 @@ def numbers_lost(build):
     found = [f"text: \\{name} reads n/a" for name in sorted(used & set(defs))
              if re.fullmatch(r"(\\ensuremath\{)?n/a\}?", defs[name])]
     if bool(defs.get("ContendedNotice")) != bool(defs.get("ContendedStamp")):
-        found.append("a contended copy without its stamp and list on page 1 (ContendedNotice, ContendedStamp)")
+        found.append("a contended copy without its stamp and its list (ContendedNotice, ContendedStamp)")
     return found
 
 

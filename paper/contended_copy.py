@@ -1,7 +1,7 @@
 """The paper as a fully contended machine would build it: every time of a results directory flagged.
 
 A build on a busy machine flags some times (paper/timing_rule.py) and the paper then prints other words,
-a draft stamp and a list of what lost every time on page 1 (make_macros.py's ContendedNotice): pages
+a draft stamp and a list of what lost every time after the abstract (make_macros.py's ContendedNotice): pages
 whose layout the idle build never shows. `flag_every_time(src, dst)` copies `src` with every time flagged
 (each CSV's flag column or share of the cores others used, the (d, L) map's share, and Google
 Benchmark's medians with wall time twice CPU time), the worst case of

@@ -10,7 +10,7 @@ share of the cores other processes used while they ran (/proc/stat) in place of 
 
 `Ledger` counts, per study, the times taken and flagged, and records a study, figure or table that
 lost every time to flags (a contended machine): paper/make_macros.py states the counts, and a copy
-with such a study is stamped "draft: contended" with the list on its first page."""
+with such a study is stamped "draft: contended" with the list after its abstract."""
 import csv
 import os
 import re
