@@ -187,7 +187,7 @@ bool parse(int argc, char** argv, const po::options_description& desc, po::varia
   po::notify(vm);
   const double budget = vm["max-seconds"].as<double>();
   if (!(budget >= 0.0)) throw Error("--max-seconds must be a number >= 0");
-  set_deadline(budget, "stopped after --max-seconds " + fmt(budget) + " s of wall-clock time (the run's budget); no output written");
+  set_deadline(budget, "stopped after --max-seconds " + fmt(budget) + " s of wall-clock time (the run's budget)");
   return true;
 }
 

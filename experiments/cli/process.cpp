@@ -47,7 +47,11 @@ std::atomic<long> g_counter{0};
 std::atomic<bool> g_deadline{false};
 std::atomic<long long> g_deadline_ns{0};
 char g_deadline_message[512];
+/// The budget's message takes its tail when it is said: whether a journal keeps the finished work then.
+std::atomic<bool> g_deadline_tail{false};
 std::atomic<bool> g_journal_open{false};  ///< note_journal()
+constexpr char kJournalTail[] = "; what finished so far is in the journal, finish with --resume\n";
+constexpr char kNoOutputTail[] = "; no output written\n";
 
 long long monotonic_ns() {
   timespec ts{};
@@ -91,9 +95,8 @@ constexpr unsigned kInterruptGraceSeconds = 1;
 /// saying why (only async-signal-safe calls: the message is composed by hand, alarm() arms the timer).
 void arm_interrupt_grace(int sig) {
   static constexpr char kHead[] = "bodypoint: error: interrupted by signal ";
-  static constexpr char kJournal[] = "; the rows finished so far are in the journal, finish with --resume\n";
-  static constexpr char kNone[] = "; no output written\n";
-  const char* const kTail = g_journal_open.load() ? kJournal : kNone;
+  const char* const kTail = g_journal_open.load() ? kJournalTail : kNoOutputTail;
+  g_deadline_tail = false;
   std::size_t n = 0;
   for (const char* c = kHead; *c && n + 1 < sizeof g_deadline_message; ++c) g_deadline_message[n++] = *c;
   char digits[12];
@@ -129,7 +132,11 @@ void say_interrupted(int sig) {
 extern "C" void on_signal(int sig) {
   if (sig == SIGALRM && g_deadline.load() && monotonic_ns() >= g_deadline_ns.load()) {  // the budget: stop now, wherever the process is
     remove_open_outputs();
-    const ssize_t n = ::write(2, g_deadline_message, std::strlen(g_deadline_message));
+    ssize_t n = ::write(2, g_deadline_message, std::strlen(g_deadline_message));
+    if (g_deadline_tail) {  // the budget's line (the grace's has its own tail)
+      const char* tail = g_journal_open.load() ? kJournalTail : kNoOutputTail;
+      n = ::write(2, tail, std::strlen(tail));
+    }
     (void)n;
     ::_exit(2);
   }
@@ -396,7 +403,8 @@ int interrupted() { return g_signal.load(); }
 
 void set_deadline(double seconds, const std::string& what) {
   if (!(seconds > 0.0) || !std::isfinite(seconds) || seconds > 1e9) return;
-  std::snprintf(g_deadline_message, sizeof g_deadline_message, "bodypoint: error: %s\n", what.c_str());
+  std::snprintf(g_deadline_message, sizeof g_deadline_message, "bodypoint: error: %s", what.c_str());
+  g_deadline_tail = true;
   g_deadline_ns.store(monotonic_ns() + static_cast<long long>(seconds * 1e9) - 1'000'000);  // the timer's slack
   g_deadline.store(true);
   itimerval t{};
@@ -414,7 +422,9 @@ void CooperativeInterrupt::check() {
     g_deadline.store(false);
     const itimerval off{};
     ::setitimer(ITIMER_REAL, &off, nullptr);
-    throw Error("interrupted by signal " + std::to_string(sig) + "; no output written");
+    std::string tail = g_journal_open.load() ? kJournalTail : kNoOutputTail;
+    tail.pop_back();  // the newline
+    throw Error("interrupted by signal " + std::to_string(sig) + tail);
   }
 }
 

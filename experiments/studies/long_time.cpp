@@ -11,13 +11,21 @@
 #include "bodypoint/invariants.hpp"
 #include "bodypoint/io.hpp"
 #include "bodypoint/methods.hpp"
+#include "bodypoint/threads.hpp"
 #include "process.hpp"
+#include "rows_file.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <iostream>
+#include <iterator>
 #include <limits>
 #include <numbers>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -35,6 +43,9 @@ constexpr double kPeerTolerance = 1e-9;
 /// Output times per decade of periods, from kLongTimeFirstPeriods to 10^3 (quick) or 10^5 (or --periods).
 constexpr int kTimesPerDecade = 4;
 constexpr double kQuickPeriods = 1e3, kFullPeriods = 1e5;
+/// A run is journalled at the output times and at least every this many periods: the reference (lp-kl8 at
+/// 400 steps a period) takes some 6 s for them on this machine, what an interrupted sitting loses at most.
+constexpr double kChunkPeriods = 1e4;
 
 /// The orbit: a = 1 about A = 1 (m = 1, period 2 pi), e = 0.5, from its periapsis. The spinning bodies turn at
 /// w = (0.5, 0, 0.5) (B = 0.3): their energy, -0.25 and less, is the scale of its relative error.
@@ -134,69 +145,209 @@ Invariants invariants_of(const Body& b, const std::vector<Centre>& centres, cons
           centres.size() == 1 ? total_angular_momentum(b.p, s, centres.front().c) : Vec3::Zero()};
 }
 
-/// One method's rows, one per time reached, and its states there; `ref` (empty: this is the reference) the
-/// reference's states at the same times.
-std::vector<State> run_method(std::ostream& csv, const LongScene& ls, const LongMethod& lm, const std::vector<double>& times,
-                              const std::vector<State>& ref) {
+/// Where a method's run stands at one boundary: what its row needs, and all a resumed run continues from.
+struct Mark {
+  double t = 0.0;
+  State s;
+  long evals = 0;
+  double max_dE = 0.0;  ///< the largest relative energy error over every step so far
+  UnwrappedPhase phase;
+  Outcome outcome = Outcome::ok;
+};
+
+/// A journal record of a mark: hexadecimal floats, so that a resumed run goes on from the very bits.
+std::string encode(const Mark& m) {
+  std::string out;
+  char buf[40];
+  const auto put = [&](double x) {
+    std::snprintf(buf, sizeof buf, "%a ", x);
+    out += buf;
+  };
+  put(m.t);
+  for (const Vec3* v : {&m.s.R, &m.s.v, &m.s.w})
+    for (int i = 0; i < 3; ++i) put((*v)[i]);
+  put(m.max_dE);
+  put(m.phase.last);
+  out += std::to_string(m.evals) + " " + std::to_string(m.phase.turns) + " " + std::to_string(static_cast<int>(m.outcome));
+  return out;
+}
+
+Mark decode(const std::string& record, const std::string& journal) {
+  std::istringstream in(record);
+  std::vector<std::string> f{std::istream_iterator<std::string>(in), std::istream_iterator<std::string>()};
+  const auto bad = [&] { return Error("the journal '" + journal + "' holds a record that is not a long-time mark; delete it to start over"); };
+  if (f.size() != 15) throw bad();
+  std::vector<double> x;
+  for (std::size_t i = 0; i < 12; ++i) {
+    char* end = nullptr;
+    x.push_back(std::strtod(f[i].c_str(), &end));
+    if (end == f[i].c_str() || *end != '\0') throw bad();
+  }
+  Mark m;
+  m.t = x[0];
+  m.s.R = Vec3(x[1], x[2], x[3]);
+  m.s.v = Vec3(x[4], x[5], x[6]);
+  m.s.w = Vec3(x[7], x[8], x[9]);
+  m.max_dE = x[10];
+  m.phase.last = x[11];
+  try {
+    m.evals = std::stol(f[12]);
+    m.phase.turns = std::stol(f[13]);
+    const int o = std::stoi(f[14]);
+    if (o < 0 || o > static_cast<int>(Outcome::incomplete)) throw bad();
+    m.outcome = static_cast<Outcome>(o);
+  } catch (const std::logic_error&) {
+    throw bad();
+  }
+  return m;
+}
+
+/// The times a run stops at: the output times and, between them, every kChunkPeriods periods; after each
+/// the run's mark is journalled. The same for every method of a scene, whatever was resumed.
+std::vector<double> boundaries(const std::vector<double>& times, double period) {
+  std::vector<double> b = times;
+  const double last = times.back();
+  for (double k = 1.0; k * kChunkPeriods * period < last; k += 1.0) {
+    const double t = k * kChunkPeriods * period;
+    const bool near_output = std::any_of(times.begin(), times.end(), [&](double o) { return std::abs(o - t) <= 1e-9 * o; });
+    if (!near_output) b.push_back(t);
+  }
+  std::sort(b.begin(), b.end());
+  return b;
+}
+
+/// One run of the study: a method on a scene (the reference is lp-kl8).
+struct Pair {
+  std::size_t scene;
+  LongMethod method;
+};
+
+/// What the runs share: the scenes, every run's boundaries' marks, the journal that keeps them.
+struct LongRuns {
+  std::vector<LongScene> scenes;
+  std::vector<std::vector<double>> times, bounds;  ///< per scene
+  std::vector<Pair> pairs;
+  std::vector<std::vector<std::optional<Mark>>> marks;  ///< per pair, per boundary
+  std::size_t stride = 0;                               ///< journal index = pair * stride + boundary
+};
+
+/// Runs pair `p` from its last journalled mark to its last boundary (or its first outcome that is not ok),
+/// journalling every boundary's mark.
+void run_pair(LongRuns& runs, std::size_t p, RowJournal& journal) {
+  const LongScene& ls = runs.scenes[runs.pairs[p].scene];
+  const LongMethod& lm = runs.pairs[p].method;
+  const std::vector<double>& bounds = runs.bounds[runs.pairs[p].scene];
+  std::vector<std::optional<Mark>>& marks = runs.marks[p];
+  std::size_t k = 0;  // the first boundary not reached
+  while (k < bounds.size() && marks[k]) ++k;
+  if (k > 0 && marks[k - 1]->outcome != Outcome::ok) return;
   const Body& body = ls.scene.bodies.front();
-  const double step = lm.per_period > 0.0 ? ls.period / lm.per_period : kPeerTolerance;
-  const MethodInfo& m = method_or_throw(lm.name);
-  const Invariants start = invariants_of(body, ls.scene.centres, body.s0);
+  const double start_E = energy(body.p, ls.scene.centres, body.s0);
+  Mark now = k > 0 ? *marks[k - 1] : Mark{0.0, body.s0, 0, 0.0, {}, Outcome::ok};
   // The energy's error at every step, its largest so far: at the output times alone it is sampled at
   // whatever phase of the orbit they fall on (a bounded error then looks like a drift).
-  double max_dE = 0.0;
-  UnwrappedPhase phase;
   const SampleSink every_step = [&](const Sample& smp) {
-    max_dE = std::max(max_dE, std::abs(energy(body.p, ls.scene.centres, smp.s) - start.E) / std::abs(start.E));
-    if (ls.kepler) phase.add(smp.s);
+    now.max_dE = std::max(now.max_dE, std::abs(energy(body.p, ls.scene.centres, smp.s) - start_E) / std::abs(start_E));
+    if (ls.kepler) now.phase.add(smp.s);
   };
   Options options;
   options.sink = &every_step;
   options.max_energy_error = std::numeric_limits<double>::infinity();  // a drift is what this study shows
   options.estimate_error = false;
-  Stepper s(m, body, ls.scene.centres, step, options);
-  std::vector<State> states;
-  for (std::size_t i = 0; i < times.size(); ++i) {
-    const Outcome o = s.advance_to(times[i]);
-    states.push_back(s.state());
-    const Invariants now = invariants_of(body, ls.scene.centres, s.state());
+  Stepper s(method_or_throw(lm.name), body, ls.scene.centres, lm.per_period > 0.0 ? ls.period / lm.per_period : kPeerTolerance, options);
+  if (k > 0) s.set_state(now.s, now.t);
+  const long evals_before = now.evals;
+  for (; k < bounds.size(); ++k) {
+    CooperativeInterrupt::check();
+    now.outcome = s.advance_to(bounds[k]);
+    now.t = bounds[k];
+    now.s = s.state();
+    now.evals = evals_before + s.force_evals();
+    marks[k] = now;
+    journal.append(p * runs.stride + k, encode(now));
+    if (now.outcome != Outcome::ok) break;  // a flagged segment ends the method's rows (its outcome says why)
+  }
+}
+
+/// The CSV rows of pair `p`: one per output time reached, and its flagged segment's, if any.
+void write_rows(std::ostream& csv, const LongRuns& runs, std::size_t p, std::size_t ref) {
+  const LongScene& ls = runs.scenes[runs.pairs[p].scene];
+  const LongMethod& lm = runs.pairs[p].method;
+  const std::vector<double>& bounds = runs.bounds[runs.pairs[p].scene];
+  const std::vector<double>& times = runs.times[runs.pairs[p].scene];
+  const Body& body = ls.scene.bodies.front();
+  const Invariants start = invariants_of(body, ls.scene.centres, body.s0);
+  const double step = lm.per_period > 0.0 ? ls.period / lm.per_period : kPeerTolerance;
+  for (std::size_t k = 0; k < bounds.size(); ++k) {
+    const std::optional<Mark>& m = runs.marks[p][k];
+    if (!m || (m->outcome == Outcome::ok && !std::binary_search(times.begin(), times.end(), bounds[k]))) continue;
+    if (p == ref && m->outcome != Outcome::ok)
+      throw Error("the long-time study's reference (lp-kl8) did not reach t = " + fmt(bounds[k]));
+    const Invariants now = invariants_of(body, ls.scene.centres, m->s);
     CsvLine row;
-    row.text(ls.name).text(lm.name).text(std::string(step_name(m))).num(step).num(times[i]).num(times[i] / ls.period);
-    row.num(std::abs(now.E - start.E) / std::abs(start.E)).num(max_dE);
+    row.text(ls.name).text(lm.name).text(std::string(step_name(method_or_throw(lm.name)))).num(step).num(bounds[k]).num(bounds[k] / ls.period);
+    row.num(std::abs(now.E - start.E) / std::abs(start.E)).num(m->max_dE);
     row.num_if(start.K2sq > 0.0, std::abs(now.K2sq - start.K2sq) / start.K2sq);  // none without a spin
     row.num_if(ls.scene.centres.size() == 1, (now.K2Q - start.K2Q).norm());
-    row.num_if(!ref.empty(), ref.empty() ? 0.0 : bodypoint::state_distance(s.state(), ref[i]));
-    row.num_if(ls.kepler, phase.error(times[i]));
-    row.count(s.force_evals()).text(std::string(outcome_name(o)));
+    row.num_if(p != ref, p == ref ? 0.0 : bodypoint::state_distance(m->s, runs.marks[ref][k]->s));
+    row.num_if(ls.kepler, m->phase.error(bounds[k]));
+    row.count(m->evals).text(std::string(outcome_name(m->outcome)));
     csv << row.str() << '\n';
-    if (o != Outcome::ok) {  // a flagged segment ends the method's rows (its outcome says why)
-      if (ref.empty()) throw Error("the long-time study's reference (lp-kl8) did not reach t = " + fmt(times[i]));
-      break;
-    }
   }
-  return states;
+}
+
+LongRuns plan_runs(double periods) {
+  LongRuns runs;
+  runs.scenes = scenes();
+  for (std::size_t i = 0; i < runs.scenes.size(); ++i) {
+    runs.times.push_back(output_times(runs.scenes[i].period, periods));
+    runs.bounds.push_back(boundaries(runs.times.back(), runs.scenes[i].period));
+    runs.stride = std::max(runs.stride, runs.bounds.back().size());
+    runs.pairs.push_back({i, {"lp-kl8", kReferenceStepsPerPeriod}});
+    for (const LongMethod& lm : long_methods()) runs.pairs.push_back({i, lm});
+  }
+  runs.marks.assign(runs.pairs.size(), {});
+  for (std::size_t p = 0; p < runs.pairs.size(); ++p) runs.marks[p].resize(runs.bounds[runs.pairs[p].scene].size());
+  return runs;
+}
+
+/// Everything that decides the marks: a journal of another request is refused.
+std::string journal_key(const LongRuns& runs, double periods) {
+  std::string request = "long-time|" + fmt(periods) + "|" + fmt(kChunkPeriods) + "|" + fmt(kPeerTolerance);
+  for (const Pair& p : runs.pairs) request += "|" + runs.scenes[p.scene].name + ":" + p.method.name + ":" + fmt(p.method.per_period);
+  return sweep_key_of(git_revision(), "long-time scenes", request);
 }
 
 }  // namespace
 
-void write_long_time_study(const std::filesystem::path& dir, bool quick, double periods) {
-  if (periods == 0.0) periods = quick ? kQuickPeriods : kFullPeriods;
+void write_long_time_study(const std::filesystem::path& dir, const LongTimeRequest& request) {
+  const double periods = request.periods == 0.0 ? (request.quick ? kQuickPeriods : kFullPeriods) : request.periods;
   if (!std::isfinite(periods) || periods < kLongTimeFirstPeriods)
     throw Error("--periods must be a finite number >= " + fmt(kLongTimeFirstPeriods) + ", got " + fmt(periods));
-  AtomicFile f((dir / "long_time.csv").string());
+  const std::string path = (dir / "long_time.csv").string();
+  AtomicFile f(path);
+  LongRuns runs = plan_runs(periods);
+  const std::string header = "# bodypoint study --name long-time" + std::string(request.quick ? " --quick" : "") + " (" + fmt(periods) +
+      " periods): err = max(|dR|/|R|, |dv|/|v|) against lp-kl8 at " + fmt(kReferenceStepsPerPeriod) +
+      " steps per period (empty in its own rows); phase_err = |M - n t| of the Kepler ellipse, M unwrapped along the run "
+      "(kepler only); max_rel_dE the largest over every step up to t; abs_dK2Q with one centre only";
+  RowJournal journal(path + ".journal", journal_key(runs, periods), runs.pairs.size() * runs.stride, {header}, request.resume);
+  for (const auto& [index, record] : journal.done())
+    runs.marks[index / runs.stride].at(index % runs.stride) = decode(record, journal.path());
+  {
+    const CooperativeInterrupt stop_at_a_boundary;  // a signal stops every run at its next boundary
+    parallel_for(runs.pairs.size(), request.threads, [&](std::size_t p) { run_pair(runs, p, journal); });
+  }
   std::ostream& csv = f.stream();
   csv << "scene,method,step_name,step,t,periods,rel_dE,max_rel_dE,rel_dK2sq,abs_dK2Q,err,phase_err,force_evals,outcome\n"
-      << "# bodypoint study --name long-time" << (quick ? " --quick" : "") << " (" << fmt(periods) << " periods): err = max(|dR|/|R|, |dv|/|v|) against lp-kl8 at "
-      << kReferenceStepsPerPeriod << " steps per period (empty in its own rows); phase_err = |M - n t| of the "
-      << "Kepler ellipse, M unwrapped along the run (kepler only); max_rel_dE the largest over every step up to t; "
-      << "abs_dK2Q with one centre only\n";
-  for (const LongScene& ls : scenes()) {
-    const std::vector<double> times = output_times(ls.period, periods);
-    const std::vector<State> ref = run_method(csv, ls, {"lp-kl8", kReferenceStepsPerPeriod}, times, {});
-    for (const LongMethod& lm : long_methods()) run_method(csv, ls, lm, times, ref);
+      << header << "\n";
+  for (std::size_t p = 0, ref = 0; p < runs.pairs.size(); ++p) {
+    if (runs.pairs[p].method.name == "lp-kl8") ref = p;
+    write_rows(csv, runs, p, ref);
   }
   f.commit();
-  std::cerr << "wrote " << (dir / "long_time.csv").string() << "\n";
+  journal.remove();
+  std::cerr << "wrote " << path << "\n";
 }
 
 }  // namespace bodypoint::cli

@@ -362,7 +362,7 @@ void study_stress(const StudyContext& c) {
 
 void study_scattering(const StudyContext& c) { write_scattering_study(c.dir, c.quick, c.threads); }
 
-void study_long_time(const StudyContext& c) { write_long_time_study(c.dir, c.quick, c.periods); }
+void study_long_time(const StudyContext& c) { write_long_time_study(c.dir, {c.quick, c.periods, c.threads, c.resume}); }
 
 const std::vector<std::pair<std::string, void (*)(const StudyContext&)>>& recipes() {
   static const std::vector<std::pair<std::string, void (*)(const StudyContext&)>> r = {
@@ -388,11 +388,12 @@ int cmd_study(int argc, char** argv) {
        "(bound orbits over 10^5 periods: invariants and phase errors)")
       ("results", defaulted(&results), "folder for the CSVs (created if missing)")
       ("quick", po::bool_switch(&quick), "coarser grids, same recipes (under two minutes on 2 cores)")
-      ("threads", po::value(&threads)->default_value(0), "worker threads for the sweeps (0: all cores)")
-      ("resume", po::bool_switch(&c.resume), "finish the sweeps of an interrupted run from their journals (<csv>.journal)")
+      ("threads", po::value(&threads)->default_value(0), "worker threads for the sweeps and the long-time study's runs (0: all cores)")
+      ("resume", po::bool_switch(&c.resume), "finish the sweeps (and the long-time study) of an interrupted run from their journals (<csv>.journal)")
       ("no-simd", po::bool_switch(&c.no_simd), "sweeps run every trajectory alone, not in batches of vector lanes (same numbers, slower)")
       ("periods", po::value(&c.periods), "long-time: the span in periods of each orbit (default 10^5, --quick 10^3; "
-       "the reference lp-kl8 costs about 7 million force evaluations per 10^3 periods and scene)");
+       "the reference lp-kl8 costs about 7 million force evaluations per 10^3 periods and scene; 10^7 periods take "
+       "hours: run them in sittings with --max-seconds and --resume)");
   po::variables_map vm;
   if (!parse(argc, argv, desc, vm,
              "usage: bodypoint study [--name d|L|h|Kx|timing|evals|appendix|errata|orders|published|all|stress|dL-map|scattering|long-time] [--results DIR] [--quick]\n"

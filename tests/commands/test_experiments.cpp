@@ -349,6 +349,36 @@ TEST(Study, LongTimeSplittingsStayBoundedWhereThePeersDrift) {
   fs::remove_all(dir);
 }
 
+/// Issue #83 (10^7 periods in sittings): a long-time study stopped by its budget (or a signal) keeps every run's
+/// state at the boundaries it reached in its journal, and --resume goes on from there to the very same bits
+/// as a run in one sitting. The first sitting's budget stops it somewhere (it takes some 3 s of CPU; on a fast
+/// machine it may finish, on a busy one it may reach nothing): the resumed CSV is the same in every case.
+TEST(Study, LongTimeStudyResumedInAnotherSittingWritesTheSameRows) {
+  const fs::path once = test::temp_path("bp_long_time_once"), sittings = test::temp_path("bp_long_time_sittings");
+  for (const fs::path& d : {once, sittings}) fs::remove_all(d);
+  const Result whole = run_cli("study --quick --name long-time --threads 2 --results " + once.string());
+  ASSERT_EQ(whole.code, 0) << whole.err;
+  const Result first = run_cli("study --quick --name long-time --threads 1 --max-seconds 1 --results " + sittings.string());
+  if (first.code != 0) {
+    EXPECT_EQ(first.code, 2) << first.err;
+    EXPECT_NE(first.err.find("finish with --resume"), std::string::npos) << first.err;
+    ASSERT_TRUE(fs::exists(sittings / "long_time.csv.journal"));
+    const Result again = run_cli("study --quick --name long-time --results " + sittings.string());
+    EXPECT_NE(again.code, 0) << "a journal of an interrupted run is not overwritten without --resume";
+    const Result second = run_cli("study --quick --name long-time --threads 2 --resume --results " + sittings.string());
+    ASSERT_EQ(second.code, 0) << second.err;
+  }
+  EXPECT_FALSE(fs::exists(sittings / "long_time.csv.journal")) << "the journal goes once the CSV is written";
+  const auto text = [](const fs::path& p) {
+    std::ifstream f(p);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+  };
+  EXPECT_EQ(text(once / "long_time.csv"), text(sittings / "long_time.csv"));
+  for (const fs::path& d : {once, sittings}) fs::remove_all(d);
+}
+
 /// Issue #22: the material point's deflection agrees with Rutherford's to 1e-10 over b = 1e-3 .. 1e3.
 constexpr double kRutherfordRel = 1e-10;
 
