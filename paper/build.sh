@@ -104,7 +104,11 @@ q=()
 step study "$bin" study "${q[@]}" --resume --results "$results"
 step stress "$bin" study "${q[@]}" --name stress --results "$results"
 step scattering "$bin" study "${q[@]}" --name scattering --results "$results"
-step long-time "$bin" study "${q[@]}" --name long-time --results "$results"
+# Bound orbits over 10^7 periods (quick: 10^3): some 8 CPU hours, journalled every 10^4 periods, so that an
+# interrupted build goes on from where each run stopped (--resume).
+long_time=(--periods 1e7)
+[ $mode = quick ] && long_time=()
+step long-time "$bin" study "${q[@]}" --resume --name long-time "${long_time[@]}" --results "$results"
 # The (d, L) stability map (thesis resolution in the full build), timed: its wall time is a number of
 # the paper.
 # One run (a study of minutes is not repeated), so its time is judged by the share of the cores other
