@@ -16,6 +16,7 @@
 #include "rows_file.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -25,7 +26,6 @@
 #include <numbers>
 #include <optional>
 #include <sstream>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -190,15 +190,17 @@ Mark decode(const std::string& record, const std::string& journal) {
   m.s.w = Vec3(x[7], x[8], x[9]);
   m.max_dE = x[10];
   m.phase.last = x[11];
-  try {
-    m.evals = std::stol(f[12]);
-    m.phase.turns = std::stol(f[13]);
-    const int o = std::stoi(f[14]);
-    if (o < 0 || o > static_cast<int>(Outcome::incomplete)) throw bad();
-    m.outcome = static_cast<Outcome>(o);
-  } catch (const std::logic_error&) {
-    throw bad();
+  long n[3];
+  for (std::size_t i = 0; i < 3; ++i) {
+    char* end = nullptr;
+    errno = 0;
+    n[i] = std::strtol(f[12 + i].c_str(), &end, 10);
+    if (end == f[12 + i].c_str() || *end != '\0' || errno == ERANGE) throw bad();
   }
+  if (n[2] < 0 || n[2] > static_cast<long>(Outcome::incomplete)) throw bad();
+  m.evals = n[0];
+  m.phase.turns = n[1];
+  m.outcome = static_cast<Outcome>(n[2]);
   return m;
 }
 
