@@ -74,6 +74,27 @@ struct KeplerCoefficients {
   T f_minus_1, g, fd, gd_minus_1;
 };
 
+/// The coefficients at the universal variable s of a flow with beta = 2 mu/r0 - v0.v0.
+template <class T>
+KeplerCoefficients<T> kepler_coefficients_at(T mu, T r0, T sigma0, T beta, T s) {
+  // In KeplerWide<T>: taken in double, the Stumpff functions' roundings are the same function of the orbit's
+  // phase every period and the energy of a repeated flow drifted one way (kep-y4's substeps on e = 0.5, 100
+  // steps per period, 10^6 steps, 8 starts: |dE/E| 5.5e-13 on average, linear in the steps); in long double
+  // and rounded once: 6.3e-14, the random walk of Brouwer's law, for 1 % more time (0.90 against 0.91 s CPU
+  // for 9 x 10^5 flows, medians of 5). The search for s stays in T: any s gives a flow (f gd - fd g = 1).
+  using W = KeplerWide<T>;
+  W c[4];
+  const W S = s;
+  stumpff<W>(W(beta) * S * S, c);
+  const W G1 = S * c[1], G2 = S * S * c[2];
+  const W r = W(r0) * c[0] + W(sigma0) * G1 + W(mu) * G2;
+  // g from s itself (t(s) - mu G3), not t - mu G3: s solves t(s) = t to a few roundings, and g taken from
+  // t with f, fd, gd from s broke f gd - fd g = 1 by that much each step, one way (kep-y4, h = 1 on a bound
+  // orbit, 300 steps: the energy drifted 1.0e-14, the state 2.0e-11 off the Kepler orbit at t = 300; now
+  // +-3e-15 either way, 1.7e-12).
+  return {T(-W(mu) * G2 / W(r0)), T(W(r0) * G1 + W(sigma0) * G2), T(-W(mu) * G1 / (W(r0) * r)), T(-W(mu) * G2 / r)};
+}
+
 /// Flow over t > 0 from a state at distance r0 = |X0| with sigma0 = X0.v0 and v0sq = v0.v0.
 template <class T>
 KeplerCoefficients<T> kepler_flow(T mu, T r0, T sigma0, T v0sq, T t) {
@@ -120,23 +141,7 @@ KeplerCoefficients<T> kepler_flow(T mu, T r0, T sigma0, T v0sq, T t) {
     }
     s = next;
   }
-  // The coefficients at the s found, in KeplerWide<T>: taken in double, the Stumpff functions' roundings are
-  // the same function of the orbit's phase every period and the energy of a repeated flow drifted one way
-  // (kep-y4's substeps on e = 0.5, 100 steps per period, 10^6 steps, 8 starts: |dE/E| 5.5e-13 on average,
-  // linear in the steps); in long double and rounded once: 6.3e-14, the random walk of Brouwer's law, for 1 %
-  // more time (0.90 against 0.91 s CPU for 9 x 10^5 flows, medians of 5). The search for s stays in T: any s
-  // gives a flow (f gd - fd g = 1).
-  using W = KeplerWide<T>;
-  W c[4];
-  const W S = s;
-  stumpff<W>(W(beta) * S * S, c);
-  const W G1 = S * c[1], G2 = S * S * c[2];
-  const W r = W(r0) * c[0] + W(sigma0) * G1 + W(mu) * G2;
-  // g from s itself (t(s) - mu G3), not t - mu G3: s solves t(s) = t to a few roundings, and g taken from
-  // t with f, fd, gd from s broke f gd - fd g = 1 by that much each step, one way (kep-y4, h = 1 on a bound
-  // orbit, 300 steps: the energy drifted 1.0e-14, the state 2.0e-11 off the Kepler orbit at t = 300; now
-  // +-3e-15 either way, 1.7e-12).
-  return {T(-W(mu) * G2 / W(r0)), T(W(r0) * G1 + W(sigma0) * G2), T(-W(mu) * G1 / (W(r0) * r)), T(-W(mu) * G2 / r)};
+  return kepler_coefficients_at(mu, r0, sigma0, beta, s);
 }
 
 }  // namespace bodypoint
