@@ -104,7 +104,7 @@ q=()
 step study "$bin" study "${q[@]}" --resume --results "$results"
 step stress "$bin" study "${q[@]}" --name stress --results "$results"
 step scattering "$bin" study "${q[@]}" --name scattering --results "$results"
-# Bound orbits over 10^7 periods (quick: 10^3): some 8 CPU hours, journalled every 10^4 periods, so that an
+# Bound orbits over 10^7 periods (quick: 10^3): some 6 CPU hours, journalled every 10^4 periods, so that an
 # interrupted build goes on from where each run stopped (--resume).
 long_time=(--periods 1e7)
 [ $mode = quick ] && long_time=()

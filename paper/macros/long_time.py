@@ -17,6 +17,14 @@ ROUNDING_LEVEL = 1e-10
 SPLITTINGS = ("lp-y4", "ttl-y4", "kep-y4")
 
 
+# Brouwer's walk makes the energy's round-off grow like t^(1/2); a fitted exponent above this over a decade
+# is read as a drift (a linear one fits 1.0; the reference lp-kl8's walk fits 0.44-0.56 per decade).
+BROUWER_ENERGY_EXP_MAX = 0.75
+
+
+UNIT_ROUNDOFF = 2.0 ** -53  # half an ulp of 1 in double precision
+
+
 DAGGER = "^\\dagger"  # a scene the method diverged on
 
 
@@ -113,3 +121,31 @@ def long_time(res, out, M):
         M.add(f"Long{word}PhaseEnd", sci(last("kepler", m, "phase_err")))
     M.add("LongKepEnergyEnd", sci(last("kepler", "kep-y4", "max_rel_dE")))
     M.add("LongTtlKeplerEnergyEnd", sci(last("kepler", "ttl-y4", "max_rel_dE")))
+    M.add("LongKepVerdict", kepler_split_verdict(rows, periods), math_mode=False)
+
+
+def kepler_split_verdict(rows, periods):
+    """What kep-y4's round-off on the ellipse follows: Brouwer's walk, or a drift in the run's last decade
+    (a bias per step that the walk hides over shorter spans: seen from 10^5 to 10^6 periods)."""
+    xs, es = long_time_series_of(rows, "kep-y4", "max_rel_dE")
+    _, ps = long_time_series_of(rows, "kep-y4", "phase_err")
+    decade = [i for i, x in enumerate(xs) if x >= periods / 10.0]
+    if len(decade) < 3:
+        return ", Brouwer's law as well"
+    e_last = slope([xs[i] for i in decade], [es[i] for i in decade])
+    p_last = slope([xs[i] for i in decade], [ps[i] for i in decade])
+    if e_last <= BROUWER_ENERGY_EXP_MAX:
+        return ", Brouwer's law as well"
+    first = next(r for r in rows if r["scene"] == "kepler" and r["method"] == "kep-y4")
+    steps = (xs[decade[-1]] - xs[decade[0]]) * 2 * math.pi / num(first["step"])
+    bias = (es[decade[-1]] - es[decade[0]]) / steps
+    return (f"; over the last decade, from {power_of_ten(periods / 10.0)} periods on, the exponents are "
+            f"{e_last:.2f} and {p_last:.2f}: a bias of ${sci(bias)}$ per step in the relative energy, "
+            f"${sci(bias / UNIT_ROUNDOFF)}$ times the unit roundoff, that the walk hides over shorter spans")
+
+
+def long_time_series_of(rows, method, column):
+    """The ellipse's (periods, value) for one method over its rows that ended ok."""
+    rs = [r for r in rows if r["scene"] == "kepler" and r["method"] == method and r["outcome"] == "ok"
+          and num(r[column]) > 0]
+    return [num(r["periods"]) for r in rs], [num(r[column]) for r in rs]
