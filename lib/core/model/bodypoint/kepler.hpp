@@ -95,9 +95,10 @@ KeplerCoefficients<T> kepler_coefficients_at(T mu, T r0, T sigma0, T beta, T s) 
   return {T(-W(mu) * G2 / W(r0)), T(W(r0) * G1 + W(sigma0) * G2), T(-W(mu) * G1 / (W(r0) * r)), T(-W(mu) * G2 / r)};
 }
 
-/// Flow over t > 0 from a state at distance r0 = |X0| with sigma0 = X0.v0 and v0sq = v0.v0.
+/// The universal variable s of a flow over t > 0 from a state at distance r0 = |X0| with sigma0 = X0.v0 and
+/// v0sq = v0.v0: t(s) = t to a few roundings.
 template <class T>
-KeplerCoefficients<T> kepler_flow(T mu, T r0, T sigma0, T v0sq, T t) {
+T kepler_universal_variable(T mu, T r0, T sigma0, T v0sq, T t) {
   const T beta = T(2) * mu / r0 - v0sq;  // -2 x energy per unit mass
   T g[4];
   auto G = [&](T s) {
@@ -141,7 +142,25 @@ KeplerCoefficients<T> kepler_flow(T mu, T r0, T sigma0, T v0sq, T t) {
     }
     s = next;
   }
-  return kepler_coefficients_at(mu, r0, sigma0, beta, s);
+  return s;
+}
+
+/// Flow over t > 0 from a state at distance r0 = |X0| with sigma0 = X0.v0 and v0sq = v0.v0.
+template <class T>
+KeplerCoefficients<T> kepler_flow(T mu, T r0, T sigma0, T v0sq, T t) {
+  const T s = kepler_universal_variable(mu, r0, sigma0, v0sq, t);
+  return kepler_coefficients_at(mu, r0, sigma0, T(2) * mu / r0 - v0sq, s);
+}
+
+/// The same flow of a double state whose r0, sigma0 and v0sq were taken in KeplerWide<double> (from a state
+/// held as a compensated pair, kepler_split.hpp): s is searched in double, and the coefficients, taken at s
+/// from the wide values, are returned wide, so that the caller forms the increments there and rounds them once.
+/// Any s gives a flow; the wide values make it the flow of the state the pair holds, not of its rounding.
+inline KeplerCoefficients<KeplerWide<double>> kepler_flow_wide(double mu, KeplerWide<double> r0, KeplerWide<double> sigma0,
+                                                               KeplerWide<double> v0sq, double t) {
+  using W = KeplerWide<double>;
+  const double s = kepler_universal_variable<double>(mu, double(r0), double(sigma0), double(v0sq), t);
+  return kepler_coefficients_at<W>(W(mu), r0, sigma0, W(2) * W(mu) / r0 - v0sq, W(s));
 }
 
 }  // namespace bodypoint
