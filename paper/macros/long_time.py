@@ -1,6 +1,5 @@
 """Section 'Long-time behaviour': invariants and phase error over many periods."""
 
-import math
 import os
 
 from macros.common import count, finite, num, power_of_ten, read_csv, sci, slope, tt
@@ -67,7 +66,7 @@ def long_time_table(rows, out, methods):
             if first["step_name"] == "tol":
                 step = f"tol {power_of_ten(num(first['step']))}"
             else:
-                step = f"{first['step_name']} $= P/{round(2 * math.pi / num(first['step']))}$"
+                step = f"{first['step_name']} $= P/{round(period_of(first) / num(first['step']))}$"
             # A scene the method diverged on reads its value at the last time it reached, marked.
             ended = {r["scene"] for r in rows if r["method"] == m and r["outcome"] != "ok"}
             energy = [f"${sci(last(sc, m, 'max_rel_dE'))}{DAGGER if sc in ended else ''}$" for sc in LONG_SCENES]
@@ -92,9 +91,9 @@ def long_time(res, out, M):
     M.add("LongPeriods", power_of_ten(periods).strip("$"))
     M.add("LongFitFrom", sci(LONG_FIT_FROM))
     first = next(r for r in rows if r["scene"] == "kepler" and r["method"] == "lp-y4")  # its period is 2 pi
-    M.add("LongStepsPerPeriod", count(round(2 * math.pi / num(first["step"]))))
+    M.add("LongStepsPerPeriod", count(round(period_of(first) / num(first["step"]))))
     ref = next(r for r in rows if r["scene"] == "kepler" and r["method"] == "lp-kl8")
-    M.add("LongRefStepsPerPeriod", count(round(2 * math.pi / num(ref["step"]))))
+    M.add("LongRefStepsPerPeriod", count(round(period_of(ref) / num(ref["step"]))))
     found = long_time_table(rows, out, methods)
     gone = {}
     for r in rows:
@@ -137,11 +136,16 @@ def kepler_split_verdict(rows, periods):
     if e_last <= BROUWER_ENERGY_EXP_MAX:
         return ", Brouwer's law as well"
     first = next(r for r in rows if r["scene"] == "kepler" and r["method"] == "kep-y4")
-    steps = (xs[decade[-1]] - xs[decade[0]]) * 2 * math.pi / num(first["step"])
+    steps = (xs[decade[-1]] - xs[decade[0]]) * period_of(first) / num(first["step"])
     bias = (es[decade[-1]] - es[decade[0]]) / steps
     return (f"; over the last decade, from {power_of_ten(periods / 10.0)} periods on, the exponents are "
             f"{e_last:.2f} and {p_last:.2f}: a bias of ${sci(bias)}$ per step in the relative energy, "
             f"${sci(bias / UNIT_ROUNDOFF)}$ times the unit roundoff, that the walk hides over shorter spans")
+
+
+def period_of(row):
+    """The orbit's period of a row, from its time and its number of periods."""
+    return num(row["t"]) / num(row["periods"])
 
 
 def long_time_series_of(rows, method, column):
