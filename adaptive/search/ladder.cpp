@@ -15,9 +15,9 @@
 //    at h* and its companion at kCompanionRatio h* (half the cost of the answer). Otherwise the answer at
 //    h* joins the ladder, whose finest run is its companion: one run. After the first such run the pilot's
 //    coarse run is delivered where the two finer runs bound its error within TOL (pilot_answer).
-// 3. A trusted estimate at most kAccept tol delivers the answer (below kProbeBelowTol with the round-off
-//    probe's floor added, rounding.cpp), verified where asked by a companion at h*/kVerifyRatio; otherwise
-//    back to 2.
+// 3. A trusted estimate at most kAccept tol delivers the answer (with the round-off probe's floor added,
+//    rounding.cpp, below kProbeBelowTol or after the ladder's estimates stalled among runs closer than
+//    kStallBelow), verified where asked by a companion at h*/kVerifyRatio; otherwise back to 2.
 // Differences that stop shrinking far below 1 are round-off: the search reports the floor it met (what the
 // finest runs still differ by). Each constant's measurement: docs/measurements.md, "Tuned constants".
 #include "search.hpp"
@@ -212,9 +212,7 @@ Level Search::ladder() {
       planned = true;  // far below its target and not confirmed by a coarser run: a coarser planned pair
       continue;
     }
-    if (d <= kRoundOff && estimate_ > kAccept * tol_)
-      throw Error("tol " + fmt_tol() + " is below the round-off floor of " + std::string(m_.name) +
-                  " on this scene (estimate " + short_number(estimate_) + ")");
+    refuse_below_round_off(d);
     if (deliverable(rungs.back(), h_c, smooth(rungs, expected) || d <= kRoundOff)) {
       if (verified(rungs, h_c)) return std::move(rungs.back());
       verified_finer = true;  // its companion joined the ladder
@@ -227,6 +225,8 @@ Level Search::ladder() {
       best_bound = estimate_;
       stalled = 0;
     } else if (++stalled < (d > kStallBelow ? kMaxFarStalls : kMaxStalls)) {
+      // A stall among runs closer than kStallBelow may be the round-off's: the answer is probed (deliverable()).
+      rounding_suspected_ = rounding_suspected_ || d <= kStallBelow;
       continue;
     } else if (d <= tol_) {
       // The finest runs differ by less than tol but their estimates are not trusted (not smooth in h): what
@@ -245,6 +245,14 @@ Level Search::ladder() {
   }
   throw Error("tol " + fmt_tol() + ": " + std::string(m_.name) + " did not reach it in " +
               std::to_string(kMaxRefinements) + " refinements");
+}
+
+/// Runs `d` apart at the round-off level (kRoundOff) whose estimate is still above what may be delivered: the
+/// TOL is below the method's round-off floor on this scene.
+void Search::refuse_below_round_off(double d) const {
+  if (d <= kRoundOff && estimate_ > kAccept * tol_)
+    throw Error("tol " + fmt_tol() + " is below the round-off floor of " + std::string(m_.name) +
+                " on this scene (estimate " + short_number(estimate_) + ")");
 }
 
 /// Whether the newest estimate is trusted: the error behaves like C h^p there. The three last runs of the
@@ -284,11 +292,15 @@ double Search::refine(std::vector<Level>& rungs, double& h_c) {
 }
 
 /// Whether the newest run `l` may be delivered: its estimate (and the round-off floor measured so far) within
-/// TOL, and the estimate `trusted`. Below kProbeBelowTol the round-off is probed on `l` itself and added to
-/// the estimate; round-off alone above TOL throws.
+/// TOL, and the estimate `trusted`. Below kProbeBelowTol, or where the ladder's estimates stalled at runs
+/// closer than kStallBelow (rounding_suspected_), the round-off is probed on `l` itself and added to the
+/// estimate; round-off alone above TOL throws. Unprobed, a stalled ladder's last triple can show the order by
+/// chance: table 3.1's pass from L = 3200 (b = 3, arrival phase 1) to t = 906 at TOL 1e-10, logh-kl6's runs
+/// at ds = 0.0106 .. 0.0054 differed by 1.5e-11, 9.6e-11, 2.4e-10, 5.7e-11, and the last was delivered
+/// 1.43e-10 off with an estimate of 2.0e-11; probed, runs that differ only in rounding differ by 9.3e-11.
 bool Search::deliverable(const Level& l, double h_c, bool trusted) {
   if (!(estimate_ + std::max(floor_, 0.0) <= kAccept * tol_ && trusted)) return false;
-  if (tol_ >= kProbeBelowTol) return true;
+  if (tol_ >= kProbeBelowTol && !rounding_suspected_) return true;
   // Measured on the run that may be delivered: a floor measured on another run is another draw of the
   // round-off (reused from a coarser run, 2 of 256 scenes at tol 1e-12 missed it).
   floor_ = rounding_floor(l, h_c);

@@ -108,6 +108,7 @@ class Search {
   Level ladder();
   double refine(std::vector<Level>& rungs, double& h_c);
   [[nodiscard]] bool smooth(const std::vector<Level>& rungs, double expected) const;
+  void refuse_below_round_off(double d) const;
   bool deliverable(const Level& l, double h_c, bool trusted);
   bool verified(std::vector<Level>& rungs, double h_c);
   bool verified_at(std::vector<Level>& rungs, double h_c, double current);
@@ -135,6 +136,7 @@ class Search {
   bool verify_;  ///< a run about to be delivered is checked against a companion at a finer step (ladder.cpp)
   double estimate_ = 0.0, last_estimate_ = std::numeric_limits<double>::quiet_NaN();
   double floor_ = -1.0;  ///< the round-off floor last measured (below kProbeBelowTol), -1 before
+  bool rounding_suspected_ = false;  ///< the ladder's estimates stalled at runs closer than kStallBelow
   double spent_evals_ = 0.0, total_wall_ = 0.0;
   long total_evals_ = 0;
   int runs_ = 0;

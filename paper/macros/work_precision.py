@@ -243,11 +243,12 @@ def branch_outliers(rows, M):
         m = re.search(r"differ by ([0-9.e+-]+)", r.get("reason", ""))
         if m:
             level[r["scene"]] = max(level.get(r["scene"], 0.0), float(m.group(1)))
-    parts = []
+    parts, low = [], 0
     for r in rows:
         if r["outcome"] != "ok" or not r["err"] or num(r["err"]) <= 1e-13 or num(r["err_estimate"]) <= 0:
             continue
         if num(r["err"]) / num(r["err_estimate"]) > 3:
+            low += 1
             where = (f"where runs that differ only in rounding differ by ${sci(level[r['scene']])}$"
                      if r["scene"] in level else "where the scene's rounding level was not measured")
             parts.append(f"{tt(r['method'])} at TOL {power_of_ten(num(r['tol']))} ({r['scene']}) erred "
@@ -261,6 +262,15 @@ def branch_outliers(rows, M):
                      + (f", against rounding levels of ${sci(min(level.values()))}$ to ${sci(max(level.values()))}$ "
                         "measured on these scenes" if level else ""))
     M.add("BranchOutliersText", "; ".join(parts) if parts else "no estimate is more than 3 times off", math_mode=False)
+    if low == 1:
+        text = "; the low one is a step search's Richardson estimate below the rounding level the same scene shows"
+    elif low:
+        text = "; the low ones are step searches' Richardson estimates below the rounding level the same scene shows"
+    else:
+        text = ("; none is low: a step search whose estimates stop falling where its runs differ by less than "
+                "$10^{-8}$ measures its answer's rounding (runs that differ only in rounding) and adds it to its "
+                "estimate before delivering it, at any TOL, as it does below $10^{-10}$")
+    M.add("BranchLowText", text + (", where Richardson does not hold" if low else ""), math_mode=False)
 
 
 # The far pass's error is smooth in the step below this spin angle per step (radians): the largest

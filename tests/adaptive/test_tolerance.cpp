@@ -277,6 +277,27 @@ TEST(Tolerance, AVerifiedAnswerOnARoundedPassIsWithinTolOrRefused) {
   }
 }
 
+// A ladder whose estimates stop falling where its runs differ by less than the far-field regime's differences
+// (search/ladder.cpp, kStallBelow) may be comparing round-off: its answer is probed for it at any TOL. On this
+// far pass (estimate_grid.py --branches, "lp far field") lp-kl6 at 1e-10 was delivered 2.5e-13 off with an
+// estimate of 1.3e-14, its last triple showing the order by chance.
+TEST(Tolerance, AStalledLadderProbesItsAnswersRoundingAtAnyTol) {
+  SceneParams sp;
+  sp.B = 0.9;
+  sp.start.d = 300.0;
+  sp.start.L = 1000.0;
+  const Scene s = thesis_scene(sp);
+  constexpr double kEnd = 80.0, kTol = 1e-10;
+  const Result r = integrate(s, "auto", Accuracy{kTol, kEnd});  // as `simulate --tol` runs it
+  ASSERT_EQ(r.outcome, Outcome::ok) << r.reason;
+  const BodyResult& br = r.bodies.front();
+  ASSERT_TRUE(br.accuracy.has_value());
+  const double err = bodypoint::state_distance(br.run.final, reference_state(s.bodies.front(), s.centres, kEnd, 1e-18L));
+  ASSERT_GT(err, kComparableError) << "the pass no longer tests the estimate";
+  EXPECT_LE(err, kTol);
+  EXPECT_GE(br.accuracy->err_estimate, err / kEstimateFactor) << br.method->name;
+}
+
 TEST(Tolerance, ADeliveredRunTooLongToKeepIsMadeAgainForItsSamples) {
   // A run that may be delivered keeps its samples for the caller's sink up to 2^20 of them (adaptive/
   // search/runs.cpp); a scattering run under events at tol 1e-10 kept every step of its finest rungs and was

@@ -24,7 +24,8 @@ inline constexpr double kTargetShare = 0.3;
 /// Below this tolerance a run about to be delivered is repeated kProbeRuns times: with its roundings
 /// changed (all but one), and once from its start moved by a rounding; what they differ by is added to the estimate
 /// (adaptive/search/rounding.cpp): an encounter amplifies round-off, which Richardson's estimate cannot tell from
-/// truncation. The search then costs that many delivered runs more.
+/// truncation. The search then costs that many delivered runs more. Above it a ladder whose estimates stalled
+/// among runs that differ by round-off's amounts is probed too (search/ladder.cpp, deliverable()).
 inline constexpr double kProbeBelowTol = 1e-10;
 inline constexpr int kProbeRuns = 3;
 /// The rounding probe's relative move of the starting state (R scaled by 1 + kStartShift, v by 1 -
