@@ -109,6 +109,7 @@ class Search {
   double refine(std::vector<Level>& rungs, double& h_c);
   [[nodiscard]] bool smooth(const std::vector<Level>& rungs, double expected) const;
   void refuse_below_round_off(double d) const;
+  bool trusted(std::vector<Level>& rungs, double h_c, double expected, double d, bool from_plan);
   bool deliverable(const Level& l, double h_c, bool trusted);
   bool verified(std::vector<Level>& rungs, double h_c);
   bool verified_at(std::vector<Level>& rungs, double h_c, double current);
