@@ -277,6 +277,19 @@ TEST(Tolerance, AVerifiedAnswerOnARoundedPassIsWithinTolOrRefused) {
   }
 }
 
+/// auto's answer to `tol` as `simulate --tol` runs it: its error against the long-double reference, its estimate.
+struct AutoAnswer {
+  double err, estimate;
+  std::string method;
+};
+AutoAnswer auto_answer(const Scene& s, double tol, double t_end) {
+  const Result r = integrate(s, "auto", Accuracy{tol, t_end});
+  if (r.outcome != Outcome::ok || !r.bodies.front().accuracy) throw Error("auto did not answer: " + r.reason);
+  const BodyResult& br = r.bodies.front();
+  return {bodypoint::state_distance(br.run.final, reference_state(s.bodies.front(), s.centres, t_end, 1e-18L)),
+          br.accuracy->err_estimate, std::string(br.method->name)};
+}
+
 // A ladder whose estimates stop falling where its runs differ by less than the far-field regime's differences
 // (search/ladder.cpp, kStallBelow) may be comparing round-off: its answer is probed for it at any TOL. On this
 // far pass (estimate_grid.py --branches, "lp far field") lp-kl6 at 1e-10 was delivered 2.5e-13 off with an
@@ -286,16 +299,11 @@ TEST(Tolerance, AStalledLadderProbesItsAnswersRoundingAtAnyTol) {
   sp.B = 0.9;
   sp.start.d = 300.0;
   sp.start.L = 1000.0;
-  const Scene s = thesis_scene(sp);
-  constexpr double kEnd = 80.0, kTol = 1e-10;
-  const Result r = integrate(s, "auto", Accuracy{kTol, kEnd});  // as `simulate --tol` runs it
-  ASSERT_EQ(r.outcome, Outcome::ok) << r.reason;
-  const BodyResult& br = r.bodies.front();
-  ASSERT_TRUE(br.accuracy.has_value());
-  const double err = bodypoint::state_distance(br.run.final, reference_state(s.bodies.front(), s.centres, kEnd, 1e-18L));
-  ASSERT_GT(err, kComparableError) << "the pass no longer tests the estimate";
-  EXPECT_LE(err, kTol);
-  EXPECT_GE(br.accuracy->err_estimate, err / kEstimateFactor) << br.method->name;
+  constexpr double kTol = 1e-10;
+  const AutoAnswer a = auto_answer(thesis_scene(sp), kTol, 80.0);
+  ASSERT_GT(a.err, kComparableError) << "the pass no longer tests the estimate";
+  EXPECT_LE(a.err, kTol);
+  EXPECT_GE(a.estimate, a.err / kEstimateFactor) << a.method;
 }
 
 // A new ladder's pair reading far below what the coarser runs predicted for it is judged by a third run
@@ -307,17 +315,12 @@ TEST(Tolerance, APairFarBelowItsPredictionIsJudgedByAThirdRun) {
   sp.start.d = 8.0;
   sp.start.Kz = 5.0;
   sp.start.Kx = -1.0;
-  const Scene s = thesis_scene(sp);
-  constexpr double kEnd = 80.0, kTol = 1e-7;
-  const Result r = integrate(s, "auto", Accuracy{kTol, kEnd});
-  ASSERT_EQ(r.outcome, Outcome::ok) << r.reason;
-  const BodyResult& br = r.bodies.front();
-  ASSERT_TRUE(br.accuracy.has_value());
-  const double err = bodypoint::state_distance(br.run.final, reference_state(s.bodies.front(), s.centres, kEnd, 1e-18L));
-  ASSERT_GT(err, kComparableError);
-  EXPECT_LE(err, kTol);
-  EXPECT_GE(br.accuracy->err_estimate, err / kEstimateFactor) << br.method->name;
-  EXPECT_LE(br.accuracy->err_estimate, err * kEstimateFactor) << br.method->name;
+  constexpr double kTol = 1e-7;
+  const AutoAnswer a = auto_answer(thesis_scene(sp), kTol, 80.0);
+  ASSERT_GT(a.err, kComparableError);
+  EXPECT_LE(a.err, kTol);
+  EXPECT_GE(a.estimate, a.err / kEstimateFactor) << a.method;
+  EXPECT_LE(a.estimate, a.err * kEstimateFactor) << a.method;
 }
 
 TEST(Tolerance, ADeliveredRunTooLongToKeepIsMadeAgainForItsSamples) {
