@@ -313,8 +313,8 @@ double Search::refine(std::vector<Level>& rungs, double& h_c) {
 /// closer than kStallBelow (rounding_suspected_), the round-off is probed on `l` itself and added to the
 /// estimate; round-off alone above TOL throws. Unprobed, a stalled ladder's last triple can show the order by
 /// chance: table 3.1's pass from L = 3200 (b = 3, arrival phase 1) to t = 906 at TOL 1e-10, logh-kl6's runs
-/// at ds = 0.0106 .. 0.0054 differed by 1.5e-11, 9.6e-11, 2.4e-10, 5.7e-11, and the last was delivered
-/// 1.43e-10 off with an estimate of 2.0e-11; probed, runs that differ only in rounding differ by 9.3e-11.
+/// at ds = 0.0134 .. 0.0054 differed by 1.5e-11, 9.6e-11, 2.4e-10, 5.7e-11, and the last was delivered
+/// 1.43e-10 off with an estimate of 2.0e-11; probed, runs that differ only in rounding differ by 2.9e-10.
 bool Search::deliverable(const Level& l, double h_c, bool trusted) {
   if (!(estimate_ + std::max(floor_, 0.0) <= kAccept * tol_ && trusted)) return false;
   if (tol_ >= kProbeBelowTol && !rounding_suspected_) return true;

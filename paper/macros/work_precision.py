@@ -262,15 +262,16 @@ def branch_outliers(rows, M):
                      + (f", against rounding levels of ${sci(min(level.values()))}$ to ${sci(max(level.values()))}$ "
                         "measured on these scenes" if level else ""))
     M.add("BranchOutliersText", "; ".join(parts) if parts else "no estimate is more than 3 times off", math_mode=False)
+    below = "below the rounding level the same scene shows, where Richardson does not hold"
     if low == 1:
-        text = "; the low one is a step search's Richardson estimate below the rounding level the same scene shows"
+        text = f"; the low one is a step search's Richardson estimate {below}"
     elif low:
-        text = "; the low ones are step searches' Richardson estimates below the rounding level the same scene shows"
+        text = f"; the low ones are step searches' Richardson estimates {below}"
     else:
         text = ("; none is low: a step search whose estimates stop falling where its runs differ by less than "
                 "$10^{-8}$ measures its answer's rounding (runs that differ only in rounding) and adds it to its "
                 "estimate before delivering it, at any TOL, as it does below $10^{-10}$")
-    M.add("BranchLowText", text + (", where Richardson does not hold" if low else ""), math_mode=False)
+    M.add("BranchLowText", text, math_mode=False)
 
 
 # The far pass's error is smooth in the step below this spin angle per step (radians): the largest
