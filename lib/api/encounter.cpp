@@ -250,11 +250,12 @@ EncounterResult encounter_twice_as_far(const Scene& far, double tol, const Optio
   const double span = encounter_span(body, far.centres);
   for (Accuracy a{tol, span};; a.tol *= kLooser) {
     // The same encounter from L: its near field is this one's, so its delivered step is where this search starts
-    // (a map's plan, Accuracy::first_step), where auto chooses its method here too at the same tol.
-    a.first_step = near && near->accuracy && near->method && near->accuracy->tol == a.tol &&
-                           &detail::choose_method_for(body, far.centres, a.tol, nullptr) == near->method
-                       ? near->accuracy->h_chosen
-                       : 0.0;
+    // (a map's plan, Accuracy::first_step) wherever auto chooses the same method for it (first_step_of): the
+    // whole run from 2L, or with far legs the run between them, which is asked for the same share of tol as
+    // the run from L was (its step for the tol the run from L was asked at, or a tighter one).
+    const bool plan = near && near->accuracy && near->method && near->accuracy->tol <= a.tol;
+    a.first_step = plan ? near->accuracy->h_chosen : 0.0;
+    a.first_step_of = plan ? near->method : nullptr;
     Options o = options;
     o.estimate_events = false;  // its observables are what the limit needs, not its closest approach's error
     EncounterResult r = encounter_at(body, far.centres, nullptr, a, o, true);

@@ -265,7 +265,7 @@ BodyResult run_with_legs(const Body& body, const std::vector<Centre>& centres, c
   near_options.events.clear();
   near_options = encounter_options(near, centres, near_options, true);
   BodyResult r = integrate_checked(near, centres, nullptr,
-                                   Accuracy{(1.0 - kLegShare) * a.tol, encounter_span(near, centres), 0.0, a.first_step},
+                                   Accuracy{(1.0 - kLegShare) * a.tol, encounter_span(near, centres), 0.0, a.first_step, a.first_step_of},
                                    near_options);
   if (r.outcome != Outcome::ok || !r.run.stopped) {  // refused, failed or unfinished: said at its own times
     r.run.force_evals += g.evals();

@@ -37,7 +37,9 @@ void run_accurately(BodyResult& r, const Body& body, const std::vector<Centre>& 
   // other is, against a companion at half the delivered step (auto_verifies, methods.hpp). logh-kl6
   // named at tol 1e-9 on an encounter was refused where auto delivered it.
   const bool unverified = r.method == &detail::choose_method_for(body, centres, a.tol, nullptr) && !auto_verifies(centres);
-  adaptive::ToleranceResult t = adaptive::search_step(*r.method, body, centres, a, options, !unverified);
+  Accuracy planned = a;
+  if (a.first_step_of && a.first_step_of != r.method) planned.first_step = 0.0;  // another method's step
+  adaptive::ToleranceResult t = adaptive::search_step(*r.method, body, centres, planned, options, !unverified);
   r.accuracy = AccuracyReport{a.tol, t.err_estimate, t.h, t.omega_c, t.runs, t.total_force_evals, t.total_wall_s,
                               std::move(t.basis)};
   r.run = std::move(t.result);

@@ -128,6 +128,7 @@ struct ControlledSteps {
   double h0, t_end, tol;
   double dt_out = 0.0;
 };
+struct MethodInfo;
 /// The accuracy mode: the final state's relative error max(|dR|/|R|, |dv|/|v|) at t_end is to be at
 /// most tol; the step (h, or ds) is searched with a Richardson error estimate (adaptive/tolerance.hpp).
 struct Accuracy {
@@ -138,6 +139,9 @@ struct Accuracy {
   /// companion at twice it, instead of its own pilot pair; 0: the search's own pilot. Either way the
   /// delivered estimate is the ladder's, trusted by the same rules.
   double first_step = 0.0;
+  /// The method first_step was delivered by: where the run's method is another, first_step is not its plan
+  /// and the search starts from its own pilot. nullptr: first_step is the run's method's, whichever it is.
+  const MethodInfo* first_step_of = nullptr;
 };
 using Advance = std::variant<FixedSteps, FictitiousSteps, ControlledSteps, Accuracy>;
 
