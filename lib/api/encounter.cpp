@@ -251,8 +251,8 @@ EncounterResult encounter_twice_as_far(const Scene& far, double tol, const Optio
   for (Accuracy a{tol, span};; a.tol *= kLooser) {
     // The same encounter from L: its near field is this one's, so its delivered step is where this search starts
     // (a map's plan, Accuracy::first_step) wherever auto chooses the same method for it (first_step_of): the
-    // whole run from 2L, or with far legs the run between them, which is asked for the same share of tol as
-    // the run from L was (its step for the tol the run from L was asked at, or a tighter one).
+    // whole run from 2L, or with far legs the run between them, which asks the same share of tol as the run
+    // from L did. A step delivered for a tighter tol is a plan too (the search coarsens a pair far below it).
     const bool plan = near && near->accuracy && near->method && near->accuracy->tol <= a.tol;
     a.first_step = plan ? near->accuracy->h_chosen : 0.0;
     a.first_step_of = plan ? near->method : nullptr;
