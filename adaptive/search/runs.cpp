@@ -8,6 +8,8 @@
 #include "bodypoint/detail/run_parts.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <string>
 #include <utility>
 
@@ -34,6 +36,15 @@ ToleranceResult Search::search() {
   out.runs = runs_;
   out.total_force_evals = total_evals_;
   out.total_wall_s = total_wall_;
+  // The companion: the run at the step nearest the delivered one's among the others, the latest of equals.
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const Ran& x : ran_) {
+    const double apart = std::abs(std::log(x.h / best.h));
+    if (apart > 0.0 && apart <= nearest && std::isfinite(apart)) {
+      nearest = apart;
+      out.companion = ToleranceResult::Companion{x.final, x.t_end};
+    }
+  }
   // The delivered run is over: a sink's Flow::stop ends its samples, not the run.
   if (delivery_.sink && best.samples_dropped) {
     replay(best);
@@ -90,6 +101,7 @@ Level Search::run_at(double h, double h_c, bool may_deliver, const Body* from) {
   }
   l.omega_c = o.omega_c;
   l.how = how;
+  ran_.push_back(Ran{l.h, l.run.final, l.run.t_end});
   spent_evals_ += static_cast<double>(std::max(l.run.force_evals, l.run.steps));
   total_wall_ += l.run.wall_s;
   total_evals_ += l.run.force_evals;

@@ -138,6 +138,13 @@ class Search {
   double estimate_ = 0.0, last_estimate_ = std::numeric_limits<double>::quiet_NaN();
   double floor_ = -1.0;  ///< the round-off floor last measured (below kProbeBelowTol), -1 before
   bool rounding_suspected_ = false;  ///< the ladder's estimates stalled at runs closer than kStallBelow
+  /// Every run's step and end, for the delivered run's companion (search()).
+  struct Ran {
+    double h;
+    State final;
+    double t_end;
+  };
+  std::vector<Ran> ran_;
   double spent_evals_ = 0.0, total_wall_ = 0.0;
   long total_evals_ = 0;
   int runs_ = 0;

@@ -77,12 +77,14 @@ void print_encounter(const std::vector<Event>& events, const BodyResult& run, co
               << ", error " << (std::isfinite(e->out_of_plane_error) ? fmt(e->out_of_plane_error) : "not known")
               << "), impact parameter b = " << fmt(sc.b) << " (model error " << fmt(e->b_error) << "), v_inf = " << fmt(sc.v_inf)
               << " (" << fmt(e->v_inf_error) << ")"
-              << ", time delay = " << fmt(sc.time_delay) << "\n"
+              << ", time delay = " << fmt(sc.time_delay) << " (error "
+              << (std::isfinite(e->time_delay_error) ? fmt(e->time_delay_error) : "not known") << ", the run's part "
+              << (std::isfinite(e->time_delay_run_error) ? fmt(e->time_delay_run_error) : "not known") << ")\n"
               << "    the asymptotes' model error in the deflection: "
               << (std::isfinite(e->asymptote_error) ? fmt(e->asymptote_error) + " (" : "") << e->asymptote_basis
               << (std::isfinite(e->asymptote_error) ? ")" : "") << "\n"
-              << "    the start distance's error (deflection, time delay): "
-              << (std::isfinite(e->start_distance_error) ? fmt(e->start_distance_error) + ", " + fmt(e->time_delay_error) + " (" : "")
+              << "    the start distance's error in the deflection: "
+              << (std::isfinite(e->start_distance_error) ? fmt(e->start_distance_error) + " (" : "")
               << e->start_distance_basis << (std::isfinite(e->start_distance_error) ? ")" : "") << "\n"
               << "    the deflection's total error (the run's, the asymptotes' and the start distance's): "
               << (std::isfinite(e->deflection_error) ? fmt(e->deflection_error) : "not known") << "\n";
@@ -505,7 +507,7 @@ int cmd_simulate(int argc, char** argv) {
   std::vector<std::optional<Encounter>> enc(runs.size());
   if (o.scattering)
     for (std::size_t b = 0; b < runs.size(); ++b) {
-      enc[b] = measure_encounter(scene.bodies[b], scene.centres, runs[b].run.run, runs[b].run.events, o.body_events[b]);
+      enc[b] = measure_encounter(scene.bodies[b], scene.centres, runs[b].run, o.body_events[b]);
       if (enc[b]->outcome != Outcome::ok)
         throw Error("body '" + scene.bodies[b].name + "': " + enc[b]->reason + "; no output written");
       runs[b].run.encounter_force_evals = add_start_distance_of(*enc[b], vm, o.so, plan, scene.bodies[b], runs[b].run);

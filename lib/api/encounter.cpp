@@ -117,6 +117,16 @@ void estimate_asymptote_error(Encounter& e, const Body& body, const std::vector<
                       fmt(kAsymptoteFall) + " - 1";
 }
 
+/// The time delay's error from the run `error` estimated: the far legs' own where they set it, otherwise
+/// the estimate's pair's (ErrorEstimate::quantity: the delay read from the run's state and time at the end
+/// of the span they were compared over, against the companion's); NaN without either.
+double time_delay_run_error(const Body& body, const std::vector<Centre>& centres, const ErrorEstimate& error, double t_end) {
+  if (!std::isnan(error.time_delay) || !error.pair) return error.time_delay;
+  const auto delay = [&](const State& s, double t) { return scattering(body.p, centres, body.s0, s, t).time_delay; };
+  const ErrorEstimate::Pair& p = *error.pair;
+  return error.quantity(delay(p.run, p.t_run), delay(p.companion, p.t_companion), kTimeDelayRounding * std::abs(t_end));
+}
+
 }  // namespace
 
 Options encounter_options(const Body& body, const std::vector<Centre>& centres, Options options, bool stop_at_departure) {
@@ -141,10 +151,13 @@ Options encounter_options(const Body& body, const std::vector<Centre>& centres, 
   return options;
 }
 
-Encounter measure_encounter(const Body& body, const std::vector<Centre>& centres, const RunResult& run,
-                            const std::vector<EventHit>& hits, const std::vector<Event>& events) {
+Encounter measure_encounter(const Body& body, const std::vector<Centre>& centres, const BodyResult& r,
+                            const std::vector<Event>& events) {
+  const RunResult& run = r.run;
+  const std::vector<EventHit>& hits = r.events;
   Encounter e;
   e.scattering = scattering(body.p, centres, body.s0, run.final, run.t_end);
+  e.time_delay_run_error = time_delay_run_error(body, centres, r.error, run.t_end);
   if (const EventHit* nearest = nearest_approach(hits, events)) {
     e.r_min = nearest->r;
     e.t_min = nearest->t;
@@ -184,8 +197,10 @@ double encounter_span(const Body& body, const std::vector<Centre>& centres) {
 }
 
 void add_start_distance_error(Encounter& at_L, const EncounterResult* at_2L, bool material, double numerical, bool at_limit) {
+  at_L.time_delay_error = Scattering::kNaN;
   if (material) {
-    at_L.start_distance_error = at_L.time_delay_error = at_L.out_of_plane_start_error = 0.0;
+    at_L.start_distance_error = at_L.out_of_plane_start_error = 0.0;
+    at_L.time_delay_error = at_L.time_delay_run_error;
     at_L.start_distance_basis = "exact: a material point's Kepler hyperbola is that of its states, wherever they are";
   } else if (!at_2L || at_2L->run.outcome != Outcome::ok || at_2L->encounter.outcome != Outcome::ok ||
              !std::isfinite(at_2L->encounter.scattering.deflection)) {
@@ -206,7 +221,9 @@ void add_start_distance_error(Encounter& at_L, const EncounterResult* at_2L, boo
     };
     at_L.start_distance_error = to_limit(sc.deflection, far.scattering.deflection) + 2.0 * far_error;
     at_L.out_of_plane_start_error = to_limit(sc.out_of_plane, far.scattering.out_of_plane) + 2.0 * far_error;
-    at_L.time_delay_error = to_limit(sc.time_delay, far.scattering.time_delay);
+    // The delay's run parts: this run's, and the far run's twice.
+    at_L.time_delay_error = to_limit(sc.time_delay, far.scattering.time_delay) + at_L.time_delay_run_error +
+                            2.0 * far.time_delay_run_error;
     at_L.start_distance_basis = "at the limit L -> infinity: 2 x(2L) - x(L) from the encounter started at twice the distance (" +
                                 fmt(far.scattering.deflection) + " rad there, estimated error " + fmt(far_error) +
                                 "), within 1.5 |x(L) - x(2L)| and twice that run's error";
@@ -215,7 +232,9 @@ void add_start_distance_error(Encounter& at_L, const EncounterResult* at_2L, boo
     const Scattering& far = at_2L->encounter.scattering;
     const double far_error = std::isfinite(at_2L->run.error.for_orbit()) ? at_2L->run.error.for_orbit() : 0.0;
     at_L.start_distance_error = kStartDistanceFactor * (std::abs(at_L.scattering.deflection - far.deflection) + far_error);
-    at_L.time_delay_error = kStartDistanceFactor * std::abs(at_L.scattering.time_delay - far.time_delay);
+    at_L.time_delay_error = kStartDistanceFactor * (std::abs(at_L.scattering.time_delay - far.time_delay) +
+                                                    at_2L->encounter.time_delay_run_error) +
+                            at_L.time_delay_run_error;
     at_L.out_of_plane_start_error = kStartDistanceFactor * (std::abs(at_L.scattering.out_of_plane - far.out_of_plane) + far_error);
     at_L.start_distance_basis = "3 |x(L) - x(2L)| from the encounter started at twice the distance (" + fmt(far.deflection) +
                                 " rad there, estimated error " + fmt(far_error) +
@@ -238,7 +257,7 @@ EncounterResult encounter_at(const Body& body, const std::vector<Centre>& centre
     r.encounter.reason = r.run.reason;
     return r;
   }
-  r.encounter = measure_encounter(body, centres, r.run.run, r.run.events, o.events);
+  r.encounter = measure_encounter(body, centres, r.run, o.events);
   return r;
 }
 

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,6 +18,9 @@ namespace bodypoint {
 /// The slowest fall of the asymptotes' model error with the distance L measured (L^-2.7; study
 /// --name scattering, docs/physics.md "Scattering"): halving the distance raises it at least 2^2.7x.
 inline constexpr double kAsymptoteFall = 2.7;
+/// A time delay is the elapsed time less quantities of its size (the asymptotes' times): its error is at
+/// least this many units in the last place of the elapsed time.
+inline constexpr double kTimeDelayRounding = 16.0 * std::numeric_limits<double>::epsilon();
 /// A run with no end time given ends at the departure, or after this many free passes (twice the
 /// start distance over the speed at infinity), then incomplete.
 inline constexpr double kEncounterSpans = 2.0;
@@ -27,9 +31,10 @@ inline constexpr double kEncounterSpans = 2.0;
 /// as a stop event. The caller's events stay first, with their indices.
 Options encounter_options(const Body& body, const std::vector<Centre>& centres, Options options, bool stop_at_departure);
 
-/// The encounter of `body` on its run (`run` and the hits of `events`, as encounter_options made them).
-Encounter measure_encounter(const Body& body, const std::vector<Centre>& centres, const RunResult& run,
-                            const std::vector<EventHit>& hits, const std::vector<Event>& events);
+/// The encounter of `body` on its run `r` (its hits of `events`, as encounter_options made them; its
+/// estimate's pair for the time delay's error).
+Encounter measure_encounter(const Body& body, const std::vector<Centre>& centres, const BodyResult& r,
+                            const std::vector<Event>& events);
 
 /// The end time an encounter of `body` runs to when none is given: kEncounterSpans free passes. Error
 /// when the body has no speed at infinity (a bound orbit, several centres).

@@ -85,6 +85,7 @@ void estimate_error(BodyResult& r, const Body& body, const std::vector<Centre>& 
   const std::optional<FineCompanion> f = finer_companion(r, body, how, options, o, rerun);
   if (!f) return;
   e.value = f->c.factor * bodypoint::state_distance(r.run.final, f->x.run.final);
+  e.pair = ErrorEstimate::Pair{r.run.final, f->x.run.final, r.run.t_end, f->x.run.t_end};
   e.basis = f->c.basis;
   if (flow_is_exact(*r.method, body, centres)) {
     e.value = std::max(e.value, bodypoint::state_distance(r.run.final, f->x.run.final));
@@ -108,3 +109,14 @@ void estimate_and_settle(BodyResult& r, const Body& body, const std::vector<Cent
 }
 
 }  // namespace bodypoint::detail
+
+namespace bodypoint {
+
+double ErrorEstimate::quantity(double x_run, double x_companion, double rounding) const {
+  if (!pair || !known()) return std::numeric_limits<double>::quiet_NaN();
+  const double apart = state_distance(pair->run, pair->companion);
+  if (!(apart > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  return std::max(kQuantityMargin * value / apart * std::abs(x_run - x_companion), rounding);
+}
+
+}  // namespace bodypoint

@@ -18,9 +18,12 @@
 #include "events.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace bodypoint::detail {
@@ -132,7 +135,7 @@ std::optional<Plan> plan_legs(const Body& body, const std::vector<Centre>& centr
 struct Leg {
   State end, coarse, averaged;  ///< the finer run's end, the coarser's, the finer's before its quiver correction
   std::string refused;  ///< FarLeg::refused of either run
-  double t = 0.0, error = 0.0;
+  double t = 0.0, t_coarse = 0.0, error = 0.0;  ///< the finer run's time to its stop, the coarser's
   long steps = 0, evals = 0;
 };
 Leg leg(const Body& body, const std::vector<Centre>& centres, const State& start, const sp::LegStop& stop) {
@@ -149,6 +152,7 @@ Leg leg(const Body& body, const std::vector<Centre>& centres, const State& start
     }
     if (eta == kLegEta) {
       out.coarse = out.end;
+      out.t_coarse = l.t;
       continue;
     }
     out.t = l.t;
@@ -204,10 +208,50 @@ double deflection_error(const Body& body, const std::vector<Centre>& centres, co
   return std::isfinite(e) ? e : std::numeric_limits<double>::quiet_NaN();
 }
 
+/// What the legs' errors and the run between them, `r` from the state `near` (its estimate's pair), make of
+/// the time delay: each leg's delay (its time less its asymptotic motion's, read through the asymptote at its
+/// end) at its end against its coarser run's and, times the model's share, its end before the quiver
+/// correction; a leg coming in moves the impact parameter too, which the encounter turns into the delay by
+/// kSensitivity |dT/db| = sin(theta)/v_inf for a point mass (Rutherford's); the run's part as any run's
+/// (ErrorEstimate::quantity, its pair read from `near`).
+double delay_error(const Body& body, const std::vector<Centre>& centres, const Legs& g, const Body& near,
+                   const BodyResult& r) {
+  const State& near_end = r.run.final;
+  const auto T = [&](const State& from, const State& to, double t) { return scattering(body.p, centres, from, to, t).time_delay; };
+  const Scattering at = scattering(body.p, centres, g.in.end, near_end, r.run.t_end);
+  const double per_b = kSensitivity * std::abs(std::sin(at.deflection)) / at.v_inf;
+  const auto across = [&](const State& x, const State& y) {
+    const Vec3 u = to_momenta(body.p, x).K1.normalized();
+    return (guiding_centre(body.p, x) - guiding_centre(body.p, y)).cross(u).norm();
+  };
+  // A leg coming in: the delay from its end to the near run's end, its own time added (along its path), and
+  // what its offset across K1 makes of the delay.
+  const auto along = [&](const Leg& l, const State& other, double t_other) {
+    return std::abs(l.t + T(l.end, near_end, r.run.t_end) - t_other - T(other, near_end, r.run.t_end));
+  };
+  // A leg going out from `from`: the delay from there to its end.
+  const auto out_part = [&](const Leg& l, const State& from, const State& other, double t_other) {
+    return std::abs(T(from, l.end, l.t) - T(from, other, t_other));
+  };
+  double e = 0.0;
+  for (const Leg* l : {&g.in_half, &g.in})
+    e += along(*l, l->coarse, l->t_coarse) + per_b * across(l->end, l->coarse) + kModelShare * along(*l, l->averaged, l->t) +
+         kAcrossModelShare * per_b * across(l->end, l->averaged);
+  const std::array<std::pair<const Leg*, const State*>, 2> out{{{&g.out_half, &near_end}, {&g.out, &g.out_half.end}}};
+  for (const auto& [l, from] : out)
+    e += out_part(*l, *from, l->coarse, l->t_coarse) + kModelShare * out_part(*l, *from, l->averaged, l->t);
+  const auto near_delay = [&](const State& s, double t) { return scattering(near.p, centres, near.s0, s, t).time_delay; };
+  if (const ErrorEstimate::Pair* p = r.error.pair ? &*r.error.pair : nullptr)
+    e += r.error.quantity(near_delay(p->run, p->t_run), near_delay(p->companion, p->t_companion),
+                          kTimeDelayRounding * std::abs(r.run.t_end));
+  else e = std::numeric_limits<double>::quiet_NaN();
+  return std::isfinite(e) ? e : std::numeric_limits<double>::quiet_NaN();
+}
+
 /// auto's run `r` between the legs made the run of the whole encounter: its hits on the encounter's own
 /// events (the near run's closest approaches, the half distance's, the end), its time, cost and errors.
 void join(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Legs& g, const Plan& plan,
-          const Options& options, const Options& near_options, double tol) {
+          const Options& options, const Body& near, const Options& near_options, double tol) {
   const Vec3& centre = centres[options.events[plan.arrival].centre].c;
   const double t_in = g.in_half.t + g.in.t;
   std::vector<EventHit> hits{hit_at(plan.arrival, g.in_half.t, g.in_half.end, centre)};
@@ -224,6 +268,8 @@ void join(BodyResult& r, const Body& body, const std::vector<Centre>& centres, c
   hits.push_back(hit_at(plan.stop, t_end, g.out.end, centre));
   const double error = g.in_half.error + g.in.error + g.out_half.error + g.out.error;
   const double orbit = deflection_error(body, centres, g, r.run.final);
+  r.error.time_delay = delay_error(body, centres, g, near, r);
+  r.error.pair.reset();  // the run's, from the hand-off: the encounter's delay is read from time_delay
   r.events = std::move(hits);
   r.run.final = g.out.end;
   r.run.t_end = t_end;
@@ -274,7 +320,7 @@ BodyResult run_with_legs(const Body& body, const std::vector<Centre>& centres, c
   g.out_half = leg(body, centres, r.run.final, {plan.about, 0.5 * plan.r0, true});
   if (g.out_half.refused.empty()) g.out = leg(body, centres, g.out_half.end, {plan.about, plan.r0, true});
   if (!g.out_half.refused.empty() || !g.out.refused.empty()) return without(g.evals() + r.total_force_evals());
-  join(r, body, centres, g, plan, options, near_options, a.tol);
+  join(r, body, centres, g, plan, options, near, near_options, a.tol);
   return r;
 }
 

@@ -42,6 +42,7 @@ void run_accurately(BodyResult& r, const Body& body, const std::vector<Centre>& 
   adaptive::ToleranceResult t = adaptive::search_step(*r.method, body, centres, planned, options, !unverified);
   r.accuracy = AccuracyReport{a.tol, t.err_estimate, t.h, t.omega_c, t.runs, t.total_force_evals, t.total_wall_s,
                               std::move(t.basis)};
+  if (t.companion) r.error.pair = ErrorEstimate::Pair{t.result.final, t.companion->final, t.result.t_end, t.companion->t_end};
   r.run = std::move(t.result);
 }
 
@@ -471,6 +472,8 @@ BodyResult in_direction(const Body& body, const Advance& how, const Options& opt
   BodyResult r = forwards(reversed, bodypoint::forwards(how), o);
   r.run.final = time_reversed(r.run.final);
   r.run.t_end = -r.run.t_end;
+  if (ErrorEstimate::Pair* p = r.error.pair ? &*r.error.pair : nullptr)
+    *p = {time_reversed(p->run), time_reversed(p->companion), -p->t_run, -p->t_companion};
   for (EventHit& h : r.events) {
     h.t = -h.t;
     h.s = time_reversed(h.s);

@@ -178,6 +178,7 @@ Record encounter_record(const Encounter& e) {
   out.number("time_delay", sc.time_delay).number("asymptote_error", e.asymptote_error);
   out.note("asymptote_basis", e.asymptote_basis);
   out.number("start_distance_error", e.start_distance_error).number("time_delay_error", e.time_delay_error);
+  out.number("time_delay_run_error", e.time_delay_run_error);
   out.note("start_distance_basis", e.start_distance_basis).count("start_distance_force_evals", e.start_distance_force_evals);
   out.number("deflection_error", e.deflection_error);
   if (sc.in) out.vector("direction_in", sc.in->direction).vector("direction_out", sc.out->direction);

@@ -201,7 +201,7 @@ SweepRow encounter_row(SweepRow row, const MethodInfo* method, const Scene& scen
   const Options options = encounter_options(body, scene.centres, sweep_options(spec), true);
   BodyResult r = detail::integrate_encounter_checked(body, scene.centres, method, how, options);  // checked by validate_sweep
   if (!ran(r.outcome)) return result_row(std::move(row), std::move(r));
-  Encounter e = measure_encounter(body, scene.centres, r.run, r.events, options.events);
+  Encounter e = measure_encounter(body, scene.centres, r, options.events);
   if (e.outcome == Outcome::ok && r.outcome == Outcome::ok)
     row.start_distance_force_evals = add_row_start_distance(e, spec, row.point, body, r);
   row.r_min = e.r_min;

@@ -766,6 +766,10 @@ void expect_legs_meet_their_reference(const Scene& s, double tol) {
   const double off = std::abs(legs.encounter.scattering.deflection - ref.encounter.scattering.deflection);
   EXPECT_LE(off, stated + ref_error) << "tol " << tol << ": " << legs.encounter.scattering.deflection << " against "
                                      << ref.encounter.scattering.deflection;
+  // The time delay within the legs' run part of its error (theirs and the run's between them) and the reference's.
+  const double delay_off = std::abs(legs.encounter.scattering.time_delay - ref.encounter.scattering.time_delay);
+  EXPECT_LE(delay_off, legs.encounter.time_delay_run_error + ref.encounter.time_delay_run_error)
+      << "tol " << tol << ": " << legs.encounter.scattering.time_delay << " against " << ref.encounter.scattering.time_delay;
   // The legs cost a small share of the run without them.
   EXPECT_LT(legs.run.total_force_evals(), ref.run.total_force_evals());
 }
@@ -799,6 +803,35 @@ TEST(Encounter, WithLegsItsCostGrowsLikeTheLogarithmOfTheStartDistance) {
   };
   const double near = cost(3200.0), far = cost(51200.0);
   EXPECT_LT(far, kLogGrowth * near) << near << " -> " << far;
+}
+
+/// A time delay's run part is its estimate's pair carried to the delay (ErrorEstimate::quantity). Made-up scenes
+/// given by their start states (no limit taken: the trajectory's delay), each at TOL 1e-6 against the same start
+/// at kDelayReferenceTol: before, the delay carried the start distance's part alone (from L = 3200 with legs, 7-200x
+/// below its distance from a tighter run).
+constexpr double kDelayReferenceTol = 1e-10;
+
+TEST(Encounter, ATimeDelayIsWithinItsRunsStatedError) {
+  const auto scene = [](double B, double A, double d, double K1, double phase) {
+    SceneParams p;
+    p.B = B;
+    p.A = A;
+    p.start.d = d;
+    p.start.K1 = K1;
+    p.start.phase = phase;
+    return thesis_scene(p);
+  };
+  for (const Scene& s : {scene(0.5, -1.0, 2.0, 5.0, 0.0), scene(0.9, 2.0, 6.0, 3.0, 0.0), scene(0.3, -0.5, 1.0, 5.0, 2.0)}) {
+    const Body& body = s.bodies.front();
+    const EncounterResult run = encounter(body, s.centres, nullptr, 1e-6);
+    const EncounterResult ref = encounter(body, s.centres, nullptr, kDelayReferenceTol);
+    ASSERT_EQ(run.encounter.outcome, Outcome::ok) << run.encounter.reason;
+    ASSERT_EQ(ref.encounter.outcome, Outcome::ok) << ref.encounter.reason;
+    ASSERT_TRUE(std::isfinite(run.encounter.time_delay_run_error));
+    EXPECT_LE(std::abs(run.encounter.scattering.time_delay - ref.encounter.scattering.time_delay),
+              run.encounter.time_delay_run_error + ref.encounter.time_delay_run_error)
+        << "B " << body.p.B << ": " << run.encounter.scattering.time_delay << " against " << ref.encounter.scattering.time_delay;
+  }
 }
 
 /// The run from twice the start distance has this run's near field (far legs bring both to the same hand-off):

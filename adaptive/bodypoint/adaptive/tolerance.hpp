@@ -18,6 +18,7 @@
 #include "bodypoint/run.hpp"
 #include "bodypoint/detail/run_parts.hpp"
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,14 @@ struct ToleranceResult {
   int runs = 0;            ///< integrations made in all (the delivered run included)
   long total_force_evals = 0;  ///< over all those runs
   double total_wall_s = 0.0;   ///< step loops of all those runs (what a user waits for)
+  /// The run at the step nearest the delivered one's (another step), at the same end: what the estimate's
+  /// pair is (ErrorEstimate::pair), for the quantities a caller reads from the final state. None where no
+  /// other step ran.
+  struct Companion {
+    State final;
+    double t_end = 0.0;
+  };
+  std::optional<Companion> companion;
 };
 
 /// Checks the scene, the accuracy asked for (check_tolerance; t_end and dt_out: check), the options and

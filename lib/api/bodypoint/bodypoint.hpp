@@ -193,6 +193,26 @@ struct ErrorEstimate {
   /// field was crossed by legs of one turn of the spin a step knows the phase along its path less well
   /// than the orbit. NaN: `value`.
   double orbit = std::numeric_limits<double>::quiet_NaN();
+  /// The pair of states the estimate compared: the run's and its companion's at the end of the span they
+  /// were compared over (the accuracy mode's: its search's end, before a stop event cut the run), with their
+  /// times. In the asymptotic regime every smooth quantity read from a final state and its time errs by the
+  /// same multiple of what the pair differs by in it (the events' rule, estimate/events.cpp): quantity().
+  struct Pair {
+    State run, companion;
+    double t_run = 0.0, t_companion = 0.0;
+  };
+  std::optional<Pair> pair;
+  /// An encounter's time delay's error as the run read it, where the run computed it itself (far legs:
+  /// the legs' and the run's between them); NaN: from `pair` (Encounter::time_delay_error).
+  double time_delay = std::numeric_limits<double>::quiet_NaN();
+  /// The error of a quantity read as x_run from pair->run and x_companion from pair->companion: what they
+  /// differ by times what the estimate makes of the pair's distance, times kQuantityMargin, at least
+  /// `rounding`; NaN without a pair or where the pair is at one state (nothing to scale).
+  /// The margin: the scaling is exact only where every quantity errs by one multiple of the pair's difference;
+  /// an encounter's time delay read so from accuracy-mode runs of made-up scenes (TOL 1e-5 .. 1e-8, no far legs)
+  /// was 0.90-1.05 of its distance from a run at 1e-11 (median 1.03), and 1.5 keeps it at most 2x above.
+  static constexpr double kQuantityMargin = 1.5;
+  [[nodiscard]] double quantity(double x_run, double x_companion, double rounding) const;
   [[nodiscard]] bool known() const { return !std::isnan(value); }
   [[nodiscard]] double for_orbit() const { return std::isnan(orbit) ? value : orbit; }
 };
@@ -308,12 +328,19 @@ struct Encounter {
   double out_of_plane_error = Scattering::kNaN;
   double out_of_plane_model_error = Scattering::kNaN;  ///< its asymptotes' model part, as asymptote_error's
   double out_of_plane_start_error = Scattering::kNaN;  ///< its start distance's part (0 where that part is exact)
-  /// The error of the deflection and of the time delay that the start's finite distance L leaves against
-  /// the limit L -> infinity of the scene as given (the observables converge as 1/L: 3 |x(L) - x(2L)| from
-  /// the same scene started at 2L, the thesis's parameters with L doubled and b, v_inf solved again; a material point
-  /// too where its K1 is given, its v_inf moving with L). 0 for a scene file's material point (its hyperbola
-  /// is that of its states); NaN when not known.
-  double start_distance_error = Scattering::kNaN, time_delay_error = Scattering::kNaN;
+  /// The error of the deflection that the start's finite distance L leaves against the limit L -> infinity
+  /// of the scene as given (the observables converge as 1/L: 3 |x(L) - x(2L)| from the same scene started
+  /// at 2L, the thesis's parameters with L doubled and b, v_inf solved again; a material point too where its
+  /// K1 is given, its v_inf moving with L). 0 for a scene file's material point (its hyperbola is that of its
+  /// states); NaN when not known.
+  double start_distance_error = Scattering::kNaN;
+  /// The time delay's error from the run: its estimate carried to the time delay read from the final state
+  /// and time (ErrorEstimate::quantity on the estimate's pair; with far legs, theirs and the run's between
+  /// them); NaN when the run has no estimate.
+  double time_delay_run_error = Scattering::kNaN;
+  /// The time delay's total error: the run's part and the start distance's, as start_distance_error's (with
+  /// the run from 2L's own run part where the delay is taken to the limit); NaN when a part is not known.
+  double time_delay_error = Scattering::kNaN;
   std::string start_distance_basis = "not known: not measured";
   long start_distance_force_evals = 0;  ///< the encounter from twice the start distance cost these (its search included)
   /// The deflection's total error: the run's estimated error (a relative error of the final state, which

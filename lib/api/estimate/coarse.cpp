@@ -217,6 +217,7 @@ bool estimated_by_coarse(BodyResult& r, const Body& body, const std::vector<Cent
   coarse->force_evals += e.force_evals;
   coarse->wall_s += e.wall_s;
   e = std::move(*coarse);
+  e.pair = ErrorEstimate::Pair{r.run.final, x.run.final, r.run.t_end, x.run.t_end};
   const std::string& what = coarse_draw_text(*c);
   if (lanes) add_rounding_draws(e, r, options, oc, [&](int k) { return std::move((*lanes)[static_cast<std::size_t>(k)]); }, what);
   else add_rounding_draws(e, r, options, oc, draw, what);

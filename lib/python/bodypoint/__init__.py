@@ -365,7 +365,7 @@ def sweep(axes, methods, *, h=1e-4, steps=0, t_end=0.0, tol=1e-10, accuracy=None
     reason, err_estimate, estimate_force_evals,
     err_basis, warning; with ``scattering=True`` the encounter's (r_min, t_min, r_min_error, t_min_error,
     deflection, out_of_plane, b_in, v_inf_in, time_delay, asymptote_error, start_distance_error,
-    time_delay_error, deflection_error, start_distance_force_evals, event_force_evals, K1_turn, spin_turn,
+    time_delay_error (the time delay's total: the run's part and the start distance's), deflection_error, start_distance_force_evals, event_force_evals, K1_turn, spin_turn,
     K1x..K1z, asymptotes); then steps, t_end, vx..vz, wx..wz. One row per (grid point, method), grid point major.
     ``progress``: a line on stderr, rewritten as rows finish (rows done, elapsed, time left), for calls
     longer than a second; None (the default) shows it where stderr is a terminal or in a Jupyter
@@ -402,10 +402,12 @@ def encounter(scene, *, t_end=None, method="auto", tol=1e-10, max_seconds=DEFAUL
     impact parameter and speed at infinity, as measured: the sweep's columns of these names), b_in_error,
     v_inf_in_error (their asymptotes' model error), out_of_plane_error, time_delay, asymptote_error (the
     asymptotes' model error in the deflection; for B = 0 about one centre its formula's rounding) and
-    asymptote_basis, start_distance_error and time_delay_error (what the finite start distance L leaves
+    asymptote_basis, start_distance_error (what the finite start distance L leaves in the deflection
     against L -> infinity: a spinning body's scene of thesis_scene() is run again from 2L, and given by b or
     v_inf its deflection, out_of_plane and time_delay are their values at that limit, 2 x(2L) - x(L); 0 for
     a material point and for a scene given by its states, whose observables are its trajectory's),
+    time_delay_error (the time delay's total: time_delay_run_error, the run's estimate carried to the
+    delay by its companion, and the start distance's part),
     start_distance_basis, start_distance_force_evals (the run from 2L; in run's total_force_evals too),
     deflection_error (the deflection's total: the run's estimate, the asymptotes' and the start
     distance's; None where a part is not known), K1_turn, spin_turn,
