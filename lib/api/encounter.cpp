@@ -117,17 +117,14 @@ void estimate_asymptote_error(Encounter& e, const Body& body, const std::vector<
                       fmt(kAsymptoteFall) + " - 1";
 }
 
-/// The time delay's error from the run `error` estimated: the far legs' own where they set it, otherwise
-/// the estimate's pair's (ErrorEstimate::quantity: the delay read from the run's state and time at the end
-/// of the span they were compared over, against the companion's); NaN without either.
+}  // namespace
+
 double time_delay_run_error(const Body& body, const std::vector<Centre>& centres, const ErrorEstimate& error, double t_end) {
   if (!std::isnan(error.time_delay) || !error.pair) return error.time_delay;
   const auto delay = [&](const State& s, double t) { return scattering(body.p, centres, body.s0, s, t).time_delay; };
   const ErrorEstimate::Pair& p = *error.pair;
   return error.quantity(delay(p.run, p.t_run), delay(p.companion, p.t_companion), kTimeDelayRounding * std::abs(t_end));
 }
-
-}  // namespace
 
 Options encounter_options(const Body& body, const std::vector<Centre>& centres, Options options, bool stop_at_departure) {
   using K = Event::Kind;

@@ -31,6 +31,12 @@ inline constexpr double kEncounterSpans = 2.0;
 /// as a stop event. The caller's events stay first, with their indices.
 Options encounter_options(const Body& body, const std::vector<Centre>& centres, Options options, bool stop_at_departure);
 
+/// The time delay's error from a run of `body` to t_end whose estimate is `error`: the far legs' own where
+/// they set it (ErrorEstimate::time_delay), otherwise its pair's (ErrorEstimate::quantity: the delay read from
+/// the run's state and time at the end of the span they were compared over, against the companion's, at least
+/// kTimeDelayRounding of t_end); NaN without either.
+double time_delay_run_error(const Body& body, const std::vector<Centre>& centres, const ErrorEstimate& error, double t_end);
+
 /// The encounter of `body` on its run `r` (its hits of `events`, as encounter_options made them; its
 /// estimate's pair for the time delay's error).
 Encounter measure_encounter(const Body& body, const std::vector<Centre>& centres, const BodyResult& r,

@@ -179,6 +179,13 @@ struct Legs {
   [[nodiscard]] long evals() const { return in_half.evals + in.evals + out_half.evals + out.evals; }
 };
 
+/// The guiding centre's offset across K1 between the states x and y (K1 of x): what moves the path (b read from
+/// K2Q does not see it: every sub-flow, the quiver's turn included, keeps K2Q).
+double offset_across_K1(const BodyPoint& p, const State& x, const State& y) {
+  const Vec3 u = to_momenta(p, x).K1.normalized();
+  return (guiding_centre(p, x) - guiding_centre(p, y)).cross(u).norm();
+}
+
 /// What the legs' errors make of the deflection (rad). A leg going out moves the outgoing asymptote: the
 /// deflection from the start to its end against to its coarser run's end, and kModelShare of that to its end
 /// before the quiver correction (the averaged model's error). A leg coming in moves the incoming asymptote:
@@ -189,14 +196,8 @@ double deflection_error(const Body& body, const std::vector<Centre>& centres, co
   const auto in_of = [&](const State& s) { return scattering(body.p, centres, s, near_end); };
   const Scattering at = in_of(g.in.end);
   const double per_b = kSensitivity * std::abs(std::sin(at.deflection)) / at.b;
-  // The guiding centre's offset across K1: what moves the path (b read from K2Q does not see it: every
-  // sub-flow, the quiver's turn included, keeps K2Q).
-  const auto across = [&](const State& x, const State& y) {
-    const Vec3 u = to_momenta(body.p, x).K1.normalized();
-    return (guiding_centre(body.p, x) - guiding_centre(body.p, y)).cross(u).norm();
-  };
   const auto in_part = [&](const Leg& l, const State& other) {
-    return std::abs(in_of(l.end).deflection - in_of(other).deflection) + per_b * across(l.end, other);
+    return std::abs(in_of(l.end).deflection - in_of(other).deflection) + per_b * offset_across_K1(body.p, l.end, other);
   };
   const auto out_part = [&](const Leg& l, const State& other) {
     return std::abs(scattering(body.p, centres, body.s0, l.end).deflection -
@@ -213,17 +214,13 @@ double deflection_error(const Body& body, const std::vector<Centre>& centres, co
 /// end) at its end against its coarser run's and, times the model's share, its end before the quiver
 /// correction; a leg coming in moves the impact parameter too, which the encounter turns into the delay by
 /// kSensitivity |dT/db| = sin(theta)/v_inf for a point mass (Rutherford's); the run's part as any run's
-/// (ErrorEstimate::quantity, its pair read from `near`).
+/// (time_delay_run_error, its pair read from `near`).
 double delay_error(const Body& body, const std::vector<Centre>& centres, const Legs& g, const Body& near,
                    const BodyResult& r) {
   const State& near_end = r.run.final;
   const auto T = [&](const State& from, const State& to, double t) { return scattering(body.p, centres, from, to, t).time_delay; };
   const Scattering at = scattering(body.p, centres, g.in.end, near_end, r.run.t_end);
   const double per_b = kSensitivity * std::abs(std::sin(at.deflection)) / at.v_inf;
-  const auto across = [&](const State& x, const State& y) {
-    const Vec3 u = to_momenta(body.p, x).K1.normalized();
-    return (guiding_centre(body.p, x) - guiding_centre(body.p, y)).cross(u).norm();
-  };
   // A leg coming in: the delay from its end to the near run's end, its own time added (along its path), and
   // what its offset across K1 makes of the delay.
   const auto along = [&](const Leg& l, const State& other, double t_other) {
@@ -235,16 +232,12 @@ double delay_error(const Body& body, const std::vector<Centre>& centres, const L
   };
   double e = 0.0;
   for (const Leg* l : {&g.in_half, &g.in})
-    e += along(*l, l->coarse, l->t_coarse) + per_b * across(l->end, l->coarse) + kModelShare * along(*l, l->averaged, l->t) +
-         kAcrossModelShare * per_b * across(l->end, l->averaged);
+    e += along(*l, l->coarse, l->t_coarse) + per_b * offset_across_K1(body.p, l->end, l->coarse) +
+         kModelShare * along(*l, l->averaged, l->t) + kAcrossModelShare * per_b * offset_across_K1(body.p, l->end, l->averaged);
   const std::array<std::pair<const Leg*, const State*>, 2> out{{{&g.out_half, &near_end}, {&g.out, &g.out_half.end}}};
   for (const auto& [l, from] : out)
     e += out_part(*l, *from, l->coarse, l->t_coarse) + kModelShare * out_part(*l, *from, l->averaged, l->t);
-  const auto near_delay = [&](const State& s, double t) { return scattering(near.p, centres, near.s0, s, t).time_delay; };
-  if (const ErrorEstimate::Pair* p = r.error.pair ? &*r.error.pair : nullptr)
-    e += r.error.quantity(near_delay(p->run, p->t_run), near_delay(p->companion, p->t_companion),
-                          kTimeDelayRounding * std::abs(r.run.t_end));
-  else e = std::numeric_limits<double>::quiet_NaN();
+  e += time_delay_run_error(near, centres, r.error, r.run.t_end);
   return std::isfinite(e) ? e : std::numeric_limits<double>::quiet_NaN();
 }
 
