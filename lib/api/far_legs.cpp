@@ -241,6 +241,13 @@ double delay_error(const Body& body, const std::vector<Centre>& centres, const L
   return std::isfinite(e) ? e : std::numeric_limits<double>::quiet_NaN();
 }
 
+/// `evals` spent for `r` beyond its run: in its count and, where the accuracy mode ran it, in the search's, which
+/// the total reads (BodyResult::total_force_evals).
+void count(BodyResult& r, long evals) {
+  r.run.force_evals += evals;
+  if (r.accuracy) r.accuracy->force_evals += evals;
+}
+
 /// auto's run `r` between the legs made the run of the whole encounter: its hits on the encounter's own
 /// events (the near run's closest approaches, the half distance's, the end), its time, cost and errors.
 void join(BodyResult& r, const Body& body, const std::vector<Centre>& centres, const Legs& g, const Plan& plan,
@@ -267,7 +274,7 @@ void join(BodyResult& r, const Body& body, const std::vector<Centre>& centres, c
   r.run.final = g.out.end;
   r.run.t_end = t_end;
   r.run.steps += g.in_half.steps + g.in.steps + g.out_half.steps + g.out.steps;
-  r.run.force_evals += g.evals();
+  count(r, g.evals());
   r.error.orbit = r.error.value + orbit;
   r.error.value += error;
   if (r.accuracy) r.accuracy->err_estimate = r.error.value;
@@ -291,7 +298,7 @@ BodyResult run_with_legs(const Body& body, const std::vector<Centre>& centres, c
                          const Plan& plan) {
   const auto without = [&](long spent) {
     BodyResult plain = integrate_checked(body, centres, nullptr, a, options);
-    plain.run.force_evals += spent;
+    count(plain, spent);
     return plain;
   };
   Legs g;
@@ -307,7 +314,7 @@ BodyResult run_with_legs(const Body& body, const std::vector<Centre>& centres, c
                                    Accuracy{(1.0 - kLegShare) * a.tol, encounter_span(near, centres), 0.0, a.first_step, a.first_step_of},
                                    near_options);
   if (r.outcome != Outcome::ok || !r.run.stopped) {  // refused, failed or unfinished: said at its own times
-    r.run.force_evals += g.evals();
+    count(r, g.evals());
     return r;
   }
   g.out_half = leg(body, centres, r.run.final, {plan.about, 0.5 * plan.r0, true});
