@@ -14,6 +14,10 @@
 #include <type_traits>
 #include <vector>
 
+namespace bodypoint {
+struct TwiceAsFar;  // encounter_parts.hpp
+}  // namespace bodypoint
+
 namespace bodypoint::cli {
 
 namespace po = boost::program_options;
@@ -84,8 +88,10 @@ double planned_end(const RunPlan& plan);
 /// Runs one body of a scene checked by make_scene as planned through the library (integrate_body with
 /// `how`, plan.options, the sink and the events, its scene not checked again). A method that refuses the scene or a run that fails throws Error with the
 /// library's reason; diverged and collision are left to the caller (outcome, reason).
+/// With `twice` (an encounter at the limit: the same from 2L) its run is set where far legs serve both
+/// (integrate_encounter_checked).
 BodyResult run_body(const RunPlan& plan, const Body& body, const std::vector<Centre>& centres, const Advance& how,
-                 const SampleSink* sink, const std::vector<Event>& events = {});
+                 const SampleSink* sink, const std::vector<Event>& events = {}, TwiceAsFar* twice = nullptr);
 
 /// One run of a study through the public API (integrate_body), as a value: a refused or failed run says
 /// so in its outcome and reason, which the study records. A study measures its errors against

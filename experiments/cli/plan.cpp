@@ -50,12 +50,12 @@ double planned_end(const RunPlan& plan) {
 }
 
 BodyResult run_body(const RunPlan& plan, const Body& body, const std::vector<Centre>& centres, const Advance& how,
-                    const SampleSink* sink, const std::vector<Event>& events) {
+                    const SampleSink* sink, const std::vector<Event>& events, TwiceAsFar* twice) {
   Options options = plan.options;
   options.events = events;
   options.sink = sink;
   detail::check_run(centres, plan.method, how, options);  // the scene was checked where it was made (make_scene)
-  BodyResult r = detail::integrate_encounter_checked(body, centres, plan.method, how, options);
+  BodyResult r = detail::integrate_encounter_checked(body, centres, plan.method, how, options, twice);
   if (!ran(r.outcome)) throw Error(r.reason);
   return r;
 }

@@ -253,15 +253,27 @@ class TrajectoryFile {
   long rows_ = 0;
 };
 
-/// The start distance's part of an encounter's error: the thesis's scene at 2L with the same asymptotic
-/// data, run to its departure by auto (twice_as_far_tol); not known for a scene file's states.
-long add_start_distance_of(Encounter& e, const po::variables_map& vm, const SceneOptions& so, const RunPlan& plan,
-                           const Body& body, const BodyResult& near) {
+/// The thesis's scene at 2L with the same asymptotic data (none for a scene file's states), and whether the
+/// encounter answers at the limit L -> infinity.
+struct FarScene {
   std::function<Expected<Scene>()> far;
-  if (!vm.count("scene")) far = [&] { return thesis_scene_twice_as_far(so.params, so.b, so.v_inf, so.arrival_phase); };
-  return add_start_distance(e, body, far, plan.search ? std::optional<double>(plan.tol) : std::nullopt, near.error.for_orbit(),
-                            "the scene file gives states, not the thesis's start distance L", {},
-                            !vm.count("scene") && answers_at_limit(so.b, so.v_inf), &near);
+  bool at_limit = false;
+  std::optional<double> tol;  ///< the accuracy mode's
+};
+FarScene far_scene_of(const po::variables_map& vm, const SceneOptions& so, const RunPlan& plan) {
+  FarScene f;
+  if (!vm.count("scene")) f.far = [&so] { return thesis_scene_twice_as_far(so.params, so.b, so.v_inf, so.arrival_phase); };
+  f.at_limit = !vm.count("scene") && answers_at_limit(so.b, so.v_inf);
+  if (plan.search) f.tol = plan.tol;
+  return f;
+}
+
+/// The start distance's part of an encounter's error: the thesis's scene at 2L with the same asymptotic
+/// data, run to its departure by auto (twice_as_far_tol), or its run beside the encounter's (`twice`); not
+/// known for a scene file's states.
+long add_start_distance_of(Encounter& e, const FarScene& f, const Body& body, const BodyResult& near, const TwiceAsFar* twice) {
+  return add_start_distance(e, body, f.far, f.tol, near.error.for_orbit(), "the scene file gives states, not the thesis's start distance L",
+                            {}, f.at_limit, &near, twice);
 }
 
 /// One body's run and, with --reference, the reference state at its end.
@@ -310,7 +322,7 @@ Reversal run_back(const RunPlan& plan, const BodyResult& fwd, const Body& body, 
 
 /// One body: budget, run (with the progress bar), health, and the reference state when asked for.
 SimulatedBody simulate_body(const SimulateOptions& o, const RunPlan& plan, const Body& body, const Scene& scene,
-                            const std::vector<Event>& events, const SampleSink* sink) {
+                            const std::vector<Event>& events, const SampleSink* sink, TwiceAsFar* twice) {
   std::optional<WorkEstimate> estimate;
   if (!plan.search) {
     estimate = estimate_work(*plan.method, body, scene.centres, plan.how, plan.options);
@@ -321,7 +333,7 @@ SimulatedBody simulate_body(const SimulateOptions& o, const RunPlan& plan, const
     const auto* accuracy = std::get_if<Accuracy>(&plan.how);
     const ProgressBar bar = accuracy ? ProgressBar("searching the step for tol " + fmt(accuracy->tol), progress_wanted(o.quiet))
                                      : ProgressBar(estimate, progress_wanted(o.quiet));
-    sb.run = run_body(plan, body, scene.centres, plan.how, sink, events);
+    sb.run = run_body(plan, body, scene.centres, plan.how, sink, events, twice);
   }
   const BodyResult& br = sb.run;
   if (br.outcome != Outcome::ok) {
@@ -461,6 +473,35 @@ void add_events(SimulateOptions& o, const Scene& scene, bool to_departure) {
   }
 }
 
+/// Every body's run and, with --scattering, its encounter (the start distance's part with it: an encounter at
+/// the limit takes its run from 2L beside it, where far legs serve both).
+struct Simulated {
+  std::vector<SimulatedBody> runs;
+  std::vector<std::optional<Encounter>> enc;
+};
+Simulated simulate_bodies(const SimulateOptions& o, const RunPlan& plan, const Scene& scene, const FarScene& far, bool to_departure,
+                          TrajectoryFile* file) {
+  Simulated out;
+  std::vector<std::optional<TwiceAsFar>> twice(scene.bodies.size());
+  for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
+    const Body& body = scene.bodies[b];
+    const SampleSink sink = file ? file->sink(static_cast<long>(b), body.p) : SampleSink();
+    if (o.scattering && to_departure) twice[b] = twice_as_far_beside(far.far, far.at_limit, body, scene.centres, far.tol);
+    out.runs.push_back(simulate_body(o, plan, body, scene, o.body_events[b], file ? &sink : nullptr, twice[b] ? &*twice[b] : nullptr));
+    if (file) file->stream() << "# body " << b << ": " << search_line(out.runs.back().run) << "; " << error_line(out.runs.back().run.error) << "\n";
+  }
+  out.enc.resize(out.runs.size());
+  if (!o.scattering) return out;
+  for (std::size_t b = 0; b < out.runs.size(); ++b) {
+    BodyResult& run = out.runs[b].run;
+    out.enc[b] = measure_encounter(scene.bodies[b], scene.centres, run, o.body_events[b]);
+    if (out.enc[b]->outcome != Outcome::ok)
+      throw Error("body '" + scene.bodies[b].name + "': " + out.enc[b]->reason + "; no output written");
+    run.encounter_force_evals = add_start_distance_of(*out.enc[b], far, scene.bodies[b], run, twice[b] ? &*twice[b] : nullptr);
+  }
+  return out;
+}
+
 }  // namespace
 
 int cmd_simulate(int argc, char** argv) {
@@ -497,21 +538,7 @@ int cmd_simulate(int argc, char** argv) {
   }
   std::unique_ptr<TrajectoryFile> file;
   if (vm.count("out")) file = std::make_unique<TrajectoryFile>(o.out, o, vm, plan, scene);
-  std::vector<SimulatedBody> runs;
-  for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
-    const Body& body = scene.bodies[b];
-    const SampleSink sink = file ? file->sink(static_cast<long>(b), body.p) : SampleSink();
-    runs.push_back(simulate_body(o, plan, body, scene, o.body_events[b], file ? &sink : nullptr));
-    if (file) file->stream() << "# body " << b << ": " << search_line(runs.back().run) << "; " << error_line(runs.back().run.error) << "\n";
-  }
-  std::vector<std::optional<Encounter>> enc(runs.size());
-  if (o.scattering)
-    for (std::size_t b = 0; b < runs.size(); ++b) {
-      enc[b] = measure_encounter(scene.bodies[b], scene.centres, runs[b].run, o.body_events[b]);
-      if (enc[b]->outcome != Outcome::ok)
-        throw Error("body '" + scene.bodies[b].name + "': " + enc[b]->reason + "; no output written");
-      runs[b].run.encounter_force_evals = add_start_distance_of(*enc[b], vm, o.so, plan, scene.bodies[b], runs[b].run);
-    }
+  auto [runs, enc] = simulate_bodies(o, plan, scene, far_scene_of(vm, o.so, plan), to_departure, file.get());
   if (file) file->commit();
   if (o.json) {
     report_json(runs, scene, plan, o, enc);

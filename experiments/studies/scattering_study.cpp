@@ -116,10 +116,16 @@ Point run_point(const Series& s, double b, double psi) {
   Options o;
   o.track_invariants = false;
   const MethodInfo* method = std::string_view(s.method) == "auto" ? nullptr : &method_or_throw(s.method);
-  EncounterResult r = encounter(body, scene->centres, method, p.tol, kNaN, o);
+  const std::function<Expected<Scene>()> far = [&] { return thesis_scene_twice_as_far(params, b, kNaN, arrival); };
+  const auto run = [&](std::optional<TwiceAsFar>& twice) {
+    twice = twice_as_far_beside(far, answers_at_limit(b, kNaN), body, scene->centres, p.tol, o);
+    return encounter_beside(body, scene->centres, method, p.tol, o, twice ? &*twice : nullptr);
+  };
+  std::optional<TwiceAsFar> twice;
+  EncounterResult r = run(twice);
   for (int k = 0; k < kRetries && r.run.outcome == Outcome::failed && r.run.reason.find("out of reach") != std::string::npos; ++k) {
     p.tol *= kRetryLooser;
-    r = encounter(body, scene->centres, method, p.tol, kNaN, o);
+    r = run(twice);
   }
   p.force_evals = r.run.total_force_evals();
   p.t_end = r.run.run.t_end;
@@ -128,9 +134,8 @@ Point run_point(const Series& s, double b, double psi) {
     p.failure = r.encounter.reason;
     return p;
   }
-  p.force_evals += add_start_distance(
-      r.encounter, body, [&] { return thesis_scene_twice_as_far(params, b, kNaN, arrival); }, p.tol, r.run.error.for_orbit(), "", o,
-      answers_at_limit(b, kNaN), &r.run);
+  p.force_evals += add_start_distance(r.encounter, body, far, p.tol, r.run.error.for_orbit(), "", o, answers_at_limit(b, kNaN),
+                                      &r.run, twice ? &*twice : nullptr);
   p.sc = r.encounter.scattering;
   p.asymptote_error = r.encounter.asymptote_error;
   p.start_distance_error = r.encounter.start_distance_error;
@@ -477,16 +482,17 @@ LCost l_cost(double L) {
   const Body& body = scene.bodies.front();
   Options o;
   o.track_invariants = false;
-  EncounterResult r = encounter(body, scene.centres, nullptr, kLCostTol, kNaN, o);
+  const std::function<Expected<Scene>()> far = [&] { return thesis_scene_twice_as_far(solved, 3.0, kNaN, 1.0); };
+  std::optional<TwiceAsFar> twice = twice_as_far_beside(far, true, body, scene.centres, kLCostTol, o);
+  EncounterResult r = encounter_beside(body, scene.centres, nullptr, kLCostTol, o, twice ? &*twice : nullptr);
   c.force_evals = r.run.total_force_evals();
   c.legs = r.run.chosen.find("far legs") != std::string::npos;
   if (r.encounter.outcome != Outcome::ok) {
     c.failure = r.encounter.reason;
     return c;
   }
-  c.force_evals += add_start_distance(
-      r.encounter, body, [&] { return thesis_scene_twice_as_far(solved, 3.0, kNaN, 1.0); }, kLCostTol,
-      r.run.error.for_orbit(), "", o, true, &r.run);
+  c.force_evals += add_start_distance(r.encounter, body, far, kLCostTol, r.run.error.for_orbit(), "", o, true, &r.run,
+                                      twice ? &*twice : nullptr);
   c.t_end = r.run.run.t_end;
   c.deflection = r.encounter.scattering.deflection;
   c.deflection_error = r.encounter.deflection_error;

@@ -32,6 +32,8 @@ void check_error_bound(double max_error);
 /// (validate), then what check_run checks. The one check integrate(), integrate_body() and a Stepper make.
 void check_request(const Scene& scene, const MethodInfo* method, const Advance& how, const Options& options);
 
+struct TwiceAsFar;  // encounter_parts.hpp
+
 }  // namespace bodypoint
 
 namespace bodypoint::detail {
@@ -48,7 +50,9 @@ BodyResult integrate_checked(const Body& body, const std::vector<Centre>& centre
 /// integrate_checked for an encounter run to its departure (the events of encounter_options): where auto
 /// runs it, the body spins and starts far enough out, its far field is crossed by legs of one turn of the
 /// spin a step (far_legs.cpp) and the run between them is auto's; otherwise integrate_checked.
+/// With `twice` (the same encounter from 2L, twice_as_far_beside) where legs serve both, one run between the legs
+/// serves both (run_pair_with_legs) and `twice->run` is set.
 BodyResult integrate_encounter_checked(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
-                                       const Advance& how, const Options& options);
+                                       const Advance& how, const Options& options, TwiceAsFar* twice = nullptr);
 
 }  // namespace bodypoint::detail

@@ -243,12 +243,13 @@ void add_start_distance_error(Encounter& at_L, const EncounterResult* at_2L, boo
 
 namespace {
 
-/// An encounter run to its departure (or t_end) at the accuracy `a`, as encounter() runs it.
+/// An encounter run to its departure (or t_end) at the accuracy `a`, as encounter() runs it (with `twice` beside
+/// it where far legs serve both).
 EncounterResult encounter_at(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method, Accuracy a,
-                             Options options, bool to_departure) {
+                             Options options, bool to_departure, TwiceAsFar* twice = nullptr) {
   const Options o = encounter_options(body, centres, std::move(options), to_departure);
   check_request(Scene{centres, {body}}, method, a, o);
-  EncounterResult r{detail::integrate_encounter_checked(body, centres, method, a, o), {}, o.events};
+  EncounterResult r{detail::integrate_encounter_checked(body, centres, method, a, o, twice), {}, o.events};
   if (r.run.outcome != Outcome::ok) {
     r.encounter.outcome = r.run.outcome;
     r.encounter.reason = r.run.reason;
@@ -256,6 +257,13 @@ EncounterResult encounter_at(const Body& body, const std::vector<Centre>& centre
   }
   r.encounter = measure_encounter(body, centres, r.run, o.events);
   return r;
+}
+
+/// The options of the encounter from 2L: the caller's, without the events' errors (its observables are what the
+/// limit needs, not its closest approach's error).
+Options twice_as_far_options(Options o) {
+  o.estimate_events = false;
+  return o;
 }
 
 }  // namespace
@@ -272,13 +280,26 @@ EncounterResult encounter_twice_as_far(const Scene& far, double tol, const Optio
     const bool plan = near && near->accuracy && near->method && near->accuracy->tol <= a.tol;
     a.first_step = plan ? near->accuracy->h_chosen : 0.0;
     a.first_step_of = plan ? near->method : nullptr;
-    Options o = options;
-    o.estimate_events = false;  // its observables are what the limit needs, not its closest approach's error
-    EncounterResult r = encounter_at(body, far.centres, nullptr, a, o, true);
+    EncounterResult r = encounter_at(body, far.centres, nullptr, a, twice_as_far_options(options), true);
     if (r.run.outcome != Outcome::failed || r.run.reason.find("out of reach") == std::string::npos ||
         a.tol * kLooser > kLoosest)
       return r;
   }
+}
+
+std::optional<TwiceAsFar> twice_as_far_beside(const std::function<Expected<Scene>()>& far, bool at_limit, const Body& body,
+                                              const std::vector<Centre>& centres, std::optional<double> tol,
+                                              const Options& options) {
+  if (!far || !at_limit || !tol || body.p.B == 0.0) return std::nullopt;
+  const Expected<Scene> scene = far();
+  if (!scene || scene->bodies.size() != 1 || scene->centres.size() != centres.size()) return std::nullopt;
+  const Body& twice = scene->bodies.front();
+  return TwiceAsFar{twice, scene->centres, encounter_options(twice, scene->centres, twice_as_far_options(options), true), std::nullopt};
+}
+
+EncounterResult encounter_beside(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method, double tol,
+                                 Options options, TwiceAsFar* twice) {
+  return encounter_at(body, centres, method, Accuracy{tol, encounter_span(body, centres)}, std::move(options), true, twice);
 }
 
 void no_start_distance_error(Encounter& e, bool material, double numerical, const std::string& why) {
@@ -288,7 +309,7 @@ void no_start_distance_error(Encounter& e, bool material, double numerical, cons
 
 long add_start_distance(Encounter& e, const Body& body, const std::function<Expected<Scene>()>& far,
                         std::optional<double> tol, double numerical, const std::string& no_far, const Options& options,
-                        bool at_limit, const BodyResult* near) {
+                        bool at_limit, const BodyResult* near, const TwiceAsFar* twice) {
   // A material point's Kepler hyperbola is that of its states, wherever they are: a scene given by its
   // start state has the observables of that trajectory, and one given by asymptotic data keeps K1 as its
   // momentum at infinity (speed_at_infinity_of), so no start distance changes them. A scene that gives
@@ -299,13 +320,32 @@ long add_start_distance(Encounter& e, const Body& body, const std::function<Expe
     if (!far) e.start_distance_basis = "none: " + no_far + "; its observables are its trajectory's";
     return 0;
   }
-  const Expected<Scene> scene = far();
-  if (!scene) {  // no scene from 2L has the data: the part is not known, and why
-    no_start_distance_error(e, false, numerical, "the scene from twice the start distance has no such data (" + scene.error() + ")");
-    return 0;
+  EncounterResult r;
+  if (twice && twice->run) {  // run beside the encounter from L (far legs)
+    r.run = *twice->run;
+    r.events = twice->options.events;
+    if (r.run.outcome == Outcome::ok) r.encounter = measure_encounter(twice->body, twice->centres, r.run, r.events);
+    // Each encounter's observables as its own run's to first order (the limit is the same either way).
+    const auto shift = [](double& at_L, double& at_2L, double by) {
+      at_2L -= by;
+      at_L -= 2.0 * by;
+    };
+    Scattering &sc = e.scattering, &far_sc = r.encounter.scattering;
+    shift(sc.deflection, far_sc.deflection, twice->deflection_shift);
+    shift(sc.time_delay, far_sc.time_delay, twice->time_delay_shift);
+    shift(sc.out_of_plane, far_sc.out_of_plane, twice->out_of_plane_shift);
+  } else {
+    const Expected<Scene> scene = far();
+    if (!scene) {  // no scene from 2L has the data: the part is not known, and why
+      no_start_distance_error(e, false, numerical, "the scene from twice the start distance has no such data (" + scene.error() + ")");
+      return 0;
+    }
+    r = encounter_twice_as_far(*scene, twice_as_far_tol(tol), options, near);
   }
-  const EncounterResult r = encounter_twice_as_far(*scene, twice_as_far_tol(tol), options, near);
   add_start_distance_error(e, &r, false, numerical, at_limit);
+  if (twice && twice->run)
+    e.start_distance_basis += "; the two share the run between their far legs, from the hand-off at the limit 2 S(2L) - S(L) (each "
+                              "its own legs), which the limit cancels to first order";
   e.start_distance_force_evals = r.run.total_force_evals();
   return e.start_distance_force_evals;
 }

@@ -46,6 +46,20 @@ Encounter measure_encounter(const Body& body, const std::vector<Centre>& centres
 /// when the body has no speed at infinity (a bound orbit, several centres).
 double encounter_span(const Body& body, const std::vector<Centre>& centres);
 
+/// The encounter from twice the start distance run beside the encounter from L where far legs serve both
+/// (integrate_encounter_checked): the legs in from L and 2L hand off at the limit L -> infinity, and one run
+/// between the legs serves both (far_legs.cpp, run_pair_with_legs); add_start_distance takes its run instead of
+/// running its own.
+struct TwiceAsFar {
+  Body body;        ///< the body of the scene from 2L (thesis_scene_twice_as_far)
+  std::vector<Centre> centres;  ///< its centres
+  Options options;  ///< its encounter's events (encounter_options) and the caller's options, as encounter_twice_as_far's
+  std::optional<BodyResult> run;  ///< its run, where it was shared; otherwise add_start_distance runs its own
+  /// What the shared run's observables differ by from its own encounter's to first order, and twice that the
+  /// encounter from L's (their hand-off at the limit differs from their own by S(2L) - S(L) and 2 (S(2L) - S(L))):
+  /// it cancels in the limit 2 x(2L) - x(L), and the limit's error reads |x(L) - x(2L)| less it.
+  double deflection_shift = 0.0, time_delay_shift = 0.0, out_of_plane_shift = 0.0;
+};
 /// The accuracy of the encounter from twice the start distance, run by auto (the run's own method may not
 /// reach its tol that far out: lp-kl8 at 1e-10 from L = 400): the run's tol where it had one, otherwise
 /// kTwiceAsFarTol (its error must stay well below the 1/L term it measures, 1e-5..1e-3 relative at L = 200).
@@ -75,14 +89,26 @@ void no_start_distance_error(Encounter& e, bool material, double numerical, cons
 /// there; otherwise the encounter from `far()` (thesis_scene_twice_as_far) run by auto at
 /// twice_as_far_tol(tol), and with `at_limit` (a scene given by b or v_inf) the observables taken to the limit
 /// L -> infinity (add_start_distance_error); `near`, the run from L, seeds the far run's search
-/// (encounter_twice_as_far). Returns the force evaluations of that second encounter (0 where
-/// none ran), also in Encounter::start_distance_force_evals.
+/// (encounter_twice_as_far); `twice` with its run (twice_as_far_beside, shared far legs' run) stands for that
+/// encounter. Returns the force evaluations of that second encounter (0 where none ran), also in
+/// Encounter::start_distance_force_evals.
 /// Whether a thesis scene given by these asymptotic data (NaN: not given) answers at the limit L -> infinity
 /// (`at_limit` of add_start_distance): given by b or v_inf.
 inline bool answers_at_limit(double b, double v_inf) { return !(std::isnan(b) && std::isnan(v_inf)); }
 long add_start_distance(Encounter& e, const Body& body, const std::function<Expected<Scene>()>& far,
                         std::optional<double> tol, double numerical, const std::string& no_far, const Options& options = {},
-                        bool at_limit = false, const BodyResult* near = nullptr);
+                        bool at_limit = false, const BodyResult* near = nullptr, const TwiceAsFar* twice = nullptr);
+/// The run from 2L to share with an encounter of `body` at the limit (`at_limit`: a scene given by asymptotic
+/// data, `far` its scene from 2L) in the accuracy mode (`tol`); none for a material point, a scene given by
+/// states, a run by step, or where `far` finds no scene (add_start_distance then says why).
+std::optional<TwiceAsFar> twice_as_far_beside(const std::function<Expected<Scene>()>& far, bool at_limit, const Body& body,
+                                              const std::vector<Centre>& centres, std::optional<double> tol,
+                                              const Options& options = {});
+/// encounter() to its departure with the run from 2L beside it (`twice`, twice_as_far_beside; or none) where far
+/// legs serve both.
+EncounterResult encounter_beside(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method, double tol,
+                                 Options options, TwiceAsFar* twice);
+
 /// The thesis's scene of the parameters `solved` (d, K1, phase solved for the asymptotic data) with the start
 /// distance L doubled and the data b, v_inf (NaN: not given, d, K1 kept) solved for again; the arrival phase
 /// as given, or (NaN) the scene's own at L (a start phase kept has no limit L -> infinity: the extra way in

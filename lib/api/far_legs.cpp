@@ -136,6 +136,7 @@ struct Leg {
   State end, coarse, averaged;  ///< the finer run's end, the coarser's, the finer's before its quiver correction
   std::string refused;  ///< FarLeg::refused of either run
   double t = 0.0, t_coarse = 0.0, error = 0.0;  ///< the finer run's time to its stop, the coarser's
+  double quiver = 0.0;  ///< the finer run's FarLeg::quiver
   long steps = 0, evals = 0;
 };
 Leg leg(const Body& body, const std::vector<Centre>& centres, const State& start, const sp::LegStop& stop) {
@@ -158,6 +159,7 @@ Leg leg(const Body& body, const std::vector<Centre>& centres, const State& start
     out.t = l.t;
     out.steps = l.steps;
     out.averaged = l.averaged_end;
+    out.quiver = l.quiver;
     out.error = state_distance(out.coarse, out.end) + kModelShare * l.quiver;
   }
   return out;
@@ -176,7 +178,22 @@ EventHit hit_at(std::size_t event, double t, const State& s, const Vec3& centre)
 /// start distance and on to the start distance.
 struct Legs {
   Leg in_half, in, out_half, out;
-  [[nodiscard]] long evals() const { return in_half.evals + in.evals + out_half.evals + out.evals; }
+  /// The encounter from 2L beside one from L (run_pair_with_legs) goes out on the other's legs to L (`out_half`
+  /// and `out`, the other's: its half distance is at their end) and on from there to 2L.
+  std::optional<Leg> beyond;
+  [[nodiscard]] long evals() const {
+    return in_half.evals + in.evals + out_half.evals + out.evals + (beyond ? beyond->evals : 0);
+  }
+  [[nodiscard]] long steps_out() const { return out_half.steps + out.steps + (beyond ? beyond->steps : 0); }
+  /// The legs going out, each with the state it starts from (`near_end`: the end of auto's run between them).
+  [[nodiscard]] std::vector<std::pair<const Leg*, const State*>> outs(const State& near_end) const {
+    std::vector<std::pair<const Leg*, const State*>> o{{&out_half, &near_end}, {&out, &out_half.end}};
+    if (beyond) o.emplace_back(&*beyond, &out.end);
+    return o;
+  }
+  [[nodiscard]] const Leg& last() const { return beyond ? *beyond : out; }
+  /// The leg going out that ends at the encounter's half distance (the departure's hit).
+  [[nodiscard]] const Leg& at_half() const { return beyond ? out : out_half; }
 };
 
 /// The guiding centre's offset across K1 between the states x and y (K1 of x): what moves the path (b read from
@@ -184,6 +201,13 @@ struct Legs {
 double offset_across_K1(const BodyPoint& p, const State& x, const State& y) {
   const Vec3 u = to_momenta(p, x).K1.normalized();
   return (guiding_centre(p, x) - guiding_centre(p, y)).cross(u).norm();
+}
+
+/// The distance of the guiding centre's straight path in the state `s` (along K1) from `about`: what moves an
+/// encounter's path between two states at the same distance from the centre (an offset across K1 that a
+/// rotation about the centre makes leaves it).
+double line_distance(const BodyPoint& p, const State& s, const Vec3& about) {
+  return (guiding_centre(p, s) - about).cross(to_momenta(p, s).K1.normalized()).norm();
 }
 
 /// What the legs' errors make of the deflection (rad). A leg going out moves the outgoing asymptote: the
@@ -205,7 +229,7 @@ double deflection_error(const Body& body, const std::vector<Centre>& centres, co
   };
   double e = 0.0;
   for (const Leg* l : {&g.in_half, &g.in}) e += in_part(*l, l->coarse) + kAcrossModelShare * in_part(*l, l->averaged);
-  for (const Leg* l : {&g.out_half, &g.out}) e += out_part(*l, l->coarse) + kModelShare * out_part(*l, l->averaged);
+  for (const auto& [l, from] : g.outs(near_end)) e += out_part(*l, l->coarse) + kModelShare * out_part(*l, l->averaged);
   return std::isfinite(e) ? e : std::numeric_limits<double>::quiet_NaN();
 }
 
@@ -234,8 +258,7 @@ double delay_error(const Body& body, const std::vector<Centre>& centres, const L
   for (const Leg* l : {&g.in_half, &g.in})
     e += along(*l, l->coarse, l->t_coarse) + per_b * offset_across_K1(body.p, l->end, l->coarse) +
          kModelShare * along(*l, l->averaged, l->t) + kAcrossModelShare * per_b * offset_across_K1(body.p, l->end, l->averaged);
-  const std::array<std::pair<const Leg*, const State*>, 2> out{{{&g.out_half, &near_end}, {&g.out, &g.out_half.end}}};
-  for (const auto& [l, from] : out)
+  for (const auto& [l, from] : g.outs(near_end))
     e += out_part(*l, *from, l->coarse, l->t_coarse) + kModelShare * out_part(*l, *from, l->averaged, l->t);
   e += time_delay_run_error(near, centres, r.error, r.run.t_end);
   return std::isfinite(e) ? e : std::numeric_limits<double>::quiet_NaN();
@@ -263,24 +286,28 @@ void join(BodyResult& r, const Body& body, const std::vector<Centre>& centres, c
     h.t += t_in;
     hits.push_back(h);
   }
-  const double t_out_half = t_in + r.run.t_end + g.out_half.t, t_end = t_out_half + g.out.t;
-  hits.push_back(hit_at(plan.departure, t_out_half, g.out_half.end, centre));
-  hits.push_back(hit_at(plan.stop, t_end, g.out.end, centre));
-  const double error = g.in_half.error + g.in.error + g.out_half.error + g.out.error;
+  double t = t_in + r.run.t_end, error = g.in_half.error + g.in.error;
+  for (const auto& [l, from] : g.outs(r.run.final)) {
+    t += l->t;
+    error += l->error;
+    if (l == &g.at_half()) hits.push_back(hit_at(plan.departure, t, l->end, centre));
+  }
+  const double t_end = t;
+  hits.push_back(hit_at(plan.stop, t_end, g.last().end, centre));
   const double orbit = deflection_error(body, centres, g, r.run.final);
   r.error.time_delay = delay_error(body, centres, g, near, r);
   r.error.pair.reset();  // the run's, from the hand-off: the encounter's delay is read from time_delay
   r.events = std::move(hits);
-  r.run.final = g.out.end;
+  r.run.final = g.last().end;
   r.run.t_end = t_end;
-  r.run.steps += g.in_half.steps + g.in.steps + g.out_half.steps + g.out.steps;
+  r.run.steps += g.in_half.steps + g.in.steps + g.steps_out();
   count(r, g.evals());
   r.error.orbit = r.error.value + orbit;
   r.error.value += error;
   if (r.accuracy) r.accuracy->err_estimate = r.error.value;
   const std::string legs = "far legs of one turn of the spin a step beyond r = " + fmt(plan.r_hand) + " (" +
                            std::to_string(g.in_half.steps + g.in.steps) + " steps in, " +
-                           std::to_string(g.out_half.steps + g.out.steps) + " out, " + std::to_string(g.evals()) +
+                           std::to_string(g.steps_out()) + " out, " + std::to_string(g.evals()) +
                            " force evaluations with their companions, estimated error " + fmt(error) + ", in the deflection " +
                            fmt(orbit) + "; the invariants are the run's between them)";
   r.error.basis += "; " + legs;
@@ -292,45 +319,184 @@ void join(BodyResult& r, const Body& body, const std::vector<Centre>& centres, c
                          "); a state at tol wants a named method");
 }
 
+/// The legs of `body` in to the hand-off: to half its start distance and on to r_hand; false where one stops short.
+bool in_legs(Legs& g, const Body& body, const std::vector<Centre>& centres, const Plan& plan) {
+  g.in_half = leg(body, centres, body.s0, {plan.about, 0.5 * plan.r0, false});
+  if (g.in_half.refused.empty()) g.in = leg(body, centres, g.in_half.end, {plan.about, plan.r_hand, false});
+  return g.in_half.refused.empty() && g.in.refused.empty();
+}
+
+/// The legs of `body` out from `from`, the end of the run between the legs: to half its start distance and on
+/// to it; false where one stops short.
+bool out_legs(Legs& g, const Body& body, const std::vector<Centre>& centres, const State& from, const Plan& plan) {
+  g.out_half = leg(body, centres, from, {plan.about, 0.5 * plan.r0, true});
+  if (g.out_half.refused.empty()) g.out = leg(body, centres, g.out_half.end, {plan.about, plan.r0, true});
+  return g.out_half.refused.empty() && g.out.refused.empty();
+}
+
+/// auto's run between the legs: from the hand-off state `at` of `body` to its departure through there, at the
+/// share of TOL the legs leave, with the encounter's events from there.
+struct Near {
+  Body body;
+  Options options;
+  BodyResult r;
+  [[nodiscard]] bool finished() const { return r.outcome == Outcome::ok && r.run.stopped; }
+};
+Near near_run(const Body& body, const State& at, const std::vector<Centre>& centres, const Accuracy& a, const Options& options) {
+  Near n{Body{body.p, at, body.name}, options, {}};
+  n.options.events.clear();
+  n.options = encounter_options(n.body, centres, n.options, true);
+  n.r = integrate_checked(n.body, centres, nullptr,
+                          Accuracy{(1.0 - kLegShare) * a.tol, encounter_span(n.body, centres), 0.0, a.first_step, a.first_step_of},
+                          n.options);
+  return n;
+}
+
+/// auto's run of `body` without legs, where a leg stopped short: `spent` counted in it.
+BodyResult without_legs(const Body& body, const std::vector<Centre>& centres, const Accuracy& a, const Options& options,
+                        long spent) {
+  BodyResult plain = integrate_checked(body, centres, nullptr, a, options);
+  count(plain, spent);
+  return plain;
+}
+
 /// The run of `plan`: the legs and auto's run between them, as one run of the whole encounter. Where a leg
 /// stops short (far_leg's reasons) the encounter is auto's run without legs, the legs' work counted in it.
 BodyResult run_with_legs(const Body& body, const std::vector<Centre>& centres, const Accuracy& a, const Options& options,
                          const Plan& plan) {
-  const auto without = [&](long spent) {
-    BodyResult plain = integrate_checked(body, centres, nullptr, a, options);
-    count(plain, spent);
-    return plain;
-  };
   Legs g;
-  g.in_half = leg(body, centres, body.s0, {plan.about, 0.5 * plan.r0, false});
-  if (!g.in_half.refused.empty()) return without(g.evals());
-  g.in = leg(body, centres, g.in_half.end, {plan.about, plan.r_hand, false});
-  if (!g.in.refused.empty()) return without(g.evals());
-  const Body near{body.p, g.in.end, body.name};
-  Options near_options = options;
-  near_options.events.clear();
-  near_options = encounter_options(near, centres, near_options, true);
-  BodyResult r = integrate_checked(near, centres, nullptr,
-                                   Accuracy{(1.0 - kLegShare) * a.tol, encounter_span(near, centres), 0.0, a.first_step, a.first_step_of},
-                                   near_options);
-  if (r.outcome != Outcome::ok || !r.run.stopped) {  // refused, failed or unfinished: said at its own times
-    count(r, g.evals());
-    return r;
+  if (!in_legs(g, body, centres, plan)) return without_legs(body, centres, a, options, g.evals());
+  Near n = near_run(body, g.in.end, centres, a, options);
+  if (!n.finished()) {  // refused, failed or unfinished: said at its own times
+    count(n.r, g.evals());
+    return n.r;
   }
-  g.out_half = leg(body, centres, r.run.final, {plan.about, 0.5 * plan.r0, true});
-  if (g.out_half.refused.empty()) g.out = leg(body, centres, g.out_half.end, {plan.about, plan.r0, true});
-  if (!g.out_half.refused.empty() || !g.out.refused.empty()) return without(g.evals() + r.total_force_evals());
-  join(r, body, centres, g, plan, options, near, near_options, a.tol);
-  return r;
+  if (!out_legs(g, body, centres, n.r.run.final, plan))
+    return without_legs(body, centres, a, options, g.evals() + n.r.total_force_evals());
+  join(n.r, body, centres, g, plan, options, n.body, n.options, a.tol);
+  return n.r;
+}
+
+/// The hand-off at the limit L -> infinity from the legs in from L (`from_L`) and from 2L (`from_2L`), landed on
+/// the same distance: Richardson's 2 S(2L) - S(L) of each of their states (a scene given by asymptotic data
+/// reaches a fixed distance in a state that converges as 1/L in its start distance, as its observables do), its
+/// model's share from the larger of their quiver corrections; its time, steps and cost are `own`'s (the leg of
+/// the encounter it hands off, whose time delay reads its time).
+Leg at_limit(const Leg& from_L, const Leg& from_2L, const Leg& own) {
+  const auto lim = [](const State& x, const State& y) { return State{2.0 * y.R - x.R, 2.0 * y.v - x.v, 2.0 * y.w - x.w}; };
+  Leg l = own;
+  l.end = lim(from_L.end, from_2L.end);
+  l.coarse = lim(from_L.coarse, from_2L.coarse);
+  l.averaged = lim(from_L.averaged, from_2L.averaged);
+  l.quiver = std::max(from_L.quiver, from_2L.quiver);
+  l.error = state_distance(l.coarse, l.end) + kModelShare * l.quiver;
+  return l;
+}
+
+/// What the run between the legs `r`, from the hand-off at the limit `lim`, makes of the run from 2L's
+/// observables against its own hand-off `own` (S(2L)) to first order: signed, what reading the incoming asymptote
+/// at `own` instead of `lim` moves them by, the other way (the hand-offs differ by a turn about the centre, 6e-9
+/// rad from L = 3200 on table 3.1, which turns the outgoing asymptote with the incoming one: the deflection with
+/// the run's own incoming asymptote moves by the turn); unsigned, what a change of the straight path's distance
+/// from the centre between them moves the deflection and the delay by (kSensitivity sin(theta)/b and
+/// sin(theta)/v_inf, Rutherford's).
+void first_order(TwiceAsFar& twice, BodyResult& r2, const BodyPoint& p, const std::vector<Centre>& centres, const Vec3& about,
+                 const State& lim, const State& own, const BodyResult& r) {
+  const Scattering at_lim = scattering(p, centres, lim, r.run.final, r.run.t_end);
+  const Scattering at_own = scattering(p, centres, own, r.run.final, r.run.t_end);
+  twice.deflection_shift = at_own.deflection - at_lim.deflection;
+  twice.time_delay_shift = at_own.time_delay - at_lim.time_delay;
+  twice.out_of_plane_shift = at_own.out_of_plane - at_lim.out_of_plane;
+  const double line = std::abs(line_distance(p, lim, about) - line_distance(p, own, about));
+  const double per = kSensitivity * std::abs(std::sin(at_lim.deflection)) * line;
+  r2.error.orbit += per / at_lim.b;
+  r2.error.time_delay += per / at_lim.v_inf;
+}
+
+/// The encounter of `body` from L and of `twice` from 2L (the same asymptotic data) with one run between the
+/// legs, from the hand-off at the limit (at_limit): each encounter is its legs and that run, and Richardson's
+/// 2 x(2L) - x(L) of their observables is the limit's as that of the two whole runs is (the run between the legs
+/// answers both hand-offs' difference from the limit's to first order, 2 (S(2L) - S(L)) for the one and
+/// S(2L) - S(L) for the other, which cancel in 2 x(2L) - x(L)); `twice` gets that first order's shift (first_order),
+/// so that the limit's error reads the two encounters' own difference. The run from 2L carries its own legs'
+/// errors and cost (the run between them and the hand-off's leg are counted once, in the run from L's, as the
+/// limit carries them once). Where a leg stops short or the
+/// run between them does not finish, the run from L as run_with_legs would have it (the work counted) and none
+/// from 2L.
+std::pair<BodyResult, std::optional<BodyResult>> run_pair_with_legs(const Body& body, TwiceAsFar& twice,
+                                                                    const std::vector<Centre>& centres, const Accuracy& a,
+                                                                    const Options& options, const Plan& plan, Plan plan2) {
+  plan2.r_hand = plan.r_hand;  // both land on the same distance
+  Legs g, g2;
+  if (!in_legs(g, body, centres, plan) || !in_legs(g2, twice.body, centres, plan2))
+    return {without_legs(body, centres, a, options, g.evals() + g2.evals()), std::nullopt};
+  const Leg from_L = g.in, from_2L = g2.in;
+  g.in = at_limit(from_L, from_2L, from_L);
+  g2.in = at_limit(from_L, from_2L, from_2L);
+  Near n = near_run(body, g.in.end, centres, a, options);
+  if (!n.finished()) {
+    count(n.r, g.evals() + g2.evals());
+    return {std::move(n.r), std::nullopt};
+  }
+  // The run from 2L goes out on this one's legs (their errors and cost counted here) and on to 2L.
+  const auto shared = [](Leg l) {
+    l.coarse = l.averaged = l.end;
+    l.t_coarse = l.t;
+    l.error = 0.0;
+    l.evals = 0;
+    return l;
+  };
+  if (out_legs(g, body, centres, n.r.run.final, plan)) {
+    g2.out_half = shared(g.out_half);
+    g2.out = shared(g.out);
+    g2.beyond = leg(twice.body, centres, g.out.end, {plan2.about, plan2.r0, true});
+  }
+  if (!g2.beyond || !g2.beyond->refused.empty())
+    return {without_legs(body, centres, a, options, g.evals() + g2.evals() + n.r.total_force_evals()), std::nullopt};
+  // The run from 2L: its own legs' errors (the run between them and the hand-off's leg are the run from L's,
+  // which the limit 2 x(2L) - x(L) carries once), its cost its legs'.
+  BodyResult r2 = n.r;
+  r2.run.force_evals = r2.event_force_evals = r2.error.force_evals = r2.run.steps = 0;
+  if (r2.accuracy) r2.accuracy->force_evals = 0;
+  r2.error.value = 0.0;
+  r2.error.time_delay = 0.0;
+  const Leg own = g2.in;  // its time is its own (its state the hand-off's, whose errors the run from L carries)
+  g2.in = shared(g2.in);
+  g2.in.evals = own.evals;
+  g2.in.t_coarse = own.t_coarse;
+  join(r2, twice.body, centres, g2, plan2, twice.options, n.body, n.options, a.tol);
+  first_order(twice, r2, body.p, centres, plan.about, g.in.end, from_2L.end, n.r);
+  r2.error.basis += "; the run between the legs and the hand-off's leg are the encounter's from L (its hand-off at the limit, "
+                    "2 S(2L) - S(L)), their errors counted there";
+  join(n.r, body, centres, g, plan, options, n.body, n.options, a.tol);
+  // This run's state from the hand-off on is the limit's: it is apart from the trajectory from L by what the
+  // hand-offs are, which its final state's error carries (as a leg's error, not carried through the encounter).
+  const double apart = state_distance(g.in.end, from_L.end);
+  n.r.error.value += apart;
+  if (n.r.accuracy) n.r.accuracy->err_estimate = n.r.error.value;
+  const std::string limit = "the run between the legs starts from the hand-off at the limit L -> infinity (2 S(2L) - S(L) of "
+                            "the legs in from L and 2L, " + fmt(apart) + " from this start's own, in the final state's error)";
+  n.r.error.basis += "; " + limit;
+  n.r.chosen += "; " + limit;
+  return {std::move(n.r), std::move(r2)};
 }
 
 }  // namespace
 
 BodyResult integrate_encounter_checked(const Body& body, const std::vector<Centre>& centres, const MethodInfo* method,
-                                       const Advance& how, const Options& options) {
-  if (const std::optional<Plan> plan = plan_legs(body, centres, method, how, options))
-    return run_with_legs(body, centres, std::get<Accuracy>(how), options, *plan);
-  return integrate_checked(body, centres, method, how, options);
+                                       const Advance& how, const Options& options, TwiceAsFar* twice) {
+  const std::optional<Plan> plan = plan_legs(body, centres, method, how, options);
+  if (!plan) return integrate_checked(body, centres, method, how, options);
+  const Accuracy& a = std::get<Accuracy>(how);
+  if (twice) {
+    const std::optional<Plan> plan2 = plan_legs(twice->body, centres, method, how, twice->options);
+    if (plan2 && plan2->r0 >= kLegGain * plan->r_hand) {
+      auto [at_L, at_2L] = run_pair_with_legs(body, *twice, centres, a, options, *plan, *plan2);
+      twice->run = std::move(at_2L);
+      return std::move(at_L);
+    }
+  }
+  return run_with_legs(body, centres, a, options, *plan);
 }
 
 }  // namespace bodypoint::detail

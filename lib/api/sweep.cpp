@@ -175,20 +175,24 @@ PointData point_data(const SweepSpec& spec, const std::vector<double>& point) {
 
 /// The start distance's part of a row's encounter error: the grid point's scene from twice its start
 /// distance (thesis_scene_twice_as_far: the point's data b, v_inf, arrival phase solved for again, the
-/// rest kept), run to its departure by auto (twice_as_far_tol).
-long add_row_start_distance(Encounter& e, const SweepSpec& spec, const std::vector<double>& point, const Body& body,
-                            const BodyResult& near) {
+/// rest kept), run to its departure by auto (twice_as_far_tol), or beside the row's run where far legs serve
+/// both (twice_as_far_beside).
+struct RowFar {
+  std::optional<PointData> d;  ///< the point's data, solved once for the far scene and the limit's rule
   std::function<Expected<Scene>()> far;
-  std::optional<PointData> d;  // the point's data, solved once for the far scene and the limit's rule
+  bool at_limit = false;
+  Options options;
+};
+RowFar row_far(const SweepSpec& spec, const std::vector<double>& point) {
+  RowFar f;
   if (spec.scene_text.empty()) {
-    d = point_data(spec, point);
-    far = [&] { return thesis_scene_twice_as_far(d->params, d->b, d->v_inf, d->arrival); };
+    f.d = point_data(spec, point);
+    f.far = [d = *f.d] { return thesis_scene_twice_as_far(d.params, d.b, d.v_inf, d.arrival); };
+    f.at_limit = answers_at_limit(f.d->b, f.d->v_inf);
   }
-  Options o;
-  o.track_invariants = false;
-  o.cancel = spec.cancel;
-  return add_start_distance(e, body, far, spec.accuracy, near.error.for_orbit(), "a scene file's body has no thesis start distance to double", o,
-                            d && answers_at_limit(d->b, d->v_inf), &near);
+  f.options.track_invariants = false;
+  f.options.cancel = spec.cancel;
+  return f;
 }
 
 /// The row of a run with its encounter (SweepSpec::scattering): integrate_encounter_checked (far legs where
@@ -199,11 +203,16 @@ SweepRow encounter_row(SweepRow row, const MethodInfo* method, const Scene& scen
                        const SweepSpec& spec) {
   const Body& body = scene.bodies.front();
   const Options options = encounter_options(body, scene.centres, sweep_options(spec), true);
-  BodyResult r = detail::integrate_encounter_checked(body, scene.centres, method, how, options);  // checked by validate_sweep
+  const RowFar f = row_far(spec, row.point);
+  std::optional<TwiceAsFar> twice = twice_as_far_beside(f.far, f.at_limit, body, scene.centres, spec.accuracy, f.options);
+  TwiceAsFar* beside = twice ? &*twice : nullptr;
+  BodyResult r = detail::integrate_encounter_checked(body, scene.centres, method, how, options, beside);  // checked by validate_sweep
   if (!ran(r.outcome)) return result_row(std::move(row), std::move(r));
   Encounter e = measure_encounter(body, scene.centres, r, options.events);
   if (e.outcome == Outcome::ok && r.outcome == Outcome::ok)
-    row.start_distance_force_evals = add_row_start_distance(e, spec, row.point, body, r);
+    row.start_distance_force_evals = add_start_distance(e, body, f.far, spec.accuracy, r.error.for_orbit(),
+                                                        "a scene file's body has no thesis start distance to double", f.options,
+                                                        f.at_limit, &r, beside);
   row.r_min = e.r_min;
   row.t_min = e.t_min;
   row.r_min_error = e.r_min_error;

@@ -545,31 +545,33 @@ py::dict encounter_py(const Scene& scene, const std::string& method, double tol,
   o.track_invariants = false;
   Interruptible stop(max_seconds);
   o.cancel = stop.flag();
+  const Body& body = scene.bodies.front();
+  // The start distance's part of the error (bodypoint.hpp, add_start_distance_error): the thesis's scene
+  // again from 2L, run beside this one where far legs serve both; a scene given by its states has no L to
+  // double. The far scene is made here, under the GIL (from the thesis's parameters, a Python dict).
+  std::optional<Expected<Scene>> far_scene;
+  bool at_limit = false;
+  if (thesis) {
+    const ThesisParams t = thesis_params_from(*thesis);  // solves the asymptotic data: once
+    far_scene = twice_as_far(t);
+    at_limit = answers_at_limit(t.data.b.value_or(kNotGiven), t.data.v_inf.value_or(kNotGiven));
+  }
+  std::function<Expected<Scene>()> far;
+  if (far_scene) far = [&far_scene] { return *far_scene; };
+  std::optional<TwiceAsFar> twice = std::isnan(t_end) ? twice_as_far_beside(far, at_limit, body, scene.centres, tol, o) : std::nullopt;
   EncounterResult r;
   {
     py::gil_scoped_release free;
-    r = encounter(scene.bodies.front(), scene.centres, m, tol, t_end, o);
+    r = twice ? encounter_beside(body, scene.centres, m, tol, o, &*twice) : encounter(body, scene.centres, m, tol, t_end, o);
   }
   stop.raise();
   if (r.run.outcome != Outcome::ok) throw Error(r.run.reason);
-  // The start distance's part of the error (bodypoint.hpp, add_start_distance_error): the thesis's scene
-  // again from 2L; a scene given by its states has no L to double.
-  const Body& body = scene.bodies.front();
   if (r.encounter.outcome == Outcome::ok) {
-    // The far scene is made here, under the GIL (from the thesis's parameters, a Python dict).
-    std::optional<Expected<Scene>> far_scene;
-    bool at_limit = false;
-    if (thesis) {
-      const ThesisParams t = thesis_params_from(*thesis);  // solves the asymptotic data: once
-      far_scene = twice_as_far(t);
-      at_limit = answers_at_limit(t.data.b.value_or(kNotGiven), t.data.v_inf.value_or(kNotGiven));
-    }
-    std::function<Expected<Scene>()> far;
-    if (far_scene) far = [&far_scene] { return *far_scene; };
     {
       py::gil_scoped_release free;
       r.run.encounter_force_evals = add_start_distance(r.encounter, body, far, tol, r.run.error.for_orbit(),
-                         "the scene gives states, not the thesis's start distance L (thesis_scene() does)", o, at_limit, &r.run);
+                         "the scene gives states, not the thesis's start distance L (thesis_scene() does)", o, at_limit, &r.run,
+                         twice ? &*twice : nullptr);
     }
     stop.raise();
   }
