@@ -427,9 +427,8 @@ void first_order(TwiceAsFar& twice, BodyResult& r2, const BodyPoint& p, const st
 /// S(2L) - S(L) for the other, which cancel in 2 x(2L) - x(L)); `twice` gets that first order's shift (first_order),
 /// so that the limit's error reads the two encounters' own difference. The run from 2L carries its own legs'
 /// errors and cost (the run between them and the hand-off's leg are counted once, in the run from L's, as the
-/// limit carries them once). Where a leg stops short or the
-/// run between them does not finish, the run from L as run_with_legs would have it (the work counted) and none
-/// from 2L.
+/// limit carries them once). Where a leg stops short or the run between them does not finish, the run from L as
+/// run_with_legs would have it (the work counted) and none from 2L.
 std::pair<BodyResult, std::optional<BodyResult>> run_pair_with_legs(const Body& body, TwiceAsFar& twice,
                                                                     const std::vector<Centre>& centres, const Accuracy& a,
                                                                     const Options& options, const Plan& plan, Plan plan2) {

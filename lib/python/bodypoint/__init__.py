@@ -408,7 +408,8 @@ def encounter(scene, *, t_end=None, method="auto", tol=1e-10, max_seconds=DEFAUL
     a material point and for a scene given by its states, whose observables are its trajectory's),
     time_delay_error (the time delay's total: time_delay_run_error, the run's estimate carried to the
     delay by its companion, and the start distance's part),
-    start_distance_basis, start_distance_force_evals (the run from 2L; in run's total_force_evals too),
+    start_distance_basis, start_distance_force_evals (the run from 2L, its far legs alone where it shares
+    the run between them with this one's; in run's total_force_evals too),
     deflection_error (the deflection's total: the run's estimate, the asymptotes' and the start
     distance's; None where a part is not known), K1_turn, spin_turn,
     r_min, t_min (the closest approach to any centre), asymptotes, direction_in and direction_out, K1,
