@@ -810,7 +810,7 @@ TEST(Encounter, LegsCrossTheFarFieldOfSeveralCentres) {
   expect_legs_meet_their_reference(s, 1e-6);
 }
 
-/// 16x the start distance adds ln(16)/0.1 steps of the legs (about 28 steps of 36 evaluations, at two steps
+/// 16x the start distance adds ln(16)/0.2 steps of the legs (about 14 steps of 36 evaluations, at two steps
 /// each, in and out): a few thousand evaluations on the encounter's 10,000-20,000; a run capped by the spin
 /// would cost about 16x.
 constexpr double kLogGrowth = 1.5;
