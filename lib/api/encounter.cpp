@@ -335,7 +335,8 @@ long add_start_distance(Encounter& e, const Body& body, const std::function<Expe
     shift(sc.time_delay, far_sc.time_delay, twice->time_delay_shift);
     shift(sc.out_of_plane, far_sc.out_of_plane, twice->out_of_plane_shift);
   } else {
-    const Expected<Scene> scene = far();
+    // The scene from 2L solved once: the one twice_as_far_beside made, where it made one.
+    const Expected<Scene> scene = twice ? Expected<Scene>(Scene{twice->centres, {twice->body}}) : far();
     if (!scene) {  // no scene from 2L has the data: the part is not known, and why
       no_start_distance_error(e, false, numerical, "the scene from twice the start distance has no such data (" + scene.error() + ")");
       return 0;
