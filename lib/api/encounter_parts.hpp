@@ -83,6 +83,9 @@ EncounterResult encounter_twice_as_far(const Scene& far, double tol, const Optio
 /// The same when the start distance cannot be doubled (a scene given by its states): the part is not
 /// known (`why`), nor is the total, for B != 0.
 void no_start_distance_error(Encounter& e, bool material, double numerical, const std::string& why);
+/// Whether a thesis scene given by these asymptotic data (NaN: not given) answers at the limit L -> infinity
+/// (`at_limit` of add_start_distance): given by b or v_inf.
+inline bool answers_at_limit(double b, double v_inf) { return !(std::isnan(b) && std::isnan(v_inf)); }
 /// The start distance's part of `e`'s error, one rule for every caller (simulate, sweep, the scattering
 /// study, Python): exact (0) for a material point, and 0 where the scene gives states (`far` empty, `no_far`
 /// saying so: its observables are its trajectory's); not known (its reason) where `far()` finds no scene
@@ -92,9 +95,6 @@ void no_start_distance_error(Encounter& e, bool material, double numerical, cons
 /// (encounter_twice_as_far); `twice` with its run (twice_as_far_beside, shared far legs' run) stands for that
 /// encounter. Returns the force evaluations of that second encounter (0 where none ran), also in
 /// Encounter::start_distance_force_evals.
-/// Whether a thesis scene given by these asymptotic data (NaN: not given) answers at the limit L -> infinity
-/// (`at_limit` of add_start_distance): given by b or v_inf.
-inline bool answers_at_limit(double b, double v_inf) { return !(std::isnan(b) && std::isnan(v_inf)); }
 long add_start_distance(Encounter& e, const Body& body, const std::function<Expected<Scene>()>& far,
                         std::optional<double> tol, double numerical, const std::string& no_far, const Options& options = {},
                         bool at_limit = false, const BodyResult* near = nullptr, const TwiceAsFar* twice = nullptr);

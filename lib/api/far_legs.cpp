@@ -470,10 +470,9 @@ std::pair<BodyResult, std::optional<BodyResult>> run_pair_with_legs(const Body& 
   if (r2.accuracy) r2.accuracy->force_evals = 0;
   r2.error.value = 0.0;
   r2.error.time_delay = 0.0;
-  const Leg own = g2.in;  // its time is its own (its state the hand-off's, whose errors the run from L carries)
-  g2.in = shared(g2.in);
-  g2.in.evals = own.evals;
-  g2.in.t_coarse = own.t_coarse;
+  // Its leg in keeps its own time and cost; its state is the hand-off's, whose errors the run from L carries.
+  g2.in.coarse = g2.in.averaged = g2.in.end;
+  g2.in.error = 0.0;
   join(r2, twice.body, centres, g2, plan2, twice.options, n.body, n.options, a.tol);
   first_order(twice, r2, body.p, centres, plan.about, g.in.end, from_2L.end, n.r);
   r2.error.basis += "; the run between the legs and the hand-off's leg are the encounter's from L (its hand-off at the limit, "
