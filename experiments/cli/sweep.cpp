@@ -123,7 +123,8 @@ std::string body_names(const SweepSpec& spec) {
 /// The header's words on an encounter sweep's columns (SweepSpec::scattering).
 std::string scattering_columns() {
   return "; r_min,t_min = the closest approach to any centre (located on the method's steps), r_min_error,t_min_error ="
-         " their estimated errors (the same event on companion runs at 2h and 4h; NaN: not known);"
+         " their estimated errors (the same event on companion runs at 2h and 4h, the far legs' part added; given by b or"
+         " v_inf, r_min_error covers r_min's distance from the limit L -> infinity; NaN: not known);"
          " deflection, out_of_plane = angles between the incoming and outgoing asymptotes (rad);"
          " b_in = impact parameter of the incoming asymptote, v_inf_in = speed at infinity on it (of the guiding centre"
          " for B != 0);"

@@ -48,15 +48,18 @@ bool has_event(const std::vector<Event>& events, Event::Kind kind, std::size_t c
                      [&](const Event& e) { return e.kind == kind && e.centre == centre && e.stop == stop; });
 }
 
-/// Why the run ended before the body left, or empty when it had left.
-std::string unfinished(const Body& body, const std::vector<Centre>& all, const RunResult& run) {
+/// Why the run ended before the body left, or empty when it had left. `departed`: the run stopped at its
+/// departure through the start distance, which it crossed on its own steps; the state located there is advanced
+/// from the step before and may lie inside by that advance's error (an attracting scene's run from 2L by
+/// ttl-pefrl at TOL 1e-6 stopped 1.7e-9 of its distance inside, and its encounter read "did not finish").
+std::string unfinished(const Body& body, const std::vector<Centre>& all, const RunResult& run, bool departed) {
   const std::vector<Centre> centres = measured_about(all);
   for (std::size_t k = 0; k < centres.size(); ++k) {
     const double r0 = start_distance(body, centres[k]);
     const Vec3 G = detail::guiding_centre(body.p, run.final) - centres[k].c;
     const auto particle = kepler_particle(body.p, run.final, centres[k].c);
     const bool receding = particle && particle->X.dot(particle->P) > 0.0;
-    if (receding && G.norm() >= r0 * (1.0 - kLeftSlack)) continue;
+    if (receding && (departed || G.norm() >= r0 * (1.0 - kLeftSlack))) continue;
     const std::string where = centres.size() > 1 ? " from centre " + std::to_string(k) : "";
     return "the run ended at t = " + fmt(run.t_end) + " with the " + (body.p.B == 0.0 ? "body" : "guiding centre") +
            " at distance " + fmt(G.norm()) + where + ", " + (receding ? "receding" : "not receding") +
@@ -161,7 +164,9 @@ Encounter measure_encounter(const Body& body, const std::vector<Centre>& centres
     e.r_min_error = nearest->r_error;
     e.t_min_error = nearest->t_error;
   }
-  e.reason = unfinished(body, centres, run);
+  const bool departed = run.stopped && !hits.empty() && events[hits.back().event].kind == Event::Kind::departure &&
+                        events[hits.back().event].stop;
+  e.reason = unfinished(body, centres, run, departed);
   const bool finished = e.reason.empty();
   // A scattering result exists only for an encounter that happened: a body (guiding centre) that
   // drifts away from the start passes no closest approach, and its "incoming" asymptote is a leg it
@@ -302,6 +307,27 @@ EncounterResult encounter_beside(const Body& body, const std::vector<Centre>& ce
   return encounter_at(body, centres, method, Accuracy{tol, encounter_span(body, centres)}, std::move(options), true, twice);
 }
 
+namespace {
+
+/// The closest approach's distance from the limit L -> infinity: r(L) converges to it neither as 1/L nor always
+/// monotonically (the helix's phase at the periapsis moves with L: B = 0.416, A = -2.946, b = 1.64, arrival phase
+/// 3.07 by logh-kl6 at 1e-10 from L = 200, 300, 400, 600: 3.17143188862, 3.17143207244, 3.17143198370,
+/// 3.17143182675, the limit about 3.1714318756; 2 r(400) - r(200) is 2.0e-7 off it, 1.4x 1.5 |r(200) - r(400)|), so
+/// it is not taken to the limit as the deflection is: its error adds kStartDistanceFactor (|r(L) - r(2L)| + the run
+/// from 2L's error), as a scene's start distance part where it is not at the limit. That run locates it without an error of its own
+/// (twice_as_far_options): the same near field at the same tol, its location's error is taken as this run's, but
+/// where the two share the run between their far legs (`shared`: this run's error carries its location and the
+/// hand-off); its legs' part is its own (far_legs.cpp, approach_error). Its time is from this start.
+void closest_from_limit(Encounter& e, const EncounterResult& twice, bool shared) {
+  const Encounter& far = twice.encounter;
+  if (!std::isfinite(e.r_min) || !std::isfinite(far.r_min)) return;
+  const double legs = twice.run.error.closest_from_legs;
+  const double far_error = (shared ? 0.0 : e.r_min_error) + (std::isfinite(legs) ? legs : 0.0);
+  e.r_min_error += kStartDistanceFactor * (std::abs(e.r_min - far.r_min) + far_error);
+}
+
+}  // namespace
+
 void no_start_distance_error(Encounter& e, bool material, double numerical, const std::string& why) {
   add_start_distance_error(e, nullptr, material, numerical, false);
   if (!material) e.start_distance_basis = "not known: " + why;
@@ -344,6 +370,7 @@ long add_start_distance(Encounter& e, const Body& body, const std::function<Expe
     r = encounter_twice_as_far(*scene, twice_as_far_tol(tol), options, near);
   }
   add_start_distance_error(e, &r, false, numerical, at_limit);
+  if (at_limit && r.encounter.outcome == Outcome::ok) closest_from_limit(e, r, twice && twice->run);
   if (twice && twice->run)
     e.start_distance_basis += "; the two share the run between their far legs, from the hand-off at the limit 2 S(2L) - S(L) (each "
                               "its own legs), which the limit cancels to first order";

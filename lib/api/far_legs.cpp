@@ -275,6 +275,52 @@ double delay_error(const Body& body, const std::vector<Centre>& centres, const L
   return std::isfinite(e) ? e : std::numeric_limits<double>::quiet_NaN();
 }
 
+/// What the legs coming in make of a closest approach that the run between them passes at its time `t` (from the
+/// hand-off): of its distance and of its time from the start.
+struct Approach {
+  double r = 0.0, t = 0.0;
+};
+/// The shares of a leg's differences taken: its coarser run's whole; of the quiver correction's effect, the
+/// averaged model's across K1 (the impact parameter), in the state (the helix and the speed) and along the path.
+struct Shares {
+  double across = 1.0, state = 1.0, along = 1.0;
+};
+/// Each leg's end against its coarser run's end and, at the model's shares (kAcrossModelShare, kModelShare,
+/// kDelayModelShare), against its end before the quiver correction. The incoming asymptote's impact parameter moved
+/// by db and its speed by dv (relative) move a point mass's periapsis sqrt(a^2 + b^2) +- a (a = |A|/(|K1| v)) by at
+/// most db + 4 a dv (Rutherford's, taken kSensitivity times as for the deflection); the helix about the guiding
+/// centre adds what its vector differs by at the leg's end and the turn that dv makes of the spin's rate
+/// (|B| |K1|/D) until `t`. The time: the legs' own times, the guiding centre's offset along K1 over the speed, and
+/// dv of the time until `t`.
+Approach approach_error(const Body& body, const std::vector<Centre>& centres, const Legs& g, const State& near_end, double t) {
+  const auto in_of = [&](const State& s) { return scattering(body.p, centres, s, near_end); };
+  const Momenta q = to_momenta(body.p, g.in.end);
+  const std::optional<Centre> far = far_field_centre(centres);
+  const double K1 = q.K1.norm(), v = in_of(g.in.end).v_inf;
+  const double a = far ? std::abs(far->A) / (K1 * v) : std::numeric_limits<double>::quiet_NaN();
+  const double spin_rate = std::abs(body.p.B) * K1 / body.p.D();
+  const Vec3 u = q.K1 / K1;
+  const auto helix = [&](const State& s) -> Vec3 { return s.R - guiding_centre(body.p, s); };
+  const double rho = helix(g.in.end).norm();
+  Approach e;
+  const auto add = [&](const Leg& l, const State& other, double t_other, const Shares& k, double until) {
+    const Scattering here = in_of(l.end), there = in_of(other);
+    const double dv = std::abs(here.v_inf - there.v_inf) / v, db = std::abs(here.b - there.b);
+    const double along = std::abs((guiding_centre(body.p, l.end) - guiding_centre(body.p, other)).dot(u));
+    e.r += kSensitivity * (k.across * db + k.state * 4.0 * a * dv) +
+           k.state * ((helix(l.end) - helix(other)).norm() + rho * spin_rate * until * dv);
+    e.t += std::abs(l.t - t_other) + k.along * along / v + k.state * until * dv;
+  };
+  for (const Leg* l : {&g.in_half, &g.in}) {
+    const double until = t + (l == &g.in_half ? g.in.t : 0.0);
+    add(*l, l->coarse, l->t_coarse, Shares{}, until);
+    add(*l, l->averaged, l->t, Shares{kAcrossModelShare, kModelShare, kDelayModelShare}, until);
+  }
+  if (!std::isfinite(e.r)) e.r = std::numeric_limits<double>::quiet_NaN();
+  if (!std::isfinite(e.t)) e.t = std::numeric_limits<double>::quiet_NaN();
+  return e;
+}
+
 /// `evals` spent for `r` beyond its run: in its count and, where the accuracy mode ran it, in the search's, which
 /// the total reads (BodyResult::total_force_evals).
 void count(BodyResult& r, long evals) {
@@ -294,6 +340,13 @@ void join(BodyResult& r, const Body& body, const std::vector<Centre>& centres, c
     if (e.kind != Event::Kind::closest_approach) continue;
     for (std::size_t k = 0; k < options.events.size(); ++k)
       if (options.events[k].kind == e.kind && options.events[k].centre == e.centre) h.event = k;
+    // Located on the run between the legs, from a hand-off that carries the legs' errors (NaN stays: the location's
+    // error not known; their part of the distance's is kept for the limit, closest_from_limit).
+    const Approach legs = approach_error(body, centres, g, r.run.final, h.t);
+    h.r_error += legs.r;
+    h.t_error += legs.t;
+    h.state_error += g.in_half.error + g.in.error;
+    r.error.closest_from_legs = std::max(r.error.closest_from_legs, legs.r);
     h.t += t_in;
     hits.push_back(h);
   }

@@ -774,6 +774,16 @@ void expect_legs_meet_their_reference(const Scene& s, double tol) {
   const double delay_off = std::abs(legs.encounter.scattering.time_delay - ref.encounter.scattering.time_delay);
   EXPECT_LE(delay_off, legs.encounter.time_delay_run_error + ref.encounter.time_delay_run_error)
       << "tol " << tol << ": " << legs.encounter.scattering.time_delay << " against " << ref.encounter.scattering.time_delay;
+  // The closest approach, located on the run between the legs from a hand-off that carries their errors: its
+  // distance and time within theirs (the legs' part had been left out, 1e3-2e4x below the distance to the
+  // reference: a made-up attracting scene from L = 12,800 at 1e-8, r_min 3.8e-7 off with 8e-11 stated).
+  // Where the reference's own location error is not known, its final state's relative error stands for it.
+  const Encounter &e = legs.encounter, &f = ref.encounter;
+  const auto ref_own = [&](double error, double x) { return std::isfinite(error) ? error : ref.run.error.value * std::abs(x); };
+  EXPECT_LE(std::abs(e.r_min - f.r_min), e.r_min_error + ref_own(f.r_min_error, f.r_min))
+      << "tol " << tol << ": " << e.r_min << " against " << f.r_min;
+  EXPECT_LE(std::abs(e.t_min - f.t_min), e.t_min_error + ref_own(f.t_min_error, f.t_min))
+      << "tol " << tol << ": " << e.t_min << " against " << f.t_min;
   // The legs cost a small share of the run without them.
   EXPECT_LT(legs.run.total_force_evals(), ref.run.total_force_evals());
 }
@@ -938,6 +948,52 @@ TEST(Encounter, AtTheLimitTheRunsFromLAndTwiceLShareTheRunBetweenTheirLegs) {
     const long shared_evals = shared.run.total_force_evals() + twice_evals;
     EXPECT_LT(shared_evals, whole.run.total_force_evals() + whole_twice_evals);
     EXPECT_LT(static_cast<double>(twice_evals), kSharedTwiceShare * static_cast<double>(shared_evals));
+  }
+}
+
+/// The closest approach of an encounter given by asymptotic data: its distance within its stated error of the
+/// limit's, the trajectories from kClosestReferenceL and twice that by ttl-kl6 named (no legs) at 1e-10, within
+/// kStartDistanceFactor (3) times what they differ by. Made up here: an attracting centre, a slow spin. Before, the
+/// error was the location's alone (from L = 200 at 1e-8: 9.6e-7 off, 2.2e-11 stated), and the same scene at 1e-6
+/// had no start distance part at all: its run from 2L stopped at its departure 1.7e-9 of its distance inside it
+/// and read "did not finish".
+constexpr double kClosestReferenceL = 3200.0;
+
+TEST(Encounter, AnEncounterAtTheLimitStatesItsClosestApproachWithinItsDistanceFromTheLimit) {
+  struct Made {
+    double A, B, K1, Kx, Kz, b, phase;
+  };
+  for (const Made m : {Made{0.489, 0.525, 3.45, -0.6, 5.13, 1.43, 1.4}, Made{2.364, 0.701, 5.87, 3.0, 2.57, 5.71, 3.73}}) {
+    const auto scene_from = [&](double L) {
+      SceneParams p;
+      p.A = m.A;
+      p.B = m.B;
+      p.start.K1 = m.K1;
+      p.start.Kx = m.Kx;
+      p.start.Kz = m.Kz;
+      p.start.L = L;
+      return with_asymptotic_data(p, m.b, Scattering::kNaN, m.phase);
+    };
+    const auto closest = [&](double L) {
+      const Scene s = thesis_scene(scene_from(L));
+      const EncounterResult r = encounter(s.bodies.front(), s.centres, find_method("ttl-kl6"), 1e-10);
+      EXPECT_EQ(r.encounter.outcome, Outcome::ok) << r.encounter.reason;
+      return r.encounter;
+    };
+    const Encounter near = closest(kClosestReferenceL), far = closest(2.0 * kClosestReferenceL);
+    const double limit_error = 3.0 * (std::abs(near.r_min - far.r_min) + near.r_min_error + far.r_min_error);
+    for (const double tol : {1e-6, 1e-8}) {
+      const SceneParams solved = scene_from(200.0);
+      const Scene s = thesis_scene(solved);
+      const Body& body = s.bodies.front();
+      EncounterResult e = encounter(body, s.centres, nullptr, tol);
+      ASSERT_EQ(e.encounter.outcome, Outcome::ok) << e.encounter.reason;
+      add_start_distance(e.encounter, body, [&] { return thesis_scene_twice_as_far(solved, m.b, Scattering::kNaN, m.phase); },
+                         tol, e.run.error.for_orbit(), "", {}, true, &e.run);
+      EXPECT_TRUE(std::isfinite(e.encounter.deflection_error)) << "A = " << m.A << ": " << e.encounter.start_distance_basis;
+      EXPECT_LE(std::abs(e.encounter.r_min - far.r_min), e.encounter.r_min_error + limit_error)
+          << "A = " << m.A << ", tol " << tol << ": " << e.encounter.r_min << " against " << far.r_min;
+    }
   }
 }
 
