@@ -19,6 +19,7 @@
 #include <optional>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 namespace bodypoint {
@@ -910,20 +911,28 @@ TEST(Encounter, WithLegsTheRunFromTwiceTheStartDistanceStartsAtTheStepDelivered)
 /// (39,564 of 170,605); a quarter tells the two apart.
 constexpr double kSharedTwiceShare = 0.25;
 
+/// A scene made up for a test, given by b and arrival phase (Kz the thesis's where not given).
+struct MadeUp {
+  double A, B, K1, Kx, b, phase;
+  double Kz = SceneParams{}.start.Kz;
+};
+SceneParams made_up_from(const MadeUp& m, double L) {
+  SceneParams p;
+  p.A = m.A;
+  p.B = m.B;
+  p.start.K1 = m.K1;
+  p.start.Kx = m.Kx;
+  p.start.Kz = m.Kz;
+  p.start.L = L;
+  return with_asymptotic_data(p, m.b, Scattering::kNaN, m.phase);
+}
+
 TEST(Encounter, AtTheLimitTheRunsFromLAndTwiceLShareTheRunBetweenTheirLegs) {
   constexpr double kTol = 1e-8;
-  struct Made {
-    double A, B, K1, Kx, b, phase, L;
-  };
   // Made up for this test, not the scenes the rule was measured on.
-  for (const Made m : {Made{-3.0, 0.6, 5.0, -1.0, 4.0, 2.2, 3200.0}, Made{-0.7, 0.4, 6.0, 2.0, 6.0, 5.5, 12800.0}}) {
-    SceneParams p;
-    p.A = m.A;
-    p.B = m.B;
-    p.start.K1 = m.K1;
-    p.start.Kx = m.Kx;
-    p.start.L = m.L;
-    const SceneParams solved = with_asymptotic_data(p, m.b, Scattering::kNaN, m.phase);
+  for (const auto& [m, L] :
+       {std::pair{MadeUp{-3.0, 0.6, 5.0, -1.0, 4.0, 2.2}, 3200.0}, std::pair{MadeUp{-0.7, 0.4, 6.0, 2.0, 6.0, 5.5}, 12800.0}}) {
+    const SceneParams solved = made_up_from(m, L);
     const Scene s = thesis_scene(solved);
     const Body& body = s.bodies.front();
     const std::function<Expected<Scene>()> far = [&] { return thesis_scene_twice_as_far(solved, m.b, Scattering::kNaN, m.phase); };
@@ -941,7 +950,7 @@ TEST(Encounter, AtTheLimitTheRunsFromLAndTwiceLShareTheRunBetweenTheirLegs) {
     const long whole_twice_evals = add_start_distance(whole.encounter, body, far, kTol, whole.run.error.for_orbit(), "", {}, true,
                                                       &whole.run);
     const Encounter &a = shared.encounter, &b = whole.encounter;
-    EXPECT_LE(std::abs(a.scattering.deflection - b.scattering.deflection), a.deflection_error + b.deflection_error) << m.L;
+    EXPECT_LE(std::abs(a.scattering.deflection - b.scattering.deflection), a.deflection_error + b.deflection_error) << L;
     EXPECT_LE(std::abs(a.scattering.out_of_plane - b.scattering.out_of_plane), a.out_of_plane_error + b.out_of_plane_error);
     EXPECT_LE(std::abs(a.scattering.time_delay - b.scattering.time_delay), a.time_delay_error + b.time_delay_error);
     // Every evaluation counted (the legs' too), and the run from 2L is its legs.
@@ -960,20 +969,8 @@ TEST(Encounter, AtTheLimitTheRunsFromLAndTwiceLShareTheRunBetweenTheirLegs) {
 constexpr double kClosestReferenceL = 3200.0;
 
 TEST(Encounter, AnEncounterAtTheLimitStatesItsClosestApproachWithinItsDistanceFromTheLimit) {
-  struct Made {
-    double A, B, K1, Kx, Kz, b, phase;
-  };
-  for (const Made m : {Made{0.489, 0.525, 3.45, -0.6, 5.13, 1.43, 1.4}, Made{2.364, 0.701, 5.87, 3.0, 2.57, 5.71, 3.73}}) {
-    const auto scene_from = [&](double L) {
-      SceneParams p;
-      p.A = m.A;
-      p.B = m.B;
-      p.start.K1 = m.K1;
-      p.start.Kx = m.Kx;
-      p.start.Kz = m.Kz;
-      p.start.L = L;
-      return with_asymptotic_data(p, m.b, Scattering::kNaN, m.phase);
-    };
+  for (const MadeUp& m : {MadeUp{0.489, 0.525, 3.45, -0.6, 1.43, 1.4, 5.13}, MadeUp{2.364, 0.701, 5.87, 3.0, 5.71, 3.73, 2.57}}) {
+    const auto scene_from = [&](double L) { return made_up_from(m, L); };
     const auto closest = [&](double L) {
       const Scene s = thesis_scene(scene_from(L));
       const EncounterResult r = encounter(s.bodies.front(), s.centres, find_method("ttl-kl6"), 1e-10);
