@@ -31,13 +31,15 @@ namespace {
 
 namespace sp = splitting;
 
-/// A leg's steps are this share of r/|v| (its companion's, the one delivered, half of it): Kahan-Li 6 with a
-/// turn for each kick errs 1.9e-9 at eta 0.1 from L = 3200 to r = 400 on table 3.1, what the averaged model leaves
-/// (bench/far_turn; 6.2e-10 at 0.05, 2.5e-9 at 0.2). The pair at 0.2 and 0.1 costs half the pair at 0.1 and 0.05,
-/// and its encounters stay within their errors: at the limit from L = 3200 and 12,800 (eight scenes, TOL 1e-6 ..
-/// 1e-8) the deflection at most 0.28 of its stated error (0.23 with 0.1), the time delay 0.43 (0.32); table 3.1
-/// from 12,800 at 1e-6 costs 26,152 evaluations (36,880 with 0.1; 23,604 from L = 200).
-constexpr double kLegEta = 0.2;
+/// A leg's steps are this share of r/|v| (its companion's, the one delivered, half of it). Its error is the averaged
+/// model's more than the step's: Kahan-Li 6 with a turn for each kick errs 1.9e-9 at eta 0.1 from L = 3200 to
+/// r = 400 on table 3.1, 2.5e-9 at 0.2 (bench/far_turn); at 0.4 the helix's phase 6e-8 (the guiding centre's orbit
+/// 1.6e-9), which the pair's difference states. The pair at 0.4 and 0.2 costs half the pair at 0.2 and 0.1, and
+/// its encounters stay within their errors (docs/measurements.md, "Legs at eta 0.4 and 0.2"): at the limit from
+/// L = 12,800 on 32 made-up scenes at TOL 1e-6 .. 1e-8 against references at 1e-10, the deflection, time delay and
+/// out-of-plane angle at most 0.6 of their stated errors, the closest approach's distance 0.36 and time 0.17; table
+/// 3.1 from 12,800 at 1e-6 costs 21,208 evaluations (26,152 at 0.2; 23,604 from L = 200).
+constexpr double kLegEta = 0.4;
 /// The leg's model error against its quiver corrections' size in the state, on the scenes of
 /// bench/far_turn.cpp (docs/measurements.md, "An encounter at infinity"): at most 1/86 of it; a bound about
 /// twice that. A leg going out is off in the outgoing asymptote's direction by this share of its
