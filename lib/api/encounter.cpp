@@ -314,15 +314,14 @@ namespace {
 /// 3.07 by logh-kl6 at 1e-10 from L = 200, 300, 400, 600: 3.17143188862, 3.17143207244, 3.17143198370,
 /// 3.17143182675, the limit about 3.1714318756; 2 r(400) - r(200) is 2.0e-7 off it, 1.4x 1.5 |r(200) - r(400)|), so
 /// it is not taken to the limit as the deflection is: its error adds kStartDistanceFactor (|r(L) - r(2L)| + the run
-/// from 2L's error), as a scene's start distance part where it is not at the limit. That run locates it without an error of its own
-/// (twice_as_far_options): the same near field at the same tol, its location's error is taken as this run's, but
-/// where the two share the run between their far legs (`shared`: this run's error carries its location and the
-/// hand-off); its legs' part is its own (far_legs.cpp, approach_error). Its time is from this start.
+/// from 2L's error), as a scene's start distance part where it is not at the limit. That run locates it without an
+/// error of its own (twice_as_far_options): the same near field at the same tol, its location's error is taken as
+/// this run's, but where the two share the run between their far legs (`shared`: this run's error carries its
+/// location and the hand-off); its legs' part is its own (far_legs.cpp, approach_error). Its time is from this start.
 void closest_from_limit(Encounter& e, const EncounterResult& twice, bool shared) {
   const Encounter& far = twice.encounter;
   if (!std::isfinite(e.r_min) || !std::isfinite(far.r_min)) return;
-  const double legs = twice.run.error.closest_from_legs;
-  const double far_error = (shared ? 0.0 : e.r_min_error) + (std::isfinite(legs) ? legs : 0.0);
+  const double far_error = (shared ? 0.0 : e.r_min_error) + twice.run.error.closest_from_legs;  // NaN: not known
   e.r_min_error += kStartDistanceFactor * (std::abs(e.r_min - far.r_min) + far_error);
 }
 

@@ -348,7 +348,8 @@ void join(BodyResult& r, const Body& body, const std::vector<Centre>& centres, c
     h.r_error += legs.r;
     h.t_error += legs.t;
     h.state_error += g.in_half.error + g.in.error;
-    r.error.closest_from_legs = std::max(r.error.closest_from_legs, legs.r);
+    double& kept = r.error.closest_from_legs;  // the largest; not known (NaN) where any is not
+    kept = std::isnan(kept) || std::isnan(legs.r) ? std::numeric_limits<double>::quiet_NaN() : std::max(kept, legs.r);
     h.t += t_in;
     hits.push_back(h);
   }

@@ -205,9 +205,9 @@ struct ErrorEstimate {
   /// An encounter's time delay's error as the run read it, where the run computed it itself (far legs:
   /// the legs' and the run's between them); NaN: from `pair` (Encounter::time_delay_error).
   double time_delay = std::numeric_limits<double>::quiet_NaN();
-  /// Far legs: their part of the error of the nearest closest approach's distance, which its EventHit::r_error adds
-  /// where the location's is known (0 without legs; an encounter's run from 2L locates without errors, and the
-  /// limit takes this part from here).
+  /// Far legs: their part of the error of a closest approach's distance (the largest over the run's), which each
+  /// EventHit::r_error adds where the location's is known (0 without legs, NaN where not known; an encounter's run
+  /// from 2L locates without errors, and the limit takes this part from here).
   double closest_from_legs = 0.0;
   /// The error of a quantity read as x_run from pair->run and x_companion from pair->companion: what they
   /// differ by times what the estimate makes of the pair's distance, times kQuantityMargin, at least
