@@ -935,7 +935,10 @@ TEST(Encounter, AtTheLimitTheRunsFromLAndTwiceLShareTheRunBetweenTheirLegs) {
     const SceneParams solved = made_up_from(m, L);
     const Scene s = thesis_scene(solved);
     const Body& body = s.bodies.front();
-    const std::function<Expected<Scene>()> far = [&] { return thesis_scene_twice_as_far(solved, m.b, Scattering::kNaN, m.phase); };
+    // Captured by copy: clang 14 does not implement C++20's capture of structured bindings (P1091).
+    const std::function<Expected<Scene>()> far = [&solved, b = m.b, phase = m.phase] {
+      return thesis_scene_twice_as_far(solved, b, Scattering::kNaN, phase);
+    };
     // Shared, as simulate, sweep, Python and the study run it ...
     std::optional<TwiceAsFar> twice = twice_as_far_beside(far, true, body, s.centres, kTol);
     ASSERT_TRUE(twice);
