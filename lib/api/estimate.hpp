@@ -59,7 +59,7 @@ inline constexpr int kMaxCompanionLevels = 10;
 /// companion pair can agree by chance: ErrorEstimate::kRoundingDraws - 1 more draws of the rounding are
 /// added (add_rounding_spread): repeats of the run (fine companions) or coarse runs (coarse companion),
 /// off the run's grid from its start moved by a rounding; the sum is taken ErrorEstimate::kRoundingBound
-/// times.
+/// times where the draws repeat the run (bound_from_draws), as it is where they are coarse (sum_of_draws).
 bool at_rounding_level(const ErrorEstimate& e);
 /// What add_rounding_spread's draws are.
 inline const std::string kRepeatRoundingDraw = "a repeat off the run's grid from its start moved by a rounding";
@@ -74,9 +74,16 @@ Advance off_grid(const Advance& how, int k = 1);
 /// The way the k-th rounding draw moves its start (start_moved_by_rounding): the first draw, the run's
 /// own companion, +1; then -1, +1, ...
 double rounding_way(int k);
-/// The estimate e, summed over ErrorEstimate::kRoundingDraws draws of the rounding, taken as a bound
-/// (kRoundingBound times the sum), its basis saying so.
-void bound_from_draws(ErrorEstimate& e);
+/// The estimate e, the pair's part `pair` plus what repeats of the run differ from it by, taken as a bound: the
+/// repeats' part kRoundingBound times, its basis saying so. A repeat measured from the run is one draw of the
+/// run's rounding, the margin a bound needs; the pair's part is not doubled, which where truncation dominates
+/// read 2.0x the error (bench/estimate_ladder.py: 80 fine pairs at 2.0-2.6).
+void bound_from_draws(ErrorEstimate& e, double pair);
+/// The estimate e of a coarse pair summed with its coarse run's further draws, each measured from the coarse
+/// run, taken as it is, its basis saying so: the pair's difference already holds two draws (the run's rounding
+/// and the coarse run's), and a further one measures the coarse run's again (bench/estimate_ladder.py, the
+/// doubled sum: 90th percentile 4.13, not doubled 2.81, none more than 3x low either way).
+void sum_of_draws(ErrorEstimate& e);
 /// The state s with R scaled by 1 + 4 eps and v by 1 - 4 eps (`way` -1: the other way): a start moved by a
 /// rounding.
 State start_moved_by_rounding(State s, double way = 1.0);

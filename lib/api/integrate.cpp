@@ -710,8 +710,9 @@ ErrorEstimate Stepper::error() const {
   e.value = twin_.factor * bodypoint::state_distance(body_.s0, twin_.s);
   e.basis = twin_.basis + ", beside every segment and write (the chain's error at t = " + fmt(t_) + ")";
   if (twin_.draw && detail::at_rounding_level(e)) {
+    const double pair = e.value;
     detail::add_rounding_spread(e, body_.s0, *twin_.draw, 0, 0.0, detail::kRepeatRoundingDraw);
-    detail::bound_from_draws(e);
+    detail::bound_from_draws(e, pair);
   }
   return e;
 }

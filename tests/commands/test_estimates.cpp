@@ -153,7 +153,10 @@ TEST(Estimates, TheCoarseCompanionCostsHalfARunAndFallsBackWhereItCannotBeTruste
   EXPECT_NE(alone.out.find("from the coarse run from its start moved the other way"), std::string::npos) << alone.out;
   // AB4 evaluates the force once a step, plus its start's (force_evals - steps) alike in every run.
   const double n = json_num(alone.out, "steps"), start = json_num(alone.out, "force_evals") - n;
-  EXPECT_EQ(json_num(alone.out, "estimate_force_evals"), kCoarseLanes * (std::ceil(n / 2) + start));
+  // Where the pair was raised to the rounding level, a second coarse run at 4h may be asked to lift it.
+  const double lanes = kCoarseLanes * (std::ceil(n / 2) + start), second = std::ceil(n / 4) + start;
+  const double paid = json_num(alone.out, "estimate_force_evals");
+  EXPECT_TRUE(paid == lanes || paid == lanes + second) << paid << " for " << lanes << " (+ " << second << ")";
   // A step that turns the spin by more than the coarse side's margin (a far step of logh-kl6 at ds = 0.05
   // turns it by 1.9 rad; lp-bm4 at h = 0.2 on two spinning centres by 1.4 rad, where the coarse pair read
   // 4.4e-6 for an error of 1.0e-4): the pair is not asymptotic there, and the fine companion decides.
@@ -307,12 +310,12 @@ TEST(Estimates, AnExactFlowIsEstimatedByItsWholeRounding) {
   EXPECT_EQ(spin.out.find("flow is exact"), std::string::npos) << spin.out;
 }
 
-TEST(Estimates, AnEstimateAtTheRoundingLevelIsABoundFromTwoDrawsOfIt) {
+TEST(Estimates, AnEstimateAtTheRoundingLevelIsABoundFromThreeDrawsOfIt) {
   // kep-y4 at h = 1 on a bound orbit (an exact flow: its error is its rounding, 8e-13..6e-12 over 20
   // revolutions) from 8 starts a unit in the last place of v apart. The coarse pair alone is one draw of
   // the rounding: 7.3e-14 for a run 5.3e-12 off from the first start (0.014x), 0.64x and 0.73x from two
-  // more. The companion's twin (its steps from the start moved the other way), the sum doubled, brings
-  // every start within 3x.
+  // more. The companion's twin (its steps from the start moved the other way), measured from the coarse run
+  // and summed with the pair's difference (three draws of the rounding), brings every start within 3x.
   constexpr int kStarts = 8;
   double vy = 1.2;
   for (int k = 0; k < kStarts; ++k, vy = std::nextafter(vy, 2.0)) {
@@ -324,7 +327,7 @@ TEST(Estimates, AnEstimateAtTheRoundingLevelIsABoundFromTwoDrawsOfIt) {
     const auto r = run_cli("simulate --json --reference --scene " + path.string() + " --t-end 300 --method kep-y4 --h 1");
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.out.find("from the coarse run from its start moved the other way"), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("a bound from 2 draws of the rounding"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("their sum a bound: 3 draws of the rounding"), std::string::npos) << r.out;
     EXPECT_GE(json_num(r.out, "err_estimate"), json_num(r.out, "err_rel") / kHonestFactor) << "v = " << v << ": " << r.out;
   }
 }

@@ -169,12 +169,13 @@ struct ErrorEstimate {
   /// Draws of the rounding where the estimate is at the scene's rounding level (below 1e-10): the
   /// companion's and this many less one more from the start moved the other way (a fixed-step coarse
   /// companion's twin, its own steps, a second vector lane beside it where the method has a batch kernel;
-  /// otherwise runs off the run's grid, a coarse one half a run), what they differ by summed and taken
-  /// kRoundingBound times, a bound rather than a value. Under
-  /// independent draws the estimate is more than 3x below the error 1 in 10 times with one draw, 1 in 150
-  /// with two, 1 in 620 with two doubled (at a median 5x the error), 1 in 3,400 with three (half a run
-  /// more). bench/estimate_ladder.py, estimates more than 3x below an error above 1e-12 at this level:
-  /// 1 with one draw, 1 with two, 0 with two doubled.
+  /// otherwise runs off the run's grid, a coarse one half a run), a bound rather than a value: a coarse
+  /// draw measured from the coarse run and summed with the pair's difference (which holds the run's and the
+  /// coarse run's roundings: three draws), a repeat of the run measured from the run and its part taken
+  /// kRoundingBound times. Under independent draws the estimate is more than 3x below the error 1 in 10
+  /// times with one draw, 1 in 150 with two, 1 in 3,400 with three. bench/estimate_ladder.py, estimates
+  /// more than 3x below an error above 1e-12 at this level: 1 with one draw, 1 with two, 0 as now
+  /// (2,708 runs; `--unseen` 1,153: 0).
   static constexpr int kRoundingDraws = 2;
   static constexpr double kRoundingBound = 2.0;
   double value = std::numeric_limits<double>::quiet_NaN();  ///< the estimate; NaN when the run has none

@@ -108,18 +108,35 @@ std::optional<std::vector<BodyResult>> coarse_lanes(const MethodInfo& m, const B
 /// centre as far as the angles allow no second, and a second coarse run that breaks down or ends otherwise, say
 /// the pair is near the end of its regime: not kept (lp-bm4 at h = 0.1 on an attracting pass, 1.0e-11 off: its
 /// coarse run at 2h, no second within the angles, is 4.2e-7 off, and the pair read 2.8e-8).
+/// `shown`: whether the pair is kept only where the three runs observe its order (a coarse run too short for a
+/// second, or a second that does not refine it, then keeps nothing).
 bool coarse_pair_asymptotic(ErrorEstimate& e, const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
                             const CoarseCompanion& c, const BodyResult& x, const BodyResult& r, const Options& options,
-                            const Options& oc, const Rerun& rerun) {
+                            const Options& oc, const Rerun& rerun, bool shown = false) {
   const double limit = coarse_ratio_limit(m, centres, x.run);
   const std::optional<CoarseCompanion> c2 = coarse_companion(m, c.how, x.run.steps, limit);
-  if (!c2) return !(limit < kMinCoarseRatio);
+  if (!c2) return !shown && !(limit < kMinCoarseRatio);
   const BodyResult y = rerun_draws(body, [&c2](int) { return c2->how; }, oc, rerun)(0);
   e.force_evals += y.total_force_evals();
   e.wall_s += y.run.wall_s;
   if (!(y.outcome == Outcome::ok && ended_alike(r, options, y, oc))) return false;
-  if (!coarser(*c2, y.run.steps, x.run.steps)) return true;
+  if (!coarser(*c2, y.run.steps, x.run.steps)) return !shown;
   return observed_order_agrees(m, body, c, *c2, r.run.final, x.run.final, y.run.final, e);
+}
+
+/// Raised to the rounding level, the estimate e stands unless three runs show the pair's order: then the pair's
+/// difference is the truncation's, and Richardson reads it (`unraised`; the rounding draws added after still count
+/// the rounding). With the raise, estimates of errors in (1e-12, 1e-10] read a median 4.9x high on the ladder.
+void lift_rounding_raise(ErrorEstimate& e, const ErrorEstimate& unraised, const MethodInfo& m, const Body& body,
+                         const std::vector<Centre>& centres, const CoarseCompanion& c, const BodyResult& x,
+                         const BodyResult& r, const Options& options, const Options& oc, const Rerun& rerun) {
+  ErrorEstimate trial = unraised;
+  if (coarse_pair_asymptotic(trial, m, body, centres, c, x, r, options, oc, rerun, true)) {
+    e = std::move(trial);
+    e.basis += ", so not raised to the rounding level";
+  } else {
+    e.force_evals = trial.force_evals, e.wall_s = trial.wall_s;
+  }
 }
 
 }  // namespace
@@ -199,6 +216,8 @@ bool estimated_by_coarse(BodyResult& r, const Body& body, const std::vector<Cent
   std::optional<ErrorEstimate> coarse;
   if (x.outcome == Outcome::ok && ended_alike(r, options, x, oc) && coarser(*c, x.run.steps, r.run.steps)) {
     coarse = coarse_estimate(*r.method, body, centres, *c, r.run.final, x.run.final, r.run.steps);
+    const std::optional<ErrorEstimate> unraised =
+        coarse_estimate(*r.method, body, centres, *c, r.run.final, x.run.final, r.run.steps, false);
     coarse_side = coarse_side_of(*r.method, body, *c, r.run.final, x.run.final);
     if (coarse && asks_second_coarse(*r.method, body, centres, *coarse) &&
         !coarse_pair_asymptotic(*coarse, *r.method, body, centres, *c, x, r, options, oc, rerun)) {
@@ -210,6 +229,8 @@ bool estimated_by_coarse(BodyResult& r, const Body& body, const std::vector<Cent
       ErrorEstimate trial = *coarse;
       if (coarse_pair_asymptotic(trial, *r.method, body, centres, *c, x, r, options, oc, rerun)) coarse = std::move(trial);
       else coarse->force_evals = trial.force_evals, coarse->wall_s = trial.wall_s;
+    } else if (coarse && unraised && unraised->value < coarse->value) {
+      lift_rounding_raise(*coarse, *unraised, *r.method, body, centres, *c, x, r, options, oc, rerun);
     }
   }
   if (!coarse || !at_rounding_level(*coarse)) lane_cost(coarse ? *coarse : e);
@@ -219,8 +240,10 @@ bool estimated_by_coarse(BodyResult& r, const Body& body, const std::vector<Cent
   e = std::move(*coarse);
   e.pair = ErrorEstimate::Pair{r.run.final, x.run.final, r.run.t_end, x.run.t_end};
   const std::string& what = coarse_draw_text(*c);
-  if (lanes) add_rounding_draws(e, r, options, oc, [&](int k) { return std::move((*lanes)[static_cast<std::size_t>(k)]); }, what);
-  else add_rounding_draws(e, r, options, oc, draw, what);
+  if (lanes)
+    add_rounding_draws(e, r, options, oc, [&](int k) { return std::move((*lanes)[static_cast<std::size_t>(k)]); }, what,
+                       &x.run.final);
+  else add_rounding_draws(e, r, options, oc, draw, what, &x.run.final);
   return true;
 }
 
@@ -276,7 +299,8 @@ Advance coarse_draw(const CoarseCompanion& c, int k) {
 }
 
 std::optional<ErrorEstimate> coarse_estimate(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
-                                             const CoarseCompanion& c, const State& run, const State& coarse, long run_steps) {
+                                             const CoarseCompanion& c, const State& run, const State& coarse, long run_steps,
+                                             bool raised) {
   if (!(coarse.R.allFinite() && coarse.v.allFinite())) return std::nullopt;
   const int p = std::min(c.asked < kStepRatio ? kCoarseMaxOrderBelow2 : kCoarseMaxOrder, fixed_order(m, body));
   const double d = bodypoint::state_distance(run, coarse);
@@ -297,7 +321,11 @@ std::optional<ErrorEstimate> coarse_estimate(const MethodInfo& m, const Body& bo
   // rounding is of its size (the two runs' roundings are independent draws, the moved start's growth one more).
   // The level is the run's own where its steps round more: a long run's rounding grows up to an ulp a step
   // (rk4 at h = 1e-5 over 20 on a spinning pass, 2e6 steps: 2.7e-10 off, read 1e-10 at the fixed level).
-  const double level = std::max(kRoundingLevel, static_cast<double>(run_steps) * kRoundingPerStep);
+  // The raise to the fixed level covers pairs that differ by less than their truncation says (attracting lp-rkn4
+  // at h = 0.02, 1.19e-10 off, its pair 3.8e-11 apart) and a run whose rounding alone is 10x its draws'
+  // (bound-spin ttl-ss10 at ds = 0.1, 1.04e-11 off, read 1.0e-12 without it); a second coarse run that observes
+  // the pair's order lifts it (estimated_by_coarse).
+  const double level = std::max(raised ? kRoundingLevel : 0.0, static_cast<double>(run_steps) * kRoundingPerStep);
   if (const double floor = std::min(d, level); floor > e.value) {
     e.value = floor;
     e.basis += floor == d ? "; at the scene's rounding level: their whole difference"

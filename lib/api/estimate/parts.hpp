@@ -62,8 +62,12 @@ const std::string& coarse_draw_text(const CoarseCompanion& c);
 double coarse_ratio_limit(const MethodInfo& m, const std::vector<Centre>& centres, const RunResult& run);
 /// The estimate from the run's and the coarse companion's final states; nullopt where it is not trusted
 /// (a coarse state not finite, an estimate above kCoarseTrusted, estimate/coarse.cpp): the fine companion decides.
+/// `raised`: below the rounding level kRoundingLevel the estimate is raised to the pair's whole difference (up
+/// to the level); without, only to the level of the run's own steps' rounding (an ulp a step), which
+/// estimated_by_coarse takes where a second coarse run shows the pair's order.
 std::optional<ErrorEstimate> coarse_estimate(const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
-                                             const CoarseCompanion& c, const State& run, const State& coarse, long run_steps);
+                                             const CoarseCompanion& c, const State& run, const State& coarse, long run_steps,
+                                             bool raised = true);
 /// Whether a coarse pair whose estimate e would be trusted asks a second coarse companion: at 1e-8 or above
 /// (kSecondCoarseFrom; nearer the rounding level the pair's difference is partly rounding), where the method's
 /// flow is not exact (estimate/coarse.cpp).
@@ -170,9 +174,12 @@ bool estimated_by_coarse(BodyResult& r, const Body& body, const std::vector<Cent
 /// run is outside its regime or the fine pair agrees by chance, and a second fine companion tells which
 /// (second_companion's check).
 inline constexpr double kAsymptoticSpread = 4.0;
-/// Adds kRoundingDraws - 1 draws of the rounding to e where it is at the rounding level (rounding.cpp).
+/// Adds kRoundingDraws - 1 draws of the rounding to e where it is at the rounding level (rounding.cpp):
+/// repeats of the run measured from it (`coarse` nullptr), the sum taken as a bound (bound_from_draws); or
+/// draws of the coarse companion measured from its final state `coarse`, the sum as it is (sum_of_draws).
 void add_rounding_draws(ErrorEstimate& e, const BodyResult& r, const Options& options, const Options& o,
-                        const std::function<BodyResult(int)>& draw, const std::string& what);
+                        const std::function<BodyResult(int)>& draw, const std::string& what,
+                        const State* coarse = nullptr);
 /// The k-th draw of the rounding as a scalar run (rounding.cpp).
 std::function<BodyResult(int)> rerun_draws(const Body& body, std::function<Advance(int)> how_of, const Options& o,
                                            const Rerun& rerun);

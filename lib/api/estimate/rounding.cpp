@@ -9,10 +9,12 @@
 namespace bodypoint::detail {
 
 /// `draw(k)`: the k-th draw (k >= 1), from the start moved rounding_way(k); `o`: the draws' options;
-/// `options`: the run's (its events index them); `what`: what they are, for the basis.
+/// `options`: the run's (its events index them); `what`: what they are, for the basis; `coarse`: the coarse
+/// companion's final state where the draws are coarse runs (measured from it), nullptr where they repeat the run.
 void add_rounding_draws(ErrorEstimate& e, const BodyResult& r, const Options& options, const Options& o,
-                        const std::function<BodyResult(int)>& draw, const std::string& what) {
+                        const std::function<BodyResult(int)>& draw, const std::string& what, const State* coarse) {
   if (!at_rounding_level(e)) return;
+  const double pair = e.value;
   for (int k = 1; k < ErrorEstimate::kRoundingDraws; ++k) {
     const BodyResult p = draw(k);
     if (!ended_alike(r, options, p, o)) {
@@ -20,9 +22,10 @@ void add_rounding_draws(ErrorEstimate& e, const BodyResult& r, const Options& op
       e.wall_s += p.run.wall_s;
       continue;
     }
-    add_rounding_spread(e, r.run.final, p.run.final, p.total_force_evals(), p.run.wall_s, what);
+    add_rounding_spread(e, coarse ? *coarse : r.run.final, p.run.final, p.total_force_evals(), p.run.wall_s, what);
   }
-  bound_from_draws(e);
+  if (coarse) sum_of_draws(e);
+  else bound_from_draws(e, pair);
 }
 
 /// The k-th draw of the rounding (k = 0: the first) as a scalar run: from the start moved rounding_way(k),
@@ -49,10 +52,15 @@ Advance off_grid(const Advance& how, int k) {
 
 double rounding_way(int k) { return k % 2 == 1 ? -1.0 : 1.0; }
 
-void bound_from_draws(ErrorEstimate& e) {
-  e.value *= ErrorEstimate::kRoundingBound;
-  e.basis += "; taken " + short_number(ErrorEstimate::kRoundingBound) + " times: a bound from " +
+void bound_from_draws(ErrorEstimate& e, double pair) {
+  e.value = pair + ErrorEstimate::kRoundingBound * (e.value - pair);
+  e.basis += "; the repeats' part taken " + short_number(ErrorEstimate::kRoundingBound) + " times: a bound from " +
              std::to_string(ErrorEstimate::kRoundingDraws) + " draws of the rounding";
+}
+
+void sum_of_draws(ErrorEstimate& e) {
+  e.basis += "; their sum a bound: " + std::to_string(ErrorEstimate::kRoundingDraws + 1) +
+             " draws of the rounding, the pair's and the coarse run's from its start moved";
 }
 
 bool at_rounding_level(const ErrorEstimate& e) { return e.value < kRoundingLevel; }
