@@ -124,19 +124,23 @@ bool coarse_pair_asymptotic(ErrorEstimate& e, const MethodInfo& m, const Body& b
   return observed_order_agrees(m, body, c, *c2, r.run.final, x.run.final, y.run.final, e);
 }
 
-/// Raised to the rounding level, the estimate e stands unless three runs show the pair's order: then the pair's
-/// difference is the truncation's, and Richardson reads it (`unraised`; the rounding draws added after still count
-/// the rounding). With the raise, estimates of errors in (1e-12, 1e-10] read a median 4.9x high on the ladder.
-void lift_rounding_raise(ErrorEstimate& e, const ErrorEstimate& unraised, const MethodInfo& m, const Body& body,
-                         const std::vector<Centre>& centres, const CoarseCompanion& c, const BodyResult& x,
-                         const BodyResult& r, const Options& options, const Options& oc, const Rerun& rerun) {
-  ErrorEstimate trial = unraised;
+/// Raised to the rounding level (coarse_estimate), the estimate e stands unless three runs show the pair's order:
+/// then the pair's difference is the truncation's, and Richardson reads it (the rounding draws added after still
+/// count the rounding). With the raise, estimates of errors in (1e-12, 1e-10] read a median 4.9x high on the ladder.
+void lift_rounding_raise(ErrorEstimate& e, const MethodInfo& m, const Body& body, const std::vector<Centre>& centres,
+                         const CoarseCompanion& c, const BodyResult& x, const BodyResult& r, const Options& options,
+                         const Options& oc, const Rerun& rerun) {
+  const std::optional<ErrorEstimate> unraised =
+      coarse_estimate(m, body, centres, c, r.run.final, x.run.final, r.run.steps, false);
+  if (!unraised || !(unraised->value < e.value)) return;
+  ErrorEstimate trial = *unraised;
   if (coarse_pair_asymptotic(trial, m, body, centres, c, x, r, options, oc, rerun, true)) {
     e = std::move(trial);
-    e.basis += ", so not raised to the rounding level";
-  } else {
-    e.force_evals = trial.force_evals, e.wall_s = trial.wall_s;
+    e.basis += ", so not raised to the rounding level " + short_number(kRoundingLevel);
+    return;
   }
+  if (trial.force_evals > unraised->force_evals) e.basis += "; a second coarse run did not show the pair's order";
+  e.force_evals = trial.force_evals, e.wall_s = trial.wall_s;
 }
 
 }  // namespace
@@ -216,8 +220,6 @@ bool estimated_by_coarse(BodyResult& r, const Body& body, const std::vector<Cent
   std::optional<ErrorEstimate> coarse;
   if (x.outcome == Outcome::ok && ended_alike(r, options, x, oc) && coarser(*c, x.run.steps, r.run.steps)) {
     coarse = coarse_estimate(*r.method, body, centres, *c, r.run.final, x.run.final, r.run.steps);
-    const std::optional<ErrorEstimate> unraised =
-        coarse_estimate(*r.method, body, centres, *c, r.run.final, x.run.final, r.run.steps, false);
     coarse_side = coarse_side_of(*r.method, body, *c, r.run.final, x.run.final);
     if (coarse && asks_second_coarse(*r.method, body, centres, *coarse) &&
         !coarse_pair_asymptotic(*coarse, *r.method, body, centres, *c, x, r, options, oc, rerun)) {
@@ -229,8 +231,8 @@ bool estimated_by_coarse(BodyResult& r, const Body& body, const std::vector<Cent
       ErrorEstimate trial = *coarse;
       if (coarse_pair_asymptotic(trial, *r.method, body, centres, *c, x, r, options, oc, rerun)) coarse = std::move(trial);
       else coarse->force_evals = trial.force_evals, coarse->wall_s = trial.wall_s;
-    } else if (coarse && unraised && unraised->value < coarse->value) {
-      lift_rounding_raise(*coarse, *unraised, *r.method, body, centres, *c, x, r, options, oc, rerun);
+    } else if (coarse) {
+      lift_rounding_raise(*coarse, *r.method, body, centres, *c, x, r, options, oc, rerun);
     }
   }
   if (!coarse || !at_rounding_level(*coarse)) lane_cost(coarse ? *coarse : e);
