@@ -333,6 +333,19 @@ TEST(Estimates, AnEstimateAtTheRoundingLevelIsABoundFromThreeDrawsOfIt) {
   }
 }
 
+TEST(Estimates, ThreeRunsShowingAHigherOrderLiftTheRoundingLevel) {
+  // The bound orbit's lp-kl8 at h = 0.1 (2.36e-11 off): its coarse pair, order capped at 4, and a second coarse
+  // run at 4h observe order 7.99; Richardson at it reads below the rounding level 1e-10, which held the estimate
+  // at 1e-10 (4.2x high). The three runs showing the order say the pair's difference is the truncation's: the
+  // estimate is Richardson's plus the rounding draws, within kHonestFactor either way.
+  const auto r = run_cli("simulate --json --reference " + bound_orbit() + " --t-end 300 --method lp-kl8 --h 0.1");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("the three observe order"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("their sum a bound: 3 draws of the rounding"), std::string::npos) << r.out;
+  EXPECT_GE(json_num(r.out, "err_estimate"), json_num(r.out, "err_rel") / kHonestFactor) << r.out;
+  EXPECT_LT(json_num(r.out, "err_estimate"), kHonestFactor * json_num(r.out, "err_rel")) << r.out;
+}
+
 TEST(Estimates, ARunCutAtAnEventIsComparedAtThatEvent) {
   const auto r = run_cli("simulate --json --reference --method lp-y4 --h 0.01 --t-end 200 --stop-at r=100");
   ASSERT_EQ(r.code, 0) << r.err;

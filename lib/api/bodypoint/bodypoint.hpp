@@ -157,7 +157,8 @@ struct Options : RunOptions {
 /// coarse steps beyond the flags or its energy, an estimate above 1e-5, too few steps) a fine companion
 /// at half the step decides, or at a tenth of the tolerance per step (step-size-controlled methods):
 /// its error is 2^-p of the run's, so the run's error is their difference over 1 - 2^-p. Where
-/// round-off dominates, the estimate is at least the pair's difference up to the rounding level 1e-10.
+/// round-off dominates, the estimate is at least the pair's difference up to the rounding level 1e-10,
+/// unless a second coarse run shows the pair's order (then the difference is the truncation's).
 /// The accuracy mode's estimate is its search's (adaptive/tolerance.hpp).
 struct ErrorEstimate {
   /// The fine companion of a run by step runs at the step over this ratio (it costs that many runs),

@@ -79,9 +79,10 @@ bool sharpened_by_second_coarse(const MethodInfo& m, const Body& body, const std
                                 const CoarseCompanion& c, const ErrorEstimate& e);
 /// Whether a second coarse companion c2 (the coarse run's own, c2.ratio times its step) shows the pair (run,
 /// coarse) in its asymptotic regime: the order the three final states observe lies within one of the orders
-/// the estimate assumes (estimate/coarse.cpp, kObservedOrderSlack); where it does, e's basis says so.
+/// the estimate assumes (estimate/coarse.cpp, kObservedOrderSlack); where it does, e's basis says so. `run_steps`:
+/// the run's steps, whose rounding level (an ulp a step) bounds e below.
 bool observed_order_agrees(const MethodInfo& m, const Body& body, const CoarseCompanion& c, const CoarseCompanion& c2,
-                           const State& run, const State& coarse, const State& coarser, ErrorEstimate& e);
+                           const State& run, const State& coarse, const State& coarser, long run_steps, ErrorEstimate& e);
 
 /// What the coarse side reads of the run (Richardson on the pair at the method's order) where the coarse run
 /// ended ok: compared with the fine pair's estimate (checks_fine_pair).
