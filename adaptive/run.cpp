@@ -64,20 +64,21 @@ using detail::StepStats;
 /// to the caller, which has just taken it). Regula falsi with Illinois safeguard on [0, ds], starting
 /// from the linear interpolant; stops when the remaining gap is below 4 ulp of the target. The advance
 /// is close to linear in ds', so this takes 2-3 trial steps per output time.
+/// `group`: the step is taken as that many of ds / group (FictitiousSteps::group).
 template <const auto& Seq, class K>
-TimeState step_to_time(K& k, const TimeState& from, double ds, double target, double t_full) {
+TimeState step_to_time(K& k, const TimeState& from, double ds, double target, double t_full, int group = 1) {
   splitting::NullObserver none;
   const double f_lo = from.time() - target, f_hi = t_full - target;
   TimeState x = from;
   const double tol = 4.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(target));
   if (std::abs(f_hi) <= tol) {  // the whole step lands on the target
-    sp::integrate<Seq>(k, x, ds, 1, none);
+    sp::integrate<Seq>(k, x, ds / group, group, none);
     return x;
   }
   land_step(
       [&](double s) {
         x = from;
-        sp::integrate<Seq>(k, x, s, 1, none);
+        sp::integrate<Seq>(k, x, s / group, group, none);
         return x.time() - target;
       },
       0.0, f_lo, ds, f_hi, tol);
@@ -208,15 +209,16 @@ struct TransformedStepper {
   static constexpr std::string_view prefix = "";
   K& k;
   double h;
+  int group = 1;  ///< FictitiousSteps::group: a step of ds is this many of ds / group
   StepAdvance step(X& x, double ds) const {
     const double before = x.time();
     sp::NullObserver none;
-    sp::integrate<Seq>(k, x, ds, 1, none);
+    sp::integrate<Seq>(k, x, ds / group, group, none);
     return {x.time(), x.time() - before};
   }
   static double time(const X& x) { return x.time(); }
   bool physical_finite(const X& x) const { return x.q.R.allFinite(); }
-  void land(X& x, double t, double t_over) const { x = step_to_time<Seq>(k, x, h, t, t_over); }
+  void land(X& x, double t, double t_over) const { x = step_to_time<Seq>(k, x, h, t, t_over, group); }
   static void set_time(X& x, double t) {
     x.t = t;
     x.t_err = 0.0;
@@ -243,10 +245,11 @@ RunResult run_time_transformed(const Body& body, const std::vector<Centre>& cent
   return dispatch(body, centres, [&](const auto& field, auto spin) {
     using K = Kernel<std::decay_t<decltype(field)>, decltype(spin)::value>;
     K k(body.p, field, options.omega_c >= 0.0 ? options.omega_c : automatic_omega_c(body, centres, spec.ds));
-    TransformedStepper<K, Seq> stepper{k, spec.ds};
+    TransformedStepper<K, Seq> stepper{k, spec.ds, spec.group};
     TimeState x0 = k.initial_state(body.s0);
     if (!std::isnan(options.carried)) K::resume(x0, options.carried);
     RunResult r = run_fictitious(stepper, x0, body, field, spec, options);
+    r.steps *= spec.group;  // the steps taken, each group's every one
     r.force_evals = k.lp.evals;
     return r;
   });

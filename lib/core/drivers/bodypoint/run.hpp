@@ -120,6 +120,12 @@ struct FictitiousSteps {
   double ds;
   std::variant<EndTime, StepCount> end;
   double dt_out = 0.0;
+  /// Each step of ds taken as this many steps of ds / group, the last one solved to land on the end time too:
+  /// the run of ds with every step halved (group 2), a companion that refines each of the run's steps, its
+  /// landing step included (a Stepper's segment shorter than a step is one landing step, which a companion at
+  /// ds/2 takes as the same single step where the segment is shorter than ds/2). Without dt_out or observers that
+  /// look inside a step (events): their states between steps come from a step of the whole group's length.
+  int group = 1;
   /// The end time (0 when the run counts steps) and the number of steps (0 when it runs to a time).
   [[nodiscard]] double t_end() const { return end.index() == 0 ? std::get<EndTime>(end).t : 0.0; }
   [[nodiscard]] long steps() const { return end.index() == 1 ? std::get<StepCount>(end).n : 0; }
