@@ -69,6 +69,12 @@ void print_encounter(const std::vector<Event>& events, const BodyResult& run, co
               << ", R = " << json_vec(h.s.R) << " (errors: " << error_text(h.t_error) << " in t, " << error_text(h.r_error)
               << " in r, " << error_text(h.state_error) << " of the state)\n";
   if (run.run.stopped) std::cout << "  the run stopped at event " << events[run.events.back().event].label() << "\n";
+  else if (run.outcome == Outcome::ok)
+    for (const Event& stop : events)  // a stop asked for and not hit: the run went on to its end
+      if (stop.stop)
+        std::cout << "  the stop event " << stop.label() << " was not hit: the run went on to t = " << fmt(run.run.t_end)
+                  << (stop.kind == Event::Kind::closest_approach ? " (its distance was least at an end of the run)" : "")
+                  << "\n";
   if (!e) return;
   const Scattering& sc = e->scattering;
   std::cout << "  scattering (asymptotes: " << sc.asymptotes << ")\n";

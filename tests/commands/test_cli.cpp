@@ -472,6 +472,15 @@ TEST(Cli, StopAtEndsTheRunAtTheEvent) {
   ASSERT_EQ(never.code, 0) << never.err;
   EXPECT_NE(never.out.find("\"stopped_by\": null"), std::string::npos);
   EXPECT_EQ(json_num(never.out, "t_end"), 4.0);
+  // The text says so: a stop not hit is not a stop.
+  const Result said = run_cli("simulate --method lp-y8 --h 2e-3 --t-end 4 --B 0 --d 2 --L 20 --stop-at r=25");
+  ASSERT_EQ(said.code, 0) << said.err;
+  EXPECT_NE(said.out.find("the stop event r=25 was not hit: the run went on to t = 4"), std::string::npos) << said.out;
+  // Going out from the start, the distance is least at the run's start: no closest approach to stop at.
+  const Result away = run_cli("simulate --method lp-y4 --h 1e-2 --t-end 2 --B 0 --d 2 --L 20 --K1 -5 --stop-at closest");
+  ASSERT_EQ(away.code, 0) << away.err;
+  EXPECT_NE(away.out.find("the stop event closest was not hit"), std::string::npos) << away.out;
+  EXPECT_NE(away.out.find("least at an end of the run"), std::string::npos) << away.out;
   // Stopped at its closest approach, the run ends at the least distance of its whole span, not at the first
   // local minimum (table 3.1: a helix wiggle at r = 10.76, t = 27.57; the encounter's minimum 9.0546 at 28.40).
   // lp-y4 at h = 1e-3 has r and t to ~1e-13 (they agree with lp-kl8 at 1e-3 to 1e-14); the values quoted
