@@ -276,6 +276,8 @@ TEST(Api, InvalidRequestsThrowWithTheQuantityNamed) {
       [&] { integrate(s, "lp-y4", Accuracy{1e-20, 1.0}); },
       [&] { integrate(s, "lp-y4", Accuracy{2.0, 1.0}); },
       [&] { integrate(s, "logh-y4", FictitiousSteps{0.1, EndTime{1.0}, -1.0}); },
+      [&] { integrate(s, "logh-y4", FictitiousSteps{0.1, EndTime{1.0}, 0.0, 0}); },    // a step taken as no steps
+      [&] { integrate(s, "logh-y4", FictitiousSteps{0.1, EndTime{1.0}, 0.1, 2}); },    // grouped, with output times
   };
   for (std::size_t i = 0; i < bad.size(); ++i) {
     try {

@@ -66,6 +66,9 @@ constexpr double kSecondCoarseFrom = 100.0 * kRoundingLevel;
 /// time-transformed pair whose steps were not cut by the ratio (the landing step, steps bound by
 /// something else) is no Richardson pair; it must take at most 1 / (1 + (ratio - 1) / 2) of the steps,
 /// as the fine companion must take kRefined = 1.5 times the run's at ratio 2.
+/// The rounding level of a run of `run_steps` steps: an ulp a step (kRoundingPerStep).
+double run_rounding_level(long run_steps) { return static_cast<double>(run_steps) * kRoundingPerStep; }
+
 bool coarser(const CoarseCompanion& c, long coarse_steps, long run_steps) {
   if (!std::holds_alternative<FictitiousSteps>(c.how)) return true;
   return static_cast<double>(run_steps) >= (1.0 + (c.ratio - 1.0) / 2.0) * static_cast<double>(coarse_steps);
@@ -174,16 +177,16 @@ bool observed_order_agrees(const MethodInfo& m, const Body& body, const CoarseCo
   // at the run's own rounding level (an ulp a step), not at kRoundingLevel: the three runs showing the order say the
   // difference is the truncation's, as where lift_rounding_raise lifts the raise, and below kRoundingLevel the
   // rounding draws are added (bound-orbit lp-kl8 at h = 0.1, order 7.99 seen, 2.36e-11 off: read 1e-10 at the
-  // fixed floor; the ladder's 90th percentile went 2.14 -> 1.87, none more than 3x low). (At the cap, order-8 pairs in their regime read 17x high at
-  // twice the step, 20x at 1.5 times: 230 of the estimate ladder's 267 estimates more than 2x high.) Where the
+  // fixed floor; the ladder's 90th percentile went 2.14 -> 1.87, none more than 3x low). (At the cap, order-8
+  // pairs in their regime read 17x high at twice the step, 20x at 1.5 times: 230 of the estimate ladder's 267
+  // estimates more than 2x high.) Where the
   // coarse run's own steps held the second back from its whole ratio (the flags' angles), the pair is near the end
   // of its regime: the order taken is kObservedOrderSlack below the one seen (strong-spin kep-y8 at h = 0.02, its
   // second coarse run at 1.49 times the first's: order 7.68 seen, 3.1e-6 off, read 6.7e-7 at 7.68, 1.35e-6 at 6.68).
   const double taken = std::min(static_cast<double>(p), c2.asked >= kStepRatio ? q : q - kObservedOrderSlack);
   if (taken > assumed) {
     const double d = bodypoint::state_distance(run, coarse);
-    const double level = static_cast<double>(run_steps) * kRoundingPerStep;
-    const double sharper = std::max(bodypoint::finer_run_error(d, c.ratio, taken), std::min(d, level));
+    const double sharper = std::max(bodypoint::finer_run_error(d, c.ratio, taken), std::min(d, run_rounding_level(run_steps)));
     if (sharper < e.value) {
       e.value = sharper;
       e.basis += ", order " + short_number(taken) + " taken";
@@ -331,7 +334,7 @@ std::optional<ErrorEstimate> coarse_estimate(const MethodInfo& m, const Body& bo
   // at h = 0.02, 1.19e-10 off, its pair 3.8e-11 apart) and a run whose rounding alone is 10x its draws'
   // (bound-spin ttl-ss10 at ds = 0.1, 1.04e-11 off, read 1.0e-12 without it); a second coarse run that observes
   // the pair's order lifts it (estimated_by_coarse).
-  const double level = std::max(raised ? kRoundingLevel : 0.0, static_cast<double>(run_steps) * kRoundingPerStep);
+  const double level = std::max(raised ? kRoundingLevel : 0.0, run_rounding_level(run_steps));
   if (const double floor = std::min(d, level); floor > e.value) {
     e.value = floor;
     e.basis += floor == d ? "; at the scene's rounding level: their whole difference"

@@ -504,6 +504,10 @@ void check(const Advance& how) {
           require_positive(a.ds, "the fictitious step ds");
           if (a.end.index() == 0) require_positive(a.t_end(), "the end time t_end");
           else require_count(a.steps(), "the number of fictitious steps");
+          require_count(a.group, "the steps a fictitious step is taken as (group)");
+          if (a.group > 1 && a.dt_out > 0.0)
+            throw Error("a fictitious step taken as " + std::to_string(a.group) +
+                        " (group) has no output times dt_out: its states between steps would come from the whole step");
         } else if constexpr (std::is_same_v<A, ControlledSteps>) {
           require_positive(a.h0, "the first trial step h0");
           require_positive(a.t_end, "the end time t_end");
