@@ -105,6 +105,7 @@ class Search {
   bool replanned(std::vector<Level>& rungs, double& h_c);
   bool coarser_rung_confirms(std::vector<Level>& rungs, double h_c);
   std::optional<Level> pilot_answer(std::vector<Level>& rungs);
+  std::optional<Level> coarser_pilot_answer(std::vector<Level>& rungs, bool planned);
   Level ladder();
   double refine(std::vector<Level>& rungs, double& h_c);
   [[nodiscard]] bool smooth(const std::vector<Level>& rungs, double expected) const;

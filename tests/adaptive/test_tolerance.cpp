@@ -253,6 +253,30 @@ TEST(Tolerance, ThePilotsCoarseRunIsDeliveredWhereFinerRunsBoundIt) {
   EXPECT_LE(r.err_estimate, kTol);
 }
 
+// Where the pilot pair already shows its coarse run within TOL, the search's third run is one at twice the
+// coarse step (half a coarse run) rather than a finer one (search/ladder.cpp, coarser_pilot_answer): a far pass
+// (d = 60, B = 0.9) at 1e-9, logh-kl6, whose steps are the spin's at any ds, delivered its pilot's coarse run
+// after a finer third run, the search 5.5 times that run (29,817 evaluations); the pilot pair and the coarser
+// run make 3.5. The whole search is at most kCoarserPilotSearch delivered runs, the error within TOL and the
+// estimate honest.
+constexpr double kCoarserPilotSearch = 4.0;
+TEST(Tolerance, APilotsCoarseRunWithinTolIsJudgedByACoarserRunNotAFinerOne) {
+  SceneParams sp;
+  sp.B = 0.9;
+  sp.start.d = 60.0;
+  const Scene s = thesis_scene(sp);
+  const Body& b = s.bodies.front();
+  constexpr double kTol = 1e-9, kEnd = 50.0;
+  const adaptive::ToleranceResult r = adaptive::run_to_tolerance(method_or_throw("logh-kl6"), b, s.centres,
+                                                                 Accuracy{kTol, kEnd}, kUnobserved, false);
+  const double err = bodypoint::state_distance(r.result.final, reference_state(b, s.centres, kEnd));
+  EXPECT_EQ(r.runs, 3) << "the pilot pair and the coarser run";
+  EXPECT_LE(static_cast<double>(r.total_force_evals), kCoarserPilotSearch * static_cast<double>(r.result.force_evals));
+  EXPECT_LE(err, kTol);
+  EXPECT_LE(r.err_estimate, kTol);
+  EXPECT_GE(r.err_estimate, err / kEstimateFactor);
+}
+
 // A verifying companion at h/2 lands on every point of the answer's grid and shares its rounding there
 // (search/ladder.cpp, kVerifyRatio). On the rounded pass (common.hpp) logh-kl8 at 1e-10 was delivered
 // 1.2e-10 off with 7.9e-11 estimated. Verified off the grid, the answer is within TOL or the search says TOL
