@@ -106,7 +106,7 @@ bool Search::seeded(std::vector<Level>& rungs) {
   if (!(seed_ > 0.0)) return false;
   const double h_c = kCompanionRatio * seed_;
   Attempt<bool> pair = attempt([&] {
-    rungs.push_back(run_at(h_c, h_c, false));
+    rungs.push_back(run_at(h_c, h_c, !delivery_.sink));  // planned_far_below may deliver it
     rungs.push_back(run_at(seed_, h_c, true));
     return state_distance(rungs[0].run.final, rungs[1].run.final) <= kUnresolvedPair;
   });
@@ -213,6 +213,29 @@ std::optional<Level> Search::coarser_pilot_answer(std::vector<Level>& rungs, boo
   return std::move(rungs[0]);
 }
 
+/// A planned pair far below its target (the row is easier than the pilot it was planned from): where a coarser
+/// run confirms the pair (coarser_rung_confirms), its companion is delivered where the pair bounds its error
+/// within TOL, at order min(p, q) of the three, and it is sound (assess(): it ran with the caller's invariant
+/// checks, at a step up to 4x the pilot's); else the planned answer as it is, as before. Only without a sink
+/// (a sweep's rows, an encounter's run from 2L): the companion ran without the caller's observers. Where the
+/// coarser run does not confirm the pair, a coarser planned pair (replanned(), `replan` set).
+std::optional<Level> Search::planned_far_below(std::vector<Level>& rungs, double& h_c, bool& replan) {
+  replan = false;
+  if (!coarser_rung_confirms(rungs, h_c)) {
+    replan = replanned(rungs, h_c);
+    return std::nullopt;
+  }
+  Level& companion = rungs[1];
+  if (delivery_.sink || !companion.run.invariants) return std::nullopt;
+  const double q = observed_order(rungs[0], rungs[1], rungs[2]);
+  const double e = coarser_run_error(state_distance(companion.run.final, rungs[2].run.final), companion.h / rungs[2].h,
+                                     static_cast<int>(std::floor(std::min<double>(p_, q))));
+  const Checks sound = checks_for(m_, c_, std::numeric_limits<double>::infinity());
+  if (!(e <= kAccept * tol_) || assess(companion.run, sound).outcome != Outcome::ok) return std::nullopt;
+  estimate_ = last_estimate_ = e;
+  return std::move(companion);
+}
+
 /// Runs that share one time-step constant c form a ladder; each new run is estimated from the run before it
 /// (Richardson, order p) and checked by the run before that (file comment).
 Level Search::ladder() {
@@ -237,10 +260,9 @@ Level Search::ladder() {
     rungs[a].samples = {};  // only the newest run can still be delivered: its predecessors' samples go
     last_estimate_ = estimate_ = pair_estimate(rungs[a], rungs.back());
     const double d = state_distance(rungs[a].run.final, rungs.back().run.final);
-    if (from_plan && estimate_ < expected / kAgree && d > kRoundOff && !coarser_rung_confirms(rungs, h_c) &&
-        replanned(rungs, h_c)) {
-      planned = true;  // far below its target and not confirmed by a coarser run: a coarser planned pair
-      continue;
+    if (from_plan && estimate_ < expected / kAgree && d > kRoundOff) {
+      if (std::optional<Level> answer = planned_far_below(rungs, h_c, planned)) return std::move(*answer);
+      if (planned) continue;  // not confirmed by a coarser run: a coarser planned pair
     }
     refuse_below_round_off(d);
     if (deliverable(rungs.back(), h_c, trusted(rungs, h_c, expected, d, from_plan))) {

@@ -104,6 +104,7 @@ class Search {
   [[nodiscard]] Error out_of_reach(double d) const;
   bool replanned(std::vector<Level>& rungs, double& h_c);
   bool coarser_rung_confirms(std::vector<Level>& rungs, double h_c);
+  std::optional<Level> planned_far_below(std::vector<Level>& rungs, double& h_c, bool& replan);
   std::optional<Level> pilot_answer(std::vector<Level>& rungs);
   std::optional<Level> coarser_pilot_answer(std::vector<Level>& rungs, bool planned);
   Level ladder();
