@@ -183,34 +183,39 @@ std::optional<Level> Search::pilot_answer(std::vector<Level>& rungs) {
   const double q = observed_order(rungs[0], rungs[1], rungs[2]);
   const double d = state_distance(rungs[0].run.final, rungs[2].run.final);
   if (!(q >= p_ - kOrderSlack && q >= 1.0 && d > kRoundOff)) return std::nullopt;
-  const double e = coarser_run_error(d, rungs[0].h / rungs[2].h, static_cast<int>(std::floor(std::min<double>(p_, q))));
+  const double e = coarser_bound(rungs[0], rungs[2], q);
   if (!(e <= kAccept * tol_)) return std::nullopt;
   estimate_ = last_estimate_ = e;
   return std::move(rungs[0]);
 }
 
+/// The error of `coarse` that its difference from the finer `fine` bounds where three runs show order q: Richardson
+/// at the lower of p and q, floored to an integer (as pilot_answer and the answers below take it).
+double Search::coarser_bound(const Level& coarse, const Level& fine, double q) const {
+  return coarser_run_error(state_distance(coarse.run.final, fine.run.final), coarse.h / fine.h,
+                           static_cast<int>(std::floor(std::min<double>(p_, q))));
+}
+
 /// Where the pilot's coarse run meets TOL by the pair's own difference, a run at twice its step (half the
-/// coarse run's cost) judges the pair before any finer run: where the three show the method's order q (within
-/// [p - kOrderSlack, p + kOrderExcess], as smooth() asks of a triple), the coarse run is delivered, its error
-/// the pair's difference over 1 - 2^-min(p, q). The run at twice the step is not delivered: its steps may
+/// coarse run's cost, coarser_rung_confirms) judges the pair before any finer run: where the three show the
+/// method's order q, the coarse run is delivered, its error the pair's difference over 1 - 2^-min(p, q). The run at twice the step is not delivered: its steps may
 /// turn the spin further than any the method chose, which only a run that tracks invariants would show.
 /// refine() only goes finer than the pilot's finer run (kMinRefinement), so the ladder's way to the same
 /// answer (pilot_answer) costs at least 2.5 coarse runs more: a far pass at TOL 1e-9 (d = 60, B = 0.9),
 /// logh-kl6's search 29,817 -> 19,026 evaluations for the same delivered run. A planned pair is judged as
 /// refine()'s new ladder is, not here. Above kProbeBelowTol only, as pilot_answer.
-std::optional<Level> Search::coarser_pilot_answer(std::vector<Level>& rungs, bool planned) {
+std::optional<Level> Search::coarser_pilot_answer(std::vector<Level>& rungs, double h_c, bool planned) {
   if (planned || tol_ < kProbeBelowTol || rungs.size() != 2 || rungs[0].samples_dropped) return std::nullopt;
   const double d = state_distance(rungs[0].run.final, rungs[1].run.final);
-  const double ratio = rungs[0].h / rungs[1].h;
-  if (!(d > kRoundOff && coarser_run_error(d, ratio, p_) <= kAccept * tol_)) return std::nullopt;
-  Attempt<Level> coarser = attempt([&] { return run_at(kCompanionRatio * rungs[0].h, rungs[0].h, false); });
-  if (!coarser.value) return std::nullopt;
-  const double q = observed_order(*coarser.value, rungs[0], rungs[1]);
-  if (!(q >= p_ - kOrderSlack && q >= 1.0 && q <= p_ + kOrderExcess)) return std::nullopt;
-  const double e = coarser_run_error(d, ratio, static_cast<int>(std::floor(std::min<double>(p_, q))));
-  if (!(e <= kAccept * tol_)) return std::nullopt;
+  if (!(d > kRoundOff && coarser_run_error(d, rungs[0].h / rungs[1].h, p_) <= kAccept * tol_)) return std::nullopt;
+  if (!coarser_rung_confirms(rungs, h_c)) return std::nullopt;  // rungs: 2 h0, h0, h0/2
+  const double e = coarser_bound(rungs[1], rungs[2], observed_order(rungs[0], rungs[1], rungs[2]));
+  if (!(e <= kAccept * tol_)) {
+    rungs.erase(rungs.begin());  // the ladder goes on from the pilot pair, as without the coarser run
+    return std::nullopt;
+  }
   estimate_ = last_estimate_ = e;
-  return std::move(rungs[0]);
+  return std::move(rungs[1]);
 }
 
 /// A planned pair far below its target (the row is easier than the pilot it was planned from): where a coarser
@@ -227,9 +232,7 @@ std::optional<Level> Search::planned_far_below(std::vector<Level>& rungs, double
   }
   Level& companion = rungs[1];
   if (delivery_.sink || !companion.run.invariants) return std::nullopt;
-  const double q = observed_order(rungs[0], rungs[1], rungs[2]);
-  const double e = coarser_run_error(state_distance(companion.run.final, rungs[2].run.final), companion.h / rungs[2].h,
-                                     static_cast<int>(std::floor(std::min<double>(p_, q))));
+  const double e = coarser_bound(companion, rungs[2], observed_order(rungs[0], rungs[1], rungs[2]));
   const Checks sound = checks_for(m_, c_, std::numeric_limits<double>::infinity());
   if (!(e <= kAccept * tol_) || assess(companion.run, sound).outcome != Outcome::ok) return std::nullopt;
   estimate_ = last_estimate_ = e;
@@ -242,7 +245,7 @@ Level Search::ladder() {
   std::vector<Level> rungs;  // runs sharing the constant c of step h_c, coarse to fine
   double h_c = 0.0;
   bool planned = first_pair(rungs, h_c);
-  if (std::optional<Level> answer = coarser_pilot_answer(rungs, planned)) return std::move(*answer);
+  if (std::optional<Level> answer = coarser_pilot_answer(rungs, h_c, planned)) return std::move(*answer);
   double best_bound = std::numeric_limits<double>::infinity();
   int stalled = 0;
   bool verified_finer = false;  // the newest rung is a verification's companion: estimate it first

@@ -106,7 +106,7 @@ class Search {
   bool coarser_rung_confirms(std::vector<Level>& rungs, double h_c);
   std::optional<Level> planned_far_below(std::vector<Level>& rungs, double& h_c, bool& replan);
   std::optional<Level> pilot_answer(std::vector<Level>& rungs);
-  std::optional<Level> coarser_pilot_answer(std::vector<Level>& rungs, bool planned);
+  std::optional<Level> coarser_pilot_answer(std::vector<Level>& rungs, double h_c, bool planned);
   Level ladder();
   double refine(std::vector<Level>& rungs, double& h_c);
   [[nodiscard]] bool smooth(const std::vector<Level>& rungs, double expected) const;
@@ -116,6 +116,7 @@ class Search {
   bool verified(std::vector<Level>& rungs, double h_c);
   bool verified_at(std::vector<Level>& rungs, double h_c, double current);
   [[nodiscard]] double pair_estimate(const Level& c, const Level& f) const;
+  [[nodiscard]] double coarser_bound(const Level& coarse, const Level& fine, double q) const;
   [[nodiscard]] double observed_order(const Level& l1, const Level& l2, const Level& l3) const;
 
   // rounding.cpp

@@ -62,13 +62,13 @@ constexpr double kObservedOrderSlack = 1.0;
 /// rounding level the pair's difference is partly rounding, and the order three runs observe says nothing.
 constexpr double kSecondCoarseFrom = 100.0 * kRoundingLevel;
 
+/// The rounding level of a run of `run_steps` steps: an ulp a step (kRoundingPerStep).
+double run_rounding_level(long run_steps) { return static_cast<double>(run_steps) * kRoundingPerStep; }
+
 /// Whether a coarse companion that took `coarse_steps` is coarser than the run of `run_steps`: a
 /// time-transformed pair whose steps were not cut by the ratio (the landing step, steps bound by
 /// something else) is no Richardson pair; it must take at most 1 / (1 + (ratio - 1) / 2) of the steps,
 /// as the fine companion must take kRefined = 1.5 times the run's at ratio 2.
-/// The rounding level of a run of `run_steps` steps: an ulp a step (kRoundingPerStep).
-double run_rounding_level(long run_steps) { return static_cast<double>(run_steps) * kRoundingPerStep; }
-
 bool coarser(const CoarseCompanion& c, long coarse_steps, long run_steps) {
   if (!std::holds_alternative<FictitiousSteps>(c.how)) return true;
   return static_cast<double>(run_steps) >= (1.0 + (c.ratio - 1.0) / 2.0) * static_cast<double>(coarse_steps);
@@ -179,10 +179,10 @@ bool observed_order_agrees(const MethodInfo& m, const Body& body, const CoarseCo
   // rounding draws are added (bound-orbit lp-kl8 at h = 0.1, order 7.99 seen, 2.36e-11 off: read 1e-10 at the
   // fixed floor; the ladder's 90th percentile went 2.14 -> 1.87, none more than 3x low). (At the cap, order-8
   // pairs in their regime read 17x high at twice the step, 20x at 1.5 times: 230 of the estimate ladder's 267
-  // estimates more than 2x high.) Where the
-  // coarse run's own steps held the second back from its whole ratio (the flags' angles), the pair is near the end
-  // of its regime: the order taken is kObservedOrderSlack below the one seen (strong-spin kep-y8 at h = 0.02, its
-  // second coarse run at 1.49 times the first's: order 7.68 seen, 3.1e-6 off, read 6.7e-7 at 7.68, 1.35e-6 at 6.68).
+  // estimates more than 2x high.) Where the coarse run's own steps held the second back from its whole ratio (the
+  // flags' angles), the pair is near the end of its regime: the order taken is kObservedOrderSlack below the one
+  // seen (strong-spin kep-y8 at h = 0.02, its second coarse run at 1.49 times the first's: order 7.68 seen, 3.1e-6
+  // off, read 6.7e-7 at 7.68, 1.35e-6 at 6.68).
   const double taken = std::min(static_cast<double>(p), c2.asked >= kStepRatio ? q : q - kObservedOrderSlack);
   if (taken > assumed) {
     const double d = bodypoint::state_distance(run, coarse);
