@@ -198,8 +198,9 @@ double Search::coarser_bound(const Level& coarse, const Level& fine, double q) c
 
 /// Where the pilot's coarse run meets TOL by the pair's own difference, a run at twice its step (half the
 /// coarse run's cost, coarser_rung_confirms) judges the pair before any finer run: where the three show the
-/// method's order q, the coarse run is delivered, its error the pair's difference over 1 - 2^-min(p, q). The run at twice the step is not delivered: its steps may
-/// turn the spin further than any the method chose, which only a run that tracks invariants would show.
+/// method's order q, the coarse run is delivered, its error the pair's difference over 1 - 2^-min(p, q). The run
+/// at twice the step is not delivered: its steps may turn the spin further than any the method chose, which only a
+/// run that tracks invariants would show.
 /// refine() only goes finer than the pilot's finer run (kMinRefinement), so the ladder's way to the same
 /// answer (pilot_answer) costs at least 2.5 coarse runs more: a far pass at TOL 1e-9 (d = 60, B = 0.9),
 /// logh-kl6's search 29,817 -> 19,026 evaluations for the same delivered run. A planned pair is judged as
