@@ -432,7 +432,7 @@ void write_tol_summary(std::ostream& summary, const std::vector<TolRow>& rows, s
   summary << "| scene | TOL | auto method | ds or h | estimate | delivered | met | time [ms] | cheapest peer meeting TOL "
              "| time [ms] | speed-up | peers meeting TOL | cheapest peer config delivering TOL | time [ms] | speed-up "
              "| delivered run [ms] | speed-up if the search were free | bodypoint's fastest config delivering TOL "
-             "| time [ms] | auto / it, evals | auto / it, time | auto's search / its delivered run, evals "
+             "| time [ms] | auto / it, evals | auto / it, time | auto's search beyond its delivered run / that run, evals "
              "| its estimate / it, evals (estimate for error) | bodypoint's cheapest config whose estimate shows TOL "
              "(run + estimate) | auto / it, evals |\n"
           << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
