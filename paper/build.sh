@@ -6,6 +6,9 @@
 #   paper/build.sh --quick    the same recipes, scenes and sections on coarse grids into paper/results-quick/
 #   paper/build.sh --resume   (with or without --quick) an interrupted build goes on from its first
 #                             unfinished step (the full build takes hours: it can be run in sittings)
+#   paper/build.sh --park     (with or without --quick) packs an interrupted build's results into
+#                             paper/sittings/, to be committed, so that a sitting on another machine (a
+#                             fresh clone) resumes it: --resume unpacks them when its results directory is empty
 #
 # Steps: bodypoint study (d, L, h, Kx sweeps, timing, force evaluations, appendix 1, errata, the sweeps
 # as published, stress, the (d, L) map, scattering, long-time), bodypoint work-precision (ladders and --by-tol),
@@ -22,15 +25,35 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 mode=full
 resume=0
+park=0
 for arg in "$@"; do
   case "$arg" in
     --quick) mode=quick ;;
     --resume) resume=1 ;;
-    *) echo "usage: paper/build.sh [--quick] [--resume]" >&2; exit 2 ;;
+    --park) park=1 ;;
+    *) echo "usage: paper/build.sh [--quick] [--resume | --park]" >&2; exit 2 ;;
   esac
 done
 results=paper/results
 [ $mode = quick ] && results=paper/results-quick
+# An unfinished build parked between sittings (--park), committed so that a fresh clone can go on with it.
+parked="paper/sittings/$(basename "$results").tar.xz"
+if [ $park = 1 ]; then
+  [ $resume = 0 ] || { echo "paper/build.sh: --park and --resume are two separate runs" >&2; exit 2; }
+  [ -f "$results/build_state.txt" ] || { echo "paper/build.sh: --park: $results holds no build" >&2; exit 2; }
+  exec 9> "$results/.lock"
+  flock -n 9 || { echo "paper/build.sh: --park: a build is still running in $results; stop it first" >&2; exit 2; }
+  mkdir -p paper/sittings
+  tar -C "$(dirname "$results")" --exclude=.lock -cJf "$parked.tmp" "$(basename "$results")"
+  mv "$parked.tmp" "$parked"
+  echo "paper/build.sh: parked $results ($(tail -1 "$results/build_stages.txt" 2>/dev/null | cut -d' ' -f1) the last step finished) in $parked ($(du -h "$parked" | cut -f1)); commit it, then paper/build.sh --resume goes on"
+  exit 0
+fi
+if [ $resume = 1 ] && [ ! -f "$results/build_state.txt" ] && [ -f "$parked" ]; then
+  mkdir -p "$(dirname "$results")"
+  tar -C "$(dirname "$results")" -xJf "$parked"
+  echo "paper/build.sh: unpacked the parked build $parked into $results"
+fi
 [ "${BODYPOINT_NO_SETUP:-0}" = 1 ] || scripts/setup.sh >/dev/null
 bindir="${BODYPOINT_BUILD_DIR:-build}/bin"
 bin=$bindir/bodypoint
@@ -42,8 +65,16 @@ mkdir -p "$results"
 # CPU (build_state.txt); each step's time is its own, so the stated build time is the sum of the steps.
 stages="$results/build_stages.txt"
 state="$results/build_state.txt"
-revision=$(git rev-parse HEAD 2>/dev/null || echo unknown)
-git diff --quiet HEAD 2>/dev/null || revision="$revision+uncommitted"
+# The revision is the newest commit that changed what makes the results: not the parked sittings, the
+# documentation, or the typesetting of the paper (its text, bibliography, figure and macro scripts), which
+# the last sitting applies to all the results; so a build parked in one commit resumes in the next.
+not_inputs=(':(exclude)paper/sittings' ':(exclude)docs' ':(exclude)*.md' ':(exclude)paper/*.tex'
+  ':(exclude)paper/*.bib' ':(exclude)paper/macros' ':(exclude)paper/make_figures.py'
+  ':(exclude)paper/make_macros.py' ':(exclude)paper/check_paper.py' ':(exclude)paper/bodypoint.pdf'
+  ':(exclude)paper/bodypoint-build.txt')
+revision=$(git log -1 --format=%H -- . "${not_inputs[@]}" 2>/dev/null || true)
+[ -n "$revision" ] || revision=unknown
+[ -z "$(git status --porcelain -- . "${not_inputs[@]}" 2>/dev/null)" ] || revision="$revision+uncommitted"
 identity="mode=$mode revision=$revision binary=$(sha256sum "$bin" | cut -c1-16) cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1)"
 sittings=1
 if [ $resume = 1 ]; then
@@ -60,6 +91,9 @@ else
   : > "$stages"
 fi
 { echo "$identity"; echo "sittings=$sittings"; } > "$state.tmp" && mv "$state.tmp" "$state"
+# Held while the build runs: --park refuses to pack results that are still being written.
+exec 9> "$results/.lock"
+flock -n 9 || { echo "paper/build.sh: another build is running in $results" >&2; exit 2; }
 
 # The machine and the software every timing of this build ran on (paper: "Reproducing this document").
 builddir="${BODYPOINT_BUILD_DIR:-build}"
@@ -85,7 +119,9 @@ eigen=/usr/include/eigen3/Eigen/src/Core/util/Macros.h
 # Where the time goes: each step's wall seconds, in order, into build_stages.txt.
 now() { date +%s.%N; }
 since() { awk -v a="$(now)" -v b="$1" 'BEGIN { print a - b }'; }
-# step NAME COMMAND...: runs the step unless --resume finds it finished; logs its wall seconds.
+# step NAME COMMAND...: runs the step unless --resume finds it finished; logs its wall seconds. A step
+# stopped by a signal logs the seconds it ran as "NAME(part)" (a journalled step goes on from there when
+# resumed), so that the build's time is still the sum of every sitting's steps.
 step() {
   local name=$1 t0
   shift
@@ -94,7 +130,9 @@ step() {
     return
   fi
   t0=$(now)
+  trap 'echo "$name(part) $(since "$t0")" >> "$stages"; exit 130' INT TERM
   "$@"
+  trap - INT TERM
   echo "$name $(since "$t0")" >> "$stages"
 }
 
