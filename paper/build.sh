@@ -46,7 +46,7 @@ if [ $park = 1 ]; then
   mkdir -p paper/sittings
   tar -C "$(dirname "$results")" --exclude=.lock -cJf "$parked.tmp" "$(basename "$results")"
   mv "$parked.tmp" "$parked"
-  echo "paper/build.sh: parked $results ($(tail -1 "$results/build_stages.txt" 2>/dev/null | cut -d' ' -f1) the last step finished) in $parked ($(du -h "$parked" | cut -f1)); commit it, then paper/build.sh --resume goes on"
+  echo "paper/build.sh: parked $results (its last logged step: $(tail -1 "$results/build_stages.txt" 2>/dev/null | cut -d' ' -f1)) in $parked ($(du -h "$parked" | cut -f1)); commit it, then paper/build.sh --resume goes on"
   exit 0
 fi
 if [ $resume = 1 ] && [ ! -f "$results/build_state.txt" ] && [ -f "$parked" ]; then
