@@ -73,9 +73,11 @@ def long_time_table(rows, out, methods):
                 step = f"tol {power_of_ten(num(first['step']))}"
             else:
                 step = f"{first['step_name']} $= P/{round(period_of(first) / num(first['step']))}$"
-            # A scene the method diverged on reads its value at the last time it reached, marked.
-            ended = {r["scene"] for r in rows if r["method"] == m and r["outcome"] != "ok"}
-            energy = [f"${sci(last(sc, m, 'max_rel_dE'))}{DAGGER if sc in ended else ''}$" for sc in LONG_SCENES]
+            # A scene the method stopped early on reads its value at the last time it reached (its flagged
+            # row, the one the text quotes), marked.
+            ended = {r["scene"]: num(r["max_rel_dE"]) for r in rows if r["method"] == m and r["outcome"] != "ok"}
+            energy = [f"${sci(ended[sc])}{DAGGER}$" if sc in ended else f"${sci(last(sc, m, 'max_rel_dE'))}$"
+                      for sc in LONG_SCENES]
             exps = [exponent(sc, m, "max_rel_dE") for sc in LONG_SCENES]
             above = [e for sc, e in zip(LONG_SCENES, exps) if last(sc, m, "max_rel_dE") > ROUNDING_LEVEL]
             k2 = max(finite(last(sc, m, "rel_dK2sq") for sc in ("spinning", "two-centres")))
@@ -101,13 +103,7 @@ def long_time(res, out, M):
     ref = next(r for r in rows if r["scene"] == "kepler" and r["method"] == "lp-kl8")
     M.add("LongRefStepsPerPeriod", count(round(period_of(ref) / num(ref["step"]))))
     found = long_time_table(rows, out, methods)
-    gone = {}
-    for r in rows:
-        if r["outcome"] != "ok" and r["method"] != "lp-kl8":
-            gone.setdefault(r["method"], []).append(SCENE_WORDS[r["scene"]])
-    parts = [f"{tt(m)} leaves {' and '.join(dict.fromkeys(where))}" for m, where in gone.items()]
-    M.add("LongDivergedText", "; ".join(parts) + " (daggers in the table)" if parts else
-          f"no method leaves its orbit within {power_of_ten(periods)} periods", math_mode=False)
+    M.add("LongDivergedText", ended_text(rows, periods), math_mode=False)
     split_above = [e for m in SPLITTINGS for sc, e in zip(LONG_SCENES, found[m][0])
                    if last(sc, m, "max_rel_dE") > ROUNDING_LEVEL]
     peers = [m for m in methods if m not in SPLITTINGS]
@@ -127,6 +123,29 @@ def long_time(res, out, M):
     M.add("LongKepEnergyEnd", sci(last("kepler", "kep-y4", "max_rel_dE")))
     M.add("LongTtlKeplerEnergyEnd", sci(last("kepler", "ttl-y4", "max_rel_dE")))
     M.add("LongKepVerdict", kepler_split_verdict(rows, periods), math_mode=False)
+
+
+# What stopped a run early, in the text's words (the study's outcome column; docs/physics.md, "Resolution and
+# accuracy flags"): a run flagged diverged left its orbit; a peer whose solver failed stopped with an error.
+ENDED_WORDS = {"diverged": "diverges", "failed": "stops, its solver failing,"}
+
+
+def ended_text(rows, periods):
+    """Which methods stopped early, on which orbit, when and how far its energy had gone: the rows whose
+    outcome is not ok (one per method and scene, its last), one clause per method and outcome."""
+    ended = {}
+    for r in rows:
+        if r["outcome"] != "ok" and r["method"] != "lp-kl8":
+            ended.setdefault((r["method"], r["outcome"]), []).append(
+                f"on {SCENE_WORDS[r['scene']]} after ${sci(num(r['periods']))}$ periods "
+                f"(energy error ${sci(num(r['max_rel_dE']))}$)")
+    if not ended:
+        return f"no method leaves its orbit within {power_of_ten(periods)} periods"
+    parts = []
+    for (m, outcome), where in ended.items():
+        places = where[0] if len(where) == 1 else ", ".join(where[:-1]) + " and " + where[-1]
+        parts.append(f"{tt(m)} {ENDED_WORDS.get(outcome, f'stops ({outcome})')} {places}")
+    return "; ".join(parts) + " (daggers in the table)"
 
 
 def kepler_split_verdict(rows, periods):
