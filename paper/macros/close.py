@@ -54,10 +54,11 @@ def third_party_speedup(res, M):
     SpeedupCloseThirdPair, in time where neither time is flagged, with the evaluations' ratio beside it."""
     rows, _ = read_csv(os.path.join(res, "work_precision.csv"))
     rows = [r for r in rows if r["scene"] == "close"]
-    parts = []
+    parts, names = [], []
     for target in (1e-7, 1e-10):
         own, _ = cheapest_reaching(rows, target, lambda fam: fam not in THIRD_PARTY and fam != "logH+BS")
         peer, _ = cheapest_reaching(rows, target, lambda fam: fam in THIRD_PARTY)
+        names.append("none" if peer is None else f"{tt(peer['method'])} (tol={num(peer['tol']):.0e})")
         if own is None or peer is None:
             parts.append(("-", 0.0, 0.0))
             continue
@@ -65,6 +66,8 @@ def third_party_speedup(res, M):
         sp = f"{num(peer['wall_s']) / num(own['wall_s']):.2g}x" if timed else "flagged"
         parts.append((sp, num(own["force_evals"]), num(peer["force_evals"])))
     M.add("SpeedupCloseThirdPair", speedup_phrase(parts), math_mode=False)
+    M.add("BestThirdPeerClosePair", f"{names[0]} for both" if names[0] == names[1] else " and ".join(names),
+          math_mode=False)
 
 
 def method_words(cell):

@@ -59,6 +59,18 @@ def long_time_series(rows):
     return last, exponent
 
 
+def exponent_text(e):
+    """A fitted growth exponent as the table and the text print it: two decimals (1.00, 1.99), or two
+    significant digits below 0.1, where two decimals would read 0.00 for a bounded error."""
+    return f"{e:.2f}" if abs(e) >= 0.1 else sci(e, 2)
+
+
+def exponent_range(values):
+    """"1.00" when the exponents agree to two decimals, else "1.99 to 2.12"."""
+    low, high = exponent_text(min(values)), exponent_text(max(values))
+    return low if low == high else f"{low} to {high}"
+
+
 def long_time_table(rows, out, methods):
     """tab_long_time: per method its step, largest energy error per scene, the energy's growth exponent
     where its error is the method's (not the rounding's), |K2|^2, the ellipse's phase error and exponent.
@@ -83,8 +95,8 @@ def long_time_table(rows, out, methods):
             k2 = max(finite(last(sc, m, "rel_dK2sq") for sc in ("spinning", "two-centres")))
             k2q = max(finite(last(sc, m, "abs_dK2Q") for sc in ("kepler", "spinning")))
             phase = exponent("kepler", m, "phase_err")
-            cells = [tt(m), step] + energy + [f"${sci(max(finite(above)), 2)}$", f"${sci(k2)}$", f"${sci(k2q)}$",
-                                              f"${sci(last('kepler', m, 'phase_err'))}$", f"${sci(phase, 2)}$"]
+            cells = [tt(m), step] + energy + [f"${exponent_text(max(finite(above)))}$", f"${sci(k2)}$", f"${sci(k2q)}$",
+                                              f"${sci(last('kepler', m, 'phase_err'))}$", f"${exponent_text(phase)}$"]
             f.write(" & ".join(cells) + " \\\\\n")
             found[m] = (exps, k2, phase)
     return found
@@ -107,15 +119,13 @@ def long_time(res, out, M):
     split_above = [e for m in SPLITTINGS for sc, e in zip(LONG_SCENES, found[m][0])
                    if last(sc, m, "max_rel_dE") > ROUNDING_LEVEL]
     peers = [m for m in methods if m not in SPLITTINGS]
-    M.add("LongSplitEnergyExpMax", f"{max(split_above):.2f}")
-    M.add("LongPeerEnergyExpMin", f"{min(e for m in peers for e in found[m][0]):.2f}")
+    M.add("LongSplitEnergyExpMax", exponent_text(max(split_above)))
+    M.add("LongPeerEnergyExpMin", exponent_text(min(e for m in peers for e in found[m][0])))
     M.add("LongSplitKTwoMax", sci(max(found[m][1] for m in SPLITTINGS)))
     M.add("LongPeerKTwoMin", sci(min(found[m][1] for m in peers)))
     leapfrogs, rk = [found[m][2] for m in ("lp-y4", "ttl-y4")], [found[m][2] for m in peers if m != "rk4"]
-    M.add("LongSplitPhaseExpMin", f"{min(leapfrogs):.2f}")
-    M.add("LongSplitPhaseExpMax", f"{max(leapfrogs):.2f}")
-    M.add("LongPeerPhaseExpMin", f"{min(rk):.2f}")
-    M.add("LongPeerPhaseExpMax", f"{max(rk):.2f}")
+    M.add("LongSplitPhaseExp", exponent_range(leapfrogs), math_mode=False)
+    M.add("LongPeerPhaseExp", exponent_range(rk), math_mode=False)
     for m, word in (("lp-kl8", "Ref"), ("kep-y4", "Kep")):
         M.add(f"Long{word}EnergyExp", f"{exponent('kepler', m, 'max_rel_dE'):.2f}")
         M.add(f"Long{word}PhaseExp", f"{exponent('kepler', m, 'phase_err'):.2f}")

@@ -8,6 +8,8 @@ import os
 import re
 import statistics
 
+from catalogue import family
+from macros.close import THIRD_PARTY
 from macros.common import (
     below, camel, count, latex_cell, latex_text, md_table, num, power_of_ten, read_csv, reference_errors, sci,
     tt,
@@ -67,6 +69,32 @@ def refusal_clause(rows, auto, M):
           math_mode=False)
 
 
+TABLE_NAMES = {"verlet": "Strang (Verlet)", "y4": "Yoshida~4", "pefrl": "PEFRL", "bm4": "Blanes--Moan~4",
+               "kl6": "Kahan--Li~6", "kl8": "Kahan--Li~8", "mcl8": "McLachlan~8"}
+
+
+def auto_table_rule(auto):
+    """The composition table auto took at each TOL of the by-TOL table, read from its runs (ks, exact, and
+    refusals left out), as a clause: "Strang (Verlet) at 10^-4, Yoshida 4 at 10^-5, PEFRL from 10^-6 to
+    10^-8, ...". A TOL at which the scenes took different tables names each."""
+    by_tol = {}
+    for r in auto:
+        if "-" in r["method"] and r["met"] == "yes":
+            by_tol.setdefault(num(r["tol"]), set()).add(r["method"].split("-", 1)[1])
+    groups = []  # [table, first TOL, last TOL], TOL falling
+    for tol in sorted(by_tol, reverse=True):
+        tables = sorted(by_tol[tol])
+        name = " or ".join(TABLE_NAMES.get(t, tt(t)) for t in tables) + ("" if len(tables) == 1 else " by scene")
+        if groups and groups[-1][0] == name:
+            groups[-1][2] = tol
+        else:
+            groups.append([name, tol, tol])
+    if not groups:
+        return "no table (no run of table~\\ref{tab:bytol} met its TOL)"
+    return ", ".join(f"{n} at {power_of_ten(a)}" if a == b else f"{n} from {power_of_ten(a)} to {power_of_ten(b)}"
+                     for n, a, b in groups)
+
+
 def by_tol(res, out, M):
     rows, _ = read_csv(os.path.join(res, "by_tol.csv"))
     auto = [r for r in rows if r["kind"] == "auto"]
@@ -77,6 +105,7 @@ def by_tol(res, out, M):
     ratios = [num(r["err_estimate"]) / num(r["err"]) for r in met if num(r["err"]) > 0]
     M.add("AutoEstLow", sci(min(ratios)) if ratios else "n/a")
     M.add("AutoEstHigh", sci(max(ratios)) if ratios else "n/a")
+    M.add("AutoTableRule", auto_table_rule(auto), math_mode=False)
     peers = [r for r in rows if r["kind"] == "at-tol"]
     M.add("PeerRuns", count(len(peers)))
     M.add("PeerMet", count(sum(1 for r in peers if r["met"] == "yes")))
@@ -94,6 +123,16 @@ def by_tol(res, out, M):
     spinning_peers = [r for r in peers if r["scene"] != "material"]
     M.add("PeerSpinRuns", count(len(spinning_peers)))
     M.add("PeerSpinMet", count(sum(1 for r in spinning_peers if r["met"] == "yes")))
+    # Table tab:bytol's peers are the third-party ones; the text's count says which of the runs that
+    # delivered were our own logh-bs.
+    third = [r for r in spinning_peers if family(r["method"]) in THIRD_PARTY]
+    own_met = sum(1 for r in spinning_peers if r["met"] == "yes" and r not in third)
+    delivered = f"{count(sum(1 for r in spinning_peers if r['met'] == 'yes'))} of {count(len(spinning_peers))} such peer runs delivered it"
+    if len(third) < len(spinning_peers):
+        delivered += (f" ({count(own_met)} of them runs of \\cmd{{logh-bs}}, our own extrapolation code, which "
+                      f"table~\\ref{{tab:bytol}} leaves out; {count(sum(1 for r in third if r['met'] == 'yes'))} "
+                      f"of the third-party peers' {count(len(third))})")
+    M.add("PeerSpinDelivered", delivered, math_mode=False)
     # Against the fastest peer asked for TOL that delivered it, on the spinning scenes: a clause of the
     # text, empty where no such peer run exists.
     at_tol = [num(row[10].rstrip("x")) for row in body if row[0] != "material" and row[10].endswith("x")]
@@ -121,7 +160,9 @@ def by_tol(res, out, M):
         for row in body:
             cells = [latex_cell(row[i]) for i in keep]
             # A delivered error below the reference's own error is not resolved: it reads "< that error".
-            if num(row[5]) < floor.get(row[0], 0.0):
+            if row[2] == "refused":  # nothing delivered: no error to print
+                cells[keep.index(5)] = "-"
+            elif num(row[5]) < floor.get(row[0], 0.0):
                 cells[keep.index(5)] = f"$<${floor[row[0]]:.0e}"  # as the other errors of the table print
             f.write(" & ".join(cells) + " \\\\\n")
 
