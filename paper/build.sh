@@ -59,6 +59,11 @@ bindir="${BODYPOINT_BUILD_DIR:-build}/bin"
 bin=$bindir/bodypoint
 py="${PYTHON:-/usr/bin/python3}"  # Debian's python3 with python3-matplotlib
 mkdir -p "$results"
+# Held while the build runs, taken before anything in $results is written (a second build started beside a
+# running one must not truncate its build_stages.txt or rewrite its build_state.txt before it is refused);
+# --park refuses to pack results that are still being written.
+exec 9> "$results/.lock"
+flock -n 9 || { echo "paper/build.sh: another build is running in $results" >&2; exit 2; }
 
 # --resume: a build interrupted (killed, or its machine needed) goes on from its first unfinished
 # step, keeping the finished steps' results, provided they come from the same mode, revision, binary and
@@ -91,9 +96,6 @@ else
   : > "$stages"
 fi
 { echo "$identity"; echo "sittings=$sittings"; } > "$state.tmp" && mv "$state.tmp" "$state"
-# Held while the build runs: --park refuses to pack results that are still being written.
-exec 9> "$results/.lock"
-flock -n 9 || { echo "paper/build.sh: another build is running in $results" >&2; exit 2; }
 
 # The machine and the software every timing of this build ran on (paper: "Reproducing this document").
 builddir="${BODYPOINT_BUILD_DIR:-build}"
