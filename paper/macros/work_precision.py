@@ -95,6 +95,20 @@ def auto_table_rule(auto):
                      for n, a, b in groups)
 
 
+def spinning_peer_runs(spinning, M):
+    """What the peers asked for TOL on the spinning scenes delivered: PeerSpinDelivered, a clause of the
+    text. Table tab:bytol's peers are the third-party ones; the clause says which of the runs that
+    delivered were our own logh-bs."""
+    met = [r for r in spinning if r["met"] == "yes"]
+    third = [r for r in spinning if family(r["method"]) in THIRD_PARTY]
+    delivered = f"{count(len(met))} of {count(len(spinning))} such peer runs delivered it"
+    if len(third) < len(spinning):
+        delivered += (f" ({count(sum(1 for r in met if r not in third))} of them runs of \\cmd{{logh-bs}}, our own "
+                      f"extrapolation code, which table~\\ref{{tab:bytol}} leaves out; "
+                      f"{count(sum(1 for r in third if r['met'] == 'yes'))} of the third-party peers' {count(len(third))})")
+    M.add("PeerSpinDelivered", delivered, math_mode=False)
+
+
 def by_tol(res, out, M):
     rows, _ = read_csv(os.path.join(res, "by_tol.csv"))
     auto = [r for r in rows if r["kind"] == "auto"]
@@ -120,19 +134,7 @@ def by_tol(res, out, M):
             ratios.setdefault(row[0], []).append(num(row[14].rstrip("x")))
         if row[16].endswith("x"):
             alone.setdefault(row[0], []).append(num(row[16].rstrip("x")))
-    spinning_peers = [r for r in peers if r["scene"] != "material"]
-    M.add("PeerSpinRuns", count(len(spinning_peers)))
-    M.add("PeerSpinMet", count(sum(1 for r in spinning_peers if r["met"] == "yes")))
-    # Table tab:bytol's peers are the third-party ones; the text's count says which of the runs that
-    # delivered were our own logh-bs.
-    third = [r for r in spinning_peers if family(r["method"]) in THIRD_PARTY]
-    own_met = sum(1 for r in spinning_peers if r["met"] == "yes" and r not in third)
-    delivered = f"{count(sum(1 for r in spinning_peers if r['met'] == 'yes'))} of {count(len(spinning_peers))} such peer runs delivered it"
-    if len(third) < len(spinning_peers):
-        delivered += (f" ({count(own_met)} of them runs of \\cmd{{logh-bs}}, our own extrapolation code, which "
-                      f"table~\\ref{{tab:bytol}} leaves out; {count(sum(1 for r in third if r['met'] == 'yes'))} "
-                      f"of the third-party peers' {count(len(third))})")
-    M.add("PeerSpinDelivered", delivered, math_mode=False)
+    spinning_peer_runs([r for r in peers if r["scene"] != "material"], M)
     # Against the fastest peer asked for TOL that delivered it, on the spinning scenes: a clause of the
     # text, empty where no such peer run exists.
     at_tol = [num(row[10].rstrip("x")) for row in body if row[0] != "material" and row[10].endswith("x")]
