@@ -58,7 +58,7 @@ def third_party_speedup(res, M):
     for target in (1e-7, 1e-10):
         own, _ = cheapest_reaching(rows, target, lambda fam: fam not in THIRD_PARTY and fam != "logH+BS")
         peer, _ = cheapest_reaching(rows, target, lambda fam: fam in THIRD_PARTY)
-        names.append("none" if peer is None else f"{tt(peer['method'])} (tol={num(peer['tol']):.0e})")
+        names.append("none" if peer is None else f"{tt(peer['method'])} (\\mbox{{tol={num(peer['tol']):.0e}}})")
         if own is None or peer is None:
             parts.append(("-", 0.0, 0.0))
             continue
