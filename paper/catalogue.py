@@ -55,6 +55,12 @@ def families():
     return out
 
 
+def table(method):
+    """The composition table a method composes its flows with (y4, kl6, ...), or "" for one without."""
+    row = _rows.get(method)
+    return row["table"] if row else ""
+
+
 def has_fictitious_step(method):
     """True for the time-transformed and regularised methods (their step is the fictitious ds)."""
     row = _rows.get(method)

@@ -77,9 +77,9 @@ def scenes_of(rows):
     return list(dict.fromkeys(r["scene"] for r in rows))
 
 
-def capped(v):
-    """Log axes drop zeros (a deviation of exactly 0); diverged runs are drawn at DIVERGED."""
-    return float("nan") if not v > 0 else min(v, DIVERGED)
+def capped(v, cap=DIVERGED):
+    """Log axes drop zeros (a deviation of exactly 0); diverged runs are drawn at `cap`."""
+    return float("nan") if not v > 0 else min(v, cap)
 
 
 def save(fig, path, listing, what, width=1.0, max_height=None):
@@ -419,8 +419,8 @@ def long_time_figure(res, figs, listing):
         for m in methods:
             rs = [r for r in rows if r["scene"] == scene and r["method"] == m]
             # Not capped at DIVERGED: a phase error grows past it (10^7 rad and more) and its slope is the result.
-            ax.plot([num(r["periods"]) for r in rs], [v if v > 0 else float("nan") for v in (num(r[column]) for r in rs)],
-                    ".-", color=colours[m], label=m, markersize=3, linewidth=0.8)
+            ax.plot([num(r["periods"]) for r in rs], [capped(num(r[column]), math.inf) for r in rs], ".-",
+                    color=colours[m], label=m, markersize=3, linewidth=0.8)
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_title(title)

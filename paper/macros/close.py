@@ -45,6 +45,11 @@ def speedup_phrase(parts):
             (f" (the peer's force evaluations over bodypoint's: {' and '.join(evals)})" if len(evals) == len(parts) else ""))
 
 
+def tol_config(row):
+    """A tolerance-driven configuration as the tables print it: tol=1e-10."""
+    return f"tol={num(row['tol']):.2g}"
+
+
 THIRD_PARTY = ("Boost.Odeint", "GSL", "SUNDIALS")  # peers nobody here wrote (logh-bs is our own extrapolation code)
 
 
@@ -58,7 +63,7 @@ def third_party_speedup(res, M):
     for target in (1e-7, 1e-10):
         own, _ = cheapest_reaching(rows, target, lambda fam: fam not in THIRD_PARTY and fam != "logH+BS")
         peer, _ = cheapest_reaching(rows, target, lambda fam: fam in THIRD_PARTY)
-        names.append("none" if peer is None else f"{tt(peer['method'])} (\\mbox{{tol={num(peer['tol']):.0e}}})")
+        names.append("none" if peer is None else f"{tt(peer['method'])} (\\mbox{{{tol_config(peer)}}})")
         if own is None or peer is None:
             parts.append(("-", 0.0, 0.0))
             continue
@@ -155,7 +160,7 @@ def close_table(res, out, M):
                 t = "\\emph{flagged}" if best["flag"] else f"{num(best['wall_s']) * 1e3:.3g}"
                 m = best["method"]
                 if best["tol"]:
-                    cfg = f"tol={num(best['tol']):.2g}"
+                    cfg = tol_config(best)
                 else:
                     cfg = f"{'ds' if has_fictitious_step(m) else 'h'}={num(best['h']):.3g}"
                 evals = int(num(best["force_evals"]))

@@ -8,7 +8,7 @@ import os
 import re
 import statistics
 
-from catalogue import family
+from catalogue import family, table
 from macros.close import THIRD_PARTY
 from macros.common import (
     below, camel, count, latex_cell, latex_text, md_table, num, power_of_ten, read_csv, reference_errors, sci,
@@ -69,22 +69,19 @@ def refusal_clause(rows, auto, M):
           math_mode=False)
 
 
-TABLE_NAMES = {"verlet": "Strang (Verlet)", "y4": "Yoshida~4", "pefrl": "PEFRL", "bm4": "Blanes--Moan~4",
-               "kl6": "Kahan--Li~6", "kl8": "Kahan--Li~8", "mcl8": "McLachlan~8"}
-
-
 def auto_table_rule(auto):
-    """The composition table auto took at each TOL of the by-TOL table, read from its runs (ks, exact, and
-    refusals left out), as a clause: "Strang (Verlet) at 10^-4, Yoshida 4 at 10^-5, PEFRL from 10^-6 to
-    10^-8, ...". A TOL at which the scenes took different tables names each."""
+    """The composition table (the catalogue's, as table tab:compositions names it) auto took at each TOL of
+    the by-TOL table, read from its runs (ks, which has none, and refusals left out), as a clause:
+    "verlet at 10^-4, y4 at 10^-5, pefrl from 10^-6 to 10^-8, ...". A TOL at which the scenes took
+    different tables names each."""
     by_tol = {}
     for r in auto:
-        if "-" in r["method"] and r["met"] == "yes":
-            by_tol.setdefault(num(r["tol"]), set()).add(r["method"].split("-", 1)[1])
+        if table(r["method"]) and r["met"] == "yes":
+            by_tol.setdefault(num(r["tol"]), set()).add(table(r["method"]))
     groups = []  # [table, first TOL, last TOL], TOL falling
     for tol in sorted(by_tol, reverse=True):
         tables = sorted(by_tol[tol])
-        name = " or ".join(TABLE_NAMES.get(t, tt(t)) for t in tables) + ("" if len(tables) == 1 else " by scene")
+        name = " or ".join(tt(t) for t in tables) + ("" if len(tables) == 1 else " by scene")
         if groups and groups[-1][0] == name:
             groups[-1][2] = tol
         else:
